@@ -1,0 +1,89 @@
+// Atomic file output (temporary name, fsync, rename).
+#include "renderer/io/atomic_file.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
+
+namespace sb::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path temporary_name(const fs::path& path) {
+  static std::atomic<unsigned> counter{0};
+  return path.parent_path() /
+         fmt::format(".{}.tmp-{}-{}", path.filename().string(), ::getpid(), counter++);
+}
+
+void sync_file(const fs::path& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  if (fd < 0) throw IoError(fmt::format("cannot reopen {} to flush it: {}", path.string(), std::strerror(errno)));
+  const int rc = ::fsync(fd);
+  const int err = errno;
+  ::close(fd);
+  if (rc != 0) throw IoError(fmt::format("cannot flush {} to disk: {}", path.string(), std::strerror(err)));
+}
+
+}  // namespace
+
+void write_atomically(const fs::path& path, const std::function<void(const fs::path&)>& write) {
+  std::error_code ec;
+  const fs::path parent = path.parent_path();
+  if (!parent.empty()) {
+    fs::create_directories(parent, ec);
+    if (ec)
+      throw IoError(fmt::format("cannot create folder {} for {}: {}", parent.string(),
+                                path.filename().string(), ec.message()));
+  }
+  const fs::path tmp = temporary_name(path);
+  try {
+    write(tmp);
+    sync_file(tmp);
+    fs::rename(tmp, path, ec);
+    if (ec) throw IoError(fmt::format("cannot rename {} to {}: {}", tmp.string(), path.string(), ec.message()));
+  } catch (const Error&) {
+    fs::remove(tmp, ec);
+    throw;
+  } catch (const std::exception& e) {
+    fs::remove(tmp, ec);
+    throw IoError(fmt::format("writing {} failed: {}", path.string(), e.what()));
+  }
+}
+
+void write_file_atomically(const fs::path& path, std::span<const unsigned char> bytes) {
+  write_atomically(path, [&](const fs::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw IoError(fmt::format("cannot open {} for writing: {}", tmp.string(), std::strerror(errno)));
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    out.flush();
+    if (!out)
+      throw IoError(fmt::format("cannot write {} ({} bytes): {}; check free disk space", path.string(),
+                                bytes.size(), std::strerror(errno)));
+  });
+}
+
+void write_text_atomically(const fs::path& path, const std::string& text) {
+  write_file_atomically(path, std::span(reinterpret_cast<const unsigned char*>(text.data()), text.size()));
+}
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(fmt::format("cannot read {}: {}", path.string(), std::strerror(errno)));
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw IoError(fmt::format("error while reading {}", path.string()));
+  return ss.str();
+}
+
+}  // namespace sb::io

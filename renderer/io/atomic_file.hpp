@@ -1,0 +1,28 @@
+// Atomic output: every file the suite writes goes to a temporary name beside its final one and is
+// renamed into place only when complete, so an interrupted run never leaves a partial file under
+// the final name.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <span>
+#include <string>
+
+namespace sb::io {
+
+/// Calls `write(tmp_path)` to produce the file under a temporary name in the same folder, then
+/// flushes it to disk and renames it to `path`. Creates missing parent folders. On any failure
+/// (including an exception from `write`) the temporary file is removed and IoError is thrown
+/// naming `path`; an existing file at `path` is left untouched.
+void write_atomically(const std::filesystem::path& path,
+                      const std::function<void(const std::filesystem::path& tmp_path)>& write);
+
+/// Writes bytes atomically (see write_atomically).
+void write_file_atomically(const std::filesystem::path& path, std::span<const unsigned char> bytes);
+/// Writes text atomically (see write_atomically).
+void write_text_atomically(const std::filesystem::path& path, const std::string& text);
+
+/// Reads a whole file; IoError naming the path if it cannot be read.
+[[nodiscard]] std::string read_file(const std::filesystem::path& path);
+
+}  // namespace sb::io

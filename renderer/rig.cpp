@@ -1,0 +1,218 @@
+// Stereo rig geometry (DESIGN §2).
+#include "renderer/rig.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
+#include "renderer/scene.hpp"
+
+namespace sb {
+
+const char* eye_name(Eye eye) {
+  switch (eye) {
+    case Eye::left: return "left";
+    case Eye::right: return "right";
+    case Eye::center: return "center";
+  }
+  return "?";
+}
+
+namespace {
+
+void require_positive(double value, const char* name, const char* hint) {
+  if (!std::isfinite(value) || value <= 0.0)
+    throw InputError(fmt::format("{} must be a positive finite number, got {}; {}", name, value, hint));
+}
+
+}  // namespace
+
+void RigParams::validate() const {
+  require_positive(interaxial, "interaxial", "give the eye separation in meters, e.g. 0.064");
+  require_positive(convergence, "convergence",
+                   "give the zero-parallax distance in meters, e.g. 2.0");
+  if (width < 1 || width > kMaxImageSide || height < 1 || height > kMaxImageSide)
+    throw InputError(fmt::format("resolution {}x{} is out of range; each side must be 1..{}", width,
+                                 height, kMaxImageSide));
+  if (!std::isfinite(vfov) || vfov <= 0.0 || vfov >= kPi)
+    throw InputError(fmt::format("vertical field of view {} degrees is out of range (0, 180)",
+                                 radians_to_degrees(vfov)));
+  require_positive(znear, "znear", "the near plane must lie in front of the camera");
+  if (!std::isfinite(zfar) || zfar <= znear)
+    throw InputError(fmt::format("zfar {} must be finite and greater than znear {}", zfar, znear));
+}
+
+CameraPose CameraPose::from_matrix(const dmat4& m) {
+  CameraPose p;
+  p.position = dvec3(m[3]);
+  dvec3 back = dvec3(m[2]);
+  dvec3 up = dvec3(m[1]);
+  if (glm::length(back) == 0.0 || glm::length(up) == 0.0)
+    throw InputError("camera transform is degenerate (zero scale); fix the camera node's transform");
+  p.back = glm::normalize(back);
+  p.right = glm::cross(up, p.back);
+  if (glm::length(p.right) < 1e-12)
+    throw InputError("camera transform is degenerate (up parallel to view direction)");
+  p.right = glm::normalize(p.right);
+  p.up = glm::cross(p.back, p.right);
+  return p;
+}
+
+CameraPose CameraPose::look_at(const dvec3& eye, const dvec3& target, const dvec3& up) {
+  dmat4 m(1.0);
+  dvec3 back = glm::normalize(eye - target);
+  dvec3 right = glm::cross(up, back);
+  if (glm::length(right) < 1e-12) right = glm::cross(dvec3(0, 0, 1), back);
+  right = glm::normalize(right);
+  m[0] = dvec4(right, 0.0);
+  m[1] = dvec4(glm::cross(back, right), 0.0);
+  m[2] = dvec4(back, 0.0);
+  m[3] = dvec4(eye, 1.0);
+  return from_matrix(m);
+}
+
+dvec3 EyeCamera::project(const dvec3& world) const {
+  const dvec3 d = world - origin;
+  const double x = glm::dot(d, right);
+  const double y = glm::dot(d, up);
+  const double z = -glm::dot(d, back);  // depth along the viewing direction
+  return {cx + f_px * x / z, cy - f_px * y / z, z};
+}
+
+dvec3 EyeCamera::unproject(double x_px, double y_px, double depth) const {
+  const double x = (x_px - cx) * depth / f_px;
+  const double y = (cy - y_px) * depth / f_px;
+  return origin + x * right + y * up - depth * back;
+}
+
+dvec3 EyeCamera::ray_direction(double x_px, double y_px) const {
+  return glm::normalize((x_px - cx) / f_px * right + (cy - y_px) / f_px * up - back);
+}
+
+dmat4 EyeCamera::view_matrix() const {
+  dmat4 m(1.0);
+  // Rows of the rotation are the basis vectors (glm is column-major: m[col][row]).
+  for (int i = 0; i < 3; ++i) {
+    m[i][0] = right[i];
+    m[i][1] = up[i];
+    m[i][2] = back[i];
+  }
+  m[3][0] = -glm::dot(right, origin);
+  m[3][1] = -glm::dot(up, origin);
+  m[3][2] = -glm::dot(back, origin);
+  return m;
+}
+
+dmat4 EyeCamera::projection_matrix() const {
+  // x_ndc = 2 x_px / W - 1 with x_px = cx + f X / Z and Z = -z_view; y_ndc = 1 - 2 y_px / H.
+  dmat4 p(0.0);
+  p[0][0] = 2.0 * f_px / width;
+  p[1][1] = 2.0 * f_px / height;
+  p[2][0] = -(2.0 * cx / width - 1.0);
+  p[2][1] = (2.0 * cy / height - 1.0);
+  p[2][2] = -(zfar + znear) / (zfar - znear);
+  p[2][3] = -1.0;
+  p[3][2] = -2.0 * zfar * znear / (zfar - znear);
+  return p;
+}
+
+double focal_px(double vfov, int height) { return 0.5 * height / std::tan(0.5 * vfov); }
+
+double interaxial_from_max_disparity(double max_disparity_px, double convergence, double vfov,
+                                     int height) {
+  return max_disparity_px * convergence / focal_px(vfov, height);
+}
+
+double max_disparity_from_interaxial(double interaxial, double convergence, double vfov,
+                                     int height) {
+  return focal_px(vfov, height) * interaxial / convergence;
+}
+
+StereoRig::StereoRig(const CameraPose& pose, const RigParams& params) : pose_(pose), params_(params) {
+  params_.validate();
+}
+
+double StereoRig::focal_px() const { return sb::focal_px(params_.vfov, params_.height); }
+
+double StereoRig::disparity_px(double depth) const {
+  return focal_px() * params_.interaxial * (1.0 / params_.convergence - 1.0 / depth);
+}
+
+double StereoRig::max_disparity_px() const {
+  return focal_px() * params_.interaxial / params_.convergence;
+}
+
+EyeCamera StereoRig::eye(Eye which) const {
+  // The eye sits at offset s along the right axis; shifting its principal point by f s / c keeps
+  // every point of the plane at distance c where the centre camera sees it (zero parallax).
+  const double s = which == Eye::left    ? -0.5 * params_.interaxial
+                   : which == Eye::right ? 0.5 * params_.interaxial
+                                         : 0.0;
+  EyeCamera cam;
+  cam.origin = pose_.position + s * pose_.right;
+  cam.right = pose_.right;
+  cam.up = pose_.up;
+  cam.back = pose_.back;
+  cam.f_px = focal_px();
+  cam.cx = 0.5 * params_.width + cam.f_px * s / params_.convergence;
+  cam.cy = 0.5 * params_.height;
+  cam.width = params_.width;
+  cam.height = params_.height;
+  cam.znear = params_.znear;
+  cam.zfar = params_.zfar;
+  return cam;
+}
+
+StereoRig resolve_rig(const Scene& scene, const RigOverrides& o) {
+  RigParams p;
+  CameraPose pose;
+  const Bounds3 b = scene.bounds();
+  const double radius = b.empty() ? 1.0 : 0.5 * glm::length(dvec3(b.extent()));
+  if (!scene.cameras.empty()) {
+    const SceneCamera& cam = scene.cameras.front();
+    pose = CameraPose::from_matrix(cam.world_from_camera);
+    p.vfov = cam.yfov;
+    p.znear = cam.znear;
+    if (cam.zfar > 0.0) p.zfar = cam.zfar;
+    if (cam.aspect > 0.0) p.width = static_cast<int>(std::lround(p.height * cam.aspect));
+  } else {
+    // Frame the bounding sphere from +Z.
+    const dvec3 c = b.empty() ? dvec3(0.0) : dvec3(b.center());
+    const double dist = radius / std::sin(0.5 * p.vfov) + 1e-3;
+    pose = CameraPose::look_at(c + dvec3(0.0, 0.0, dist), c);
+    p.znear = std::max(1e-3, 1e-4 * dist);
+    p.convergence = dist;
+  }
+  if (scene.rig.width) p.width = *scene.rig.width;
+  if (scene.rig.height) p.height = *scene.rig.height;
+  if (scene.rig.interaxial) p.interaxial = *scene.rig.interaxial;
+  if (scene.rig.convergence) p.convergence = *scene.rig.convergence;
+  if (o.width) p.width = *o.width;
+  if (o.height) p.height = *o.height;
+  if (o.vfov) p.vfov = *o.vfov;
+  if (o.convergence) p.convergence = *o.convergence;
+  if (o.interaxial && o.max_disparity_px)
+    throw InputError("give either --interaxial or --max-disparity, not both");
+  if (o.interaxial) p.interaxial = *o.interaxial;
+  if (o.max_disparity_px) {
+    require_positive(*o.max_disparity_px, "max disparity",
+                     "give the disparity at infinity in pixels, e.g. 30");
+    require_positive(p.convergence, "convergence", "give the zero-parallax distance in meters");
+    p.interaxial = interaxial_from_max_disparity(*o.max_disparity_px, p.convergence, p.vfov, p.height);
+  }
+  // Far plane far enough for the whole scene as seen from the camera.
+  const double reach = glm::length(pose.position - dvec3(b.empty() ? vec3(0.0f) : b.center())) + radius;
+  p.zfar = std::max(p.zfar, 2.0 * reach);
+  return StereoRig(pose, p);
+}
+
+std::string describe(const StereoRig& rig) {
+  const RigParams& p = rig.params();
+  return fmt::format("{}x{}, vfov {:.2f} deg, interaxial {:.4f} m, convergence {:.3f} m, "
+                     "f {:.1f} px, max disparity {:.2f} px",
+                     p.width, p.height, radians_to_degrees(p.vfov), p.interaxial, p.convergence,
+                     rig.focal_px(), rig.max_disparity_px());
+}
+
+}  // namespace sb

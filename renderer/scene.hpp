@@ -1,0 +1,100 @@
+// The in-memory scene every pipeline renders: world-space triangle meshes, materials, textures,
+// punctual lights and cameras, as loaded from glTF (renderer/io/gltf_loader.hpp).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "renderer/math.hpp"
+
+namespace sb {
+
+/// A base colour texture: linear RGBA float, row 0 at the top of the image.
+struct Texture {
+  std::string name;
+  int width = 0;
+  int height = 0;
+  std::vector<float> rgba;  ///< width * height * 4, linear (sRGB decoded)
+  bool repeat_s = true;     ///< glTF wrapS REPEAT (else CLAMP_TO_EDGE; MIRRORED_REPEAT is reported)
+  bool repeat_t = true;
+};
+
+/// Lambertian material (DESIGN §3): albedo = base colour factor x base colour texture.
+struct Material {
+  std::string name;
+  vec4 base_color{1.0f};
+  int base_color_texture = -1;  ///< index into Scene::textures, or -1
+  int texcoord = 0;             ///< which TEXCOORD_n set the texture reads
+  bool double_sided = false;    ///< glTF doubleSided
+};
+
+/// A triangle mesh in world space (one glTF primitive instanced by one node).
+struct Mesh {
+  std::string name;
+  int node = -1;       ///< glTF node index that instanced it
+  int material = -1;   ///< index into Scene::materials; -1 = default white material
+  std::vector<vec3> positions;
+  std::vector<vec3> normals;  ///< empty, or one per position (shading normals, world space)
+  std::vector<vec2> uvs;      ///< empty, or one per position (the material's TEXCOORD set)
+  std::vector<uint32_t> indices;  ///< three per triangle
+
+  [[nodiscard]] size_t triangle_count() const { return indices.size() / 3; }
+};
+
+/// A punctual light (KHR_lights_punctual). Intensity is used as radiometric: a point light of
+/// intensity I emits I W/sr (glTF's candela read as W/sr), a directional light of intensity E
+/// gives irradiance E W/m^2 on a surface facing it.
+struct Light {
+  enum class Type { point, directional, spot };
+  std::string name;
+  Type type = Type::point;
+  vec3 position{0.0f};
+  vec3 direction{0.0f, 0.0f, -1.0f};  ///< direction the light travels (world space, unit)
+  vec3 color{1.0f};
+  float intensity = 1.0f;
+  float range = 0.0f;  ///< 0 = infinite
+  float inner_cone = 0.0f;
+  float outer_cone = 0.78539816f;
+};
+
+/// A perspective camera placed in the scene.
+struct SceneCamera {
+  std::string name;
+  int node = -1;
+  dmat4 world_from_camera{1.0};  ///< camera looks down its -Z, +Y up
+  double yfov = 0.8;             ///< radians
+  double aspect = 0.0;           ///< 0 = not given
+  double znear = 0.01;
+  double zfar = 0.0;             ///< 0 = infinite
+};
+
+/// Stereo-rig defaults stored by a scene in its camera node's `extras.stereobench`.
+struct RigDefaults {
+  std::optional<double> interaxial;   ///< m
+  std::optional<double> convergence;  ///< m
+  std::optional<int> width;
+  std::optional<int> height;
+};
+
+/// A loaded scene.
+struct Scene {
+  std::string path;  ///< file it came from
+  std::string name;
+  std::vector<Mesh> meshes;
+  std::vector<Material> materials;
+  std::vector<Texture> textures;
+  std::vector<Light> lights;
+  std::vector<SceneCamera> cameras;
+  RigDefaults rig;            ///< from the first camera that carries stereobench extras
+  vec3 background{0.0f};      ///< radiance of rays that miss (scene extras)
+  float ambient = 0.0f;       ///< ambient term of DESIGN §3 (scene extras)
+  std::vector<std::string> warnings;  ///< unsupported features, each named once
+
+  [[nodiscard]] size_t triangle_count() const;
+  [[nodiscard]] size_t vertex_count() const;
+  [[nodiscard]] Bounds3 bounds() const;
+};
+
+}  // namespace sb
