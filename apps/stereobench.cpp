@@ -1,3 +1,45 @@
-// stereobench command line (placeholder main until the subcommands land).
+// stereobench: the command-line tool. Maps subcommands to library calls and errors to exit codes.
 #include <cstdio>
-int main() { return 0; }
+#include <exception>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "apps/commands.hpp"
+#include "renderer/error.hpp"
+#include "renderer/io/gltf_loader.hpp"
+#include "renderer/io/image_io.hpp"
+#include "sb_version.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"stereobench: offline validation and benchmarking of accelerated stereo rendering.\n"
+               "Renders stereo pairs with every pipeline of the source papers, measures the synthesized\n"
+               "right eye against ground truth, and reports quality, holes and time.",
+               "stereobench"};
+  app.require_subcommand(1);
+  app.option_defaults()->always_capture_default();
+  app.set_version_flag("--version",
+                       fmt::format("stereobench {}\n  {}\n  OpenImageIO {}", SB_VERSION_STRING,
+                                   sb::io::gltf_loader_version(), sb::io::oiio_version()));
+  sb::cli::register_scenes_command(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);  // --help, --version
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    std::fprintf(stderr, "Run `stereobench --help` (or `stereobench SUBCOMMAND --help`) for usage.\n");
+    return static_cast<int>(sb::ExitCode::bad_input);
+  } catch (const sb::Error& e) {
+    std::fprintf(stderr, "stereobench: error: %s\n", e.what());
+    return static_cast<int>(e.code());
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "stereobench: error: out of memory; try a smaller scene or resolution\n");
+    return static_cast<int>(sb::ExitCode::environment);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "stereobench: internal error: %s\n", e.what());
+    return static_cast<int>(sb::ExitCode::environment);
+  }
+  return 0;
+}

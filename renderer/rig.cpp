@@ -1,7 +1,9 @@
 // Stereo rig geometry (DESIGN §2).
 #include "renderer/rig.hpp"
 
+#include <cctype>
 #include <cmath>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -205,6 +207,29 @@ StereoRig resolve_rig(const Scene& scene, const RigOverrides& o) {
   const double reach = glm::length(pose.position - dvec3(b.empty() ? vec3(0.0f) : b.center())) + radius;
   p.zfar = std::max(p.zfar, 2.0 * reach);
   return StereoRig(pose, p);
+}
+
+ivec2 parse_resolution(const std::string& text) {
+  static const std::pair<const char*, ivec2> named[] = {
+      {"hd", {1920, 1080}}, {"fhd", {1920, 1080}}, {"1080p", {1920, 1080}}, {"720p", {1280, 720}},
+      {"qhd", {2560, 1440}}, {"4k", {3840, 2160}},  {"uhd", {3840, 2160}},  {"8k", {7680, 4320}}};
+  std::string lower;
+  for (char ch : text) lower.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(ch))));
+  for (const auto& [name, size] : named)
+    if (lower == name) return size;
+  const size_t x = lower.find('x');
+  auto parse_side = [&](const std::string& s) -> long {
+    if (s.empty() || s.size() > 9 || s.find_first_not_of("0123456789") != std::string::npos) return -1;
+    return std::stol(s);
+  };
+  const long w = x == std::string::npos ? -1 : parse_side(lower.substr(0, x));
+  const long h = x == std::string::npos ? -1 : parse_side(lower.substr(x + 1));
+  if (w < 0 || h < 0)
+    throw InputError(fmt::format("resolution '{}' is not WIDTHxHEIGHT (e.g. 1920x1080) or one of hd, 720p, "
+                                 "qhd, 4k, 8k", text));
+  if (w < 1 || h < 1 || w > kMaxImageSide || h > kMaxImageSide)
+    throw InputError(fmt::format("resolution {}x{} is out of range; each side must be 1..{}", w, h, kMaxImageSide));
+  return {static_cast<int>(w), static_cast<int>(h)};
 }
 
 std::string describe(const StereoRig& rig) {

@@ -1,0 +1,62 @@
+// Shared command-line options.
+#include "apps/cli_common.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
+#include "scenes/catalog.hpp"
+
+namespace sb::cli {
+
+void RigCli::add_to(CLI::App& app) {
+  auto* g = "Stereo rig (defaults come from the scene's camera)";
+  app.add_option("--interaxial,-e", interaxial, "Eye separation in meters (default 0.064)")->group(g);
+  app.add_option("--max-disparity", max_disparity,
+                 "Give the interaxial as the disparity at infinity in pixels, f_px*e/c")
+      ->group(g)
+      ->excludes("--interaxial");
+  app.add_option("--convergence,-c", convergence, "Zero-parallax distance in meters (default 2.0)")->group(g);
+  app.add_option("--resolution,-r", resolution, "Image size per eye: WxH, hd (1920x1080), 4k, 720p, qhd, 8k")
+      ->group(g);
+  app.add_option("--vfov", vfov_deg, "Vertical field of view in degrees (default: the scene camera's)")->group(g);
+}
+
+namespace {
+
+double positive(double v, const char* option, const char* hint) {
+  if (!std::isfinite(v) || v <= 0.0)
+    throw InputError(fmt::format("{} {} is not a positive finite number; {}", option, v, hint));
+  return v;
+}
+
+}  // namespace
+
+RigOverrides RigCli::overrides() const {
+  RigOverrides o;
+  if (interaxial) o.interaxial = positive(*interaxial, "--interaxial", "give the eye separation in meters, e.g. 0.064");
+  if (max_disparity)
+    o.max_disparity_px = positive(*max_disparity, "--max-disparity", "give the disparity at infinity in pixels, e.g. 30");
+  if (convergence)
+    o.convergence = positive(*convergence, "--convergence", "give the zero-parallax distance in meters, e.g. 2.0");
+  if (resolution) {
+    const ivec2 r = parse_resolution(*resolution);
+    o.width = r.x;
+    o.height = r.y;
+  }
+  if (vfov_deg) {
+    if (!std::isfinite(*vfov_deg) || *vfov_deg <= 0.0 || *vfov_deg >= 180.0)
+      throw InputError(fmt::format("--vfov {} is out of range; give degrees in (0, 180)", *vfov_deg));
+    o.vfov = degrees_to_radians(*vfov_deg);
+  }
+  return o;
+}
+
+void add_scenes_dir_option(CLI::App& app, std::string& dir) {
+  dir = scenes::default_scenes_dir().string();
+  app.add_option("--scenes-dir", dir, "Folder where built-in scenes are generated and cached (env STEREOBENCH_SCENES)")
+      ->capture_default_str();
+}
+
+}  // namespace sb::cli

@@ -1,0 +1,29 @@
+// Options shared by several subcommands (rig, scene folder), declared once with their help.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "renderer/rig.hpp"
+
+namespace sb::cli {
+
+/// The stereo-rig options (--interaxial, --max-disparity, --convergence, --resolution, --vfov).
+struct RigCli {
+  std::optional<double> interaxial;
+  std::optional<double> max_disparity;
+  std::optional<double> convergence;
+  std::optional<std::string> resolution;
+  std::optional<double> vfov_deg;
+
+  void add_to(CLI::App& app);
+  /// Checks the values (positive, finite, in range) and converts them; InputError otherwise.
+  [[nodiscard]] RigOverrides overrides() const;
+};
+
+/// --scenes-dir: where built-in scenes are generated and cached.
+void add_scenes_dir_option(CLI::App& app, std::string& dir);
+
+}  // namespace sb::cli

@@ -1,0 +1,164 @@
+// `stereobench scenes`: list the built-in scene generators, generate scenes, describe scene files.
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "apps/cli_common.hpp"
+#include "apps/commands.hpp"
+#include "renderer/error.hpp"
+#include "renderer/io/gltf_loader.hpp"
+#include "renderer/rig.hpp"
+#include "scenes/catalog.hpp"
+#include "scenes/generators.hpp"
+
+namespace sb::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+void list_generators() {
+  fmt::print("{:<15} {:<20} {}\n", "scene", "file", "description");
+  for (const scenes::GeneratorInfo& g : scenes::generators()) {
+    fmt::print("{:<15} {:<20} {}{}\n", g.name, g.file_name, g.description, g.analytic ? " [analytic test scene]" : "");
+    for (const scenes::GeneratorParam& p : g.params)
+      fmt::print("{:<15}   --param {}={} ({} .. {}): {}\n", "", p.name, p.default_value, p.min_value, p.max_value, p.help);
+  }
+}
+
+struct GenerateArgs {
+  std::vector<std::string> names;
+  bool all = false;
+  std::string out_dir;
+  uint64_t seed = 1;
+  std::vector<std::string> params;
+};
+
+std::map<std::string, double> parse_params(const std::vector<std::string>& items) {
+  std::map<std::string, double> out;
+  for (const std::string& item : items) {
+    const size_t eq = item.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError(fmt::format("--param '{}' is not NAME=VALUE", item));
+    const std::string value = item.substr(eq + 1);
+    size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(value, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != value.size() || !std::isfinite(v))
+      throw InputError(fmt::format("--param {}: '{}' is not a finite number", item.substr(0, eq), value));
+    out[item.substr(0, eq)] = v;
+  }
+  return out;
+}
+
+void generate_scenes(const GenerateArgs& args) {
+  std::vector<std::string> names = args.names;
+  if (args.all) {
+    if (!names.empty()) throw InputError("give scene names or --all, not both");
+    for (const scenes::GeneratorInfo& g : scenes::generators())
+      if (g.builtin) names.push_back(g.name);
+  }
+  if (names.empty()) throw InputError("name the scenes to generate, or give --all (see `stereobench scenes list`)");
+  scenes::GenerateOptions opt;
+  opt.seed = args.seed;
+  opt.params = parse_params(args.params);
+  if (!opt.params.empty() && names.size() != 1)
+    throw InputError("--param applies to one scene; generate the scenes one at a time");
+  for (const std::string& n : names) (void)scenes::find_generator(n);  // fail before writing anything
+  fmt::print("{:<15} {:>12} {:>10} {:>7} {:>12} {:>9}  {}\n", "scene", "triangles", "vertices", "lights", "bytes",
+             "seconds", "file");
+  for (const std::string& n : names) {
+    const scenes::GeneratorInfo& g = scenes::find_generator(n);
+    // Default scenes are stamped so that commands naming them reuse the file.
+    const bool builtin = opt.seed == 1 && opt.params.empty();
+    const scenes::GenerateResult r = builtin ? scenes::generate_builtin(n, args.out_dir)
+                                             : scenes::generate(n, opt, fs::path(args.out_dir) / g.file_name);
+    fmt::print("{:<15} {:>12} {:>10} {:>7} {:>12} {:>9.2f}  {}\n", n, r.triangles, r.vertices, r.lights, r.bytes,
+               r.seconds, r.path.string());
+  }
+}
+
+struct InfoArgs {
+  std::vector<std::string> scenes;
+  std::string scenes_dir;
+  RigCli rig;
+};
+
+void print_info(const InfoArgs& args) {
+  const RigOverrides overrides = args.rig.overrides();  // check options before any work
+  for (const std::string& spec : args.scenes) {
+    const fs::path path = scenes::resolve_scene(spec, args.scenes_dir);
+    const auto t0 = std::chrono::steady_clock::now();
+    const Scene scene = io::load_gltf(path);
+    const double load_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const Bounds3 b = scene.bounds();
+    size_t lights_by_type[3] = {0, 0, 0};
+    for (const Light& l : scene.lights) ++lights_by_type[static_cast<int>(l.type)];
+    size_t textured = 0;
+    for (const Material& m : scene.materials) textured += m.base_color_texture >= 0;
+    fmt::print("scene      {} ({})\n", scene.name, path.string());
+    fmt::print("geometry   {} triangles, {} vertices, {} meshes\n", scene.triangle_count(), scene.vertex_count(),
+               scene.meshes.size());
+    fmt::print("materials  {} ({} textured), {} textures\n", scene.materials.size(), textured, scene.textures.size());
+    fmt::print("lights     {} point, {} directional, {} spot\n", lights_by_type[0], lights_by_type[1], lights_by_type[2]);
+    fmt::print("bounds     [{:.3f}, {:.3f}, {:.3f}] .. [{:.3f}, {:.3f}, {:.3f}] m\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x,
+               b.hi.y, b.hi.z);
+    fmt::print("cameras    {}\n", scene.cameras.empty() ? std::string("none (rig frames the bounds)") : scene.cameras.front().name);
+    const StereoRig rig = resolve_rig(scene, overrides);
+    fmt::print("rig        {}\n", describe(rig));
+    // Disparity range over the scene's depth range as seen from the centre camera.
+    const EyeCamera centre = rig.eye(Eye::center);
+    double zmin = 1e300, zmax = 0.0;
+    for (int i = 0; i < 8; ++i) {
+      const dvec3 corner((i & 1) ? b.hi.x : b.lo.x, (i & 2) ? b.hi.y : b.lo.y, (i & 4) ? b.hi.z : b.lo.z);
+      const double z = centre.project(corner).z;
+      zmin = std::min(zmin, z);
+      zmax = std::max(zmax, z);
+    }
+    zmin = std::max(zmin, rig.params().znear);
+    if (zmax > zmin)
+      fmt::print("disparity  {:.2f} px (bounds' nearest depth {:.3f} m) .. {:.2f} px (farthest {:.3f} m)\n",
+                 rig.disparity_px(zmin), zmin, rig.disparity_px(zmax), zmax);
+    fmt::print("loaded in  {:.3f} s\n", load_s);
+    for (const std::string& w : scene.warnings) fmt::print("warning    {}\n", w);
+    fmt::print("\n");
+  }
+}
+
+}  // namespace
+
+void register_scenes_command(CLI::App& root) {
+  CLI::App* scenes = root.add_subcommand("scenes", "List, generate and describe scenes");
+  scenes->require_subcommand(1);
+
+  CLI::App* list = scenes->add_subcommand("list", "List the built-in scene generators and their parameters");
+  list->callback([] { list_generators(); });
+
+  auto gen = std::make_shared<GenerateArgs>();
+  gen->out_dir = scenes::default_scenes_dir().string();
+  CLI::App* g = scenes->add_subcommand("generate", "Generate built-in scenes as glTF (seeded, deterministic)");
+  g->add_option("names", gen->names, "Scenes to generate (see `scenes list`)");
+  g->add_flag("--all", gen->all, "Generate every built-in scene with default parameters");
+  g->add_option("--out,-o", gen->out_dir, "Output folder")->capture_default_str();
+  g->add_option("--seed", gen->seed, "Random seed; same seed, same file")->capture_default_str();
+  g->add_option("--param,-p", gen->params, "Generator parameter NAME=VALUE (see `scenes list`)");
+  g->callback([gen] { generate_scenes(*gen); });
+
+  auto info = std::make_shared<InfoArgs>();
+  CLI::App* i = scenes->add_subcommand("info", "Load scenes and print their contents and default stereo rig");
+  i->add_option("scenes", info->scenes, "Scene files (.gltf/.glb) or built-in scene names")->required();
+  add_scenes_dir_option(*i, info->scenes_dir);
+  info->rig.add_to(*i);
+  i->callback([info] { print_info(*info); });
+}
+
+}  // namespace sb::cli

@@ -1,0 +1,369 @@
+// Structural glTF JSON check with JSON-pointer error messages.
+#include "renderer/io/gltf_check.hpp"
+
+#include <cmath>
+#include <initializer_list>
+#include <string_view>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "renderer/error.hpp"
+
+namespace sb::io {
+
+namespace {
+
+using nlohmann::json;
+
+/// Walks the document with the current JSON pointer and the sizes of the top-level arrays.
+class Checker {
+ public:
+  Checker(const json& doc, std::string file) : doc_(doc), file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const std::string& path, const std::string& what) const {
+    throw InputError(fmt::format("{}: {}: {}", file_, path.empty() ? "/" : path, what));
+  }
+
+  [[nodiscard]] size_t array_size(std::string_view top) const {
+    if (top == "lights") {
+      const json* ext = find(doc_, "extensions");
+      const json* khr = ext ? find(*ext, "KHR_lights_punctual") : nullptr;
+      const json* lights = khr ? find(*khr, "lights") : nullptr;
+      return lights && lights->is_array() ? lights->size() : 0;
+    }
+    const json* a = find(doc_, std::string(top));
+    return a && a->is_array() ? a->size() : 0;
+  }
+
+  static const json* find(const json& obj, const std::string& key) {
+    if (!obj.is_object()) return nullptr;
+    auto it = obj.find(key);
+    return it == obj.end() ? nullptr : &*it;
+  }
+
+  const json& require_object(const json& v, const std::string& path) const {
+    if (!v.is_object()) fail(path, fmt::format("expected a JSON object, found {}", v.type_name()));
+    return v;
+  }
+
+  const json& require_array(const json& v, const std::string& path) const {
+    if (!v.is_array()) fail(path, fmt::format("expected a JSON array, found {}", v.type_name()));
+    return v;
+  }
+
+  /// An optional member of `obj`; when `required` is set its absence is a fault.
+  const json* member(const json& obj, const std::string& key, const std::string& path,
+                     bool required = false) const {
+    const json* v = find(obj, key);
+    if (!v && required) fail(path + "/" + key, "required property is missing");
+    return v;
+  }
+
+  uint64_t integer(const json& v, const std::string& path, uint64_t lo = 0,
+                   uint64_t hi = (uint64_t{1} << 53)) const {
+    if (!v.is_number_integer() || (v.is_number_integer() && !v.is_number_unsigned() && v.get<int64_t>() < 0)) {
+      if (v.is_number_integer()) fail(path, fmt::format("must be a non-negative integer, found {}", v.dump()));
+      fail(path, fmt::format("must be an integer, found {} {}", v.type_name(), v.dump()));
+    }
+    const uint64_t x = v.get<uint64_t>();
+    if (x < lo || x > hi) fail(path, fmt::format("value {} is out of range [{}, {}]", x, lo, hi));
+    return x;
+  }
+
+  double number(const json& v, const std::string& path) const {
+    if (!v.is_number()) fail(path, fmt::format("must be a number, found {} {}", v.type_name(), v.dump()));
+    const double x = v.get<double>();
+    if (!std::isfinite(x)) fail(path, "must be finite");
+    return x;
+  }
+
+  void boolean(const json& v, const std::string& path) const {
+    if (!v.is_boolean()) fail(path, fmt::format("must be true or false, found {} {}", v.type_name(), v.dump()));
+  }
+
+  const std::string& string(const json& v, const std::string& path) const {
+    if (!v.is_string()) fail(path, fmt::format("must be a string, found {} {}", v.type_name(), v.dump()));
+    return v.get_ref<const std::string&>();
+  }
+
+  void number_array(const json& v, const std::string& path, size_t len) const {
+    require_array(v, path);
+    if (v.size() != len) fail(path, fmt::format("must have {} elements, found {}", len, v.size()));
+    for (size_t i = 0; i < v.size(); ++i) number(v[i], fmt::format("{}/{}", path, i));
+  }
+
+  /// An index into the top-level array `top`.
+  void index(const json& v, const std::string& path, std::string_view top) const {
+    const uint64_t i = integer(v, path);
+    const size_t n = array_size(top);
+    if (i >= n)
+      fail(path, fmt::format("refers to {}[{}] but the file has {} {}", top, i, n, top));
+  }
+
+  void opt_index(const json& obj, const std::string& key, const std::string& path,
+                 std::string_view top, bool required = false) const {
+    if (const json* v = member(obj, key, path, required)) index(*v, path + "/" + key, top);
+  }
+
+  void opt_integer(const json& obj, const std::string& key, const std::string& path,
+                   uint64_t lo = 0, uint64_t hi = (uint64_t{1} << 53), bool required = false) const {
+    if (const json* v = member(obj, key, path, required)) integer(*v, path + "/" + key, lo, hi);
+  }
+
+  void opt_number(const json& obj, const std::string& key, const std::string& path,
+                  bool required = false) const {
+    if (const json* v = member(obj, key, path, required)) number(*v, path + "/" + key);
+  }
+
+  void opt_bool(const json& obj, const std::string& key, const std::string& path) const {
+    if (const json* v = member(obj, key, path)) boolean(*v, path + "/" + key);
+  }
+
+  void opt_string(const json& obj, const std::string& key, const std::string& path,
+                  bool required = false) const {
+    if (const json* v = member(obj, key, path, required)) string(*v, path + "/" + key);
+  }
+
+  void opt_number_array(const json& obj, const std::string& key, const std::string& path,
+                        size_t len) const {
+    if (const json* v = member(obj, key, path)) number_array(*v, path + "/" + key, len);
+  }
+
+  void opt_object(const json& obj, const std::string& key, const std::string& path) const {
+    if (const json* v = member(obj, key, path)) require_object(*v, path + "/" + key);
+  }
+
+  /// Calls `each(element, path)` for every element of the top-level array `key`, which must hold objects.
+  template <class F>
+  void each(const json& obj, const std::string& key, const std::string& path, F&& f) const {
+    const json* arr = member(obj, key, path);
+    if (!arr) return;
+    const std::string apath = path + "/" + key;
+    require_array(*arr, apath);
+    for (size_t i = 0; i < arr->size(); ++i) {
+      const std::string p = fmt::format("{}/{}", apath, i);
+      f(require_object((*arr)[i], p), p);
+    }
+  }
+
+  void texture_info(const json& obj, const std::string& key, const std::string& path) const {
+    const json* t = member(obj, key, path);
+    if (!t) return;
+    const std::string p = path + "/" + key;
+    require_object(*t, p);
+    opt_index(*t, "index", p, "textures", true);
+    opt_integer(*t, "texCoord", p, 0, 255);
+  }
+
+  void extras(const json& obj, const std::string& path) const {
+    const json* e = member(obj, "extras", path);
+    if (!e || !e->is_object()) return;  // extras may be anything; only ours is checked
+    const json* sb = find(*e, "stereobench");
+    if (!sb) return;
+    const std::string p = path + "/extras/stereobench";
+    require_object(*sb, p);
+    opt_number(*sb, "interaxial", p);
+    opt_number(*sb, "convergence", p);
+    opt_integer(*sb, "width", p, 1, 16384);
+    opt_integer(*sb, "height", p, 1, 16384);
+    opt_number_array(*sb, "background", p, 3);
+    opt_number(*sb, "ambient", p);
+  }
+
+  void run() const {
+    require_object(doc_, "");
+    const json* asset = member(doc_, "asset", "", true);
+    require_object(*asset, "/asset");
+    const std::string& version = string(*member(*asset, "version", "/asset", true), "/asset/version");
+    if (version.rfind("2.", 0) != 0)
+      fail("/asset/version", fmt::format("glTF version '{}' is not supported; only 2.x files load", version));
+
+    for (const char* key : {"extensionsUsed", "extensionsRequired"})
+      if (const json* a = member(doc_, key, "")) {
+        require_array(*a, std::string("/") + key);
+        for (size_t i = 0; i < a->size(); ++i) string((*a)[i], fmt::format("/{}/{}", key, i));
+      }
+
+    opt_index(doc_, "scene", "", "scenes");
+    each(doc_, "scenes", "", [&](const json& s, const std::string& p) {
+      if (const json* nodes = member(s, "nodes", p)) {
+        require_array(*nodes, p + "/nodes");
+        for (size_t i = 0; i < nodes->size(); ++i) index((*nodes)[i], fmt::format("{}/nodes/{}", p, i), "nodes");
+      }
+      extras(s, p);
+    });
+
+    each(doc_, "nodes", "", [&](const json& n, const std::string& p) {
+      if (const json* ch = member(n, "children", p)) {
+        require_array(*ch, p + "/children");
+        for (size_t i = 0; i < ch->size(); ++i) index((*ch)[i], fmt::format("{}/children/{}", p, i), "nodes");
+      }
+      opt_index(n, "mesh", p, "meshes");
+      opt_index(n, "camera", p, "cameras");
+      opt_number_array(n, "matrix", p, 16);
+      opt_number_array(n, "translation", p, 3);
+      opt_number_array(n, "rotation", p, 4);
+      opt_number_array(n, "scale", p, 3);
+      if (const json* ext = member(n, "extensions", p)) {
+        require_object(*ext, p + "/extensions");
+        if (const json* l = find(*ext, "KHR_lights_punctual")) {
+          const std::string lp = p + "/extensions/KHR_lights_punctual";
+          require_object(*l, lp);
+          opt_index(*l, "light", lp, "lights", true);
+        }
+      }
+      extras(n, p);
+    });
+
+    each(doc_, "meshes", "", [&](const json& m, const std::string& p) {
+      const json* prims = member(m, "primitives", p, true);
+      require_array(*prims, p + "/primitives");
+      each(m, "primitives", p, [&](const json& prim, const std::string& pp) {
+        const json* attrs = member(prim, "attributes", pp, true);
+        require_object(*attrs, pp + "/attributes");
+        for (auto it = attrs->begin(); it != attrs->end(); ++it)
+          index(it.value(), pp + "/attributes/" + it.key(), "accessors");
+        opt_index(prim, "indices", pp, "accessors");
+        opt_index(prim, "material", pp, "materials");
+        opt_integer(prim, "mode", pp, 0, 6);
+      });
+    });
+
+    each(doc_, "accessors", "", [&](const json& a, const std::string& p) {
+      opt_index(a, "bufferView", p, "bufferViews");
+      opt_integer(a, "byteOffset", p);
+      const uint64_t ct = integer(*member(a, "componentType", p, true), p + "/componentType");
+      if (ct != 5120 && ct != 5121 && ct != 5122 && ct != 5123 && ct != 5125 && ct != 5126)
+        fail(p + "/componentType",
+             fmt::format("{} is not a glTF component type (5120 BYTE, 5121 UNSIGNED_BYTE, 5122 SHORT, "
+                         "5123 UNSIGNED_SHORT, 5125 UNSIGNED_INT, 5126 FLOAT)", ct));
+      opt_bool(a, "normalized", p);
+      opt_integer(a, "count", p, 1, (uint64_t{1} << 53), true);
+      const std::string& type = string(*member(a, "type", p, true), p + "/type");
+      if (type != "SCALAR" && type != "VEC2" && type != "VEC3" && type != "VEC4" && type != "MAT2" &&
+          type != "MAT3" && type != "MAT4")
+        fail(p + "/type", fmt::format("'{}' is not a glTF accessor type (SCALAR, VEC2..4, MAT2..4)", type));
+      if (const json* sp = member(a, "sparse", p)) {
+        const std::string sp_path = p + "/sparse";
+        require_object(*sp, sp_path);
+        opt_integer(*sp, "count", sp_path, 1, (uint64_t{1} << 53), true);
+        const json* idx = member(*sp, "indices", sp_path, true);
+        require_object(*idx, sp_path + "/indices");
+        opt_index(*idx, "bufferView", sp_path + "/indices", "bufferViews", true);
+        opt_integer(*idx, "byteOffset", sp_path + "/indices");
+        const uint64_t ict = integer(*member(*idx, "componentType", sp_path + "/indices", true),
+                                     sp_path + "/indices/componentType");
+        if (ict != 5121 && ict != 5123 && ict != 5125)
+          fail(sp_path + "/indices/componentType",
+               fmt::format("{} is not an index type (5121, 5123, 5125)", ict));
+        const json* val = member(*sp, "values", sp_path, true);
+        require_object(*val, sp_path + "/values");
+        opt_index(*val, "bufferView", sp_path + "/values", "bufferViews", true);
+        opt_integer(*val, "byteOffset", sp_path + "/values");
+      }
+    });
+
+    each(doc_, "bufferViews", "", [&](const json& v, const std::string& p) {
+      opt_index(v, "buffer", p, "buffers", true);
+      opt_integer(v, "byteOffset", p);
+      opt_integer(v, "byteLength", p, 1, (uint64_t{1} << 53), true);
+      opt_integer(v, "byteStride", p, 4, 252);
+      opt_integer(v, "target", p);
+    });
+
+    each(doc_, "buffers", "", [&](const json& b, const std::string& p) {
+      opt_string(b, "uri", p);
+      opt_integer(b, "byteLength", p, 1, (uint64_t{1} << 53), true);
+    });
+
+    each(doc_, "materials", "", [&](const json& m, const std::string& p) {
+      if (const json* pbr = member(m, "pbrMetallicRoughness", p)) {
+        const std::string pp = p + "/pbrMetallicRoughness";
+        require_object(*pbr, pp);
+        opt_number_array(*pbr, "baseColorFactor", pp, 4);
+        texture_info(*pbr, "baseColorTexture", pp);
+        texture_info(*pbr, "metallicRoughnessTexture", pp);
+      }
+      texture_info(m, "normalTexture", p);
+      texture_info(m, "occlusionTexture", p);
+      texture_info(m, "emissiveTexture", p);
+      opt_number_array(m, "emissiveFactor", p, 3);
+      opt_bool(m, "doubleSided", p);
+      opt_string(m, "alphaMode", p);
+    });
+
+    each(doc_, "textures", "", [&](const json& t, const std::string& p) {
+      opt_index(t, "source", p, "images");
+      opt_index(t, "sampler", p, "samplers");
+    });
+
+    each(doc_, "images", "", [&](const json& im, const std::string& p) {
+      opt_string(im, "uri", p);
+      opt_index(im, "bufferView", p, "bufferViews");
+      opt_string(im, "mimeType", p);
+      if (!find(im, "uri") && !find(im, "bufferView"))
+        fail(p, "image has neither 'uri' nor 'bufferView'");
+    });
+
+    each(doc_, "samplers", "", [&](const json& s, const std::string& p) {
+      for (const char* k : {"magFilter", "minFilter", "wrapS", "wrapT"}) opt_integer(s, k, p);
+    });
+
+    each(doc_, "cameras", "", [&](const json& c, const std::string& p) {
+      const std::string& type = string(*member(c, "type", p, true), p + "/type");
+      if (type == "perspective") {
+        const json* per = member(c, "perspective", p, true);
+        const std::string pp = p + "/perspective";
+        require_object(*per, pp);
+        const double yfov = number(*member(*per, "yfov", pp, true), pp + "/yfov");
+        if (yfov <= 0.0 || yfov >= 3.14159265358979)
+          fail(pp + "/yfov", fmt::format("vertical field of view {} rad is outside (0, pi)", yfov));
+        const double znear = number(*member(*per, "znear", pp, true), pp + "/znear");
+        if (znear <= 0.0) fail(pp + "/znear", fmt::format("znear {} must be positive", znear));
+        if (const json* ar = member(*per, "aspectRatio", pp))
+          if (number(*ar, pp + "/aspectRatio") <= 0.0) fail(pp + "/aspectRatio", "must be positive");
+        if (const json* zf = member(*per, "zfar", pp))
+          if (number(*zf, pp + "/zfar") <= znear) fail(pp + "/zfar", "must be greater than znear");
+      } else if (type == "orthographic") {
+        require_object(*member(c, "orthographic", p, true), p + "/orthographic");
+      } else {
+        fail(p + "/type", fmt::format("'{}' is not a camera type (perspective, orthographic)", type));
+      }
+    });
+
+    if (const json* ext = member(doc_, "extensions", "")) {
+      require_object(*ext, "/extensions");
+      if (const json* khr = find(*ext, "KHR_lights_punctual")) {
+        const std::string kp = "/extensions/KHR_lights_punctual";
+        require_object(*khr, kp);
+        each(*khr, "lights", kp, [&](const json& l, const std::string& p) {
+          const std::string& type = string(*member(l, "type", p, true), p + "/type");
+          if (type != "point" && type != "directional" && type != "spot")
+            fail(p + "/type", fmt::format("'{}' is not a light type (point, directional, spot)", type));
+          opt_number_array(l, "color", p, 3);
+          if (const json* i = member(l, "intensity", p))
+            if (number(*i, p + "/intensity") < 0.0) fail(p + "/intensity", "must not be negative");
+          if (const json* r = member(l, "range", p))
+            if (number(*r, p + "/range") <= 0.0) fail(p + "/range", "must be positive");
+          if (type == "spot") {
+            const json* s = member(l, "spot", p, true);
+            require_object(*s, p + "/spot");
+            opt_number(*s, "innerConeAngle", p + "/spot");
+            opt_number(*s, "outerConeAngle", p + "/spot");
+          }
+        });
+      }
+    }
+  }
+
+ private:
+  const json& doc_;
+  std::string file_;
+};
+
+}  // namespace
+
+void check_gltf_json(const nlohmann::json& doc, const std::string& file) { Checker(doc, file).run(); }
+
+}  // namespace sb::io

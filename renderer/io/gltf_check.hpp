@@ -1,0 +1,15 @@
+// Structural check of a glTF 2.0 JSON document before it is loaded: every field the suite reads is
+// checked for type and range, every cross-reference for bounds, and the first fault is reported
+// with its JSON pointer (e.g. "/accessors/3/count").
+#pragma once
+
+#include <string>
+
+#include <nlohmann/json_fwd.hpp>
+
+namespace sb::io {
+
+/// Throws InputError "<file>: <json pointer>: <what is wrong>; <what to do>" at the first fault.
+void check_gltf_json(const nlohmann::json& doc, const std::string& file);
+
+}  // namespace sb::io

@@ -1,0 +1,751 @@
+// glTF 2.0 loading: container and JSON checks, tinygltf for buffers and images, conversion to
+// world-space meshes with every accessor layout the format allows.
+#include "renderer/io/gltf_loader.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <set>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#define TINYGLTF_IMPLEMENTATION
+#define TINYGLTF_NO_STB_IMAGE
+#define TINYGLTF_NO_STB_IMAGE_WRITE
+#define TINYGLTF_NO_INCLUDE_STB_IMAGE
+#define TINYGLTF_NO_INCLUDE_STB_IMAGE_WRITE
+#include <tiny_gltf.h>
+
+#include "renderer/color.hpp"
+#include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
+#include "renderer/io/gltf_check.hpp"
+#include "renderer/io/image_io.hpp"
+
+namespace sb::io {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const char* gltf_loader_version() { return "tinygltf 2.7.0"; }
+
+namespace {
+
+/// Hard limit on the triangles one scene may expand to (instancing included).
+constexpr uint64_t kMaxTriangles = 1'500'000'000;
+
+struct GlbParts {
+  std::string json_text;
+  bool is_glb = false;
+};
+
+uint32_t read_u32(const std::string& bytes, size_t offset) {
+  uint32_t v;
+  std::memcpy(&v, bytes.data() + offset, 4);
+  return v;
+}
+
+/// Splits a .glb container into its JSON chunk, checking every length against the file.
+GlbParts split_container(const std::string& bytes, const std::string& file) {
+  GlbParts parts;
+  if (bytes.size() < 4 || bytes.compare(0, 4, "glTF") != 0) {
+    parts.json_text = bytes;
+    return parts;
+  }
+  parts.is_glb = true;
+  if (bytes.size() < 20)
+    throw InputError(fmt::format("{}: truncated .glb: {} bytes, shorter than the 20-byte header; "
+                                 "the file is damaged, regenerate or re-export it", file, bytes.size()));
+  const uint32_t version = read_u32(bytes, 4);
+  const uint32_t length = read_u32(bytes, 8);
+  if (version != 2)
+    throw InputError(fmt::format("{}: .glb container version {} is not supported (only 2)", file, version));
+  if (length != bytes.size())
+    throw InputError(fmt::format("{}: truncated or padded .glb: header says {} bytes, file has {}; "
+                                 "the file is damaged, regenerate or re-export it", file, length, bytes.size()));
+  const uint32_t json_len = read_u32(bytes, 12);
+  const uint32_t json_type = read_u32(bytes, 16);
+  if (json_type != 0x4E4F534A)
+    throw InputError(fmt::format("{}: .glb first chunk is not JSON (type 0x{:08x})", file, json_type));
+  if (uint64_t{20} + json_len > bytes.size())
+    throw InputError(fmt::format("{}: truncated .glb: JSON chunk of {} bytes runs past the end of the "
+                                 "{}-byte file", file, json_len, bytes.size()));
+  const uint64_t bin_at = uint64_t{20} + json_len;
+  if (bin_at < bytes.size()) {
+    if (bin_at + 8 > bytes.size())
+      throw InputError(fmt::format("{}: truncated .glb: BIN chunk header cut off at byte {}", file, bin_at));
+    const uint32_t bin_len = read_u32(bytes, bin_at);
+    const uint32_t bin_type = read_u32(bytes, bin_at + 4);
+    if (bin_type != 0x004E4942)
+      throw InputError(fmt::format("{}: .glb second chunk is not BIN (type 0x{:08x})", file, bin_type));
+    if (bin_at + 8 + bin_len > bytes.size())
+      throw InputError(fmt::format("{}: truncated .glb: BIN chunk of {} bytes runs past the end of the "
+                                   "{}-byte file", file, bin_len, bytes.size()));
+  }
+  parts.json_text = bytes.substr(20, json_len);
+  return parts;
+}
+
+bool is_data_uri(const std::string& uri) { return uri.rfind("data:", 0) == 0; }
+
+std::string percent_decode(const std::string& s) {
+  std::string out;
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (s[i] == '%' && i + 2 < s.size() && std::isxdigit(static_cast<unsigned char>(s[i + 1])) &&
+        std::isxdigit(static_cast<unsigned char>(s[i + 2]))) {
+      out.push_back(static_cast<char>(std::stoi(s.substr(i + 1, 2), nullptr, 16)));
+      i += 2;
+    } else {
+      out.push_back(s[i]);
+    }
+  }
+  return out;
+}
+
+/// A base64 data URI buffer must decode to at least its declared byteLength.
+void check_data_uri_length(const json& buffer, const std::string& where, const std::string& file) {
+  const std::string& uri = buffer.at("uri").get_ref<const std::string&>();
+  const size_t comma = uri.find(',');
+  if (comma == std::string::npos || uri.rfind(";base64", comma) == std::string::npos)
+    throw InputError(fmt::format("{}: {}/uri: data URI is not base64-encoded; only base64 data URIs are "
+                                 "supported", file, where));
+  size_t chars = uri.size() - comma - 1;
+  size_t pad = 0;
+  while (chars > 0 && pad < 2 && uri[comma + chars] == '=') { --chars; ++pad; }
+  const uint64_t have = (chars * 3) / 4;
+  const uint64_t need = buffer.at("byteLength").get<uint64_t>();
+  if (have < need)
+    throw InputError(fmt::format("{}: {}: the data URI holds {} bytes but byteLength says {}; the buffer is "
+                                 "truncated", file, where, have, need));
+}
+
+/// External buffers and images must exist, and buffers must hold their declared byteLength.
+void check_external_files(const json& doc, const fs::path& dir, const std::string& file) {
+  for (const char* top : {"buffers", "images"}) {
+    auto it = doc.find(top);
+    if (it == doc.end()) continue;
+    for (size_t i = 0; i < it->size(); ++i) {
+      const json& e = (*it)[i];
+      auto u = e.find("uri");
+      if (u == e.end()) continue;
+      if (is_data_uri(u->get<std::string>())) {
+        if (std::string(top) == "buffers") check_data_uri_length(e, fmt::format("/buffers/{}", i), file);
+        continue;
+      }
+      const fs::path p = dir / percent_decode(u->get<std::string>());
+      const std::string where = fmt::format("/{}/{}/uri", top, i);
+      std::error_code ec;
+      if (!fs::is_regular_file(p, ec))
+        throw InputError(fmt::format("{}: {}: referenced file '{}' does not exist; put it beside the "
+                                     "scene or fix the uri", file, where, p.string()));
+      if (std::string(top) == "buffers") {
+        const uint64_t need = e.at("byteLength").get<uint64_t>();
+        const uint64_t have = fs::file_size(p, ec);
+        if (have != need)
+          throw InputError(fmt::format("{}: {}: '{}' has {} bytes but byteLength says {}; the buffer is "
+                                       "{} or the file is inconsistent", file, where, p.string(), have, need,
+                                       have < need ? "truncated" : "of another size"));
+      }
+    }
+  }
+}
+
+/// Keeps the encoded bytes of an image; decoding happens in the converter through image_io.
+bool keep_image_bytes(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
+                      const unsigned char* bytes, int size, void*) {
+  image->image.assign(bytes, bytes + size);
+  image->width = -1;  // marks "encoded, not decoded"
+  image->height = -1;
+  return true;
+}
+
+/// A checked view of one accessor's elements.
+struct AccessorView {
+  const unsigned char* base = nullptr;  ///< nullptr: no bufferView, elements are zero
+  size_t count = 0;
+  int components = 0;
+  int component_type = 0;
+  size_t component_size = 0;
+  size_t stride = 0;
+  bool normalized = false;
+};
+
+int component_count(int type) {
+  switch (type) {
+    case TINYGLTF_TYPE_SCALAR: return 1;
+    case TINYGLTF_TYPE_VEC2: return 2;
+    case TINYGLTF_TYPE_VEC3: return 3;
+    case TINYGLTF_TYPE_VEC4: return 4;
+    case TINYGLTF_TYPE_MAT2: return 4;
+    case TINYGLTF_TYPE_MAT3: return 9;
+    case TINYGLTF_TYPE_MAT4: return 16;
+    default: return 0;
+  }
+}
+
+size_t component_size(int ct) {
+  switch (ct) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+    default: return 0;
+  }
+}
+
+const char* type_name(int components) {
+  switch (components) {
+    case 1: return "SCALAR";
+    case 2: return "VEC2";
+    case 3: return "VEC3";
+    case 4: return "VEC4";
+    default: return "MAT";
+  }
+}
+
+/// Reads one component as float, applying glTF's normalisation rules.
+float read_component(const unsigned char* p, int ct, bool normalized) {
+  switch (ct) {
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: { float f; std::memcpy(&f, p, 4); return f; }
+    case TINYGLTF_COMPONENT_TYPE_BYTE: { int8_t v; std::memcpy(&v, p, 1); return normalized ? std::max(v / 127.0f, -1.0f) : float(v); }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: { uint8_t v = *p; return normalized ? v / 255.0f : float(v); }
+    case TINYGLTF_COMPONENT_TYPE_SHORT: { int16_t v; std::memcpy(&v, p, 2); return normalized ? std::max(v / 32767.0f, -1.0f) : float(v); }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t v; std::memcpy(&v, p, 2); return normalized ? v / 65535.0f : float(v); }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { uint32_t v; std::memcpy(&v, p, 4); return normalized ? float(v / 4294967295.0) : float(v); }
+    default: return 0.0f;
+  }
+}
+
+uint32_t read_index(const unsigned char* p, int ct) {
+  switch (ct) {
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return *p;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t v; std::memcpy(&v, p, 2); return v; }
+    default: { uint32_t v; std::memcpy(&v, p, 4); return v; }
+  }
+}
+
+/// Converts a tinygltf model into a Scene, checking every byte range it reads.
+class Converter {
+ public:
+  Converter(const tinygltf::Model& model, const json& doc, std::string file, const GltfLoadOptions& options)
+      : m_(model), doc_(doc), file_(std::move(file)), options_(options) {}
+
+  Scene run() {
+    Scene scene;
+    scene.path = file_;
+    check_extensions();
+    convert_materials(scene);
+    traverse(scene);
+    read_scene_extras(scene);
+    if (scene.meshes.empty())
+      throw InputError(fmt::format("{}: the scene has no triangles to render (no mesh with TRIANGLES, "
+                                   "TRIANGLE_STRIP or TRIANGLE_FAN primitives is reachable from the scene's "
+                                   "nodes); add geometry or pick another scene", file_));
+    if (!m_.animations.empty()) warn("animations", fmt::format("{} animation(s) are not played; the scene is rendered at rest", m_.animations.size()));
+    if (!m_.skins.empty()) warn("skins", fmt::format("{} skin(s) ignored: meshes render in their bind pose", m_.skins.size()));
+    for (const auto& [key, count] : warning_counts_)
+      scene.warnings.push_back(count > 1 ? fmt::format("{} ({} occurrences)", warning_text_[key], count)
+                                         : warning_text_[key]);
+    return scene;
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& path, const std::string& what) const {
+    throw InputError(fmt::format("{}: {}: {}", file_, path, what));
+  }
+
+  /// Records an unsupported feature once, counting repeats.
+  void warn(const std::string& key, const std::string& text) {
+    if (warning_counts_[key]++ == 0) warning_text_[key] = "unsupported: " + text;
+  }
+
+  void check_extensions() {
+    static const std::set<std::string> supported = {"KHR_lights_punctual"};
+    for (size_t i = 0; i < m_.extensionsRequired.size(); ++i)
+      if (!supported.count(m_.extensionsRequired[i]))
+        fail(fmt::format("/extensionsRequired/{}", i),
+             fmt::format("extension '{}' is required by the file but not supported (supported: "
+                         "KHR_lights_punctual); re-export without it", m_.extensionsRequired[i]));
+    for (const std::string& e : m_.extensionsUsed)
+      if (!supported.count(e)) warn("ext:" + e, fmt::format("extension '{}' is ignored", e));
+  }
+
+  AccessorView view_of(int index, const std::string& path) const {
+    const tinygltf::Accessor& a = m_.accessors[static_cast<size_t>(index)];
+    const std::string apath = fmt::format("/accessors/{}", index);
+    AccessorView v;
+    v.count = a.count;
+    v.components = component_count(a.type);
+    v.component_type = a.componentType;
+    v.component_size = component_size(a.componentType);
+    v.normalized = a.normalized;
+    const size_t elem = v.component_size * static_cast<size_t>(v.components);
+    if (a.bufferView < 0) {
+      v.stride = elem;
+      return v;
+    }
+    const tinygltf::BufferView& bv = m_.bufferViews[static_cast<size_t>(a.bufferView)];
+    const tinygltf::Buffer& buf = m_.buffers[static_cast<size_t>(bv.buffer)];
+    const std::string bvpath = fmt::format("/bufferViews/{}", a.bufferView);
+    if (bv.byteOffset > buf.data.size() || bv.byteLength > buf.data.size() - bv.byteOffset)
+      fail(bvpath, fmt::format("bytes [{}, {}) lie outside buffer {} of {} bytes (used by {})", bv.byteOffset,
+                               bv.byteOffset + bv.byteLength, bv.buffer, buf.data.size(), path));
+    v.stride = bv.byteStride ? bv.byteStride : elem;
+    if (v.stride < elem)
+      fail(bvpath + "/byteStride", fmt::format("stride {} is smaller than one {} element of {} bytes (accessor {})",
+                                               v.stride, type_name(v.components), elem, index));
+    // Last byte read. The JSON check bounds count and offsets by 2^53 and strides by 252, so
+    // this sum cannot overflow 64 bits.
+    const uint64_t end = uint64_t{a.byteOffset} + uint64_t{v.stride} * (a.count - 1) + elem;
+    if (end > bv.byteLength)
+      fail(apath, fmt::format("{} elements of {} bytes (stride {}) from offset {} need {} bytes, but "
+                              "bufferView {} has {}; the count is wrong or the buffer is truncated (used by {})",
+                              a.count, elem, v.stride, a.byteOffset, end,
+                              a.bufferView, bv.byteLength, path));
+    v.base = buf.data.data() + bv.byteOffset + a.byteOffset;
+    return v;
+  }
+
+  /// Reads an accessor as floats (count x components), applying sparse substitution.
+  std::vector<float> read_floats(int index, int want_components, const std::string& path) {
+    const AccessorView v = view_of(index, path);
+    if (v.components != want_components)
+      fail(path, fmt::format("accessor {} has type {}, but {} is needed here", index, type_name(v.components),
+                             type_name(want_components)));
+    std::vector<float> out(v.count * static_cast<size_t>(v.components), 0.0f);
+    if (v.base)
+      for (size_t i = 0; i < v.count; ++i)
+        for (int c = 0; c < v.components; ++c)
+          out[i * v.components + c] =
+              read_component(v.base + i * v.stride + c * v.component_size, v.component_type, v.normalized);
+    apply_sparse(index, v, out);
+    for (float f : out)
+      if (!std::isfinite(f)) fail(fmt::format("/accessors/{}", index), fmt::format("contains a non-finite value (used by {})", path));
+    return out;
+  }
+
+  void apply_sparse(int index, const AccessorView& v, std::vector<float>& out) {
+    const tinygltf::Accessor& a = m_.accessors[static_cast<size_t>(index)];
+    if (!a.sparse.isSparse) return;
+    const std::string sp = fmt::format("/accessors/{}/sparse", index);
+    const size_t n = static_cast<size_t>(a.sparse.count);
+    auto span_of = [&](int view, size_t offset, size_t bytes, const std::string& where) -> const unsigned char* {
+      const tinygltf::BufferView& bv = m_.bufferViews[static_cast<size_t>(view)];
+      const tinygltf::Buffer& buf = m_.buffers[static_cast<size_t>(bv.buffer)];
+      if (bv.byteOffset > buf.data.size() || bv.byteLength > buf.data.size() - bv.byteOffset ||
+          offset > bv.byteLength || bytes > bv.byteLength - offset)
+        fail(where, fmt::format("{} bytes at offset {} lie outside bufferView {}", bytes, offset, view));
+      return buf.data.data() + bv.byteOffset + offset;
+    };
+    const size_t isize = component_size(a.sparse.indices.componentType);
+    const unsigned char* idx = span_of(a.sparse.indices.bufferView, a.sparse.indices.byteOffset, n * isize, sp + "/indices");
+    const size_t elem = v.component_size * static_cast<size_t>(v.components);
+    const unsigned char* val = span_of(a.sparse.values.bufferView, a.sparse.values.byteOffset, n * elem, sp + "/values");
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t target = read_index(idx + i * isize, a.sparse.indices.componentType);
+      if (target >= v.count)
+        fail(sp + "/indices", fmt::format("sparse index {} at element {} is out of range for {} elements", target, i, v.count));
+      for (int c = 0; c < v.components; ++c)
+        out[target * v.components + c] = read_component(val + i * elem + c * v.component_size, v.component_type, v.normalized);
+    }
+  }
+
+  std::vector<uint32_t> read_indices(int index, size_t vertex_count, const std::string& path) {
+    const AccessorView v = view_of(index, path);
+    if (v.components != 1)
+      fail(path, fmt::format("index accessor {} has type {}, indices must be SCALAR", index, type_name(v.components)));
+    if (v.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+        v.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        v.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+      fail(path, fmt::format("index accessor {} has component type {}; indices must be UNSIGNED_BYTE, "
+                             "UNSIGNED_SHORT or UNSIGNED_INT", index, v.component_type));
+    if (m_.accessors[static_cast<size_t>(index)].sparse.isSparse)
+      warn("sparse-indices", "sparse index accessors (the dense part is used)");
+    std::vector<uint32_t> out(v.count, 0);
+    if (v.base)
+      for (size_t i = 0; i < v.count; ++i) out[i] = read_index(v.base + i * v.stride, v.component_type);
+    for (size_t i = 0; i < out.size(); ++i)
+      if (out[i] >= vertex_count)
+        fail(fmt::format("/accessors/{}", index),
+             fmt::format("index value {} at element {} is out of range: the primitive has {} vertices (used by {})",
+                         out[i], i, vertex_count, path));
+    return out;
+  }
+
+  void convert_materials(Scene& scene) {
+    std::map<int, int> texture_of_gltf;  // glTF texture index -> Scene::textures index
+    for (size_t i = 0; i < m_.materials.size(); ++i) {
+      const tinygltf::Material& gm = m_.materials[i];
+      const std::string path = fmt::format("/materials/{}", i);
+      Material mat;
+      mat.name = gm.name.empty() ? fmt::format("material{}", i) : gm.name;
+      const auto& f = gm.pbrMetallicRoughness.baseColorFactor;
+      mat.base_color = vec4(float(f[0]), float(f[1]), float(f[2]), float(f[3]));
+      mat.double_sided = gm.doubleSided;
+      if (gm.normalTexture.index >= 0) warn("normalTexture", "normal textures are ignored (geometric or vertex normals are used)");
+      if (gm.emissiveTexture.index >= 0 || gm.emissiveFactor[0] > 0 || gm.emissiveFactor[1] > 0 || gm.emissiveFactor[2] > 0)
+        warn("emissive", "emission is ignored (direct light from punctual lights only)");
+      if (gm.alphaMode != "OPAQUE") warn("alpha:" + gm.alphaMode, fmt::format("alphaMode {} (rendered as OPAQUE)", gm.alphaMode));
+      for (const auto& [ext, value] : gm.extensions) warn("ext:" + ext, fmt::format("material extension '{}' is ignored", ext));
+      const int t = gm.pbrMetallicRoughness.baseColorTexture.index;
+      if (t >= 0 && options_.load_textures) {
+        mat.texcoord = gm.pbrMetallicRoughness.baseColorTexture.texCoord;
+        auto it = texture_of_gltf.find(t);
+        if (it == texture_of_gltf.end()) {
+          const int converted = convert_texture(scene, t, path + "/pbrMetallicRoughness/baseColorTexture");
+          it = texture_of_gltf.emplace(t, converted).first;
+        }
+        mat.base_color_texture = it->second;
+      }
+      scene.materials.push_back(std::move(mat));
+    }
+  }
+
+  int convert_texture(Scene& scene, int t, const std::string& path) {
+    const tinygltf::Texture& gt = m_.textures[static_cast<size_t>(t)];
+    if (gt.source < 0) {
+      warn("texture-no-source", "textures without an image source (the factor alone is used)");
+      return -1;
+    }
+    const tinygltf::Image& gi = m_.images[static_cast<size_t>(gt.source)];
+    const std::string ipath = fmt::format("/images/{}", gt.source);
+    if (gi.width != -1 || gi.image.empty())
+      fail(ipath, fmt::format("image has no data (used by {})", path));
+    DecodedImage img;
+    try {
+      img = decode_image(gi.image, fmt::format("{} {}", file_, ipath));
+    } catch (const Error& e) {
+      fail(ipath, fmt::format("cannot decode the image: {}", e.what()));
+    }
+    Texture tex;
+    tex.name = gi.name.empty() ? (gi.uri.empty() || is_data_uri(gi.uri) ? fmt::format("image{}", gt.source) : gi.uri) : gi.name;
+    tex.width = img.width;
+    tex.height = img.height;
+    tex.rgba.resize(static_cast<size_t>(img.width) * img.height * 4);
+    const int ch = img.channels;
+    for (size_t p = 0; p < static_cast<size_t>(img.width) * img.height; ++p) {
+      const float* s = img.values.data() + p * ch;
+      float r = s[0], g = ch >= 3 ? s[1] : s[0], b = ch >= 3 ? s[2] : s[0];
+      float a = ch == 4 ? s[3] : ch == 2 ? s[1] : 1.0f;
+      // glTF base colour textures are sRGB-encoded.
+      tex.rgba[p * 4 + 0] = srgb_to_linear(r);
+      tex.rgba[p * 4 + 1] = srgb_to_linear(g);
+      tex.rgba[p * 4 + 2] = srgb_to_linear(b);
+      tex.rgba[p * 4 + 3] = a;
+    }
+    if (gt.sampler >= 0) {
+      const tinygltf::Sampler& s = m_.samplers[static_cast<size_t>(gt.sampler)];
+      tex.repeat_s = s.wrapS != TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+      tex.repeat_t = s.wrapT != TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+      if (s.wrapS == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT || s.wrapT == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT)
+        warn("mirrored", "MIRRORED_REPEAT wrapping (treated as REPEAT)");
+    }
+    scene.textures.push_back(std::move(tex));
+    return static_cast<int>(scene.textures.size() - 1);
+  }
+
+  static dmat4 local_matrix(const tinygltf::Node& n) {
+    if (n.matrix.size() == 16) {
+      dmat4 m;
+      for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r) m[c][r] = n.matrix[static_cast<size_t>(c * 4 + r)];
+      return m;
+    }
+    dmat4 t(1.0), r(1.0), s(1.0);
+    if (n.translation.size() == 3) t[3] = dvec4(n.translation[0], n.translation[1], n.translation[2], 1.0);
+    if (n.rotation.size() == 4) {
+      dquat q(n.rotation[3], n.rotation[0], n.rotation[1], n.rotation[2]);  // glm: (w, x, y, z)
+      const double len = glm::length(q);
+      if (len > 0.0) q = q / len;
+      r = dmat4(glm::mat3_cast(q));
+    }
+    if (n.scale.size() == 3) {
+      s[0][0] = n.scale[0];
+      s[1][1] = n.scale[1];
+      s[2][2] = n.scale[2];
+    }
+    return t * r * s;
+  }
+
+  /// Walks the scene's node forest iteratively (deep or cyclic hierarchies cannot overflow the stack).
+  void traverse(Scene& scene) {
+    std::vector<int> roots;
+    if (!m_.scenes.empty()) {
+      const size_t si = m_.defaultScene >= 0 ? static_cast<size_t>(m_.defaultScene) : 0;
+      for (int n : m_.scenes[si].nodes) roots.push_back(n);
+      if (m_.scenes.size() > 1) warn("scenes", fmt::format("{} scenes in the file; only scene {} is loaded", m_.scenes.size(), si));
+    } else {
+      std::vector<bool> has_parent(m_.nodes.size(), false);
+      for (const auto& n : m_.nodes)
+        for (int c : n.children) has_parent[static_cast<size_t>(c)] = true;
+      for (size_t i = 0; i < m_.nodes.size(); ++i)
+        if (!has_parent[i]) roots.push_back(static_cast<int>(i));
+    }
+    // Count the triangles the traversal would produce before allocating them.
+    std::vector<int> parent(m_.nodes.size(), -1);
+    std::vector<bool> visited(m_.nodes.size(), false);
+    struct Item { int node; dmat4 world; };
+    std::vector<Item> stack;
+    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, dmat4(1.0)});
+    std::vector<Item> order;
+    uint64_t triangles = 0;
+    while (!stack.empty()) {
+      Item item = stack.back();
+      stack.pop_back();
+      const size_t ni = static_cast<size_t>(item.node);
+      if (visited[ni])
+        fail(fmt::format("/nodes/{}", ni), "node is reached twice: the node hierarchy has a cycle or a node "
+                                           "with two parents, which glTF forbids");
+      visited[ni] = true;
+      const tinygltf::Node& n = m_.nodes[ni];
+      item.world = item.world * local_matrix(n);
+      order.push_back(item);
+      if (n.mesh >= 0) {
+        const auto& prims = m_.meshes[static_cast<size_t>(n.mesh)].primitives;
+        for (size_t pi = 0; pi < prims.size(); ++pi)
+          triangles += estimated_triangles(prims[pi], fmt::format("/meshes/{}/primitives/{}", n.mesh, pi));
+      }
+      if (triangles > kMaxTriangles)
+        fail(fmt::format("/nodes/{}", ni), fmt::format("the scene expands to more than {} triangles; this is "
+                                                        "beyond what the renderer holds in memory", kMaxTriangles));
+      for (auto c = n.children.rbegin(); c != n.children.rend(); ++c) stack.push_back({*c, item.world});
+    }
+    for (const Item& item : order) visit(scene, item.node, item.world);
+  }
+
+  /// Triangles a primitive will produce; checks the byte range of the accessor it counts by.
+  uint64_t estimated_triangles(const tinygltf::Primitive& prim, const std::string& path) const {
+    int counted = prim.indices;
+    if (counted < 0)
+      if (auto it = prim.attributes.find("POSITION"); it != prim.attributes.end()) counted = it->second;
+    if (counted < 0) return 0;
+    const uint64_t n = view_of(counted, path).count;
+    return prim.mode == TINYGLTF_MODE_TRIANGLES ? n / 3 : n;
+  }
+
+  void visit(Scene& scene, int ni, const dmat4& world) {
+    const tinygltf::Node& n = m_.nodes[static_cast<size_t>(ni)];
+    const std::string npath = fmt::format("/nodes/{}", ni);
+    if (n.skin >= 0) warn("node-skin", "skinned nodes render in their bind pose");
+    if (n.mesh >= 0) convert_mesh(scene, ni, n.mesh, world);
+    if (n.camera >= 0) convert_camera(scene, ni, world);
+    auto ext = n.extensions.find("KHR_lights_punctual");
+    if (ext != n.extensions.end()) {
+      const int li = ext->second.Get("light").GetNumberAsInt();
+      convert_light(scene, li, world);
+    }
+  }
+
+  void convert_mesh(Scene& scene, int ni, int mi, const dmat4& world) {
+    const tinygltf::Mesh& gm = m_.meshes[static_cast<size_t>(mi)];
+    const dmat3 normal_matrix = glm::transpose(glm::inverse(dmat3(world)));
+    const bool flip = glm::determinant(dmat3(world)) < 0.0;
+    for (size_t pi = 0; pi < gm.primitives.size(); ++pi) {
+      const tinygltf::Primitive& prim = gm.primitives[pi];
+      const std::string ppath = fmt::format("/meshes/{}/primitives/{}", mi, pi);
+      if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+          prim.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+        static const char* names[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP"};
+        warn(fmt::format("mode{}", prim.mode), fmt::format("primitives of mode {} are skipped (only triangles render)",
+                                                         prim.mode >= 0 && prim.mode < 4 ? names[prim.mode] : "?"));
+        continue;
+      }
+      if (!prim.targets.empty()) warn("morph", "morph targets are ignored (base shape used)");
+      auto pos_it = prim.attributes.find("POSITION");
+      if (pos_it == prim.attributes.end()) fail(ppath + "/attributes", "primitive has no POSITION attribute");
+      Mesh mesh;
+      mesh.name = gm.name.empty() ? fmt::format("mesh{}", mi) : gm.name;
+      if (gm.primitives.size() > 1) mesh.name += fmt::format(".{}", pi);
+      mesh.node = ni;
+      mesh.material = prim.material;
+      const std::vector<float> pos = read_floats(pos_it->second, 3, ppath + "/attributes/POSITION");
+      const size_t nv = pos.size() / 3;
+      mesh.positions.resize(nv);
+      for (size_t v = 0; v < nv; ++v)
+        mesh.positions[v] = vec3(world * dvec4(pos[v * 3], pos[v * 3 + 1], pos[v * 3 + 2], 1.0));
+      if (auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
+        const std::vector<float> nrm = read_floats(it->second, 3, ppath + "/attributes/NORMAL");
+        if (nrm.size() != pos.size())
+          fail(ppath + "/attributes/NORMAL", fmt::format("has {} elements but POSITION has {}", nrm.size() / 3, nv));
+        mesh.normals.resize(nv);
+        for (size_t v = 0; v < nv; ++v) {
+          dvec3 nn = normal_matrix * dvec3(nrm[v * 3], nrm[v * 3 + 1], nrm[v * 3 + 2]);
+          const double len = glm::length(nn);
+          mesh.normals[v] = len > 0.0 ? vec3(nn / len) : vec3(0.0f, 1.0f, 0.0f);
+        }
+      }
+      const int tc = prim.material >= 0 ? scene.materials[static_cast<size_t>(prim.material)].texcoord : 0;
+      const std::string uv_name = fmt::format("TEXCOORD_{}", tc);
+      if (auto it = prim.attributes.find(uv_name); it != prim.attributes.end()) {
+        const std::vector<float> uv = read_floats(it->second, 2, ppath + "/attributes/" + uv_name);
+        if (uv.size() / 2 != nv)
+          fail(ppath + "/attributes/" + uv_name, fmt::format("has {} elements but POSITION has {}", uv.size() / 2, nv));
+        mesh.uvs.resize(nv);
+        for (size_t v = 0; v < nv; ++v) mesh.uvs[v] = vec2(uv[v * 2], uv[v * 2 + 1]);
+      } else if (prim.material >= 0 && scene.materials[static_cast<size_t>(prim.material)].base_color_texture >= 0) {
+        warn("missing-uv", "textured materials on primitives without texture coordinates (texture ignored there)");
+      }
+      std::vector<uint32_t> idx;
+      if (prim.indices >= 0) {
+        idx = read_indices(prim.indices, nv, ppath + "/indices");
+      } else {
+        idx.resize(nv);
+        for (size_t v = 0; v < nv; ++v) idx[v] = static_cast<uint32_t>(v);
+      }
+      mesh.indices = triangulate(idx, prim.mode, ppath);
+      if (flip)
+        for (size_t t = 0; t < mesh.indices.size(); t += 3) std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
+      if (!mesh.indices.empty()) scene.meshes.push_back(std::move(mesh));
+    }
+  }
+
+  std::vector<uint32_t> triangulate(const std::vector<uint32_t>& idx, int mode, const std::string& path) {
+    std::vector<uint32_t> out;
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+      if (idx.size() % 3 != 0)
+        fail(path, fmt::format("TRIANGLES primitive has {} indices, not a multiple of 3", idx.size()));
+      return idx;
+    }
+    if (idx.size() < 3) return out;
+    out.reserve((idx.size() - 2) * 3);
+    for (size_t i = 0; i + 2 < idx.size(); ++i) {
+      if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+        // Every other triangle of a strip is wound the other way round.
+        if (i % 2 == 0) out.insert(out.end(), {idx[i], idx[i + 1], idx[i + 2]});
+        else out.insert(out.end(), {idx[i + 1], idx[i], idx[i + 2]});
+      } else {
+        out.insert(out.end(), {idx[0], idx[i + 1], idx[i + 2]});
+      }
+    }
+    return out;
+  }
+
+  void convert_camera(Scene& scene, int ni, const dmat4& world) {
+    const tinygltf::Node& n = m_.nodes[static_cast<size_t>(ni)];
+    const tinygltf::Camera& gc = m_.cameras[static_cast<size_t>(n.camera)];
+    if (gc.type != "perspective") {
+      warn("ortho", "orthographic cameras are ignored");
+      return;
+    }
+    SceneCamera cam;
+    cam.name = n.name.empty() ? (gc.name.empty() ? fmt::format("camera{}", n.camera) : gc.name) : n.name;
+    cam.node = ni;
+    cam.world_from_camera = world;
+    cam.yfov = gc.perspective.yfov;
+    cam.aspect = gc.perspective.aspectRatio;
+    cam.znear = gc.perspective.znear;
+    cam.zfar = gc.perspective.zfar;
+    if (scene.cameras.empty()) {
+      const json& node_json = doc_.at("nodes").at(static_cast<size_t>(ni));
+      if (auto e = node_json.find("extras"); e != node_json.end() && e->is_object())
+        if (auto sbx = e->find("stereobench"); sbx != e->end()) {
+          if (sbx->contains("interaxial")) scene.rig.interaxial = sbx->at("interaxial").get<double>();
+          if (sbx->contains("convergence")) scene.rig.convergence = sbx->at("convergence").get<double>();
+          if (sbx->contains("width")) scene.rig.width = sbx->at("width").get<int>();
+          if (sbx->contains("height")) scene.rig.height = sbx->at("height").get<int>();
+        }
+    } else {
+      warn("cameras", "more than one camera: the first in node order is the default rig's pose");
+    }
+    scene.cameras.push_back(cam);
+  }
+
+  void convert_light(Scene& scene, int li, const dmat4& world) {
+    const json& lj = doc_.at("extensions").at("KHR_lights_punctual").at("lights").at(static_cast<size_t>(li));
+    Light l;
+    l.name = lj.value("name", fmt::format("light{}", li));
+    const std::string type = lj.at("type").get<std::string>();
+    l.type = type == "directional" ? Light::Type::directional : type == "spot" ? Light::Type::spot : Light::Type::point;
+    if (auto c = lj.find("color"); c != lj.end()) l.color = vec3((*c)[0].get<float>(), (*c)[1].get<float>(), (*c)[2].get<float>());
+    l.intensity = lj.value("intensity", 1.0f);
+    l.range = lj.value("range", 0.0f);
+    if (l.range > 0.0f) warn("range", "light 'range' (lights have no cutoff; inverse-square falloff is exact)");
+    if (l.type == Light::Type::spot) {
+      const json& s = lj.at("spot");
+      l.inner_cone = s.value("innerConeAngle", 0.0f);
+      l.outer_cone = s.value("outerConeAngle", 0.78539816f);
+    }
+    l.position = vec3(world[3]);
+    const dvec3 d = dvec3(world * dvec4(0.0, 0.0, -1.0, 0.0));
+    l.direction = glm::length(d) > 0.0 ? vec3(glm::normalize(d)) : vec3(0.0f, 0.0f, -1.0f);
+    scene.lights.push_back(l);
+  }
+
+  void read_scene_extras(Scene& scene) {
+    auto scenes = doc_.find("scenes");
+    if (scenes == doc_.end() || scenes->empty()) return;
+    const size_t si = m_.defaultScene >= 0 ? static_cast<size_t>(m_.defaultScene) : 0;
+    const json& s = (*scenes)[si];
+    if (auto n = s.find("name"); n != s.end() && n->is_string()) scene.name = n->get<std::string>();
+    auto e = s.find("extras");
+    if (e == s.end() || !e->is_object()) return;
+    auto sbx = e->find("stereobench");
+    if (sbx == e->end()) return;
+    if (auto b = sbx->find("background"); b != sbx->end())
+      scene.background = vec3((*b)[0].get<float>(), (*b)[1].get<float>(), (*b)[2].get<float>());
+    if (auto a = sbx->find("ambient"); a != sbx->end()) scene.ambient = a->get<float>();
+  }
+
+  const tinygltf::Model& m_;
+  const json& doc_;
+  std::string file_;
+  GltfLoadOptions options_;
+  std::map<std::string, int> warning_counts_;
+  std::map<std::string, std::string> warning_text_;
+};
+
+}  // namespace
+
+Scene load_gltf(const fs::path& path, const GltfLoadOptions& options) {
+  const std::string file = path.string();
+  std::error_code ec;
+  if (!fs::exists(path, ec))
+    throw InputError(fmt::format("{}: scene file does not exist; check the path, or run "
+                                 "`stereobench scenes list` for the built-in scenes", file));
+  if (!fs::is_regular_file(path, ec))
+    throw InputError(fmt::format("{}: not a regular file; give a .gltf or .glb file", file));
+  std::string bytes;
+  try {
+    bytes = read_file(path);
+  } catch (const IoError& e) {
+    throw InputError(e.what());
+  }
+  if (bytes.empty()) throw InputError(fmt::format("{}: the file is empty; give a .gltf or .glb file", file));
+  const GlbParts parts = split_container(bytes, file);
+  json doc;
+  try {
+    doc = json::parse(parts.json_text);
+  } catch (const json::parse_error& e) {
+    throw InputError(fmt::format("{}: not valid JSON at byte {}: {}", file, e.byte, e.what()));
+  }
+  check_gltf_json(doc, file);
+  const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  check_external_files(doc, dir, file);
+
+  tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(keep_image_bytes, nullptr);
+  tinygltf::Model model;
+  std::string err, warn;
+  const bool ok = parts.is_glb
+      ? loader.LoadBinaryFromMemory(&model, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),
+                                    static_cast<unsigned int>(bytes.size()), dir.string())
+      : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), static_cast<unsigned int>(bytes.size()),
+                                   dir.string());
+  if (!ok || !err.empty()) {
+    while (!err.empty() && (err.back() == '\n' || err.back() == '\r')) err.pop_back();
+    throw InputError(fmt::format("{}: cannot load: {}", file, err.empty() ? "unknown error" : err));
+  }
+  for (size_t i = 0; i < model.buffers.size(); ++i)
+    if (model.buffers[i].data.size() < static_cast<size_t>(doc["buffers"][i]["byteLength"].get<uint64_t>()))
+      throw InputError(fmt::format("{}: /buffers/{}: holds {} bytes but byteLength says {}; the buffer is truncated",
+                                   file, i, model.buffers[i].data.size(), doc["buffers"][i]["byteLength"].get<uint64_t>()));
+  Scene scene = Converter(model, doc, file, options).run();
+  if (scene.name.empty()) scene.name = path.stem().string();
+  return scene;
+}
+
+}  // namespace sb::io

@@ -1,0 +1,25 @@
+// Resolves a scene argument — a file path or the name of a built-in scene — to a glTF file,
+// generating built-in scenes on first use into a cache folder.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "scenes/generators.hpp"
+
+namespace sb::scenes {
+
+/// The folder built-in scenes are generated into: $STEREOBENCH_SCENES if set, else out/scenes.
+[[nodiscard]] std::filesystem::path default_scenes_dir();
+
+/// A path to an existing .gltf/.glb file is returned as is. A built-in scene name returns
+/// `<scenes_dir>/<file>`, generated (with default seed and parameters) when missing or written by
+/// another version of the generator. Anything else is an InputError listing the built-in names.
+[[nodiscard]] std::filesystem::path resolve_scene(const std::string& spec,
+                                                  const std::filesystem::path& scenes_dir);
+
+/// Generates a built-in scene with its default seed and parameters into `scenes_dir` and stamps it,
+/// so that resolve_scene() reuses it until the generator's version changes.
+GenerateResult generate_builtin(const std::string& name, const std::filesystem::path& scenes_dir);
+
+}  // namespace sb::scenes

@@ -1,0 +1,207 @@
+// The corpus of broken scene files: each must fail with InputError (exit code 3 from the CLI) and a
+// message naming the file and the JSON pointer of the fault — never a crash.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <functional>
+
+#include "renderer/error.hpp"
+#include "renderer/io/gltf_loader.hpp"
+#include "support/mini_gltf.hpp"
+
+namespace sb {
+namespace {
+
+using nlohmann::json;
+using test::MiniGltf;
+using test::TempDir;
+
+struct BadCase {
+  std::string name;
+  std::string file;                                  ///< file name written into the temp folder
+  std::function<void(const std::filesystem::path&)> make;  ///< writes the broken file
+  std::string expect;                                ///< substring of the message (JSON pointer etc.)
+};
+
+/// A valid one-triangle scene with `edit` applied to its JSON before writing.
+std::function<void(const std::filesystem::path&)> edited(std::function<void(MiniGltf&)> edit,
+                                                           int form = 0) {
+  return [edit, form](const std::filesystem::path& p) {
+    MiniGltf g;
+    g.add_triangle();
+    edit(g);
+    if (form == 0) g.write_gltf(p);
+    if (form == 1) g.write_gltf_embedded(p);
+    if (form == 2) g.write_glb(p);
+  };
+}
+
+void write_text(const std::filesystem::path& p, const std::string& s) { MiniGltf::write_text(p, s); }
+
+std::vector<BadCase> corpus() {
+  std::vector<BadCase> c;
+  c.push_back({"not_json", "a.gltf", [](auto& p) { write_text(p, "{ \"asset\": { \"version\": \"2.0\" "); }, "not valid JSON"});
+  c.push_back({"empty_file", "a.gltf", [](auto& p) { write_text(p, ""); }, "empty"});
+  c.push_back({"top_level_array", "a.gltf", [](auto& p) { write_text(p, "[1,2,3]"); }, "expected a JSON object"});
+  c.push_back({"no_asset", "a.gltf", [](auto& p) { write_text(p, "{}"); }, "/asset: required property is missing"});
+  c.push_back({"version_1", "a.gltf", [](auto& p) { write_text(p, R"({"asset":{"version":"1.0"}})"); }, "/asset/version"});
+  c.push_back({"empty_scene", "a.gltf", [](auto& p) { write_text(p, R"({"asset":{"version":"2.0"}})"); }, "no triangles"});
+  c.push_back({"empty_node_list", "a.gltf", [](auto& p) { write_text(p, R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[]}],"scene":0})"); }, "no triangles"});
+  c.push_back({"count_is_string", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["count"] = "three"; }), "/accessors/0/count: must be an integer"});
+  c.push_back({"count_is_float", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["count"] = 3.5; }), "/accessors/0/count"});
+  c.push_back({"count_negative", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["count"] = -3; }), "/accessors/0/count"});
+  c.push_back({"mesh_is_string", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["mesh"] = "tri"; }), "/nodes/0/mesh"});
+  c.push_back({"translation_wrong_length", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["translation"] = {1, 2}; }), "/nodes/0/translation: must have 3 elements"});
+  c.push_back({"matrix_has_string", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["matrix"] = json::array({1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, "x", 0, 1}); }), "/nodes/0/matrix/13"});
+  c.push_back({"primitives_not_array", "a.gltf", edited([](MiniGltf& g) { g.doc["meshes"][0]["primitives"] = json::object(); }), "/meshes/0/primitives: expected a JSON array"});
+  c.push_back({"attributes_missing", "a.gltf", edited([](MiniGltf& g) { g.doc["meshes"][0]["primitives"][0].erase("attributes"); }), "/meshes/0/primitives/0/attributes: required"});
+  c.push_back({"no_position", "a.gltf", edited([](MiniGltf& g) { g.doc["meshes"][0]["primitives"][0]["attributes"] = json::object(); }), "/meshes/0/primitives/0/attributes: primitive has no POSITION"});
+  c.push_back({"node_mesh_out_of_range", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["mesh"] = 7; }), "/nodes/0/mesh: refers to meshes[7]"});
+  c.push_back({"scene_node_out_of_range", "a.gltf", edited([](MiniGltf& g) { g.doc["scenes"][0]["nodes"] = {4}; }), "/scenes/0/nodes/0: refers to nodes[4]"});
+  c.push_back({"attribute_accessor_out_of_range", "a.gltf", edited([](MiniGltf& g) { g.doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = 9; }), "/meshes/0/primitives/0/attributes/POSITION: refers to accessors[9]"});
+  c.push_back({"material_out_of_range", "a.gltf", edited([](MiniGltf& g) { g.doc["meshes"][0]["primitives"][0]["material"] = 0; }), "/meshes/0/primitives/0/material: refers to materials[0]"});
+  c.push_back({"buffer_view_out_of_range", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["bufferView"] = 3; }), "/accessors/0/bufferView"});
+  c.push_back({"accessor_past_view", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["count"] = 4; }), "/accessors/0: 4 elements"});
+  c.push_back({"absurd_count", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["count"] = 9007199254740992ull; }), "/accessors/0"});
+  c.push_back({"count_beyond_2p53", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["count"] = 18446744073709551615ull; }), "/accessors/0/count: value"});
+  c.push_back({"accessor_offset_past_view", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["byteOffset"] = 4; }), "/accessors/0"});
+  c.push_back({"view_past_buffer", "a.gltf", edited([](MiniGltf& g) { g.doc["bufferViews"][0]["byteLength"] = 4096; }), "/bufferViews/0"});
+  c.push_back({"stride_too_small", "a.gltf", edited([](MiniGltf& g) { g.doc["bufferViews"][0]["byteStride"] = 8; }), "/bufferViews/0/byteStride"});
+  c.push_back({"stride_out_of_range", "a.gltf", edited([](MiniGltf& g) { g.doc["bufferViews"][0]["byteStride"] = 2; }), "/bufferViews/0/byteStride: value 2 is out of range"});
+  c.push_back({"bad_component_type", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["componentType"] = 5124; }), "/accessors/0/componentType"});
+  c.push_back({"bad_accessor_type", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["type"] = "VEC5"; }), "/accessors/0/type"});
+  c.push_back({"position_wrong_type", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["type"] = "VEC2"; }), "/meshes/0/primitives/0/attributes/POSITION: accessor 0 has type VEC2"});
+  c.push_back({"index_value_out_of_range", "a.gltf", edited([](MiniGltf& g) {
+    std::vector<uint16_t> idx = {0, 1, 7, 0};
+    const int a = g.add_accessor(g.add_view(idx), 5123, 3, "SCALAR");
+    g.doc["meshes"][0]["primitives"][0]["indices"] = a;
+  }), "index value 7 at element 2 is out of range"});
+  c.push_back({"float_indices", "a.gltf", edited([](MiniGltf& g) {
+    std::vector<float> idx = {0, 1, 2};
+    const int a = g.add_accessor(g.add_view(idx), 5126, 3, "SCALAR");
+    g.doc["meshes"][0]["primitives"][0]["indices"] = a;
+  }), "/meshes/0/primitives/0/indices: index accessor 1 has component type 5126"});
+  c.push_back({"triangle_count_not_multiple", "a.gltf", edited([](MiniGltf& g) {
+    std::vector<uint16_t> idx = {0, 1, 2, 0};
+    const int a = g.add_accessor(g.add_view(idx), 5123, 4, "SCALAR");
+    g.doc["meshes"][0]["primitives"][0]["indices"] = a;
+  }), "not a multiple of 3"});
+  c.push_back({"nan_position", "a.gltf", edited([](MiniGltf& g) {
+    float nan = std::nanf("");
+    std::memcpy(g.bin.data() + 4, &nan, 4);
+  }), "non-finite"});
+  c.push_back({"node_cycle", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["children"] = {0}; }), "/nodes/0: node is reached twice"});
+  c.push_back({"missing_bin", "a.gltf", [](const std::filesystem::path& p) {
+    MiniGltf g;
+    g.add_triangle();
+    g.write_gltf(p);
+    std::filesystem::remove(p.parent_path() / "a.bin");
+  }, "/buffers/0/uri: referenced file"});
+  c.push_back({"truncated_bin", "a.gltf", [](const std::filesystem::path& p) {
+    MiniGltf g;
+    g.add_triangle();
+    g.write_gltf(p);
+    std::filesystem::resize_file(p.parent_path() / "a.bin", 10);
+  }, "/buffers/0/uri: '"});
+  c.push_back({"buffer_length_is_string", "a.gltf", edited([](MiniGltf& g) { g.doc["buffers"] = json::array({{{"byteLength", "36"}}}); }, 2), "/buffers/0/byteLength"});
+  c.push_back({"base64_too_short", "a.gltf", [](const std::filesystem::path& p) {
+    MiniGltf g;
+    g.add_triangle();
+    g.finish_buffer("data:application/octet-stream;base64," + MiniGltf::base64(std::vector<unsigned char>(12, 0)));
+    MiniGltf::write_text(p, g.doc.dump());
+  }, "/buffers/0"});
+  c.push_back({"truncated_glb", "a.glb", [](const std::filesystem::path& p) {
+    MiniGltf g;
+    g.add_triangle();
+    g.write_glb(p);
+    std::filesystem::resize_file(p, std::filesystem::file_size(p) - 16);
+  }, "truncated"});
+  c.push_back({"glb_header_only", "a.glb", [](auto& p) { write_text(p, std::string("glTF\x02\0\0\0", 8)); }, "truncated .glb"});
+  c.push_back({"glb_json_chunk_past_end", "a.glb", [](const std::filesystem::path& p) {
+    MiniGltf g;
+    g.add_triangle();
+    g.write_glb(p);
+    std::string bytes = MiniGltf::base64({});  // unused; read and patch the JSON length
+    std::ifstream in(p, std::ios::binary);
+    std::vector<unsigned char> data((std::istreambuf_iterator<char>(in)), {});
+    data[12] = 0xFF; data[13] = 0xFF; data[14] = 0x00; data[15] = 0x00;
+    MiniGltf::write_bytes(p, data);
+  }, "JSON chunk"});
+  c.push_back({"required_extension", "a.gltf", edited([](MiniGltf& g) { g.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"}; }), "/extensionsRequired/0: extension 'KHR_draco_mesh_compression'"});
+  c.push_back({"light_reference_out_of_range", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["extensions"]["KHR_lights_punctual"]["light"] = 2; }), "/nodes/0/extensions/KHR_lights_punctual/light: refers to lights[2]"});
+  c.push_back({"light_bad_type", "a.gltf", edited([](MiniGltf& g) { g.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array({{{"type", "area"}}}); }), "/extensions/KHR_lights_punctual/lights/0/type"});
+  c.push_back({"light_negative_intensity", "a.gltf", edited([](MiniGltf& g) { g.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array({{{"type", "point"}, {"intensity", -1}}}); }), "/extensions/KHR_lights_punctual/lights/0/intensity"});
+  c.push_back({"camera_zero_fov", "a.gltf", edited([](MiniGltf& g) { g.doc["cameras"] = json::array({{{"type", "perspective"}, {"perspective", {{"yfov", 0}, {"znear", 0.1}}}}}); }), "/cameras/0/perspective/yfov"});
+  c.push_back({"rig_extras_wrong_type", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["extras"]["stereobench"]["interaxial"] = "wide"; }), "/nodes/0/extras/stereobench/interaxial"});
+  c.push_back({"texture_out_of_range", "a.gltf", edited([](MiniGltf& g) { g.doc["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 3}}}}}}}); }), "/materials/0/pbrMetallicRoughness/baseColorTexture/index: refers to textures[3]"});
+  c.push_back({"corrupt_image", "a.gltf", edited([](MiniGltf& g) {
+    std::vector<unsigned char> junk(64, 0x42);
+    g.doc["images"] = json::array({{{"bufferView", g.add_view(junk.data(), junk.size())}, {"mimeType", "image/png"}}});
+    g.doc["textures"] = json::array({{{"source", 0}}});
+    g.doc["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}});
+    g.doc["meshes"][0]["primitives"][0]["material"] = 0;
+  }), "/images/0: cannot decode"});
+  c.push_back({"missing_image_file", "a.gltf", edited([](MiniGltf& g) { g.doc["images"] = json::array({{{"uri", "nope.png"}}}); }), "/images/0/uri: referenced file"});
+  return c;
+}
+
+/// Runs the CLI on a scene and returns (exit code, stderr).
+std::pair<int, std::string> run_cli(const std::filesystem::path& scene) {
+  const std::string cmd = std::string(SB_CLI_PATH) + " scenes info '" + scene.string() + "' 2>&1 >/dev/null";
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 512> buf{};
+  while (pipe && std::fgets(buf.data(), buf.size(), pipe)) out += buf.data();
+  const int status = pipe ? ::pclose(pipe) : -1;
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+TEST(BadScenes, EveryCaseIsAClearInputError) {
+  TempDir dir("bad");
+  for (const BadCase& bc : corpus()) {
+    SCOPED_TRACE(bc.name);
+    const auto folder = dir / bc.name;
+    std::filesystem::create_directories(folder);
+    const auto path = folder / bc.file;
+    bc.make(path);
+    try {
+      (void)io::load_gltf(path);
+      ADD_FAILURE() << bc.name << ": loaded without error";
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find(path.string()), std::string::npos) << "message does not name the file: " << msg;
+      EXPECT_NE(msg.find(bc.expect), std::string::npos) << "expected '" << bc.expect << "' in: " << msg;
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << bc.name << ": wrong exception type: " << e.what();
+    }
+  }
+}
+
+TEST(BadScenes, CommandLineExitsWithCode3AndNamesTheFault) {
+  TempDir dir("badcli");
+  for (const BadCase& bc : corpus()) {
+    SCOPED_TRACE(bc.name);
+    const auto folder = dir / bc.name;
+    std::filesystem::create_directories(folder);
+    const auto path = folder / bc.file;
+    bc.make(path);
+    const auto [code, err] = run_cli(path);
+    EXPECT_EQ(code, 3) << err;
+    EXPECT_NE(err.find(bc.expect), std::string::npos) << err;
+  }
+}
+
+TEST(BadScenes, NonExistentPathAndDirectory) {
+  TempDir dir("nopath");
+  EXPECT_THROW((void)io::load_gltf(dir / "missing.gltf"), InputError);
+  EXPECT_THROW((void)io::load_gltf(dir.path()), InputError);
+  const auto [code, err] = run_cli(dir / "missing.gltf");
+  EXPECT_EQ(code, 3);
+  EXPECT_NE(err.find("does not exist"), std::string::npos) << err;
+}
+
+}  // namespace
+}  // namespace sb

@@ -1,0 +1,275 @@
+// glTF loading of well-formed files: hierarchy, every accessor layout, strips and fans, the three
+// container forms, materials and textures, lights, cameras and the stereo-rig extras.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "renderer/color.hpp"
+#include "renderer/io/gltf_loader.hpp"
+#include "renderer/io/image_io.hpp"
+#include "renderer/rig.hpp"
+#include "support/mini_gltf.hpp"
+
+namespace sb {
+namespace {
+
+using nlohmann::json;
+using test::MiniGltf;
+using test::TempDir;
+
+void expect_vec3(const vec3& a, const vec3& b, float tol = 1e-5f) {
+  EXPECT_NEAR(a.x, b.x, tol);
+  EXPECT_NEAR(a.y, b.y, tol);
+  EXPECT_NEAR(a.z, b.z, tol);
+}
+
+TEST(GltfLoader, NodeHierarchyComposesTransforms) {
+  TempDir dir("hier");
+  MiniGltf g;
+  const int p = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  const int m = g.add_mesh(json::array({{{"attributes", {{"POSITION", p}}}}}));
+  // Child: rotate 90 degrees about Z, scale 2; parent: translate (10, 0, 0).
+  const double s = std::sqrt(0.5);
+  const int child = g.add_node({{"mesh", m}, {"rotation", {0, 0, s, s}}, {"scale", {2, 2, 2}}}, false);
+  g.add_node({{"translation", {10, 0, 0}}, {"children", {child}}});
+  g.write_gltf(dir / "h.gltf");
+  const Scene scene = io::load_gltf(dir / "h.gltf");
+  ASSERT_EQ(scene.meshes.size(), 1u);
+  const Mesh& mesh = scene.meshes[0];
+  expect_vec3(mesh.positions[0], {10, 0, 0});
+  expect_vec3(mesh.positions[1], {10, 2, 0});   // x axis rotated onto y, scaled by 2
+  expect_vec3(mesh.positions[2], {8, 0, 0});    // y axis rotated onto -x
+  EXPECT_EQ(mesh.node, child);
+}
+
+TEST(GltfLoader, MatrixTransformAndNegativeScaleKeepsFacing) {
+  TempDir dir("mat");
+  MiniGltf g;
+  const int p = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  const int m = g.add_mesh(json::array({{{"attributes", {{"POSITION", p}}}}}));
+  g.add_node({{"mesh", m}, {"matrix", {-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 5, 6, 7, 1}}});
+  g.write_gltf(dir / "m.gltf");
+  const Scene scene = io::load_gltf(dir / "m.gltf");
+  const Mesh& mesh = scene.meshes[0];
+  expect_vec3(mesh.positions[1], {4, 6, 7});
+  // Mirroring flips the winding so the geometric normal still faces +Z.
+  const vec3 a = mesh.positions[mesh.indices[0]], b = mesh.positions[mesh.indices[1]], c = mesh.positions[mesh.indices[2]];
+  EXPECT_GT(glm::cross(b - a, c - a).z, 0.0f);
+}
+
+TEST(GltfLoader, EveryComponentTypeStrideAndNormalisation) {
+  TempDir dir("acc");
+  MiniGltf g;
+  // Interleaved position (3 floats) + normal (3 normalized bytes + 1 pad) with stride 16.
+  struct V { float p[3]; int8_t n[4]; };
+  std::vector<V> verts = {{{0, 0, 0}, {0, 0, 127, 0}}, {{1, 0, 0}, {0, 0, 127, 0}}, {{0, 1, 0}, {0, -128, 0, 0}}};
+  const int view = g.add_view(verts.data(), verts.size() * sizeof(V), sizeof(V));
+  const int pos = g.add_accessor(view, 5126, 3, "VEC3");
+  g.doc["accessors"][pos]["min"] = {0, 0, 0};
+  g.doc["accessors"][pos]["max"] = {1, 1, 0};
+  const int nrm = g.add_accessor(view, 5120, 3, "VEC3", 12, true);
+  // UVs as normalized unsigned shorts, then as normalized unsigned bytes.
+  std::vector<uint16_t> uv16 = {0, 0, 65535, 0, 0, 32768};
+  const int uv_a = g.add_accessor(g.add_view(uv16), 5123, 3, "VEC2", 0, true);
+  std::vector<uint8_t> uv8 = {0, 0, 255, 0, 0, 51, 0, 0};
+  const int uv_b = g.add_accessor(g.add_view(uv8), 5121, 3, "VEC2", 0, true);
+  std::vector<uint8_t> i8 = {0, 1, 2, 0};
+  std::vector<uint16_t> i16 = {2, 1, 0, 0};
+  std::vector<uint32_t> i32 = {0, 2, 1};
+  const int ia = g.add_accessor(g.add_view(i8), 5121, 3, "SCALAR");
+  const int ib = g.add_accessor(g.add_view(i16), 5123, 3, "SCALAR");
+  const int ic = g.add_accessor(g.add_view(i32), 5125, 3, "SCALAR");
+  g.doc["materials"] = json::array({{{"name", "uv1"}, {"pbrMetallicRoughness", {{"baseColorFactor", {1, 1, 1, 1}}}}}});
+  const int m = g.add_mesh(json::array({
+      {{"attributes", {{"POSITION", pos}, {"NORMAL", nrm}, {"TEXCOORD_0", uv_a}}}, {"indices", ia}},
+      {{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv_b}}}, {"indices", ib}},
+      {{"attributes", {{"POSITION", pos}}}, {"indices", ic}, {"material", 0}},
+  }));
+  g.add_node({{"mesh", m}});
+  g.write_gltf(dir / "a.gltf");
+  const Scene scene = io::load_gltf(dir / "a.gltf");
+  ASSERT_EQ(scene.meshes.size(), 3u);
+  const Mesh& a = scene.meshes[0];
+  ASSERT_EQ(a.normals.size(), 3u);
+  expect_vec3(a.normals[0], {0, 0, 1});
+  expect_vec3(a.normals[2], {0, -1, 0});  // -128 clamps to -1
+  ASSERT_EQ(a.uvs.size(), 3u);
+  EXPECT_NEAR(a.uvs[1].x, 1.0f, 1e-6f);
+  EXPECT_NEAR(a.uvs[2].y, 32768.0f / 65535.0f, 1e-6f);
+  EXPECT_EQ(a.indices, (std::vector<uint32_t>{0, 1, 2}));
+  EXPECT_NEAR(scene.meshes[1].uvs[2].y, 0.2f, 1e-6f);
+  EXPECT_EQ(scene.meshes[1].indices, (std::vector<uint32_t>{2, 1, 0}));
+  EXPECT_EQ(scene.meshes[2].indices, (std::vector<uint32_t>{0, 2, 1}));
+  EXPECT_EQ(scene.meshes[2].material, 0);
+}
+
+TEST(GltfLoader, SparseAccessorAndAccessorWithoutView) {
+  TempDir dir("sparse");
+  MiniGltf g;
+  std::vector<float> base = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  const int pos = g.add_positions(base);
+  std::vector<uint16_t> sidx = {1, 0};
+  std::vector<float> sval = {5, 5, 5};
+  const int iv = g.add_view(sidx);
+  const int vv = g.add_view(sval);
+  g.doc["accessors"][pos]["sparse"] = {{"count", 1}, {"indices", {{"bufferView", iv}, {"componentType", 5123}}},
+                                       {"values", {{"bufferView", vv}}}};
+  g.doc["accessors"][pos]["max"] = {5, 5, 5};
+  const int m = g.add_mesh(json::array({{{"attributes", {{"POSITION", pos}}}}}));
+  g.add_node({{"mesh", m}});
+  g.write_gltf(dir / "s.gltf");
+  const Scene scene = io::load_gltf(dir / "s.gltf");
+  expect_vec3(scene.meshes[0].positions[1], {5, 5, 5});
+  expect_vec3(scene.meshes[0].positions[2], {0, 1, 0});
+}
+
+TEST(GltfLoader, StripsAndFansAreTriangulated) {
+  TempDir dir("strip");
+  MiniGltf g;
+  const int pos = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 2, 0, 0});
+  std::vector<uint16_t> idx = {0, 1, 2, 3, 4};
+  const int ia = g.add_accessor(g.add_view(idx), 5123, 5, "SCALAR");
+  const int m = g.add_mesh(json::array({{{"attributes", {{"POSITION", pos}}}, {"indices", ia}, {"mode", 5}},
+                                        {{"attributes", {{"POSITION", pos}}}, {"mode", 6}}}));
+  g.add_node({{"mesh", m}});
+  g.write_gltf(dir / "st.gltf");
+  const Scene scene = io::load_gltf(dir / "st.gltf");
+  ASSERT_EQ(scene.meshes.size(), 2u);
+  EXPECT_EQ(scene.meshes[0].indices, (std::vector<uint32_t>{0, 1, 2, 2, 1, 3, 2, 3, 4}));
+  EXPECT_EQ(scene.meshes[1].indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 0, 3, 4}));
+  EXPECT_EQ(scene.triangle_count(), 6u);
+}
+
+TEST(GltfLoader, ExternalEmbeddedAndBinaryContainersAgree) {
+  TempDir dir("forms");
+  std::vector<Scene> scenes;
+  for (int form = 0; form < 3; ++form) {
+    MiniGltf g;
+    g.add_triangle();
+    const auto path = dir / ("f" + std::to_string(form) + (form == 2 ? ".glb" : ".gltf"));
+    if (form == 0) g.write_gltf(path);
+    if (form == 1) g.write_gltf_embedded(path);
+    if (form == 2) g.write_glb(path);
+    scenes.push_back(io::load_gltf(path));
+  }
+  for (const Scene& s : scenes) {
+    ASSERT_EQ(s.meshes.size(), 1u);
+    EXPECT_EQ(s.meshes[0].positions, scenes[0].meshes[0].positions);
+    EXPECT_EQ(s.meshes[0].indices, scenes[0].meshes[0].indices);
+  }
+}
+
+TEST(GltfLoader, BaseColourFactorAndEmbeddedTextureAreLinear) {
+  TempDir dir("tex");
+  MiniGltf g;
+  const int pos = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  std::vector<float> uv = {0, 0, 1, 0, 0, 1};
+  const int uva = g.add_accessor(g.add_view(uv), 5126, 3, "VEC2");
+  // 2x1 sRGB texture: code 128 grey and pure red.
+  const uint8_t px[] = {128, 128, 128, 255, 255, 0, 0, 255};
+  const std::vector<unsigned char> png = io::encode_png(px, 2, 1, 4);
+  const int iv = g.add_view(png.data(), png.size());
+  g.doc["images"] = json::array({{{"bufferView", iv}, {"mimeType", "image/png"}}});
+  g.doc["samplers"] = json::array({{{"wrapS", 33071}, {"wrapT", 10497}}});
+  g.doc["textures"] = json::array({{{"source", 0}, {"sampler", 0}}});
+  g.doc["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.25, 1, 1}},
+                                                                {"baseColorTexture", {{"index", 0}}}}},
+                                     {"doubleSided", true}}});
+  const int m = g.add_mesh(json::array({{{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uva}}}, {"material", 0}}}));
+  g.add_node({{"mesh", m}});
+  g.write_glb(dir / "t.glb");
+  const Scene scene = io::load_gltf(dir / "t.glb");
+  ASSERT_EQ(scene.materials.size(), 1u);
+  const Material& mat = scene.materials[0];
+  EXPECT_EQ(mat.base_color, vec4(0.5f, 0.25f, 1.0f, 1.0f));
+  EXPECT_TRUE(mat.double_sided);
+  ASSERT_EQ(mat.base_color_texture, 0);
+  const Texture& t = scene.textures[0];
+  ASSERT_EQ(t.width, 2);
+  ASSERT_EQ(t.height, 1);
+  EXPECT_NEAR(t.rgba[0], srgb8_to_linear(128), 1e-6f);
+  EXPECT_NEAR(t.rgba[4], 1.0f, 1e-6f);
+  EXPECT_NEAR(t.rgba[5], 0.0f, 1e-6f);
+  EXPECT_FALSE(t.repeat_s);
+  EXPECT_TRUE(t.repeat_t);
+  ASSERT_EQ(scene.meshes[0].uvs.size(), 3u);
+}
+
+TEST(GltfLoader, PunctualLightsCameraAndRigExtras) {
+  TempDir dir("lights");
+  MiniGltf g;
+  g.add_triangle();
+  g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+  g.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array({
+      {{"type", "point"}, {"color", {1, 0.5, 0.25}}, {"intensity", 20}},
+      {{"type", "directional"}, {"intensity", 3}},
+      {{"type", "spot"}, {"spot", {{"innerConeAngle", 0.1}, {"outerConeAngle", 0.5}}}},
+  });
+  g.add_node({{"translation", {1, 2, 3}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  // Directional light rotated to point down -Y (90 degrees about +X turns -Z into -Y).
+  const double s = std::sqrt(0.5);
+  g.add_node({{"rotation", {-s, 0, 0, s}}, {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}});
+  g.add_node({{"extensions", {{"KHR_lights_punctual", {{"light", 2}}}}}});
+  g.doc["cameras"] = json::array({{{"type", "perspective"},
+                                   {"perspective", {{"yfov", 0.5}, {"znear", 0.1}, {"zfar", 100}, {"aspectRatio", 2.0}}}}});
+  g.add_node({{"name", "cam"}, {"camera", 0}, {"translation", {0, 0, 5}},
+              {"extras", {{"stereobench", {{"interaxial", 0.07}, {"convergence", 3.0}, {"width", 640}, {"height", 320}}}}}});
+  g.doc["scenes"][0]["extras"] = {{"stereobench", {{"background", {0.1, 0.2, 0.3}}, {"ambient", 0.05}}}};
+  g.write_gltf(dir / "l.gltf");
+  const Scene scene = io::load_gltf(dir / "l.gltf");
+  ASSERT_EQ(scene.lights.size(), 3u);
+  EXPECT_EQ(scene.lights[0].type, Light::Type::point);
+  expect_vec3(scene.lights[0].position, {1, 2, 3});
+  expect_vec3(scene.lights[0].color, {1, 0.5f, 0.25f});
+  EXPECT_FLOAT_EQ(scene.lights[0].intensity, 20.0f);
+  EXPECT_EQ(scene.lights[1].type, Light::Type::directional);
+  expect_vec3(scene.lights[1].direction, {0, -1, 0});
+  EXPECT_EQ(scene.lights[2].type, Light::Type::spot);
+  EXPECT_FLOAT_EQ(scene.lights[2].outer_cone, 0.5f);
+  ASSERT_EQ(scene.cameras.size(), 1u);
+  EXPECT_EQ(scene.cameras[0].name, "cam");
+  EXPECT_DOUBLE_EQ(scene.cameras[0].yfov, 0.5);
+  EXPECT_EQ(scene.rig.width, 640);
+  EXPECT_EQ(scene.rig.height, 320);
+  EXPECT_DOUBLE_EQ(*scene.rig.interaxial, 0.07);
+  expect_vec3(scene.background, {0.1f, 0.2f, 0.3f});
+  EXPECT_FLOAT_EQ(scene.ambient, 0.05f);
+  const StereoRig rig = resolve_rig(scene, {});
+  EXPECT_EQ(rig.params().width, 640);
+  EXPECT_DOUBLE_EQ(rig.params().convergence, 3.0);
+  EXPECT_DOUBLE_EQ(rig.pose().position.z, 5.0);
+}
+
+TEST(GltfLoader, UnsupportedFeaturesAreNamedOnce) {
+  TempDir dir("unsup");
+  MiniGltf g;
+  const int pos = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  g.doc["materials"] = json::array({{{"normalTexture", {{"index", 0}}}}, {{"normalTexture", {{"index", 0}}}}});
+  const uint8_t px[] = {255, 255, 255, 255};
+  const std::vector<unsigned char> png = io::encode_png(px, 1, 1, 4);
+  g.doc["images"] = json::array({{{"bufferView", g.add_view(png.data(), png.size())}, {"mimeType", "image/png"}}});
+  g.doc["textures"] = json::array({{{"source", 0}}});
+  const int m = g.add_mesh(json::array({{{"attributes", {{"POSITION", pos}}}, {"material", 0}},
+                                        {{"attributes", {{"POSITION", pos}}}, {"material", 1}},
+                                        {{"attributes", {{"POSITION", pos}}}, {"mode", 1}}}));
+  g.add_node({{"mesh", m}});
+  g.doc["extensionsUsed"] = {"KHR_materials_unlit"};
+  g.write_gltf(dir / "u.gltf");
+  const Scene scene = io::load_gltf(dir / "u.gltf");
+  EXPECT_EQ(scene.meshes.size(), 2u);
+  int normal_warnings = 0, line_warnings = 0, ext_warnings = 0;
+  for (const std::string& w : scene.warnings) {
+    normal_warnings += w.find("normal textures") != std::string::npos;
+    line_warnings += w.find("LINES") != std::string::npos;
+    ext_warnings += w.find("KHR_materials_unlit") != std::string::npos;
+  }
+  EXPECT_EQ(normal_warnings, 1);
+  EXPECT_EQ(line_warnings, 1);
+  EXPECT_EQ(ext_warnings, 1);
+  bool counted = false;
+  for (const std::string& w : scene.warnings) counted |= w.find("normal textures") != std::string::npos && w.find("2 occurrences") != std::string::npos;
+  EXPECT_TRUE(counted);
+}
+
+}  // namespace
+}  // namespace sb
