@@ -138,7 +138,11 @@ void print_info(const InfoArgs& args) {
 
 void register_scenes_command(CLI::App& root) {
   CLI::App* scenes = root.add_subcommand("scenes", "List, generate and describe scenes");
-  scenes->require_subcommand(1);
+  scenes->require_subcommand(0, 1);
+  scenes->callback([scenes] {
+    if (scenes->get_subcommands().empty())
+      throw InputError("`stereobench scenes` needs a subcommand: list, generate or info (see --help)");
+  });
 
   CLI::App* list = scenes->add_subcommand("list", "List the built-in scene generators and their parameters");
   list->callback([] { list_generators(); });

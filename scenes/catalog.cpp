@@ -8,6 +8,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "sb_scenes_hash.hpp"
 #include "sb_version.hpp"
 #include "scenes/generators.hpp"
 
@@ -20,7 +21,8 @@ namespace {
 fs::path stamp_path(const fs::path& scene) { return fs::path(scene.string() + ".stamp"); }
 
 std::string stamp_text(const std::string& name) {
-  return fmt::format("stereobench {} generator {} seed 1 default parameters\n", SB_VERSION_STRING, name);
+  return fmt::format("stereobench {} generators {} scene {} seed 1 default parameters\n", SB_VERSION_STRING,
+                     SB_SCENES_SOURCE_HASH, name);
 }
 
 }  // namespace

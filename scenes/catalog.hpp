@@ -14,7 +14,8 @@ namespace sb::scenes {
 
 /// A path to an existing .gltf/.glb file is returned as is. A built-in scene name returns
 /// `<scenes_dir>/<file>`, generated (with default seed and parameters) when missing or written by
-/// another version of the generator. Anything else is an InputError listing the built-in names.
+/// another version of the generator
+/// (the stamp beside it records a hash of the generator sources). Anything else is an InputError listing the built-in names.
 [[nodiscard]] std::filesystem::path resolve_scene(const std::string& spec,
                                                   const std::filesystem::path& scenes_dir);
 

@@ -16,6 +16,7 @@ struct GeneratorParam {
   double min_value = 0.0;
   double max_value = 0.0;
   std::string help;
+  bool integer = false;  ///< only whole numbers are accepted
 };
 
 /// What a generator makes, for `stereobench scenes list` and the registry.
@@ -28,11 +29,13 @@ struct GeneratorInfo {
   std::vector<GeneratorParam> params;
 };
 
+/// How to generate: the seed and parameter overrides.
 struct GenerateOptions {
   uint64_t seed = 1;
   std::map<std::string, double> params;  ///< overrides; unknown names are an InputError
 };
 
+/// What a generation wrote: the file and its counts (meshes counted once per instancing node).
 struct GenerateResult {
   std::filesystem::path path;
   size_t triangles = 0;

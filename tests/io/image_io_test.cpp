@@ -1,0 +1,537 @@
+// Tests of image file I/O: bit-exact stereo EXR round trips, metadata, foreign EXR layouts (half
+// float, plain RGBA, Blender and multi-view names, multi-part), sRGB PNG previews, in-memory PNG
+// encoding and decoding, and the error paths (missing, corrupt and unwritable files).
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "renderer/color.hpp"
+#include "renderer/error.hpp"
+#include "renderer/image.hpp"
+#include "renderer/io/atomic_file.hpp"
+#include "renderer/io/image_io.hpp"
+
+namespace sb {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A fresh folder per test under the system temporary folder, removed afterwards.
+class ImageIoTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() / ("sb-image-io-" + std::string(info->name()) + "-" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  [[nodiscard]] fs::path path(const std::string& name) const { return dir_ / name; }
+  /// Names of the entries in the test folder.
+  [[nodiscard]] std::vector<std::string> entries() const {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir_)) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+
+  fs::path dir_;
+};
+
+/// A float with random bits that is not NaN (covers infinities, denormals and -0).
+float random_float(std::mt19937& rng) {
+  for (;;) {
+    const float f = std::bit_cast<float>(static_cast<uint32_t>(rng()));
+    if (!std::isnan(f)) return f;
+  }
+}
+
+/// An image with every standard plane plus generic float and uint32 planes, random content.
+Image random_image(int width, int height, uint32_t seed) {
+  std::mt19937 rng(seed);
+  Image image(width, height);
+  for (const std::string_view name : {planes::rgb, planes::depth, planes::normal, planes::albedo}) {
+    for (float& v : image.add_plane(name).f32()) v = random_float(rng);
+  }
+  const auto primid = image.add_plane(planes::primid).u32();
+  for (std::size_t i = 0; i < primid.size(); ++i) primid[i] = i % 3 == 0 ? kNoPrimitive : static_cast<uint32_t>(rng());
+  primid[0] = kNoPrimitive;
+  primid[1] = 0;
+  const auto source = image.add_plane(planes::source).u32();
+  for (std::size_t i = 0; i < source.size(); ++i) source[i] = static_cast<uint32_t>(i % kSourceCount);
+  // Other planes, in the order a reader restores them (by name).
+  for (float& v : image.add_plane("feature", 5, PlaneType::f32).f32()) v = random_float(rng);
+  for (float& v : image.add_plane("motion", 2, PlaneType::f32).f32()) v = random_float(rng);
+  for (uint32_t& v : image.add_plane("sample_count", 1, PlaneType::u32).u32()) v = static_cast<uint32_t>(rng());
+  return image;
+}
+
+std::vector<std::string> channel_names(const fs::path& file) {
+  std::vector<std::string> names;
+  for (const auto& ch : io::read_channel_info(file)) names.push_back(ch.name);
+  return names;
+}
+
+std::string format_of(const fs::path& file, const std::string& channel) {
+  for (const auto& ch : io::read_channel_info(file))
+    if (ch.name == channel) return ch.format;
+  return "<missing>";
+}
+
+bool has_oiiotool() { return std::system("oiiotool --version > /dev/null 2>&1") == 0; }
+
+void run(const std::string& command) { ASSERT_EQ(std::system(command.c_str()), 0) << command; }
+
+void write_bytes(const fs::path& file, const std::vector<unsigned char>& bytes) {
+  std::ofstream out(file, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+}
+
+std::vector<unsigned char> read_bytes(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+/// Expects `f` to throw an error of type E whose message contains `needle`.
+template <typename E, typename F>
+void expect_error(F&& f, const std::string& needle) {
+  try {
+    f();
+    ADD_FAILURE() << "expected an exception mentioning '" << needle << "'";
+  } catch (const E& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << "message: " << e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "wrong exception type, message: " << e.what();
+  }
+}
+
+// ---- EXR round trips ------------------------------------------------------------------------
+
+TEST_F(ImageIoTest, StereoExrRoundTripIsBitExactForEveryPlaneType) {
+  const Image left = random_image(37, 23, 1);
+  const Image right = random_image(37, 23, 2);
+  const fs::path file = path("pair.exr");
+  io::write_exr_stereo(file, left, right);
+
+  const auto [read_left, read_right] = io::read_exr_stereo(file);
+  EXPECT_TRUE(read_left == left) << "planes read: " << read_left.plane_list();
+  EXPECT_TRUE(read_right == right) << "planes read: " << read_right.plane_list();
+  EXPECT_EQ(read_left.plane(planes::primid).u32()[0], kNoPrimitive);
+
+  // Channel names and per-channel formats follow the OpenEXR layer conventions.
+  const std::vector<std::string> names = channel_names(file);
+  for (const std::string eye : {"left.", "right."}) {
+    for (const std::string ch : {"R", "G", "B", "Z", "N.X", "N.Y", "N.Z", "albedo.R", "albedo.G", "albedo.B", "primid",
+                                 "source", "motion.R", "motion.G", "sample_count", "feature.0", "feature.4"})
+      EXPECT_NE(std::find(names.begin(), names.end(), eye + ch), names.end()) << eye + ch;
+    EXPECT_EQ(format_of(file, eye + "R"), "float");
+    EXPECT_EQ(format_of(file, eye + "Z"), "float");
+    EXPECT_EQ(format_of(file, eye + "primid"), "uint");
+    EXPECT_EQ(format_of(file, eye + "source"), "uint");
+    EXPECT_EQ(format_of(file, eye + "sample_count"), "uint");
+  }
+  EXPECT_EQ(io::read_exr_metadata(file).at("compression"), "zip");
+  EXPECT_EQ(entries(), std::vector<std::string>{"pair.exr"});  // no temporary left behind
+}
+
+TEST_F(ImageIoTest, MonoExrUsesUnprefixedChannelsAndRoundTrips) {
+  const Image image = random_image(16, 9, 3);
+  const fs::path file = path("mono.exr");
+  io::write_exr(file, image);
+  const std::vector<std::string> names = channel_names(file);
+  for (const std::string ch : {"R", "G", "B", "Z", "N.X", "albedo.B", "primid", "source"})
+    EXPECT_NE(std::find(names.begin(), names.end(), ch), names.end()) << ch;
+  EXPECT_TRUE(io::read_exr(file) == image);
+  // A mono file is not a stereo pair, and a stereo file is not a mono image.
+  expect_error<InputError>([&] { (void)io::read_exr_stereo(file); }, "no stereo pair");
+  io::write_exr_stereo(path("pair.exr"), image, image);
+  expect_error<InputError>([&] { (void)io::read_exr(path("pair.exr")); }, "read_exr_stereo");
+}
+
+TEST_F(ImageIoTest, PlaneOrderIsRestoredCanonically) {
+  Image image(4, 3);
+  image.add_plane("zeta", 1, PlaneType::f32).fill(2.0f);
+  image.add_plane(planes::source).fill(static_cast<uint32_t>(Source::traced));
+  image.add_plane(planes::rgb).fill(0.25f);
+  image.add_plane("beta", 3, PlaneType::u32).fill(9u);
+  io::write_exr(path("order.exr"), image);
+  const Image read = io::read_exr(path("order.exr"));
+  EXPECT_EQ(read.plane_list(), "rgb, source, beta, zeta");  // standard planes first, then by name
+  EXPECT_EQ(read.plane("beta").at_u32(3, 2, 2), 9u);
+  EXPECT_EQ(read.plane("zeta").f32()[5], 2.0f);
+  EXPECT_EQ(read.plane(planes::source).u32()[11], static_cast<uint32_t>(Source::traced));
+}
+
+TEST_F(ImageIoTest, SameImageGivesByteIdenticalExrFiles) {
+  const Image image = random_image(21, 13, 14);
+  io::write_exr_stereo(path("a.exr"), image, image, {{"stereobench/rig", "{}"}});
+  io::write_exr_stereo(path("b.exr"), image, image, {{"stereobench/rig", "{}"}});
+  EXPECT_EQ(read_bytes(path("a.exr")), read_bytes(path("b.exr")));
+  // No time stamp: OpenImageIO would otherwise add the current time to every file.
+  EXPECT_EQ(io::read_exr_metadata(path("a.exr")).count("DateTime"), 0u);
+}
+
+TEST_F(ImageIoTest, MetadataRoundTrips) {
+  const std::string rig_json = R"({"interaxial":0.064,"convergence":2.0,"width":37,"name":"caf\u00e9 \"quoted\""})";
+  const io::ImageMetadata metadata = {
+      {"stereobench/rig", rig_json},
+      {"stereobench/provenance", std::string(10000, 'x')},
+      {"stereobench:colon", "a value"},
+      {"stereobench/utf8", "Wi\xc3\x9fmann"},
+  };
+  const Image image = random_image(5, 4, 4);
+  io::write_exr_stereo(path("meta.exr"), image, image, metadata);
+  const io::ImageMetadata read = io::read_exr_metadata(path("meta.exr"));
+  for (const auto& [key, value] : metadata) {
+    ASSERT_TRUE(read.count(key)) << key;
+    EXPECT_EQ(read.at(key), value) << key;
+  }
+}
+
+TEST_F(ImageIoTest, ReservedOrInvalidMetadataKeysAreRejectedBeforeWriting) {
+  const Image image = random_image(4, 4, 5);
+  expect_error<InputError>([&] { io::write_exr(path("a.exr"), image, {{"compression", "none"}}); }, "compression");
+  expect_error<InputError>([&] { io::write_exr(path("a.exr"), image, {{"", "x"}}); }, "invalid");
+  expect_error<InputError>([&] { io::write_exr(path("a.exr"), image, {{"stereobench/x", ""}}); }, "empty");
+  expect_error<InputError>([&] { io::write_exr(path("a.exr"), image, {}, {io::ExrFloatFormat::f32, "lzw"}); }, "lzw");
+  EXPECT_TRUE(entries().empty());
+}
+
+TEST_F(ImageIoTest, UnwritableImagesAreInputErrors) {
+  expect_error<InputError>([&] { io::write_exr(path("e.exr"), Image(0, 0)); }, "empty");
+  expect_error<InputError>([&] { io::write_exr(path("e.exr"), Image(3, 3)); }, "no planes");
+  expect_error<InputError>([&] { io::write_exr_stereo(path("e.exr"), random_image(4, 4, 1), random_image(5, 4, 2)); },
+                           "differ in size");
+  EXPECT_TRUE(entries().empty());
+}
+
+TEST_F(ImageIoTest, HalfFloatExrFromOwnWriterReadsExactly) {
+  // Values representable in half precision survive the round trip exactly.
+  Image image(8, 4);
+  auto rgb = image.add_plane(planes::rgb).f32();
+  for (std::size_t i = 0; i < rgb.size(); ++i) rgb[i] = static_cast<float>(i) / 64.0f - 0.5f;
+  image.add_plane(planes::depth).fill(1000.5f);  // 11 significant bits: exact in half
+  image.add_plane(planes::primid).fill(0xFFFFFFF0u);
+  io::write_exr(path("half.exr"), image, {}, {io::ExrFloatFormat::f16, "piz"});
+  EXPECT_EQ(format_of(path("half.exr"), "R"), "half");
+  EXPECT_EQ(format_of(path("half.exr"), "primid"), "uint");  // ids are never narrowed
+  EXPECT_TRUE(io::read_exr(path("half.exr")) == image);
+}
+
+TEST_F(ImageIoTest, PlainRgbaHalfExrFromAnotherToolIsRead) {
+  if (!has_oiiotool()) GTEST_SKIP() << "oiiotool (Debian package openimageio-tools) is not installed";
+  // What POV-Ray's +FE writes: plain R, G, B, A in half float.
+  const fs::path file = path("povray.exr");
+  run("oiiotool --pattern constant:color=0.25,0.5,1,0.75 5x3 4 -d half -o " + file.string());
+  EXPECT_EQ(format_of(file, "R"), "half");
+  const Image image = io::read_exr(file);
+  EXPECT_EQ(image.width(), 5);
+  EXPECT_EQ(image.height(), 3);
+  EXPECT_EQ(image.plane_list(), "rgb, alpha");
+  EXPECT_EQ(image.rgb_at(4, 2), (std::array<float, 3>{0.25f, 0.5f, 1.0f}));
+  EXPECT_EQ(image.plane(planes::alpha).at_f32(0, 0), 0.75f);
+
+  // A plain float RGB file too.
+  run("oiiotool --pattern constant:color=0.125,2,3 2x2 3 -d float -o " + path("plain.exr").string());
+  EXPECT_EQ(io::read_exr(path("plain.exr")).rgb_at(1, 1), (std::array<float, 3>{0.125f, 2.0f, 3.0f}));
+
+  // A data window smaller than the display window lands at its offset; the rest stays zero.
+  run("oiiotool --pattern constant:color=1,2,3 2x2 3 -d float --origin +1+1 --fullsize 4x3+0+0 -o " +
+      path("window.exr").string());
+  const Image window = io::read_exr(path("window.exr"));
+  EXPECT_EQ(window.width(), 4);
+  EXPECT_EQ(window.height(), 3);
+  EXPECT_EQ(window.rgb_at(1, 1), (std::array<float, 3>{1, 2, 3}));
+  EXPECT_EQ(window.rgb_at(2, 2), (std::array<float, 3>{1, 2, 3}));
+  EXPECT_EQ(window.rgb_at(0, 0), (std::array<float, 3>{0, 0, 0}));
+  EXPECT_EQ(window.rgb_at(3, 1), (std::array<float, 3>{0, 0, 0}));
+}
+
+TEST_F(ImageIoTest, BlenderMultilayerNamesMapToStandardPlanes) {
+  if (!has_oiiotool()) GTEST_SKIP() << "oiiotool (Debian package openimageio-tools) is not installed";
+  const fs::path file = path("blender.exr");
+  run("oiiotool --pattern constant:color=0.1,0.2,0.3,1,5,0,0,1,0.5,0.5,0.5,7 3x2 12 -d half "
+      "--chnames ViewLayer.Combined.R,ViewLayer.Combined.G,ViewLayer.Combined.B,ViewLayer.Combined.A,"
+      "ViewLayer.Depth.Z,ViewLayer.Normal.X,ViewLayer.Normal.Y,ViewLayer.Normal.Z,"
+      "ViewLayer.DiffCol.R,ViewLayer.DiffCol.G,ViewLayer.DiffCol.B,ViewLayer.Emit.R -o " +
+      file.string());
+  const Image image = io::read_exr(file);
+  EXPECT_EQ(image.plane_list(), "rgb, alpha, depth, normal, albedo, viewlayer_emit");
+  EXPECT_EQ(image.plane(planes::depth).at_f32(2, 1), 5.0f);
+  EXPECT_EQ(image.plane(planes::normal).at_f32(0, 0, 2), 1.0f);
+  EXPECT_EQ(image.plane(planes::albedo).at_f32(1, 1, 1), 0.5f);
+  EXPECT_EQ(image.plane("viewlayer_emit").at_f32(0, 1), 7.0f);
+}
+
+TEST_F(ImageIoTest, MultiViewAndMultiPartStereoFilesAreRead) {
+  if (!has_oiiotool()) GTEST_SKIP() << "oiiotool (Debian package openimageio-tools) is not installed";
+  // OpenEXR multi-view: the default (left) view's channels carry no view name.
+  const fs::path multiview = path("multiview.exr");
+  run("oiiotool --pattern constant:color=1,2,3,4,5,6 2x2 6 -d float --chnames R,G,B,right.R,right.G,right.B -o " +
+      multiview.string());
+  const auto [left, right] = io::read_exr_stereo(multiview);
+  EXPECT_EQ(left.rgb_at(1, 1), (std::array<float, 3>{1, 2, 3}));
+  EXPECT_EQ(right.rgb_at(1, 1), (std::array<float, 3>{4, 5, 6}));
+
+  // Two parts named left and right.
+  const fs::path parts = path("parts.exr");
+  run("oiiotool --pattern constant:color=1,2,3 2x2 3 -d float --sattrib oiio:subimagename left "
+      "--pattern constant:color=7,8,9 2x2 3 -d float --sattrib oiio:subimagename right --siappend -o " +
+      parts.string());
+  const auto [part_left, part_right] = io::read_exr_stereo(parts);
+  EXPECT_EQ(part_left.rgb_at(0, 0), (std::array<float, 3>{1, 2, 3}));
+  EXPECT_EQ(part_right.rgb_at(0, 0), (std::array<float, 3>{7, 8, 9}));
+}
+
+// ---- Errors on reading ----------------------------------------------------------------------
+
+TEST_F(ImageIoTest, MissingFileSaysItDoesNotExist) {
+  const fs::path file = path("nowhere.exr");
+  expect_error<InputError>([&] { (void)io::read_exr(file); }, file.string() + " does not exist");
+  expect_error<InputError>([&] { (void)io::read_exr_stereo(file); }, "does not exist");
+  expect_error<InputError>([&] { (void)io::read_exr_metadata(file); }, "does not exist");
+  expect_error<InputError>([&] { (void)io::read_image(path("nowhere.png")); }, "does not exist");
+}
+
+TEST_F(ImageIoTest, RandomBytesAreAnInputErrorNamingTheFile) {
+  std::mt19937 rng(7);
+  std::vector<unsigned char> garbage(4096);
+  for (auto& b : garbage) b = static_cast<unsigned char>(rng());
+  for (const std::string name : {"garbage.exr", "garbage.png", "garbage.jpg", "garbage"}) {
+    write_bytes(path(name), garbage);
+    expect_error<InputError>([&] { (void)io::read_exr(path(name)); }, path(name).string());
+    expect_error<InputError>([&] { (void)io::read_image(path(name)); }, path(name).string());
+  }
+  expect_error<InputError>([&] { (void)io::decode_image(garbage, "scene.glb image 2"); }, "scene.glb image 2");
+}
+
+TEST_F(ImageIoTest, TruncatedExrIsAnInputErrorNamingTheFile) {
+  const Image image = random_image(64, 48, 8);
+  io::write_exr_stereo(path("full.exr"), image, image);
+  const std::vector<unsigned char> bytes = read_bytes(path("full.exr"));
+  for (const std::size_t keep : {bytes.size() / 2, bytes.size() - 100, std::size_t{200}, std::size_t{8}}) {
+    const fs::path cut = path("cut-" + std::to_string(keep) + ".exr");
+    write_bytes(cut, {bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(keep)});
+    expect_error<InputError>([&] { (void)io::read_exr_stereo(cut); }, cut.string());
+  }
+}
+
+TEST_F(ImageIoTest, TruncatedPngIsAnInputError) {
+  std::vector<uint8_t> pixels(32 * 32 * 3);
+  std::mt19937 rng(9);
+  for (auto& p : pixels) p = static_cast<uint8_t>(rng());
+  const std::vector<unsigned char> png = io::encode_png(pixels.data(), 32, 32, 3);
+  const std::vector<unsigned char> cut(png.begin(), png.begin() + static_cast<std::ptrdiff_t>(png.size() / 2));
+  expect_error<InputError>([&] { (void)io::decode_image(cut, "half.png"); }, "half.png");
+  expect_error<InputError>([&] { (void)io::decode_image({}, "empty.png"); }, "empty.png");
+}
+
+// ---- Errors on writing ----------------------------------------------------------------------
+
+TEST_F(ImageIoTest, WritingBelowARegularFileIsAnIoErrorAndLeavesNothing) {
+  write_bytes(path("blocker"), {1, 2, 3});
+  const Image image = random_image(4, 4, 10);
+  EXPECT_THROW(io::write_exr_stereo(path("blocker") / "pair.exr", image, image), IoError);
+  EXPECT_THROW(io::write_exr(path("blocker") / "sub" / "mono.exr", image), IoError);
+  EXPECT_THROW(io::write_png_preview(path("blocker") / "preview.png", image), IoError);
+  EXPECT_THROW(io::write_png_rgb8(path("blocker") / "rgb.png", std::vector<uint8_t>(12), 2, 2), IoError);
+  EXPECT_EQ(entries(), std::vector<std::string>{"blocker"});
+  EXPECT_EQ(read_bytes(path("blocker")), (std::vector<unsigned char>{1, 2, 3}));
+}
+
+TEST_F(ImageIoTest, FailureInsideWriteAtomicallyLeavesNoFileAndNoTemporary) {
+  const fs::path file = path("out.bin");
+  fs::path seen_tmp;
+  EXPECT_THROW(io::write_atomically(file,
+                                    [&](const fs::path& tmp) {
+                                      seen_tmp = tmp;
+                                      std::ofstream(tmp) << "partial content";
+                                      throw std::runtime_error("simulated failure half-way");
+                                    }),
+               IoError);
+  EXPECT_FALSE(seen_tmp.empty());
+  EXPECT_FALSE(fs::exists(seen_tmp));
+  EXPECT_TRUE(entries().empty());
+
+  // An existing file under the final name is left untouched, and typed errors pass through.
+  write_bytes(file, {42});
+  EXPECT_THROW(io::write_atomically(file,
+                                    [&](const fs::path& tmp) {
+                                      std::ofstream(tmp) << "new";
+                                      throw InputError("simulated bad input");
+                                    }),
+               InputError);
+  EXPECT_EQ(entries(), std::vector<std::string>{"out.bin"});
+  EXPECT_EQ(read_bytes(file), std::vector<unsigned char>{42});
+}
+
+TEST_F(ImageIoTest, OverwritingAnExistingExrReplacesItCompletely) {
+  io::write_exr(path("x.exr"), random_image(8, 8, 11));
+  const Image second = random_image(3, 2, 12);
+  io::write_exr(path("x.exr"), second);
+  EXPECT_TRUE(io::read_exr(path("x.exr")) == second);
+  EXPECT_EQ(entries(), std::vector<std::string>{"x.exr"});
+}
+
+// ---- PNG ------------------------------------------------------------------------------------
+
+/// The sRGB OETF in double precision, clamped and rounded: the reference for the previews.
+int reference_srgb8(double linear) {
+  const double v = std::isnan(linear) ? 0.0 : std::clamp(linear, 0.0, 1.0);
+  const double encoded = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+  return static_cast<int>(std::lround(encoded * 255.0));
+}
+
+TEST(ColorTest, SrgbFunctionsFollowThePiecewiseFormula) {
+  EXPECT_EQ(linear_to_srgb8(0.0f), 0);
+  EXPECT_EQ(linear_to_srgb8(0.0031308f), 10);  // 12.92 * 0.0031308 * 255 = 10.31
+  EXPECT_EQ(linear_to_srgb8(0.5f), 188);       // 0.735357 * 255 = 187.52
+  EXPECT_EQ(linear_to_srgb8(1.0f), 255);
+  EXPECT_EQ(linear_to_srgb8(7.0f), 255);
+  EXPECT_EQ(linear_to_srgb8(-0.25f), 0);
+  EXPECT_EQ(linear_to_srgb8(std::numeric_limits<float>::quiet_NaN()), 0);
+  EXPECT_EQ(linear_to_srgb8(std::numeric_limits<float>::infinity()), 255);
+  EXPECT_NEAR(linear_to_srgb(0.0031308f), 0.04045f, 1e-6f);
+  EXPECT_NEAR(srgb_to_linear(0.04045f), 0.0031308f, 1e-7f);
+  EXPECT_NEAR(srgb_to_linear(0.5f), 0.21404114f, 1e-7f);
+  for (int code = 0; code <= 255; ++code) {
+    EXPECT_EQ(linear_to_srgb8(srgb8_to_linear(static_cast<uint8_t>(code))), code);
+    EXPECT_NEAR(linear_to_srgb(srgb_to_linear(code / 255.0f)), code / 255.0f, 1e-6f);
+  }
+}
+
+TEST_F(ImageIoTest, PngPreviewEqualsTheSrgbFormula) {
+  const std::vector<float> inputs = {0.0f,  0.0031308f, 0.0031309f, 0.5f,  1.0f,  1.5f,   -0.2f,
+                                     1e-4f, 0.2f,       0.99f,      0.18f, 1e30f, -1e30f, 0.0404f};
+  Image image(static_cast<int>(inputs.size()), 2);
+  Plane& rgb = image.add_plane(planes::rgb);
+  Plane& depth = image.add_plane(planes::depth);
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < image.width(); ++x) {
+      for (int c = 0; c < 3; ++c) rgb.at_f32(x, y, c) = inputs[static_cast<std::size_t>((x + c + y) % image.width())];
+      depth.at_f32(x, y) = inputs[static_cast<std::size_t>(x)];
+    }
+  io::write_png_preview(path("rgb.png"), image);
+  io::write_png_preview(path("depth.png"), image, planes::depth);
+
+  const io::DecodedImage png = io::read_image(path("rgb.png"));
+  ASSERT_EQ(png.width, image.width());
+  ASSERT_EQ(png.height, 2);
+  ASSERT_EQ(png.channels, 3);
+  EXPECT_TRUE(png.srgb);
+  EXPECT_EQ(png.format, "png");
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < image.width(); ++x)
+      for (int c = 0; c < 3; ++c) {
+        const float value = png.values[(static_cast<std::size_t>(y) * static_cast<std::size_t>(png.width) +
+                                        static_cast<std::size_t>(x)) *
+                                           3 +
+                                       static_cast<std::size_t>(c)];
+        EXPECT_EQ(std::lround(value * 255.0f), reference_srgb8(rgb.at_f32(x, y, c))) << "input " << rgb.at_f32(x, y, c);
+      }
+
+  const io::DecodedImage gray = io::read_image(path("depth.png"));
+  ASSERT_EQ(gray.channels, 1);
+  for (int x = 0; x < image.width(); ++x)
+    EXPECT_EQ(std::lround(gray.values[static_cast<std::size_t>(x)] * 255.0f),
+              reference_srgb8(inputs[static_cast<std::size_t>(x)]));
+}
+
+TEST_F(ImageIoTest, PngPreviewRejectsUnsuitablePlanes) {
+  Image image(4, 4);
+  image.add_plane(planes::primid);
+  image.add_plane("motion", 2, PlaneType::f32);
+  expect_error<InputError>([&] { io::write_png_preview(path("p.png"), image); }, "no plane 'rgb'");
+  expect_error<InputError>([&] { io::write_png_preview(path("p.png"), image, planes::primid); }, "primid");
+  expect_error<InputError>([&] { io::write_png_preview(path("p.png"), image, "motion"); }, "1 or 3 float");
+  expect_error<InputError>([&] { io::write_png_rgb8(path("p.png"), std::vector<uint8_t>(11), 2, 2); }, "needs");
+  EXPECT_TRUE(entries().empty());
+}
+
+TEST_F(ImageIoTest, PngRgb8IsWrittenVerbatim) {
+  const std::vector<uint8_t> rgb = {0, 1, 2, 253, 254, 255, 10, 20, 30, 40, 50, 60};
+  io::write_png_rgb8(path("rgb8.png"), rgb, 2, 2);
+  const io::DecodedImage png = io::read_image(path("rgb8.png"));
+  ASSERT_EQ(png.values.size(), rgb.size());
+  for (std::size_t i = 0; i < rgb.size(); ++i) EXPECT_EQ(std::lround(png.values[i] * 255.0f), rgb[i]);
+}
+
+TEST_F(ImageIoTest, EncodePngRoundTripsAndIsDeterministic) {
+  std::mt19937 rng(13);
+  for (int channels = 1; channels <= 4; ++channels) {
+    const int width = 19 + channels;
+    const int height = 7;
+    std::vector<uint8_t> pixels(static_cast<std::size_t>(width * height * channels));
+    for (auto& p : pixels) p = static_cast<uint8_t>(rng());
+    const std::vector<unsigned char> a = io::encode_png(pixels.data(), width, height, channels);
+    const std::vector<unsigned char> b = io::encode_png(pixels.data(), width, height, channels);
+    ASSERT_GT(a.size(), 8u);
+    EXPECT_EQ(a, b) << "two encodings of the same pixels differ";
+    EXPECT_EQ(std::vector<unsigned char>(a.begin(), a.begin() + 4), (std::vector<unsigned char>{0x89, 'P', 'N', 'G'}));
+
+    // The name carries no extension: the format is found from the bytes. Alpha (2 and 4
+    // channels) must come back straight, not premultiplied.
+    const io::DecodedImage decoded = io::decode_image(a, "texture without extension");
+    EXPECT_EQ(decoded.width, width);
+    EXPECT_EQ(decoded.height, height);
+    EXPECT_EQ(decoded.channels, channels);
+    EXPECT_TRUE(decoded.srgb);
+    ASSERT_EQ(decoded.values.size(), pixels.size());
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+      ASSERT_EQ(std::lround(decoded.values[i] * 255.0f), pixels[i]) << "sample " << i;
+      ASSERT_NEAR(decoded.values[i], static_cast<float>(pixels[i]) / 255.0f, 1e-7f) << "sample " << i;
+    }
+  }
+  EXPECT_THROW((void)io::encode_png(nullptr, 2, 2, 3), InputError);
+  const uint8_t one = 0;
+  EXPECT_THROW((void)io::encode_png(&one, 0, 1, 1), InputError);
+  EXPECT_THROW((void)io::encode_png(&one, 1, 1, 5), InputError);
+}
+
+TEST_F(ImageIoTest, DecodeImageReadsExrFromMemoryAsLinear) {
+  Image image(3, 2);
+  image.add_plane(planes::rgb).fill(0.75f);
+  io::write_exr(path("tex.exr"), image);
+  const std::vector<unsigned char> bytes = read_bytes(path("tex.exr"));
+  const io::DecodedImage decoded = io::decode_image(bytes, "embedded.exr");
+  EXPECT_EQ(decoded.format, "openexr");
+  EXPECT_FALSE(decoded.srgb);
+  EXPECT_EQ(decoded.channels, 3);
+  for (const float v : decoded.values) EXPECT_EQ(v, 0.75f);
+}
+
+TEST_F(ImageIoTest, DecodeImageReadsJpegFromMemoryAsSrgb) {
+  if (!has_oiiotool()) GTEST_SKIP() << "oiiotool (Debian package openimageio-tools) is not installed";
+  run("oiiotool --pattern constant:color=0.2,0.4,0.6 16x8 3 -d uint8 -o " + path("tex.jpg").string());
+  const io::DecodedImage decoded = io::decode_image(read_bytes(path("tex.jpg")), "scene.gltf image 0");
+  EXPECT_EQ(decoded.format, "jpeg");
+  EXPECT_TRUE(decoded.srgb);
+  EXPECT_EQ(decoded.width, 16);
+  EXPECT_EQ(decoded.height, 8);
+  ASSERT_EQ(decoded.channels, 3);
+  EXPECT_NEAR(decoded.values[0], 0.2f, 2.0f / 255.0f);  // lossy, but a flat colour survives closely
+  EXPECT_NEAR(decoded.values[2], 0.6f, 2.0f / 255.0f);
+}
+
+TEST(ImageIoVersionTest, OiioVersionIsReported) {
+  const std::string version = io::oiio_version();
+  EXPECT_EQ(std::count(version.begin(), version.end(), '.'), 2) << version;
+  EXPECT_NE(version, "0.0.0");
+}
+
+}  // namespace
+}  // namespace sb

@@ -1,0 +1,388 @@
+// Tests of the scene generators: the registry and its parameter checks, byte-identical output
+// per seed, the counts each scene promises, sane bounds and a camera that looks at the content,
+// and the Khronos glTF validator over every built-in scene.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <string>
+
+#include <sys/wait.h>
+
+#include "gltf_reader_support.hpp"
+#include "renderer/error.hpp"
+#include "scenes/generators.hpp"
+
+namespace sb::scenes {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const std::vector<std::string> kExpectedNames = {"spheres",   "atrium",    "bistro",         "temple",
+                                                 "dragon",    "complexity", "lit-plane",     "box-wall",
+                                                 "thin-pole", "textured-plane", "slanted-plane"};
+
+/// A folder of its own for the running test, under the build tree; removed again when the test
+/// passes (kept for inspection when it fails).
+class ScratchDir {
+ public:
+  ScratchDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = std::string(info->test_suite_name()) + "." + info->name();
+    std::replace(name.begin(), name.end(), '/', '_');
+    path_ = fs::path(SB_BINARY_DIR) / "Testing" / "scenes" / name;
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  ~ScratchDir() {
+    std::error_code ec;
+    if (!::testing::Test::HasFailure()) fs::remove_all(path_, ec);
+  }
+  [[nodiscard]] fs::path operator/(const std::string& file) const { return path_ / file; }
+  [[nodiscard]] const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+std::vector<unsigned char> file_bytes(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+/// Expects `f` to throw InputError whose message contains every one of `parts`.
+template <typename F>
+void expect_input_error(F&& f, const std::vector<std::string>& parts) {
+  try {
+    f();
+    ADD_FAILURE() << "no InputError thrown";
+  } catch (const InputError& e) {
+    for (const std::string& p : parts) EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what() << " lacks " << p;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Registry and parameters
+
+TEST(SceneRegistry, ListsEveryGeneratorInOrder) {
+  std::vector<std::string> names;
+  for (const GeneratorInfo& g : generators()) names.push_back(g.name);
+  EXPECT_EQ(names, kExpectedNames);
+  for (const GeneratorInfo& g : generators()) {
+    SCOPED_TRACE(g.name);
+    EXPECT_FALSE(g.description.empty());
+    EXPECT_EQ(g.file_name, g.name + (g.analytic ? ".gltf" : ".glb"));
+    EXPECT_TRUE(g.builtin);
+    for (const GeneratorParam& p : g.params) {
+      EXPECT_LE(p.min_value, p.default_value);
+      EXPECT_LE(p.default_value, p.max_value);
+      EXPECT_FALSE(p.help.empty());
+    }
+  }
+  EXPECT_TRUE(find_generator("lit-plane").analytic);
+  EXPECT_FALSE(find_generator("dragon").analytic);
+}
+
+TEST(SceneRegistry, UnknownGeneratorListsTheKnownOnes) {
+  expect_input_error([] { (void)find_generator("sponza"); }, {"sponza", "spheres", "slanted-plane"});
+  expect_input_error([] { (void)generate("sponza", {}, fs::path(SB_BINARY_DIR) / "x.glb"); }, {"sponza"});
+}
+
+TEST(SceneRegistry, RejectsUnknownAndOutOfRangeParameters) {
+  const ScratchDir dir;
+  const fs::path out = dir / "s.glb";
+  GenerateOptions o;
+  o.params = {{"radius", 1.0}};
+  expect_input_error([&] { (void)generate("spheres", o, out); }, {"radius", "spheres", "count", "segments"});
+  o.params = {{"count", 0.0}};
+  expect_input_error([&] { (void)generate("spheres", o, out); }, {"count", "0", "[1, 100000]"});
+  o.params = {{"triangles", 1e9}};
+  expect_input_error([&] { (void)generate("complexity", o, out); }, {"triangles", "1000000000", "[100000, 100000000]"});
+  o.params = {{"segments", 12.5}};
+  expect_input_error([&] { (void)generate("spheres", o, out); }, {"segments", "12.5", "whole number"});
+  o.params = {{"count", std::numeric_limits<double>::quiet_NaN()}};
+  expect_input_error([&] { (void)generate("spheres", o, out); }, {"count", "nan"});
+  o.params = {{"anything", 1.0}};
+  expect_input_error([&] { (void)generate("atrium", o, out); }, {"anything", "none"});
+  expect_input_error([&] { (void)generate("lit-plane", {}, dir / "plane.obj"); }, {"plane.obj", ".glb", ".gltf"});
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(SceneParams, TriangleCountsFollowTheParameter) {
+  const ScratchDir dir;
+  for (const double n : {250000.0, 1200000.0}) {
+    GenerateOptions o;
+    o.params["triangles"] = n;
+    const GenerateResult r = generate("complexity", o, dir / "complexity.glb");
+    EXPECT_NEAR(static_cast<double>(r.triangles), n, 0.01 * n);
+    // From 10^6 triangles on, the objects use 32-bit indices.
+    const test::ReadGltf g = test::read_gltf(r.path);
+    size_t wide = 0;
+    for (const json& a : g.doc["accessors"])
+      if (a["type"] == "SCALAR" && a["componentType"] == 5125) ++wide;
+    EXPECT_EQ(wide > 0, n >= 1e6) << n;
+  }
+  GenerateOptions o;
+  o.params["triangles"] = 300000;
+  const GenerateResult r = generate("dragon", o, dir / "dragon.glb");
+  const test::ReadGltf g = test::read_gltf(r.path);
+  size_t largest = 0;
+  for (const test::ReadPrimitive& p : g.primitives) largest = std::max(largest, p.indices.size() / 3);
+  EXPECT_NEAR(static_cast<double>(largest), 3e5, 3e3);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Determinism: every generator, with parameters that keep it quick.
+
+class SceneDeterminism : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(SceneDeterminism, SameSeedSameBytesOtherSeedOtherFile) {
+  const std::string name = GetParam();
+  const GeneratorInfo& info = find_generator(name);
+  const ScratchDir dir;
+  GenerateOptions o;
+  o.seed = 7;
+  if (name == "dragon") o.params["triangles"] = 100000;  // the full size is checked below
+  const std::string ext = info.analytic ? ".gltf" : ".glb";
+  (void)generate(name, o, dir / ("a" + ext));
+  (void)generate(name, o, dir / ("b" + ext));
+  EXPECT_EQ(file_bytes(dir / ("a" + ext)), file_bytes(dir / ("b" + ext)));
+  o.seed = 8;
+  (void)generate(name, o, dir / ("c" + ext));
+  EXPECT_NE(file_bytes(dir / ("a" + ext)), file_bytes(dir / ("c" + ext)));  // the seed is recorded
+  // Random scenes change their content (geometry, placements, colours, textures) with the seed;
+  // analytic ones do not.
+  const auto content = [](const fs::path& p) {
+    json doc = test::read_gltf(p).doc;
+    doc["scenes"][0]["extras"]["stereobench"].erase("seed");
+    return std::pair{doc, test::read_binary_payload(p)};
+  };
+  EXPECT_EQ(content(dir / ("a" + ext)) == content(dir / ("c" + ext)), info.analytic);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllGenerators, SceneDeterminism, ::testing::ValuesIn(kExpectedNames),
+                         [](const auto& p) {
+                           std::string s = p.param;
+                           std::replace(s.begin(), s.end(), '-', '_');
+                           return s;
+                         });
+
+// ---------------------------------------------------------------------------------------------
+// Structure of every built-in scene at its defaults.
+
+/// Whether a ray hits any triangle of the scene (Moller-Trumbore).
+bool ray_hits(const test::ReadGltf& g, const dvec3& origin, const dvec3& dir) {
+  for (const test::ReadPrimitive& p : g.primitives)
+    for (size_t t = 0; t + 2 < p.indices.size(); t += 3) {
+      const dvec3 a(p.positions[p.indices[t]]), b(p.positions[p.indices[t + 1]]), c(p.positions[p.indices[t + 2]]);
+      const dvec3 e1 = b - a, e2 = c - a, q = glm::cross(dir, e2);
+      const double det = glm::dot(e1, q);
+      if (std::fabs(det) < 1e-14) continue;
+      const dvec3 s = origin - a;
+      const double u = glm::dot(s, q) / det;
+      if (u < 0.0 || u > 1.0) continue;
+      const dvec3 r = glm::cross(s, e1);
+      const double v = glm::dot(dir, r) / det;
+      if (v < 0.0 || u + v > 1.0) continue;
+      if (glm::dot(e2, r) / det > 1e-4) return true;
+    }
+  return false;
+}
+
+/// What each scene promises.
+struct Expectation {
+  size_t min_triangles = 1;
+  size_t max_triangles = std::numeric_limits<size_t>::max();
+  size_t point_lights = 0;
+  size_t directional_lights = 0;
+  size_t min_textures = 0;
+  bool grounded = true;  ///< stands on y = 0
+};
+
+Expectation expectation(const std::string& name) {
+  if (name == "spheres") return {528000, 528000, 5, 0, 0, false};  // 1000 spheres x 2*24*11
+  if (name == "atrium") return {200000, 900000, 8, 1, 4};
+  if (name == "bistro") return {200000, 900000, 13, 1, 3};
+  if (name == "temple") return {200000, 900000, 13, 1, 3};
+  if (name == "dragon") return {1089000, 1111000 + 1000, 5, 0, 0};
+  if (name == "complexity") return {99000, 101000, 2, 1, 0};
+  if (name == "lit-plane") return {2, 1000, 1, 0, 0, false};
+  if (name == "textured-plane") return {2, 10000, 0, 1, 1};
+  if (name == "slanted-plane") return {2, 10000, 0, 1, 0, false};
+  return {2, 10000, 1, 0, 0};  // box-wall, thin-pole
+}
+
+class SceneStructure : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(SceneStructure, CountsBoundsAndCamera) {
+  const std::string name = GetParam();
+  const ScratchDir dir;
+  const fs::path path = dir / find_generator(name).file_name;
+  const GenerateResult r = generate(name, {}, path);
+  std::printf("%-15s %9zu triangles %9zu vertices %3zu lights %10zu bytes %6.2f s\n", name.c_str(), r.triangles,
+              r.vertices, r.lights, r.bytes, r.seconds);
+  EXPECT_EQ(r.path, path);
+  EXPECT_EQ(r.bytes, fs::file_size(path));
+  EXPECT_GE(r.seconds, 0.0);
+
+  const test::ReadGltf g = test::read_gltf(path);
+  // The result agrees with the file, and the file with the scene's promise.
+  EXPECT_EQ(g.triangle_count(), r.triangles);
+  EXPECT_EQ(g.vertex_count(), r.vertices);
+  const Expectation e = expectation(name);
+  EXPECT_GE(r.triangles, e.min_triangles);
+  EXPECT_LE(r.triangles, e.max_triangles);
+  EXPECT_EQ(g.light_count("point"), e.point_lights);
+  EXPECT_EQ(g.light_count("directional"), e.directional_lights);
+  EXPECT_EQ(r.lights, e.point_lights + e.directional_lights);
+  EXPECT_GE(g.doc.value("textures", json::array()).size(), e.min_textures);
+  if (name == "dragon") {
+    // One mesh carries (1.1 M +- 1 %) triangles; the rest is the ground plane.
+    size_t largest = 0;
+    for (const test::ReadPrimitive& p : g.primitives) largest = std::max(largest, p.indices.size() / 3);
+    EXPECT_NEAR(static_cast<double>(largest), 1.1e6, 1.1e4);
+  }
+  if (name == "complexity") {
+    EXPECT_NEAR(static_cast<double>(r.triangles), 1e5, 1e3);
+  }
+
+  // Bounds: finite and of a sensible size; the ground or floor at y = 0.
+  const Bounds3 b = g.bounds();
+  ASSERT_FALSE(b.empty());
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_TRUE(std::isfinite(b.lo[k]) && std::isfinite(b.hi[k]));
+    EXPECT_LT(b.extent()[k], 2000.0f);
+  }
+  EXPECT_GT(glm::length(b.extent()), 0.5f);
+  if (e.grounded) {
+    EXPECT_NEAR(b.lo.y, 0.0f, 1e-3f);
+  }
+  // Point lights sit within (a margin around) the scene.
+  for (const vec3& p : g.point_light_positions())
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_GE(p[k], b.lo[k] - 5.0f);
+      EXPECT_LE(p[k], b.hi[k] + 5.0f);
+    }
+
+  // The camera: the rig defaults, and a view that has the content in front of it.
+  const int cam = g.camera_node();
+  ASSERT_GE(cam, 0);
+  const json& sbx = g.doc["nodes"][static_cast<size_t>(cam)]["extras"]["stereobench"];
+  EXPECT_EQ(sbx["interaxial"].get<double>(), 0.064);
+  EXPECT_EQ(sbx["width"].get<int>(), 1920);
+  EXPECT_EQ(sbx["height"].get<int>(), 1080);
+  const double convergence = sbx["convergence"].get<double>();
+  EXPECT_GT(convergence, 0.5);
+  EXPECT_LT(convergence, 100.0);
+  const json& persp = g.doc["cameras"][0]["perspective"];
+  const double tan_v = std::tan(0.5 * persp["yfov"].get<double>());
+  const double tan_h = tan_v * persp["aspectRatio"].get<double>();
+  const dmat4 world_from_cam = g.node_world[static_cast<size_t>(cam)];
+  const dmat4 cam_from_world = glm::inverse(world_from_cam);
+  const auto in_view = [&](const vec3& p, double* depth) {
+    const dvec3 c = dvec3(cam_from_world * dvec4(dvec3(p), 1.0));
+    *depth = -c.z;
+    return -c.z > 0.0 && std::fabs(c.x) <= tan_h * -c.z && std::fabs(c.y) <= tan_v * -c.z;
+  };
+  double depth = 0.0;
+  const vec3 centre = b.center();
+  EXPECT_TRUE(in_view(centre, &depth)) << "bounds centre " << centre.x << " " << centre.y << " " << centre.z;
+  size_t front = 0, total = 0;
+  for (const test::ReadPrimitive& p : g.primitives)
+    for (const vec3& v : p.positions) {
+      ++total;
+      (void)in_view(v, &depth);
+      front += depth > persp["znear"].get<double>() ? 1 : 0;
+    }
+  EXPECT_GT(static_cast<double>(front), 0.75 * static_cast<double>(total)) << "most geometry should lie in front of the camera";
+  // Rays through a 7 x 7 grid over the image: most should hit the scene rather than the background.
+  const dvec3 eye(world_from_cam[3]);
+  int hits = 0;
+  for (int j = 0; j < 7; ++j)
+    for (int i = 0; i < 7; ++i) {
+      const double x = (i - 3) / 3.5 * tan_h, y = (j - 3) / 3.5 * tan_v;
+      hits += ray_hits(g, eye, glm::normalize(dvec3(world_from_cam * dvec4(x, y, -1.0, 0.0)))) ? 1 : 0;
+    }
+  EXPECT_GE(hits, 25) << "only " << hits << " of 49 view rays hit the scene";
+}
+
+INSTANTIATE_TEST_SUITE_P(BuiltinScenes, SceneStructure, ::testing::ValuesIn(kExpectedNames),
+                         [](const auto& p) {
+                           std::string s = p.param;
+                           std::replace(s.begin(), s.end(), '-', '_');
+                           return s;
+                         });
+
+// ---------------------------------------------------------------------------------------------
+// The Khronos glTF validator over every built-in scene.
+
+/// Runs a shell command, returning its exit status and output.
+int run(const std::string& command, std::string& output) {
+  output.clear();
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return -1;
+  std::array<char, 4096> buf{};
+  while (fgets(buf.data(), static_cast<int>(buf.size()), pipe) != nullptr) output += buf.data();
+  const int status = pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
+
+class KhronosValidator : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!fs::exists(fs::path(SB_SOURCE_DIR) / "ci" / "node_modules" / "gltf-validator" / "package.json"))
+      // A missing validator is a failure, never a silent pass: ci/test.sh installs it.
+      FAIL() << "the Khronos glTF validator is not installed (ci/node_modules/gltf-validator); "
+                "install it with `bash ci/install-deps.sh validator`";
+    script_ = fs::path(SB_SOURCE_DIR) / "tests" / "tools" / "validate_gltf.mjs";
+  }
+  fs::path script_;
+};
+
+TEST_F(KhronosValidator, EveryBuiltinSceneHasNoErrors) {
+  const ScratchDir dir;
+  std::string command = "node " + quoted(script_);
+  std::printf("%-15s %9s %9s %6s %10s %7s\n", "scene", "triangles", "vertices", "lights", "bytes", "seconds");
+  for (const GeneratorInfo& info : generators()) {
+    if (!info.builtin) continue;
+    const GenerateResult r = generate(info.name, {}, dir / info.file_name);  // complexity at its default 1e5
+    std::printf("%-15s %9zu %9zu %6zu %10zu %7.2f\n", info.name.c_str(), r.triangles, r.vertices, r.lights, r.bytes, r.seconds);
+    command += " " + quoted(dir / info.file_name);
+  }
+  std::string output;
+  const int status = run(command, output);
+  std::printf("%s", output.c_str());
+  EXPECT_EQ(status, 0) << output;
+  for (const GeneratorInfo& info : generators()) {
+    if (info.builtin) {
+      EXPECT_NE(output.find(info.file_name + ": 0 errors"), std::string::npos) << info.name;
+    }
+  }
+}
+
+TEST_F(KhronosValidator, ReportsAnInvalidFile) {
+  const ScratchDir dir;
+  (void)generate("lit-plane", {}, dir / "plane.gltf");
+  json doc = json::parse(file_bytes(dir / "plane.gltf"));
+  doc["meshes"][0]["primitives"][0]["material"] = 9;  // no such material
+  doc["accessors"][0]["min"] = json::array({0, 0, 0});
+  std::ofstream(dir / "broken.gltf") << doc.dump();
+  std::string output;
+  EXPECT_EQ(run("node " + quoted(script_) + " " + quoted(dir / "broken.gltf"), output), 1) << output;
+  EXPECT_NE(output.find("/meshes/0/primitives/0/material"), std::string::npos) << output;
+  EXPECT_NE(output.find("ACCESSOR_MIN_MISMATCH"), std::string::npos) << output;
+}
+
+}  // namespace
+}  // namespace sb::scenes
