@@ -9,6 +9,7 @@
 #include <string>
 
 #include "support/mini_gltf.hpp"
+#include "support/scratch_dir.hpp"
 
 namespace sb {
 namespace {
@@ -44,7 +45,7 @@ TEST(Cli, VersionAndHelp) {
 }
 
 TEST(Cli, BadArgumentsExitWith3AndSayWhy) {
-  test::TempDir dir("cli");
+  test::ScratchDir dir("cli");
   test::MiniGltf g;
   g.add_triangle();
   g.write_gltf(dir / "tri.gltf");
@@ -81,7 +82,7 @@ TEST(Cli, BadArgumentsExitWith3AndSayWhy) {
 }
 
 TEST(Cli, SceneInfoPrintsRigAndDisparities) {
-  test::TempDir dir("cliinfo");
+  test::ScratchDir dir("cliinfo");
   test::MiniGltf g;
   g.add_triangle();
   g.write_gltf(dir / "tri.gltf");

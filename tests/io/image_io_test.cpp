@@ -3,6 +3,8 @@
 // encoding and decoding, and the error paths (missing, corrupt and unwritable files).
 #include <gtest/gtest.h>
 
+#include <memory>
+
 #include <unistd.h>
 
 #include <array>
@@ -22,24 +24,21 @@
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/image_io.hpp"
 
+#include "support/scratch_dir.hpp"
+
 namespace sb {
 namespace {
 
 namespace fs = std::filesystem;
 
-/// A fresh folder per test under the system temporary folder, removed afterwards.
+/// A fresh scratch folder per test.
 class ImageIoTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("sb-image-io-" + std::string(info->name()) + "-" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    scratch_ = std::make_unique<test::ScratchDir>();
+    dir_ = scratch_->path();
   }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
+  void TearDown() override { scratch_.reset(); }
   [[nodiscard]] fs::path path(const std::string& name) const { return dir_ / name; }
   /// Names of the entries in the test folder.
   [[nodiscard]] std::vector<std::string> entries() const {
@@ -49,6 +48,7 @@ class ImageIoTest : public ::testing::Test {
     return names;
   }
 
+  std::unique_ptr<test::ScratchDir> scratch_;
   fs::path dir_;
 };
 

@@ -11,13 +11,14 @@
 #include "renderer/error.hpp"
 #include "renderer/io/gltf_loader.hpp"
 #include "support/mini_gltf.hpp"
+#include "support/scratch_dir.hpp"
 
 namespace sb {
 namespace {
 
 using nlohmann::json;
 using test::MiniGltf;
-using test::TempDir;
+using test::ScratchDir;
 
 struct BadCase {
   std::string name;
@@ -160,7 +161,7 @@ std::pair<int, std::string> run_cli(const std::filesystem::path& scene) {
 }
 
 TEST(BadScenes, EveryCaseIsAClearInputError) {
-  TempDir dir("bad");
+  ScratchDir dir("bad");
   for (const BadCase& bc : corpus()) {
     SCOPED_TRACE(bc.name);
     const auto folder = dir / bc.name;
@@ -181,7 +182,7 @@ TEST(BadScenes, EveryCaseIsAClearInputError) {
 }
 
 TEST(BadScenes, CommandLineExitsWithCode3AndNamesTheFault) {
-  TempDir dir("badcli");
+  ScratchDir dir("badcli");
   for (const BadCase& bc : corpus()) {
     SCOPED_TRACE(bc.name);
     const auto folder = dir / bc.name;
@@ -195,7 +196,7 @@ TEST(BadScenes, CommandLineExitsWithCode3AndNamesTheFault) {
 }
 
 TEST(BadScenes, NonExistentPathAndDirectory) {
-  TempDir dir("nopath");
+  ScratchDir dir("nopath");
   EXPECT_THROW((void)io::load_gltf(dir / "missing.gltf"), InputError);
   EXPECT_THROW((void)io::load_gltf(dir.path()), InputError);
   const auto [code, err] = run_cli(dir / "missing.gltf");

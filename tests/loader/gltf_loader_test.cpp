@@ -9,13 +9,14 @@
 #include "renderer/io/image_io.hpp"
 #include "renderer/rig.hpp"
 #include "support/mini_gltf.hpp"
+#include "support/scratch_dir.hpp"
 
 namespace sb {
 namespace {
 
 using nlohmann::json;
 using test::MiniGltf;
-using test::TempDir;
+using test::ScratchDir;
 
 void expect_vec3(const vec3& a, const vec3& b, float tol = 1e-5f) {
   EXPECT_NEAR(a.x, b.x, tol);
@@ -24,7 +25,7 @@ void expect_vec3(const vec3& a, const vec3& b, float tol = 1e-5f) {
 }
 
 TEST(GltfLoader, NodeHierarchyComposesTransforms) {
-  TempDir dir("hier");
+  ScratchDir dir("hier");
   MiniGltf g;
   const int p = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
   const int m = g.add_mesh(json::array({{{"attributes", {{"POSITION", p}}}}}));
@@ -43,7 +44,7 @@ TEST(GltfLoader, NodeHierarchyComposesTransforms) {
 }
 
 TEST(GltfLoader, MatrixTransformAndNegativeScaleKeepsFacing) {
-  TempDir dir("mat");
+  ScratchDir dir("mat");
   MiniGltf g;
   const int p = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
   const int m = g.add_mesh(json::array({{{"attributes", {{"POSITION", p}}}}}));
@@ -58,7 +59,7 @@ TEST(GltfLoader, MatrixTransformAndNegativeScaleKeepsFacing) {
 }
 
 TEST(GltfLoader, EveryComponentTypeStrideAndNormalisation) {
-  TempDir dir("acc");
+  ScratchDir dir("acc");
   MiniGltf g;
   // Interleaved position (3 floats) + normal (3 normalized bytes + 1 pad) with stride 16.
   struct V { float p[3]; int8_t n[4]; };
@@ -104,7 +105,7 @@ TEST(GltfLoader, EveryComponentTypeStrideAndNormalisation) {
 }
 
 TEST(GltfLoader, SparseAccessorAndAccessorWithoutView) {
-  TempDir dir("sparse");
+  ScratchDir dir("sparse");
   MiniGltf g;
   std::vector<float> base = {0, 0, 0, 1, 0, 0, 0, 1, 0};
   const int pos = g.add_positions(base);
@@ -124,7 +125,7 @@ TEST(GltfLoader, SparseAccessorAndAccessorWithoutView) {
 }
 
 TEST(GltfLoader, StripsAndFansAreTriangulated) {
-  TempDir dir("strip");
+  ScratchDir dir("strip");
   MiniGltf g;
   const int pos = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 2, 0, 0});
   std::vector<uint16_t> idx = {0, 1, 2, 3, 4};
@@ -141,7 +142,7 @@ TEST(GltfLoader, StripsAndFansAreTriangulated) {
 }
 
 TEST(GltfLoader, ExternalEmbeddedAndBinaryContainersAgree) {
-  TempDir dir("forms");
+  ScratchDir dir("forms");
   std::vector<Scene> scenes;
   for (int form = 0; form < 3; ++form) {
     MiniGltf g;
@@ -160,7 +161,7 @@ TEST(GltfLoader, ExternalEmbeddedAndBinaryContainersAgree) {
 }
 
 TEST(GltfLoader, BaseColourFactorAndEmbeddedTextureAreLinear) {
-  TempDir dir("tex");
+  ScratchDir dir("tex");
   MiniGltf g;
   const int pos = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
   std::vector<float> uv = {0, 0, 1, 0, 0, 1};
@@ -196,7 +197,7 @@ TEST(GltfLoader, BaseColourFactorAndEmbeddedTextureAreLinear) {
 }
 
 TEST(GltfLoader, PunctualLightsCameraAndRigExtras) {
-  TempDir dir("lights");
+  ScratchDir dir("lights");
   MiniGltf g;
   g.add_triangle();
   g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
@@ -241,7 +242,7 @@ TEST(GltfLoader, PunctualLightsCameraAndRigExtras) {
 }
 
 TEST(GltfLoader, UnsupportedFeaturesAreNamedOnce) {
-  TempDir dir("unsup");
+  ScratchDir dir("unsup");
   MiniGltf g;
   const int pos = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
   g.doc["materials"] = json::array({{{"normalTexture", {{"index", 0}}}}, {{"normalTexture", {{"index", 0}}}}});

@@ -17,6 +17,7 @@
 
 #include "gltf_reader_support.hpp"
 #include "renderer/error.hpp"
+#include "support/scratch_dir.hpp"
 #include "scenes/generators.hpp"
 
 namespace sb::scenes {
@@ -29,35 +30,8 @@ const std::vector<std::string> kExpectedNames = {"spheres",   "atrium",    "bist
                                                  "dragon",    "complexity", "lit-plane",     "box-wall",
                                                  "thin-pole", "textured-plane", "slanted-plane"};
 
-/// A folder of its own for the running test, under the build tree; removed again when the test
-/// passes (kept for inspection when it fails).
-class ScratchDir {
- public:
-  ScratchDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    std::string name = std::string(info->test_suite_name()) + "." + info->name();
-    std::replace(name.begin(), name.end(), '/', '_');
-    path_ = fs::path(SB_BINARY_DIR) / "Testing" / "scenes" / name;
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ScratchDir(const ScratchDir&) = delete;
-  ScratchDir& operator=(const ScratchDir&) = delete;
-  ~ScratchDir() {
-    std::error_code ec;
-    if (!::testing::Test::HasFailure()) fs::remove_all(path_, ec);
-  }
-  [[nodiscard]] fs::path operator/(const std::string& file) const { return path_ / file; }
-  [[nodiscard]] const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
-std::vector<unsigned char> file_bytes(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using test::ScratchDir;
+using test::file_bytes;
 
 /// Expects `f` to throw InputError whose message contains every one of `parts`.
 template <typename F>
