@@ -115,18 +115,18 @@ void print_info(const InfoArgs& args) {
     fmt::print("cameras    {}\n", scene.cameras.empty() ? std::string("none (rig frames the bounds)") : scene.cameras.front().name);
     const StereoRig rig = resolve_rig(scene, overrides);
     fmt::print("rig        {}\n", describe(rig));
-    // Disparity range over the scene's depth range as seen from the centre camera.
+    // Disparity range over the vertices the centre camera sees.
     const EyeCamera centre = rig.eye(Eye::center);
     double zmin = 1e300, zmax = 0.0;
-    for (int i = 0; i < 8; ++i) {
-      const dvec3 corner((i & 1) ? b.hi.x : b.lo.x, (i & 2) ? b.hi.y : b.lo.y, (i & 4) ? b.hi.z : b.lo.z);
-      const double z = centre.project(corner).z;
-      zmin = std::min(zmin, z);
-      zmax = std::max(zmax, z);
-    }
-    zmin = std::max(zmin, rig.params().znear);
-    if (zmax > zmin)
-      fmt::print("disparity  {:.2f} px (bounds' nearest depth {:.3f} m) .. {:.2f} px (farthest {:.3f} m)\n",
+    for (const Mesh& m : scene.meshes)
+      for (const vec3& p : m.positions) {
+        const dvec3 q = centre.project(dvec3(p));
+        if (q.z < rig.params().znear || q.x < 0.0 || q.y < 0.0 || q.x > centre.width || q.y > centre.height) continue;
+        zmin = std::min(zmin, q.z);
+        zmax = std::max(zmax, q.z);
+      }
+    if (zmax > 0.0)
+      fmt::print("disparity  {:.2f} px at the nearest visible vertex ({:.3f} m) .. {:.2f} px at the farthest ({:.3f} m)\n",
                  rig.disparity_px(zmin), zmin, rig.disparity_px(zmax), zmax);
     fmt::print("loaded in  {:.3f} s\n", load_s);
     for (const std::string& w : scene.warnings) fmt::print("warning    {}\n", w);
