@@ -59,4 +59,21 @@ void add_scenes_dir_option(CLI::App& app, std::string& dir) {
       ->capture_default_str();
 }
 
+std::map<std::string, std::string> parse_key_values(const std::vector<std::string>& items, const char* option) {
+  std::map<std::string, std::string> out;
+  for (const std::string& item : items) {
+    const size_t eq = item.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError(fmt::format("{} '{}' is not NAME=VALUE", option, item));
+    out[item.substr(0, eq)] = item.substr(eq + 1);
+  }
+  return out;
+}
+
+int checked_threads(int threads) {
+  if (threads < 0 || threads > 1024)
+    throw InputError(fmt::format("--threads {} is out of range; give 0 (all cores) or 1..1024", threads));
+  return threads;
+}
+
 }  // namespace sb::cli

@@ -1,7 +1,9 @@
 // Options shared by several subcommands (rig, scene folder), declared once with their help.
 #pragma once
 
+#include <map>
 #include <optional>
+#include <vector>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -25,5 +27,12 @@ struct RigCli {
 
 /// --scenes-dir: where built-in scenes are generated and cached.
 void add_scenes_dir_option(CLI::App& app, std::string& dir);
+
+/// Parses NAME=VALUE items (--option) into a map; InputError for an item without '='.
+[[nodiscard]] std::map<std::string, std::string> parse_key_values(const std::vector<std::string>& items,
+                                                                  const char* option);
+
+/// Checks a --threads value: 0 (all cores) or 1..1024.
+[[nodiscard]] int checked_threads(int threads);
 
 }  // namespace sb::cli

@@ -22,6 +22,8 @@ int main(int argc, char** argv) {
                        fmt::format("stereobench {}\n  {}\n  OpenImageIO {}", SB_VERSION_STRING,
                                    sb::io::gltf_loader_version(), sb::io::oiio_version()));
   sb::cli::register_scenes_command(app);
+  sb::cli::register_render_command(app);
+  sb::cli::register_bench_command(app);
 
   try {
     app.parse(argc, argv);

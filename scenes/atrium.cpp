@@ -204,10 +204,11 @@ void build(const GeneratorContext& ctx, GltfBuilder& b) {
       const mat4 place = translation(bay.centre) * rotation_y(bay.yaw);
       const float r1 = 0.5f * bay.span - capital_half_width(ground_spec);
       append_mesh(panels, make_arch_panel(bay.span, kSlabBottom - kSpring1, r1, 0.6f, 32, 0.5f), place * translation({0.0f, kSpring1, 0.0f}));
-      append_mesh(mouldings, make_arch_ring(r1, r1 + 0.14f, 0.68f, 32, 0.0f, kPiF, 1.0f), place * translation({0.0f, kSpring1, 0.0f}));
+      // The archivolt projects 4 cm below the panel's soffit, so that no two faces coincide.
+      append_mesh(mouldings, make_arch_ring(r1 - 0.04f, r1 + 0.14f, 0.68f, 32, 0.0f, kPiF, 1.0f), place * translation({0.0f, kSpring1, 0.0f}));
       const float r2 = 0.5f * bay.span - capital_half_width(upper_spec);
       append_mesh(panels, make_arch_panel(bay.span, kRoofBottom - kSpring2, r2, 0.45f, 32, 0.5f), place * translation({0.0f, kSpring2, 0.0f}));
-      append_mesh(mouldings, make_arch_ring(r2, r2 + 0.1f, 0.52f, 32, 0.0f, kPiF, 1.0f), place * translation({0.0f, kSpring2, 0.0f}));
+      append_mesh(mouldings, make_arch_ring(r2 - 0.03f, r2 + 0.1f, 0.52f, 32, 0.0f, kPiF, 1.0f), place * translation({0.0f, kSpring2, 0.0f}));
       // Cornice lip under the gallery floor and the parapet on the roof edge.
       append_mesh(mouldings, make_box({-0.5f * bay.span, kSlabBottom + 0.12f, 0.2f}, {0.5f * bay.span, kGallery + 0.05f, 0.55f}, 1.0f), place);
       append_mesh(mouldings, make_box({-0.5f * bay.span, kRoofTop, -0.15f}, {0.5f * bay.span, kWallTop - 0.1f, 0.15f}, 1.0f), place);

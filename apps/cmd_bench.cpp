@@ -1,0 +1,135 @@
+// `stereobench bench`: time pipelines side by side on one scene and rig; medians, min/max per stage,
+// ray throughput and speed-ups against a baseline from the same run.
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "apps/cli_common.hpp"
+#include "apps/commands.hpp"
+#include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
+#include "renderer/io/gltf_loader.hpp"
+#include "renderer/io/render_output.hpp"
+#include "scenes/catalog.hpp"
+#include "validation/benchmark.hpp"
+
+namespace sb::cli {
+
+namespace {
+
+struct BenchArgs {
+  std::string scene = "bistro";
+  std::vector<std::string> pipelines;
+  std::string baseline = "plain-raster";
+  int repetitions = 5;
+  int warmup = 1;
+  int threads = 0;
+  std::vector<std::string> options;
+  std::string json_out;
+  std::string scenes_dir;
+  RigCli rig;
+};
+
+std::vector<std::string> split_names(const std::vector<std::string>& items) {
+  std::vector<std::string> out;
+  for (const std::string& item : items) {
+    std::stringstream ss(item);
+    std::string name;
+    while (std::getline(ss, name, ','))
+      if (!name.empty()) out.push_back(name);
+  }
+  return out;
+}
+
+double peak_rss_mib() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_maxrss / 1024.0;
+}
+
+void run_bench_command(const BenchArgs& a) {
+  const RigOverrides overrides = a.rig.overrides();
+  BenchConfig config;
+  config.pipelines = split_names(a.pipelines);
+  if (config.pipelines.empty())
+    for (const Pipeline* p : pipelines()) config.pipelines.push_back(p->info().name);
+  for (const std::string& n : config.pipelines) (void)find_pipeline(n);
+  config.baseline = a.baseline;
+  if (std::find(config.pipelines.begin(), config.pipelines.end(), config.baseline) == config.pipelines.end())
+    config.pipelines.insert(config.pipelines.begin(), config.baseline);
+  config.repetitions = a.repetitions;
+  config.warmup = a.warmup;
+  for (const auto& [key, value] : parse_key_values(a.options, "--option")) {
+    const size_t dot = key.find('.');
+    if (dot == std::string::npos || dot == 0)
+      throw InputError(fmt::format("--option {}={}: name it PIPELINE.OPTION=VALUE, e.g. plain-raster.tile=32", key, value));
+    config.options[key.substr(0, dot)][key.substr(dot + 1)] = value;
+  }
+  const Executor executor(checked_threads(a.threads));
+  const Scene scene = io::load_gltf(scenes::resolve_scene(a.scene, a.scenes_dir));
+  const StereoRig rig = resolve_rig(scene, overrides);
+  const RenderScene prepared(scene);
+  fmt::print("scene {} ({} triangles), {}, {} threads, {} warm-up + {} repetitions\n", scene.name,
+             scene.triangle_count(), describe(rig), executor.threads(), a.warmup, a.repetitions);
+  fmt::print("bvh build {:.1f} ms, {:.1f} MiB\n", prepared.bvh_build_seconds() * 1e3,
+             prepared.rays().memory_bytes() / 1048576.0);
+  const BenchResult r = run_bench(prepared, rig, config, executor,
+                                  [](const std::string& line) { fmt::print(stderr, "  {}\n", line); });
+
+  fmt::print("\n{:<16} {:>11} {:>11} {:>11} {:>9} {:>13} {:>13}\n", "pipeline", "median ms", "min ms", "max ms",
+             "speed-up", "Mrays/s", "Mprimary/s");
+  for (const PipelineBench& b : r.pipelines) {
+    const Summary t = summarize(b.total_seconds);
+    auto counter = [&](const char* n) { auto it = b.counters.find(n); return it == b.counters.end() ? 0.0 : double(it->second); };
+    const double primary = counter("primary_rays"), shadow = counter("shadow_rays");
+    fmt::print("{:<16} {:>11.2f} {:>11.2f} {:>11.2f} {:>8.2f}x {:>13.2f} {:>13.2f}\n", b.name, t.median * 1e3,
+               t.min * 1e3, t.max * 1e3, b.speedup.median, (primary + shadow) / t.median * 1e-6,
+               primary / t.median * 1e-6);
+  }
+  fmt::print("\nper-stage medians (min..max), ms\n");
+  for (const PipelineBench& b : r.pipelines) {
+    fmt::print("{}\n", b.name);
+    for (const std::string& st : b.stage_order) {
+      const Summary s = summarize(b.stage_seconds.at(st));
+      fmt::print("  {:<22} {:>10.2f} ({:.2f}..{:.2f})\n", st, s.median * 1e3, s.min * 1e3, s.max * 1e3);
+    }
+  }
+  fmt::print("\nspeed-up = median over repetitions of {}'s total / the pipeline's total, paired per repetition\n",
+             r.baseline);
+  fmt::print("peak resident memory {:.0f} MiB\n", peak_rss_mib());
+  if (!a.json_out.empty()) {
+    nlohmann::json j = bench_to_json(r);
+    j["scene"] = {{"name", scene.name}, {"path", scene.path}, {"triangles", scene.triangle_count()}};
+    j["rig"] = io::rig_to_json(rig);
+    j["bvh"] = {{"build_s", prepared.bvh_build_seconds()}, {"memory_bytes", prepared.rays().memory_bytes()}};
+    j["peak_rss_mib"] = peak_rss_mib();
+    j["versions"] = io::versions_json();
+    io::write_text_atomically(a.json_out, j.dump(2) + "\n");
+    fmt::print("wrote {}\n", a.json_out);
+  }
+}
+
+}  // namespace
+
+void register_bench_command(CLI::App& root) {
+  auto a = std::make_shared<BenchArgs>();
+  CLI::App* b = root.add_subcommand("bench", "Time pipelines side by side: medians per stage, throughput, speed-ups");
+  b->add_option("--scene,-s", a->scene, "Scene file (.gltf/.glb) or built-in scene name")->capture_default_str();
+  b->add_option("--pipelines,-p", a->pipelines, "Pipelines to time, comma-separated (default: all registered)");
+  b->add_option("--baseline,-b", a->baseline, "Pipeline the speed-ups are measured against")->capture_default_str();
+  b->add_option("--repetitions,-n", a->repetitions, "Timed repetitions per pipeline")->capture_default_str();
+  b->add_option("--warmup,-w", a->warmup, "Untimed warm-up runs per pipeline")->capture_default_str();
+  b->add_option("--threads,-t", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
+  b->add_option("--option,-o", a->options, "Pipeline option PIPELINE.NAME=VALUE");
+  b->add_option("--json", a->json_out, "Also write the results (with raw samples) to this JSON file");
+  add_scenes_dir_option(*b, a->scenes_dir);
+  a->rig.add_to(*b);
+  b->callback([a] { run_bench_command(*a); });
+}
+
+}  // namespace sb::cli

@@ -1,0 +1,90 @@
+// The pipeline interface and registry. A pipeline is one file in renderer/pipelines/ that
+// registers itself by name (SB_REGISTER_PIPELINE) and describes itself; the harness owns the
+// loop, threads, timing and I/O.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "renderer/image.hpp"
+#include "renderer/parallel.hpp"
+#include "renderer/render_scene.hpp"
+#include "renderer/rig.hpp"
+#include "renderer/stats.hpp"
+
+namespace sb {
+
+/// One option a pipeline accepts, with its default and help.
+struct OptionSpec {
+  std::string name;
+  std::string default_value;
+  std::string help;
+};
+
+/// What a pipeline is: its source paper and section, its options, and the tolerance the
+/// conformance test holds it to against plain-rt.
+struct PipelineInfo {
+  std::string name;
+  std::string paper;     ///< e.g. "Al-Hagri 2012"
+  std::string section;   ///< e.g. "3.1.1 (naive)"
+  std::string summary;   ///< one line
+  std::vector<OptionSpec> options;
+  double min_psnr_left = 50.0;   ///< dB against plain-rt's left eye on the analytic scenes
+  double min_psnr_right = 50.0;  ///< dB against plain-rt's right eye on the analytic scenes
+};
+
+/// Options after checking: every key is one the pipeline declared (InputError otherwise, naming
+/// the key and listing the valid ones); missing keys take their defaults.
+class PipelineOptions {
+ public:
+  PipelineOptions() = default;
+  PipelineOptions(const PipelineInfo& info, const std::map<std::string, std::string>& given);
+
+  [[nodiscard]] const std::string& get(const std::string& name) const;
+  [[nodiscard]] double get_double(const std::string& name) const;
+  [[nodiscard]] int get_int(const std::string& name) const;
+  [[nodiscard]] bool get_bool(const std::string& name) const;
+  [[nodiscard]] const std::map<std::string, std::string>& values() const { return values_; }
+
+ private:
+  std::string pipeline_;
+  std::map<std::string, std::string> values_;
+};
+
+/// A pipeline's output: both eyes with AOVs and source tags, per-stage timings and counters.
+struct StereoResult {
+  Image left;
+  Image right;
+  Timings timings;
+  Counters counters;
+};
+
+/// What the harness hands a pipeline besides scene, rig and options.
+struct RenderContext {
+  const Executor& executor;
+};
+
+class Pipeline {
+ public:
+  virtual ~Pipeline() = default;
+  [[nodiscard]] virtual const PipelineInfo& info() const = 0;
+  [[nodiscard]] virtual StereoResult render(const RenderScene& scene, const StereoRig& rig,
+                                            const PipelineOptions& options, const RenderContext& ctx) const = 0;
+};
+
+/// Every registered pipeline, sorted by name.
+[[nodiscard]] std::vector<const Pipeline*> pipelines();
+/// The pipeline of that name; InputError listing the registered names otherwise.
+[[nodiscard]] const Pipeline& find_pipeline(const std::string& name);
+
+/// Adds a pipeline to the registry at static-initialisation time.
+struct PipelineRegistration {
+  explicit PipelineRegistration(std::unique_ptr<Pipeline> pipeline);
+};
+
+#define SB_REGISTER_PIPELINE(Type) \
+  static const ::sb::PipelineRegistration sb_pipeline_registration_##Type{std::make_unique<Type>()}
+
+}  // namespace sb

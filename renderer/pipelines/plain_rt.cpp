@@ -1,0 +1,42 @@
+// plain-rt: both eyes fully ray traced (Al-Hagri's naive stereo ray tracer); also the built-in
+// ground truth.
+#include "renderer/pipeline.hpp"
+#include "renderer/stages/eye_image.hpp"
+#include "renderer/stages/trace.hpp"
+
+namespace sb {
+namespace {
+
+class PlainRt final : public Pipeline {
+ public:
+  const PipelineInfo& info() const override {
+    static const PipelineInfo i{
+        "plain-rt", "Al-Hagri 2012", "3.1 (naive stereo ray tracer)",
+        "trace primary rays for each eye and shade them; the built-in ground truth", {}, 200.0, 200.0};
+    return i;
+  }
+
+  StereoResult render(const RenderScene& scene, const StereoRig& rig, const PipelineOptions&,
+                      const RenderContext& ctx) const override {
+    StereoResult r;
+    const int w = rig.params().width, h = rig.params().height;
+    for (Eye e : {Eye::left, Eye::right}) {
+      const char* name = eye_name(e);
+      Image image = make_eye_image(w, h);
+      TraceCounts counts;
+      {
+        ScopedStage stage(r.timings, std::string(name) + "_trace");
+        trace_eye(scene, rig.eye(e), ctx.executor, image, counts);
+      }
+      add_counts(r.counters, counts, name, true);
+      (e == Eye::left ? r.left : r.right) = std::move(image);
+    }
+    r.counters.set("hole_pixels", 0);
+    return r;
+  }
+};
+
+SB_REGISTER_PIPELINE(PlainRt);
+
+}  // namespace
+}  // namespace sb

@@ -1,0 +1,50 @@
+// The software rasterizer: multi-threaded tile binning, near-plane clipping, top-left fill rule,
+// perspective-correct barycentrics, depth test; writes a visibility G-buffer for one eye.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "renderer/math.hpp"
+#include "renderer/parallel.hpp"
+#include "renderer/rig.hpp"
+#include "renderer/scene_geometry.hpp"
+
+namespace sb {
+
+/// Visibility at pixel centres (x + 0.5, y + 0.5) in the eye's pixel coordinates (EyeCamera).
+struct GBuffer {
+  int width = 0;
+  int height = 0;
+  std::vector<float> depth;     ///< linear view depth (distance along -Z); +inf where nothing is visible
+  std::vector<uint32_t> prim;   ///< global triangle id (SceneGeometry), kNoPrimitiveId where empty
+  std::vector<vec2> bary;       ///< perspective-correct (b1, b2): p = (1-b1-b2) v0 + b1 v1 + b2 v2
+  std::vector<vec4> duv;        ///< (du/dx, dv/dx, du/dy, dv/dy) of the mesh UVs per pixel; 0 without UVs
+
+  [[nodiscard]] size_t index(int x, int y) const { return static_cast<size_t>(y) * width + x; }
+};
+
+/// What the rasterizer did, for the pipeline counters.
+struct RasterStats {
+  uint64_t triangles_submitted = 0;
+  uint64_t culled_backface = 0;
+  uint64_t culled_frustum = 0;
+  uint64_t clipped_near = 0;          ///< triangles that crossed the near plane and were clipped
+  uint64_t triangles_rasterized = 0;  ///< triangles (after clipping) that reached the tiles
+  uint64_t fragments_tested = 0;
+  uint64_t fragments_written = 0;
+};
+
+struct RasterOptions {
+  int tile = 64;
+  /// When set (width*height entries), only pixels whose mask is non-zero are written: the stencil
+  /// of re-rasterized hole filling. Every triangle is still processed.
+  const uint8_t* write_mask = nullptr;
+};
+
+/// Rasterizes every triangle of the scene from `eye`. Deterministic for any thread count: the
+/// nearest depth wins, exact depth ties go to the lower triangle id.
+[[nodiscard]] GBuffer rasterize(const SceneGeometry& geometry, const EyeCamera& eye, const Executor& executor,
+                                const RasterOptions& options = {}, RasterStats* stats = nullptr);
+
+}  // namespace sb

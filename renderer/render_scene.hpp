@@ -1,0 +1,40 @@
+// A scene prepared for rendering: global triangle ids, the Embree BVH and the textures' mip chains,
+// built once and shared by every pipeline and every repetition.
+#pragma once
+
+#include <vector>
+
+#include "renderer/embree/ray_scene.hpp"
+#include "renderer/scene.hpp"
+#include "renderer/scene_geometry.hpp"
+#include "renderer/texture.hpp"
+
+namespace sb {
+
+class RenderScene {
+ public:
+  explicit RenderScene(const Scene& scene);
+  RenderScene(const RenderScene&) = delete;
+  RenderScene& operator=(const RenderScene&) = delete;
+
+  [[nodiscard]] const Scene& scene() const { return *scene_; }
+  [[nodiscard]] const SceneGeometry& geometry() const { return geometry_; }
+  [[nodiscard]] const RayScene& rays() const { return rays_; }
+  [[nodiscard]] const MipTexture& texture(int index) const { return textures_[static_cast<size_t>(index)]; }
+  /// Seconds spent building the BVH and the mip chains.
+  [[nodiscard]] double bvh_build_seconds() const { return rays_.build_seconds(); }
+  [[nodiscard]] double texture_build_seconds() const { return texture_seconds_; }
+  /// A length below the float resolution of the scene's coordinates times a safety factor: the
+  /// offset of shadow-ray origins.
+  [[nodiscard]] float ray_epsilon() const { return ray_epsilon_; }
+
+ private:
+  const Scene* scene_;
+  SceneGeometry geometry_;
+  RayScene rays_;
+  std::vector<MipTexture> textures_;
+  double texture_seconds_ = 0.0;
+  float ray_epsilon_ = 1e-4f;
+};
+
+}  // namespace sb

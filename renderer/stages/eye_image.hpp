@@ -1,0 +1,55 @@
+// An eye's output image with the standard AOV planes, and a writer that fills one pixel of all of
+// them at once.
+#pragma once
+
+#include <limits>
+
+#include "renderer/image.hpp"
+#include "renderer/shading.hpp"
+
+namespace sb {
+
+/// A width x height image with planes rgb, depth, normal, albedo, primid and source.
+[[nodiscard]] Image make_eye_image(int width, int height);
+
+/// Cached plane pointers of an eye image for per-pixel writes from parallel loops (each pixel is
+/// written by one task only).
+class EyeWriter {
+ public:
+  explicit EyeWriter(Image& image);
+
+  /// A visible surface.
+  void surface(size_t index, const SurfacePoint& p, const vec3& radiance, const vec3& albedo, float depth,
+               Source source) {
+    set3(rgb_, index, radiance);
+    set3(normal_, index, p.shading_normal);
+    set3(albedo_, index, albedo);
+    depth_[index] = depth;
+    prim_[index] = p.prim;
+    source_[index] = static_cast<uint32_t>(source);
+  }
+  /// A ray or pixel that sees no geometry: the background.
+  void background(size_t index, const vec3& background, Source source) {
+    set3(rgb_, index, background);
+    set3(normal_, index, vec3(0.0f));
+    set3(albedo_, index, vec3(0.0f));
+    depth_[index] = std::numeric_limits<float>::infinity();
+    prim_[index] = kNoPrimitive;
+    source_[index] = static_cast<uint32_t>(source);
+  }
+
+ private:
+  static void set3(float* plane, size_t index, const vec3& v) {
+    plane[index * 3 + 0] = v.x;
+    plane[index * 3 + 1] = v.y;
+    plane[index * 3 + 2] = v.z;
+  }
+  float* rgb_;
+  float* normal_;
+  float* albedo_;
+  float* depth_;
+  uint32_t* prim_;
+  uint32_t* source_;
+};
+
+}  // namespace sb

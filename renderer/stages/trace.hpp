@@ -1,0 +1,41 @@
+// Ray-traced shading of an eye's pixels: a whole image in 4x4 packets, or any list of pixels
+// (the hole fillers), each traced from the eye through its pixel centre and shaded by shade().
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include "renderer/image.hpp"
+#include "renderer/parallel.hpp"
+#include "renderer/render_scene.hpp"
+#include "renderer/rig.hpp"
+
+namespace sb {
+
+/// Rays cast by a tracing stage.
+struct TraceCounts {
+  uint64_t primary_rays = 0;
+  uint64_t shadow_rays = 0;
+  uint64_t pixels_shaded = 0;
+};
+
+/// Traces and shades every pixel of `image` (made by make_eye_image) from `eye`; source = traced.
+void trace_eye(const RenderScene& scene, const EyeCamera& eye, const Executor& executor, Image& image,
+               TraceCounts& counts);
+
+/// Traces and shades the listed pixels (indices y * width + x) only; the others are left as they
+/// are. Pixels are traced in packets of 16 in list order, so any list gives the same result per pixel
+/// as trace_eye.
+void trace_pixels(const RenderScene& scene, const EyeCamera& eye, const Executor& executor,
+                  std::span<const uint32_t> pixels, Image& image, TraceCounts& counts, Source source = Source::traced);
+
+}  // namespace sb
+
+namespace sb {
+
+class Counters;
+/// Adds trace counts to a pipeline's counters: primary_rays and shadow_rays (totals) and
+/// pixels_shaded_<eye>; with `traced` also pixels_traced_<eye>.
+void add_counts(Counters& counters, const TraceCounts& counts, const char* eye, bool traced);
+
+}  // namespace sb

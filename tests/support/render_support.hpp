@@ -1,0 +1,55 @@
+// Test helpers for rendering: built-in scenes from a shared cache under the build tree, a pipeline
+// run at a chosen resolution and thread count, and a simple PSNR on sRGB-encoded 8-bit values.
+#pragma once
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <string>
+
+#include "renderer/color.hpp"
+#include "renderer/io/gltf_loader.hpp"
+#include "renderer/pipeline.hpp"
+#include "scenes/catalog.hpp"
+
+namespace sb::test {
+
+/// A built-in scene, generated once into the build tree and shared by the tests.
+inline Scene load_builtin(const std::string& name) {
+  const std::filesystem::path cache = std::filesystem::path(SB_BINARY_DIR) / "Testing" / "scenes-cache";
+  return io::load_gltf(scenes::resolve_scene(name, cache));
+}
+
+/// The scene's default rig at another resolution.
+inline StereoRig rig_at(const Scene& scene, int width, int height) {
+  RigOverrides o;
+  o.width = width;
+  o.height = height;
+  return resolve_rig(scene, o);
+}
+
+inline StereoResult render_with(const std::string& pipeline, const RenderScene& scene, const StereoRig& rig,
+                                int threads = 0, const std::map<std::string, std::string>& options = {}) {
+  const Pipeline& p = find_pipeline(pipeline);
+  const Executor executor(threads);
+  return p.render(scene, rig, PipelineOptions(p.info(), options), RenderContext{executor});
+}
+
+/// PSNR of the sRGB-encoded 8-bit rgb planes (infinity for identical images).
+inline double psnr_srgb8(const Image& a, const Image& b) {
+  const float* pa = a.data_f32(planes::rgb);
+  const float* pb = b.data_f32(planes::rgb);
+  const size_t n = a.pixel_count() * 3;
+  double se = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    const double d = double(linear_to_srgb8(pa[i])) - double(linear_to_srgb8(pb[i]));
+    se += d * d;
+  }
+  if (se == 0.0) return std::numeric_limits<double>::infinity();
+  return 10.0 * std::log10(255.0 * 255.0 / (se / double(n)));
+}
+
+/// True when every plane of the two images is bitwise equal.
+inline bool bit_identical(const Image& a, const Image& b) { return a == b; }
+
+}  // namespace sb::test

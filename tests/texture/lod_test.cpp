@@ -1,0 +1,263 @@
+// The two level-of-detail rules of DESIGN §3 — screen-space UV derivatives (raster) and ray cones
+// (ray tracing) — on analytic textured planes, where both can be computed exactly at a pixel; the
+// raster and ray-traced paths must pick the same mip level within +-0.5.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "renderer/error.hpp"
+#include "renderer/texture.hpp"
+
+namespace sb {
+namespace {
+
+/// DESIGN §3's agreement tolerance between the raster and the ray-traced LOD, in mip levels.
+constexpr double kAgreement = 0.5;
+
+/// A pinhole camera at the origin looking down -Z with +Y up (DESIGN §2): pixel x to the right,
+/// y down, the principal point at the image centre, f_px = (H / 2) / tan(vfov / 2).
+struct PinholeCamera {
+  int width = 1920;
+  int height = 1080;
+  double vfov = 0.0;
+  double f_px = 0.0;
+
+  PinholeCamera(int w, int h, double vfov_degrees)
+      : width(w), height(h), vfov(degrees_to_radians(vfov_degrees)), f_px(0.5 * h / std::tan(0.5 * vfov)) {}
+
+  /// Ray direction through continuous pixel (x, y), scaled to view depth 1 (its z is -1).
+  [[nodiscard]] dvec3 direction(double x, double y) const {
+    return {(x - 0.5 * width) / f_px, -(y - 0.5 * height) / f_px, -1.0};
+  }
+};
+
+/// An infinite plane through q with unit normal n and orthonormal in-plane axes t1, t2, textured
+/// with u = (p - q).t1 / size_u, v = (p - q).t2 / size_v on a tex_w x tex_h texture.
+struct TexturedPlane {
+  dvec3 q{0.0};
+  dvec3 n{0.0, 0.0, 1.0};
+  dvec3 t1{1.0, 0.0, 0.0};
+  dvec3 t2{0.0, -1.0, 0.0};
+  double size_u = 1.0;
+  double size_v = 1.0;
+  int tex_w = 1024;
+  int tex_h = 1024;
+
+  /// A plane crossing the optical axis at `distance`, facing the camera and then tilted by `tilt`
+  /// degrees about the in-image axis at `axis_angle` degrees from the screen x axis; the texture
+  /// is turned by `uv_rotation` degrees within the plane.
+  static TexturedPlane tilted(double distance, double tilt, double axis_angle, double uv_rotation = 0.0) {
+    const double psi = degrees_to_radians(axis_angle);
+    const dquat tilt_q = glm::angleAxis(degrees_to_radians(tilt), dvec3(std::cos(psi), std::sin(psi), 0.0));
+    const dquat turn_q = glm::angleAxis(degrees_to_radians(uv_rotation), dvec3(0.0, 0.0, 1.0));
+    const dmat3 r = glm::mat3_cast(tilt_q * turn_q);
+    TexturedPlane p;
+    p.q = {0.0, 0.0, -distance};
+    p.n = r * dvec3(0.0, 0.0, 1.0);
+    p.t1 = r * dvec3(1.0, 0.0, 0.0);
+    p.t2 = r * dvec3(0.0, -1.0, 0.0);
+    return p;
+  }
+};
+
+/// Every LOD of one pixel, in mip levels.
+struct PixelLods {
+  bool visible = false;
+  double view_angle = 0.0;      ///< degrees between the primary ray and the plane's normal
+  double cos_phi = 1.0;         ///< cosine of the angle between the primary ray and the optical axis
+  double derivative = 0.0;      ///< lod_from_derivatives (the rule the raster path uses)
+  double opengl = 0.0;          ///< OpenGL: longer of the two Jacobian columns
+  double geometric_mean = 0.0;  ///< sqrt |det J|
+  double minor_axis = 0.0;      ///< smallest singular value of J
+  double cone = 0.0;            ///< lod_from_ray_cone with W = t alpha (Ray Tracing Gems ch. 20)
+  double cone_corrected = 0.0;  ///< lod_from_ray_cone with W = t alpha cos^1.5(phi) (texture.hpp)
+  double cone_cos2 = 0.0;       ///< lod_from_ray_cone with W = t alpha cos^2(phi) (exact head-on)
+};
+
+/// Both rules at the centre of pixel (x, y), from the exact screen derivatives of the plane's UVs
+/// and the exact hit distance and angle of the primary ray.
+PixelLods lods_at(const PinholeCamera& cam, const TexturedPlane& plane, double x, double y) {
+  PixelLods out;
+  const dvec3 d = cam.direction(x, y);
+  const double nd = glm::dot(plane.n, d);
+  if (std::fabs(nd) < 1e-12) return out;
+  const double z = glm::dot(plane.n, plane.q) / nd;  // view depth of the hit (d has z = -1)
+  if (z <= 0.0) return out;
+  out.visible = true;
+
+  // Screen derivatives of the hit point p(x, y) = z(x, y) d(x, y): with dd/dx = e_x / f and
+  // dd/dy = -e_y / f, dp/dx = (z / f) (e_x - (n.e_x / n.d) d), and the same for y.
+  const dvec3 ex(1.0, 0.0, 0.0), ey(0.0, -1.0, 0.0);
+  const dvec3 dp_dx = (z / cam.f_px) * (ex - (glm::dot(plane.n, ex) / nd) * d);
+  const dvec3 dp_dy = (z / cam.f_px) * (ey - (glm::dot(plane.n, ey) / nd) * d);
+  const double du_dx = glm::dot(dp_dx, plane.t1) / plane.size_u, dv_dx = glm::dot(dp_dx, plane.t2) / plane.size_v;
+  const double du_dy = glm::dot(dp_dy, plane.t1) / plane.size_u, dv_dy = glm::dot(dp_dy, plane.t2) / plane.size_v;
+  out.derivative = lod_from_derivatives(vec4(du_dx, dv_dx, du_dy, dv_dy), plane.tex_w, plane.tex_h);
+
+  // The alternative choices of rho, from the same texel-space Jacobian.
+  const dvec2 col_x(du_dx * plane.tex_w, dv_dx * plane.tex_h), col_y(du_dy * plane.tex_w, dv_dy * plane.tex_h);
+  const double det = std::fabs(col_x.x * col_y.y - col_x.y * col_y.x);
+  const double e = glm::dot(col_x, col_x), g = glm::dot(col_y, col_y), f = glm::dot(col_x, col_y);
+  const double sigma_max = std::sqrt(0.5 * (e + g) + std::sqrt(0.25 * (e - g) * (e - g) + f * f));
+  out.opengl = std::log2(std::max(glm::length(col_x), glm::length(col_y)));
+  out.geometric_mean = 0.5 * std::log2(det);
+  out.minor_axis = std::log2(det / sigma_max);
+
+  // The ray cone of the primary ray through the same pixel, hitting a triangle of the plane.
+  const dvec3 p0 = plane.q, p1 = plane.q + plane.size_u * plane.t1, p2 = plane.q + plane.size_v * plane.t2;
+  const float triangle = ray_cone_triangle_lod(vec3(p0), vec3(p1), vec3(p2), vec2(0.0f, 0.0f), vec2(1.0f, 0.0f),
+                                               vec2(0.0f, 1.0f), plane.tex_w, plane.tex_h);
+  const double t = z * glm::length(d);
+  const double abs_cos = std::fabs(nd) / glm::length(d);
+  const double alpha = ray_cone_spread(cam.vfov, cam.height);
+  out.cos_phi = 1.0 / glm::length(d);
+  out.view_angle = radians_to_degrees(std::acos(std::min(1.0, abs_cos)));
+  out.cone = lod_from_ray_cone(triangle, static_cast<float>(t * alpha), static_cast<float>(abs_cos));
+  out.cone_corrected = lod_from_ray_cone(triangle, static_cast<float>(t * alpha * std::pow(out.cos_phi, 1.5)),
+                                         static_cast<float>(abs_cos));
+  out.cone_cos2 = lod_from_ray_cone(triangle, static_cast<float>(t * alpha * out.cos_phi * out.cos_phi),
+                                    static_cast<float>(abs_cos));
+  return out;
+}
+
+const std::vector<double> kTilts = {0, 10, 20, 30, 40, 50, 60, 70, 75, 80};
+const std::vector<double> kAxes = {0, 30, 45, 60, 90};  // tilt axis on screen, degrees from x
+
+TEST(LodFromDerivatives, IsLog2OfTheFootprintMajorAxisInTexels) {
+  // Two texels per pixel along both axes: level 1.
+  EXPECT_FLOAT_EQ(lod_from_derivatives(vec4(2.0f / 256, 0.0f, 0.0f, 2.0f / 128), 256, 128), 1.0f);
+  // Axis-aligned anisotropy: the longer axis counts (4 texels in u, 1 in v).
+  EXPECT_FLOAT_EQ(lod_from_derivatives(vec4(4.0f / 64, 0.0f, 0.0f, 1.0f / 64), 64, 64), 2.0f);
+  // Magnification: a quarter texel per pixel.
+  EXPECT_FLOAT_EQ(lod_from_derivatives(vec4(0.25f / 64, 0.0f, 0.0f, 0.25f / 64), 64, 64), -2.0f);
+  // No UV variation: -inf (sampling clamps to level 0).
+  EXPECT_EQ(lod_from_derivatives(vec4(0.0f), 64, 64), -std::numeric_limits<float>::infinity());
+  // Turning the footprint on screen does not change the level: a 4 x 1 texel footprint whose long
+  // axis lies along the screen diagonal. The OpenGL rule would give log2(sqrt(8.5)) = 1.54 here.
+  const float c = std::sqrt(0.5f);
+  const vec4 diagonal(4.0f * c / 64, -1.0f * c / 64, 4.0f * c / 64, 1.0f * c / 64);
+  EXPECT_NEAR(lod_from_derivatives(diagonal, 64, 64), 2.0f, 1e-6f);
+  EXPECT_THROW((void)lod_from_derivatives(vec4(1.0f), 0, 64), InputError);
+}
+
+TEST(RayCone, SpreadIsTheAngleOfOnePixelOnTheOpticalAxis) {
+  const PinholeCamera cam(1920, 1080, 40.0);
+  EXPECT_NEAR(ray_cone_spread(cam.vfov, cam.height), std::atan(1.0 / cam.f_px), 1e-15);
+  EXPECT_NEAR(ray_cone_spread(degrees_to_radians(90.0), 2), std::atan(1.0), 1e-15);
+  EXPECT_THROW((void)ray_cone_spread(0.0, 1080), InputError);
+  EXPECT_THROW((void)ray_cone_spread(kPi, 1080), InputError);
+  EXPECT_THROW((void)ray_cone_spread(1.0, 0), InputError);
+}
+
+TEST(RayCone, TriangleLodIsHalfLog2OfTheAreaRatio) {
+  // Legs of 2 m carrying uv legs of 1 on a 512 x 256 texture: t_a = 512 * 256, p_a = 4.
+  const vec3 p0(1.0f, 2.0f, 3.0f), p1 = p0 + vec3(2.0f, 0.0f, 0.0f), p2 = p0 + vec3(0.0f, 0.0f, -2.0f);
+  const vec2 a(0.25f, 0.5f), b = a + vec2(1.0f, 0.0f), c = a + vec2(0.0f, 1.0f);
+  EXPECT_FLOAT_EQ(ray_cone_triangle_lod(p0, p1, p2, a, b, c, 512, 256), 0.5f * std::log2(512.0f * 256.0f / 4.0f));
+  // Winding does not matter.
+  EXPECT_FLOAT_EQ(ray_cone_triangle_lod(p0, p2, p1, a, b, c, 512, 256),
+                  ray_cone_triangle_lod(p0, p1, p2, a, b, c, 512, 256));
+  // Degenerate UVs: -inf (level 0); degenerate positions with valid UVs: +inf (coarsest level).
+  EXPECT_EQ(ray_cone_triangle_lod(p0, p1, p2, a, a, c, 512, 256), -std::numeric_limits<float>::infinity());
+  EXPECT_EQ(ray_cone_triangle_lod(p0, p0, p2, a, b, c, 512, 256), std::numeric_limits<float>::infinity());
+}
+
+TEST(RayCone, LodAddsWidthAndAngleTerms) {
+  EXPECT_FLOAT_EQ(lod_from_ray_cone(2.0f, 0.25f, 0.5f), 2.0f - 2.0f + 1.0f);
+  // Width and cosine are used as magnitudes (a cone's width can turn negative past a focus).
+  EXPECT_FLOAT_EQ(lod_from_ray_cone(2.0f, -0.25f, -0.5f), 1.0f);
+  EXPECT_EQ(lod_from_ray_cone(2.0f, 0.0f, 1.0f), -std::numeric_limits<float>::infinity());
+}
+
+TEST(LodAgreement, HeadOnPlaneOnTheOpticalAxisGivesTheSameLevel) {
+  // A plane facing the camera at distance D: one pixel covers D / f_px metres, i.e.
+  // (tex_w / size_u) D / f_px texels, so both rules must give log2 of that exactly.
+  const PinholeCamera cam(1920, 1080, 40.0);
+  for (const double distance : {0.5, 3.0, 40.0})
+    for (const bool square : {true, false}) {
+      TexturedPlane plane = TexturedPlane::tilted(distance, 0.0, 0.0);
+      if (!square) {  // a 2048 x 512 texture stretched over 4 m x 1 m: still 512 texels per metre
+        plane.tex_w = 2048;
+        plane.tex_h = 512;
+        plane.size_u = 4.0;
+      }
+      const PixelLods l = lods_at(cam, plane, 959.5, 539.5);
+      ASSERT_TRUE(l.visible);
+      const double expected = std::log2(plane.tex_w / plane.size_u * distance / cam.f_px);
+      EXPECT_NEAR(l.derivative, expected, 1e-4) << "distance " << distance;
+      EXPECT_NEAR(l.cone, expected, 1e-4) << "distance " << distance;
+      EXPECT_NEAR(l.cone - l.derivative, 0.0, 1e-4) << "distance " << distance;
+    }
+}
+
+TEST(LodAgreement, TiltedPlaneOnTheOpticalAxis) {
+  // For each tilt up to 80 degrees, tilt axes across the screen and a texture turned within the
+  // plane, the largest |cone - rule| at the centre pixel for every choice of rho.
+  const PinholeCamera cam(1920, 1080, 40.0);
+  fmt::print("centre pixel, max |ray cone - rule| in levels (vfov 40, 1920x1080)\n");
+  fmt::print("{:>6} {:>12} {:>12} {:>12} {:>12}\n", "tilt", "implemented", "opengl-max", "geo-mean", "minor-axis");
+  for (const double tilt : kTilts) {
+    double worst[4] = {0.0, 0.0, 0.0, 0.0};
+    for (const double axis : kAxes)
+      for (const double uv_rotation : {0.0, 30.0}) {
+        const PixelLods l = lods_at(cam, TexturedPlane::tilted(3.0, tilt, axis, uv_rotation), 959.5, 539.5);
+        ASSERT_TRUE(l.visible);
+        worst[0] = std::max(worst[0], std::fabs(l.cone - l.derivative));
+        worst[1] = std::max(worst[1], std::fabs(l.cone - l.opengl));
+        worst[2] = std::max(worst[2], std::fabs(l.cone - l.geometric_mean));
+        worst[3] = std::max(worst[3], std::fabs(l.cone - l.minor_axis));
+
+        // The OpenGL rule falls short of the footprint's major axis when the tilt is not along a
+        // pixel axis: by 0.5 log2((cos^2 + 1) / 2) for a diagonal tilt (-> 0.5 at grazing angles).
+        const double c = std::cos(degrees_to_radians(tilt));
+        if (axis == 45.0 && uv_rotation == 0.0) {
+          EXPECT_NEAR(l.opengl - l.cone, 0.5 * std::log2((c * c + 1.0) / 2.0), 1e-3) << "tilt " << tilt;
+        }
+      }
+    fmt::print("{:>6.0f} {:>12.4f} {:>12.4f} {:>12.4f} {:>12.4f}\n", tilt, worst[0], worst[1], worst[2], worst[3]);
+    EXPECT_LE(worst[0], kAgreement) << "tilt " << tilt;
+    EXPECT_LE(worst[0], 1e-3) << "tilt " << tilt << ": the major axis should equal the cone exactly here";
+  }
+}
+
+TEST(LodAgreement, AcrossTheFrame) {
+  // A 9 x 7 grid of pixel centres covering the whole frame (corners included), tilts up to 80
+  // degrees about several screen axes; pixels that see the plane at more than 80 degrees from its
+  // normal are left out. With RTG's constant primary spread the cone picks coarser levels off the
+  // optical axis, -2 log2 cos(phi) for a head-on plane, whatever rho the rasterizer uses. The
+  // table also shows the primary widths t alpha cos^2(phi) and t alpha cos^1.5(phi) and the OpenGL
+  // max-axis rule; with cos^1.5, the one texture.hpp recommends, the paths agree within +-0.5.
+  for (const double vfov : {40.0, 60.0}) {
+    const PinholeCamera cam(1920, 1080, vfov);
+    fmt::print("whole frame, max |ray cone - raster rule| in levels (vfov {:.0f}, 1920x1080)\n", vfov);
+    fmt::print("{:>6} {:>16} {:>16} {:>16} {:>16} {:>16} {:>16}\n", "tilt", "major t*alpha", "major cos^2",
+               "major cos^1.5", "opengl t*alpha", "opengl cos^2", "opengl cos^1.5");
+    for (const double tilt : kTilts) {
+      // Rule x primary width: {major, opengl} x {t alpha, t alpha cos^2, t alpha cos^1.5}.
+      double worst[2][3] = {{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
+      for (const double axis : kAxes)
+        for (int j = 0; j < 7; ++j)
+          for (int i = 0; i < 9; ++i) {
+            const double x = 0.5 + i * (cam.width - 1) / 8.0, y = 0.5 + j * (cam.height - 1) / 6.0;
+            const PixelLods l = lods_at(cam, TexturedPlane::tilted(3.0, tilt, axis), x, y);
+            if (!l.visible || l.view_angle > 80.0) continue;
+            const double rules[2] = {l.derivative, l.opengl}, cones[3] = {l.cone, l.cone_cos2, l.cone_corrected};
+            for (int r = 0; r < 2; ++r)
+              for (int c = 0; c < 3; ++c) worst[r][c] = std::max(worst[r][c], std::fabs(cones[c] - rules[r]));
+            if (tilt == 0.0) {
+              EXPECT_NEAR(l.cone - l.derivative, -2.0 * std::log2(l.cos_phi), 1e-4) << "pixel " << x << "," << y;
+            }
+          }
+      fmt::print("{:>6.0f} {:>16.4f} {:>16.4f} {:>16.4f} {:>16.4f} {:>16.4f} {:>16.4f}\n", tilt, worst[0][0],
+                 worst[0][1], worst[0][2], worst[1][0], worst[1][1], worst[1][2]);
+      EXPECT_LE(worst[0][2], kAgreement) << "vfov " << vfov << " tilt " << tilt;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace sb

@@ -1,0 +1,96 @@
+// Side-by-side pipeline benchmark.
+#include "validation/benchmark.hpp"
+
+#include <algorithm>
+#include <functional>
+
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
+
+namespace sb {
+
+Summary summarize(std::vector<double> v) {
+  Summary s;
+  if (v.empty()) return s;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  s.median = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  s.min = v.front();
+  s.max = v.back();
+  return s;
+}
+
+BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const BenchConfig& config,
+                      const Executor& executor, const std::function<void(const std::string&)>& progress) {
+  if (config.repetitions < 1) throw InputError(fmt::format("--repetitions {} must be at least 1", config.repetitions));
+  if (config.warmup < 0) throw InputError(fmt::format("--warmup {} must not be negative", config.warmup));
+  if (std::find(config.pipelines.begin(), config.pipelines.end(), config.baseline) == config.pipelines.end())
+    throw InputError(fmt::format("baseline '{}' is not among the benchmarked pipelines", config.baseline));
+  std::vector<const Pipeline*> ps;
+  std::vector<PipelineOptions> opts;
+  for (const std::string& name : config.pipelines) {
+    ps.push_back(&find_pipeline(name));
+    auto it = config.options.find(name);
+    opts.emplace_back(ps.back()->info(), it == config.options.end() ? std::map<std::string, std::string>{} : it->second);
+  }
+  for (const auto& [name, o] : config.options)
+    if (std::find(config.pipelines.begin(), config.pipelines.end(), name) == config.pipelines.end())
+      throw InputError(fmt::format("options given for pipeline '{}', which is not benchmarked", name));
+
+  BenchResult result;
+  result.baseline = config.baseline;
+  result.repetitions = config.repetitions;
+  result.threads = executor.threads();
+  result.pipelines.resize(ps.size());
+  const RenderContext ctx{executor};
+  for (int w = 0; w < config.warmup; ++w)
+    for (size_t i = 0; i < ps.size(); ++i) {
+      (void)ps[i]->render(scene, rig, opts[i], ctx);
+      if (progress) progress(fmt::format("warm-up {}/{} {}", w + 1, config.warmup, ps[i]->info().name));
+    }
+  for (int rep = 0; rep < config.repetitions; ++rep)
+    for (size_t i = 0; i < ps.size(); ++i) {
+      const StereoResult r = ps[i]->render(scene, rig, opts[i], ctx);
+      PipelineBench& b = result.pipelines[i];
+      b.name = ps[i]->info().name;
+      for (const auto& [stage, s] : r.timings.stages()) {
+        if (!b.stage_seconds.count(stage)) b.stage_order.push_back(stage);
+        b.stage_seconds[stage].push_back(s);
+      }
+      b.total_seconds.push_back(r.timings.total());
+      b.counters = r.counters.snapshot();
+      if (progress)
+        progress(fmt::format("repetition {}/{} {} {:.1f} ms", rep + 1, config.repetitions, b.name, r.timings.total() * 1e3));
+    }
+  const size_t base = static_cast<size_t>(
+      std::find(config.pipelines.begin(), config.pipelines.end(), config.baseline) - config.pipelines.begin());
+  for (PipelineBench& b : result.pipelines) {
+    std::vector<double> ratios;
+    for (int rep = 0; rep < config.repetitions; ++rep)
+      ratios.push_back(result.pipelines[base].total_seconds[static_cast<size_t>(rep)] / b.total_seconds[static_cast<size_t>(rep)]);
+    b.speedup = summarize(ratios);
+  }
+  return result;
+}
+
+nlohmann::json bench_to_json(const BenchResult& r) {
+  nlohmann::json out = {{"baseline", r.baseline}, {"repetitions", r.repetitions}, {"threads", r.threads}};
+  auto summary = [](const Summary& s) { return nlohmann::json{{"median", s.median}, {"min", s.min}, {"max", s.max}}; };
+  for (const PipelineBench& b : r.pipelines) {
+    nlohmann::json stages = nlohmann::json::object();
+    for (const std::string& st : b.stage_order) {
+      stages[st] = summary(summarize(b.stage_seconds.at(st)));
+      stages[st]["samples"] = b.stage_seconds.at(st);
+    }
+    out["pipelines"].push_back({{"name", b.name},
+                                {"total_s", summary(summarize(b.total_seconds))},
+                                {"total_samples_s", b.total_seconds},
+                                {"stages_s", stages},
+                                {"speedup_vs_baseline", summary(b.speedup)},
+                                {"counters", b.counters}});
+  }
+  return out;
+}
+
+}  // namespace sb

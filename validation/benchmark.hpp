@@ -1,0 +1,55 @@
+// Side-by-side timing of pipelines on one scene and rig: warm-up, then repetitions that run every
+// pipeline in turn (so machine noise hits all alike), summarised as median/min/max per stage and
+// as speed-ups against a baseline measured in the same run (DESIGN §8).
+#pragma once
+
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "renderer/pipeline.hpp"
+
+namespace sb {
+
+struct BenchConfig {
+  std::vector<std::string> pipelines;  ///< names, in report order
+  std::string baseline;                ///< one of `pipelines`
+  int warmup = 1;
+  int repetitions = 5;
+  std::map<std::string, std::map<std::string, std::string>> options;  ///< per pipeline
+};
+
+/// Median, minimum and maximum of a sample.
+struct Summary {
+  double median = 0.0, min = 0.0, max = 0.0;
+};
+[[nodiscard]] Summary summarize(std::vector<double> values);
+
+struct PipelineBench {
+  std::string name;
+  std::vector<std::string> stage_order;
+  std::map<std::string, std::vector<double>> stage_seconds;  ///< per repetition
+  std::vector<double> total_seconds;
+  std::map<std::string, uint64_t> counters;  ///< of the last repetition (counters are deterministic)
+  Summary speedup;  ///< baseline total / this total, paired per repetition
+};
+
+struct BenchResult {
+  std::vector<PipelineBench> pipelines;
+  std::string baseline;
+  int repetitions = 0;
+  int threads = 0;
+};
+
+/// Runs the benchmark. `progress` (may be empty) is called after every run with a short line.
+[[nodiscard]] BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const BenchConfig& config,
+                                    const Executor& executor,
+                                    const std::function<void(const std::string&)>& progress = {});
+
+/// The result as JSON (medians, min, max, raw samples, speed-ups, counters).
+[[nodiscard]] nlohmann::json bench_to_json(const BenchResult& result);
+
+}  // namespace sb
