@@ -13,7 +13,7 @@ class IdealCopy final : public Pipeline {
     // The right eye is the left one: its PSNR against the true right eye is whatever the
     // disparity makes it, so the conformance test checks only the left eye.
     static const PipelineInfo i{
-        "ideal-copy", "Al-Hagri 2012", "4.2 (imaginary ideal stereo ray tracer)",
+        "ideal-copy", "Al-Hagri 2012", "4.1 (imaginary ideal ray tracer)",
         "trace the left eye and copy it to the right: the speed limit and a quality floor", {}, 200.0, 0.0};
     return i;
   }

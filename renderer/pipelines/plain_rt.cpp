@@ -11,7 +11,7 @@ class PlainRt final : public Pipeline {
  public:
   const PipelineInfo& info() const override {
     static const PipelineInfo i{
-        "plain-rt", "Al-Hagri 2012", "3.1 (naive stereo ray tracer)",
+        "plain-rt", "Al-Hagri 2012", "4.1 (naive ray tracer, the baseline)",
         "trace primary rays for each eye and shade them; the built-in ground truth", {}, 200.0, 200.0};
     return i;
   }

@@ -55,6 +55,10 @@ ProjectedVertex VertexTransform::project(const vec3& position) const {
   v.hx = glm::dot(row_x_, p);
   v.hy = glm::dot(row_y_, p);
   v.w = glm::dot(row_w_, p);
+  if (!std::isfinite(v.hx) || !std::isfinite(v.hy) || !std::isfinite(v.w)) {
+    v.outcode = kCullBits;
+    return v;
+  }
   v.outcode = outcode(v.hx, v.hy, v.w);
   if ((v.outcode & kClipBits) == 0) {
     v.fx = snap(v.hx, v.w);
@@ -259,8 +263,9 @@ void setup_triangles(const SetupInputs& in, uint32_t begin, uint32_t end, std::v
     const ProjectedVertex* base = in.vertices + in.vertex_base[mesh];
     const ProjectedVertex &a = base[i0], &b = base[i1], &c = base[i2];
 
-    // Frustum culling: all three vertices outside one image border or behind the near plane.
-    if ((a.outcode & b.outcode & c.outcode & kCullBits) != 0) {
+    // Frustum culling: all three vertices outside one image border or behind the near plane (or
+    // any of them not a finite position).
+    if (((a.outcode & b.outcode & c.outcode & kCullBits) | ((a.outcode | b.outcode | c.outcode) & kOutInvalid)) != 0) {
       ++counts.culled_frustum;
       continue;
     }

@@ -14,7 +14,7 @@
 namespace sb::raster {
 
 /// Snapped vertex positions carry 13 sub-pixel bits (1/8192 px) and pixel centres are integers.
-/// The snapping moves an edge by at most 1/16384 px, which keeps long axis-aligned edges that pass
+/// Snapping moves a vertex by at most 1/16384 px per axis, which keeps long axis-aligned edges that pass
 /// within a hair of a pixel-centre column on the same side as an exact ray test.
 constexpr int kSubpixelBits = 13;
 constexpr int64_t kSubpixelOne = int64_t{1} << kSubpixelBits;
@@ -26,8 +26,8 @@ constexpr int64_t kSubpixelHalf = kSubpixelOne / 2;
 /// 2^60.2: int64 never overflows.
 constexpr double kGuardBandPx = 32768.0;  // 2^15
 
-/// Outcode bits: the four image borders (culling only), the near plane (culling and clipping) and
-/// the four guard-band planes (clipping only).
+/// Outcode bits: the four image borders (culling only), the near plane (culling and clipping),
+/// the four guard-band planes (clipping only) and invalid positions.
 enum Outcode : uint32_t {
   kOutLeft = 1u << 0,
   kOutRight = 1u << 1,
@@ -38,8 +38,9 @@ enum Outcode : uint32_t {
   kOutGuardRight = 1u << 6,
   kOutGuardTop = 1u << 7,
   kOutGuardBottom = 1u << 8,
+  kOutInvalid = 1u << 9,  ///< a non-finite position: its triangles are dropped as culled
 };
-constexpr uint32_t kCullBits = kOutLeft | kOutRight | kOutTop | kOutBottom | kOutNear;
+constexpr uint32_t kCullBits = kOutLeft | kOutRight | kOutTop | kOutBottom | kOutNear | kOutInvalid;
 constexpr uint32_t kClipBits = kOutNear | kOutGuardLeft | kOutGuardRight | kOutGuardTop | kOutGuardBottom;
 constexpr int kClipPlaneCount = 5;  ///< near, then the guard band's left, right, top, bottom
 

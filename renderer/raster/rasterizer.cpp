@@ -22,8 +22,8 @@ using raster::RasterTriangle;
 constexpr uint32_t kMinChunkTriangles = 16384;
 /// How many binned triangles ahead a tile prefetches.
 constexpr size_t kPrefetchDistance = 8;
-/// Boxes at least this many pixels wide (minus one) are scanned by exact row spans.
-constexpr int kSpanMinWidth = 8;
+/// Boxes up to this many pixels wide test every pixel centre; wider ones solve exact row spans.
+constexpr int kPerPixelMaxWidth = 8;
 
 /// The image's tiles, numbered row by row as Executor::for_tiles visits them.
 struct TileGrid {
@@ -98,7 +98,7 @@ class TileRaster {
 
     // Scan the rows: narrow boxes test every pixel centre, wide ones (long slivers, large
     // triangles) first solve each row's exact covered span.
-    const bool use_spans = x_end - x_begin >= kSpanMinWidth;
+    const bool use_spans = x_end - x_begin + 1 > kPerPixelMaxWidth;
     for (int y = y_begin; y <= y_end; ++y, row[0] += step_y[0], row[1] += step_y[1], row[2] += step_y[2]) {
       const double q_row = t.inv_w.y * (y + 0.5) + t.inv_w.z;
       const size_t image_row = static_cast<size_t>(y) * image_width_;
@@ -255,7 +255,8 @@ GBuffer rasterize(const SceneGeometry& geometry, const EyeCamera& eye, const Exe
 
   // Vertex stage: every vertex of every mesh to homogeneous pixel coordinates, once.
   std::vector<size_t> vertex_base(scene.meshes.size() + 1, 0);
-  for (size_t m = 0; m < scene.meshes.size(); ++m) vertex_base[m + 1] = vertex_base[m] + scene.meshes[m].positions.size();
+  for (size_t m = 0; m < scene.meshes.size(); ++m)
+    vertex_base[m + 1] = vertex_base[m] + scene.meshes[m].positions.size();
   const size_t vertex_count = vertex_base.back();
   const auto vertices = std::make_unique_for_overwrite<raster::ProjectedVertex[]>(vertex_count);
   const raster::VertexTransform transform(eye);
@@ -265,7 +266,8 @@ GBuffer rasterize(const SceneGeometry& geometry, const EyeCamera& eye, const Exe
 
   // Setup and binning: contiguous chunks of ids, each with its own bins; a tile later walks the
   // chunks in order, which concatenates its bins in triangle-id order.
-  const TileGrid grid{options.tile, (width + options.tile - 1) / options.tile, (height + options.tile - 1) / options.tile};
+  const int tile = options.tile;
+  const TileGrid grid{tile, (width + tile - 1) / tile, (height + tile - 1) / tile};
   const uint32_t triangle_count = geometry.triangle_count();
   const size_t chunk_count = std::clamp<size_t>(triangle_count / kMinChunkTriangles, 1,
                                                 4 * static_cast<size_t>(executor.threads()));
@@ -296,11 +298,11 @@ GBuffer rasterize(const SceneGeometry& geometry, const EyeCamera& eye, const Exe
 
   // Tiles: each rasterizes its bins into a private depth buffer, then resolves its pixels.
   std::vector<TileCounts> tile_counts(grid.count());
-  executor.for_tiles(width, height, options.tile, [&](const PixelRect& rect) {
-    const size_t tile = grid.index_of(rect);
+  executor.for_tiles(width, height, tile, [&](const PixelRect& rect) {
+    const size_t index = grid.index_of(rect);
     TileRaster raster(rect, width, options.write_mask);
     for (const Chunk& chunk : chunks) {
-      const size_t begin = chunk.bin_offsets[tile], end = chunk.bin_offsets[tile + 1];
+      const size_t begin = chunk.bin_offsets[index], end = chunk.bin_offsets[index + 1];
       for (size_t k = begin; k < end; ++k) {
         // Bins index scattered records: fetch a few ahead of use.
         if (k + kPrefetchDistance < end) __builtin_prefetch(&chunk.triangles[chunk.bin_items[k + kPrefetchDistance]]);
@@ -308,7 +310,7 @@ GBuffer rasterize(const SceneGeometry& geometry, const EyeCamera& eye, const Exe
       }
     }
     raster.resolve(inputs, g);
-    tile_counts[tile] = {raster.tested, raster.written};
+    tile_counts[index] = {raster.tested, raster.written};
   });
 
   // Counters: sums of per-chunk and per-tile counts, independent of scheduling.

@@ -27,16 +27,16 @@ struct GBuffer {
 /// What the rasterizer did, for the pipeline counters.
 struct RasterStats {
   uint64_t triangles_submitted = 0;
-  uint64_t culled_backface = 0;
-  uint64_t culled_frustum = 0;
+  uint64_t culled_backface = 0;       ///< back faces of single-sided meshes (front_facing())
+  uint64_t culled_frustum = 0;        ///< wholly outside one image border, behind the near plane, or non-finite
   uint64_t clipped_near = 0;          ///< triangles that crossed the near plane and were clipped
   uint64_t triangles_rasterized = 0;  ///< triangles (after clipping) that reached the tiles
-  uint64_t fragments_tested = 0;
-  uint64_t fragments_written = 0;
+  uint64_t fragments_tested = 0;      ///< covered pixel centres that reached the depth test (write mask passed)
+  uint64_t fragments_written = 0;     ///< fragments that passed the depth test when tested
 };
 
 struct RasterOptions {
-  int tile = 64;
+  int tile = 64;  ///< tile side in pixels, 4..1024; the image does not depend on it
   /// When set (width*height entries), only pixels whose mask is non-zero are written: the stencil
   /// of re-rasterized hole filling. Every triangle is still processed.
   const uint8_t* write_mask = nullptr;

@@ -10,9 +10,12 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "renderer/error.hpp"
+#include "renderer/raster/raster_setup.hpp"
 #include "renderer/raster/rasterizer.hpp"
 #include "renderer/scene.hpp"
 
@@ -23,7 +26,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // ---- Scenes and cameras built in code ----
 
-/// A pinhole eye at `origin` looking down -Z (or along a look-at basis).
+/// A pinhole eye at the world origin looking down -Z.
 EyeCamera make_eye(int width, int height, double f_px, double cx, double cy, double znear = 0.05) {
   EyeCamera eye;
   eye.width = width;
@@ -36,6 +39,7 @@ EyeCamera make_eye(int width, int height, double f_px, double cx, double cy, dou
   return eye;
 }
 
+/// The same eye moved to `pose`.
 EyeCamera with_pose(EyeCamera eye, const CameraPose& pose) {
   eye.origin = pose.position;
   eye.right = pose.right;
@@ -78,6 +82,7 @@ void add_pixel_triangle(Scene& s, const EyeCamera& eye, dvec2 a, dvec2 b, dvec2 
   add_mesh(s, {at(eye, a.x, a.y, depth), at(eye, b.x, b.y, depth), at(eye, c.x, c.y, depth)}, {0, 1, 2}, material);
 }
 
+/// Rasterizes with a fresh executor of `threads` threads.
 GBuffer render(const Scene& scene, const EyeCamera& eye, int threads = 1, const RasterOptions& options = {},
                RasterStats* stats = nullptr) {
   const SceneGeometry geometry(scene);
@@ -85,6 +90,7 @@ GBuffer render(const Scene& scene, const EyeCamera& eye, int threads = 1, const 
   return rasterize(geometry, eye, executor, options, stats);
 }
 
+/// 1 where a pixel holds a primitive.
 std::vector<int> coverage(const GBuffer& g) {
   std::vector<int> c(g.prim.size());
   for (size_t i = 0; i < c.size(); ++i) c[i] = g.prim[i] != kNoPrimitiveId ? 1 : 0;
@@ -105,6 +111,7 @@ std::vector<int> summed_coverage(const Scene& scene, const EyeCamera& eye) {
 
 // ---- Brute-force reference: exact ray-triangle intersection in double at pixel centres ----
 
+/// The reference at one pixel centre: nearest id, depth and Möller–Trumbore (u, v).
 struct RefHit {
   uint32_t prim = kNoPrimitiveId;
   double depth = kInf;
@@ -223,6 +230,7 @@ void add_sphere(Scene& s, const dvec3& centre, double radius, int rings, int seg
   add_mesh(s, std::move(positions), std::move(indices), material, std::move(uvs));
 }
 
+/// Bit-identical G-buffers.
 bool same_gbuffer(const GBuffer& a, const GBuffer& b) {
   const auto bytes_equal = [](const auto& x, const auto& y) {
     return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(x[0])) == 0;
@@ -252,7 +260,8 @@ TEST(Rasterizer, FanAroundAPixelCentreIsWatertight) {
   // Radius 20 exercises the row-span scan of wide triangles, radius 2 the per-pixel scan.
   const EyeCamera eye = make_eye(64, 64, 64.0, 32.0, 32.0);
   const dvec2 c{32.5, 32.5};
-  const std::vector<dvec2> rim = {{2, 0}, {2, 1}, {2, 2}, {0, 2}, {-2, 2}, {-2, 0}, {-2, -2}, {-1, -2}, {0, -2}, {2, -2}};
+  const std::vector<dvec2> rim = {{2, 0},   {2, 1},   {2, 2},   {0, 2},  {-2, 2},
+                                  {-2, 0}, {-2, -2}, {-1, -2}, {0, -2}, {2, -2}};
   for (double radius : {20.0, 2.0}) {
     Scene s = empty_scene();
     for (size_t k = 0; k < rim.size(); ++k) {
@@ -334,7 +343,7 @@ TEST(Rasterizer, DepthTestPicksTheNearerTriangleAndTiesGoToTheLowerId) {
   // Identical triangles in three meshes: equal depths everywhere, the lowest id wins.
   Scene ties = empty_scene();
   for (int k = 0; k < 3; ++k) add_pixel_triangle(ties, eye, {3.3, 2.1}, {44.7, 9.9}, {12.2, 30.8}, 2.5);
-  // A slanted one sharing the id order but not the depth, drawn first.
+  // A farther triangle takes the lowest id: the nearer, tied ones must still win.
   add_mesh(ties, {at(eye, 0, 0, 9.0), at(eye, 48, 0, 9.0), at(eye, 0, 32, 9.0)}, {0, 1, 2});
   std::rotate(ties.meshes.begin(), ties.meshes.begin() + 3, ties.meshes.end());
   for (int threads : {1, 2}) {
@@ -367,7 +376,8 @@ TEST(Rasterizer, PerspectiveCorrectBarycentricsReconstructPointsOnTheEyeRay) {
       if (g.prim[i] == kNoPrimitiveId) continue;
       ++covered;
       const dvec2 b(g.bary[i]);
-      const dvec3 p = (1.0 - b.x - b.y) * dvec3(m.positions[0]) + b.x * dvec3(m.positions[1]) + b.y * dvec3(m.positions[2]);
+      const dvec3 p = (1.0 - b.x - b.y) * dvec3(m.positions[0]) + b.x * dvec3(m.positions[1]) +
+                      b.y * dvec3(m.positions[2]);
       const dvec3 rel = p - eye.origin;
       const dvec3 dir = eye.ray_direction(x + 0.5, y + 0.5);
       const double off_ray = glm::length(rel - glm::dot(rel, dir) * dir);
@@ -407,7 +417,8 @@ TEST(Rasterizer, TriangleCrossingTheNearPlaneIsClipped) {
       // Barycentrics refer to the original, unclipped vertices.
       EXPECT_GE(g.depth[i], eye.znear * (1.0 - 1e-6));
       const dvec2 b(g.bary[i]);
-      const dvec3 p = (1.0 - b.x - b.y) * dvec3(m.positions[0]) + b.x * dvec3(m.positions[1]) + b.y * dvec3(m.positions[2]);
+      const dvec3 p = (1.0 - b.x - b.y) * dvec3(m.positions[0]) + b.x * dvec3(m.positions[1]) +
+                      b.y * dvec3(m.positions[2]);
       EXPECT_NEAR(-glm::dot(p - eye.origin, eye.back), g.depth[i], 1e-5 * g.depth[i]);
       const dvec3 px = eye.project(p);
       EXPECT_NEAR(px.x, x + 0.5, 1e-3);
@@ -432,6 +443,27 @@ TEST(Rasterizer, HugeTrianglesBeyondTheGuardBandMatchTheReference) {
   EXPECT_EQ(stats.clipped_near, 2u);
   const std::vector<RefHit> ref = reference(s, eye);
   EXPECT_GE(agreement(g, ref), 0.995);
+}
+
+TEST(Rasterizer, VerticesBeyondTheGuardBandAreClippedExactly) {
+  // In front of the near plane but projecting ~10^5 px off-screen: clipped to the guard band only.
+  const EyeCamera eye = make_eye(160, 90, 100.0, 80.0, 45.0, 0.05);
+  Scene s = empty_scene();
+  add_mesh(s, {vec3(-100.0f, -0.05f, -0.1f), vec3(100.0f, -0.02f, -0.1f), vec3(0.3f, 0.6f, -4.0f)}, {0, 1, 2});
+  const raster::VertexTransform transform(eye);
+  for (const vec3& p : s.meshes[0].positions) {
+    const uint32_t code = transform.project(p).outcode;
+    EXPECT_EQ(code & raster::kOutNear, 0u);
+    if (p.z > -1.0f) {
+      EXPECT_NE(code & (raster::kOutGuardLeft | raster::kOutGuardRight), 0u);
+    }
+  }
+  RasterStats stats;
+  const GBuffer g = render(s, eye, 1, {}, &stats);
+  EXPECT_EQ(stats.clipped_near, 0u);
+  EXPECT_GE(stats.triangles_rasterized, 2u);  // the clipped polygon is a fan
+  EXPECT_GE(agreement(g, reference(s, eye)), 0.995);
+  EXPECT_GT(std::count(g.prim.begin(), g.prim.end(), 0u), 1000);
 }
 
 TEST(Rasterizer, TrianglesOutsideTheFrustumAreCulled) {
@@ -616,6 +648,19 @@ TEST(Rasterizer, RejectsBadOptionsAndIndices) {
   EXPECT_THROW((void)render(s, eye), InputError);
 }
 
+TEST(Rasterizer, NonFiniteVerticesDropTheirTriangles) {
+  const EyeCamera eye = make_eye(16, 16, 16.0, 8.0, 8.0);
+  Scene s = empty_scene();
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  add_mesh(s, {at(eye, 1, 1, 2.0), at(eye, 15, 1, 2.0), vec3(nan, 0.0f, -2.0f)}, {0, 1, 2});
+  add_mesh(s, {at(eye, 1, 1, 2.0), vec3(0.0f, inf, -2.0f), at(eye, 1, 15, 2.0)}, {0, 1, 2});
+  add_pixel_triangle(s, eye, {1, 1}, {15, 15}, {1, 15}, 3.0);
+  RasterStats stats;
+  const GBuffer g = render(s, eye, 2, {}, &stats);
+  EXPECT_EQ(stats.culled_frustum, 2u);
+  for (uint32_t p : g.prim) EXPECT_TRUE(p == kNoPrimitiveId || p == 2u);
+}
+
 // ---- Performance (printed, never asserted: DESIGN §8) ----
 
 TEST(Rasterizer, MillionTrianglesAt1080p) {
@@ -649,7 +694,8 @@ TEST(Rasterizer, MillionTrianglesAt1080p) {
     EXPECT_EQ(stats.triangles_submitted, 1000000u);
     if (threads == 1) {
       first = std::move(g);
-      const auto covered = std::count_if(first.prim.begin(), first.prim.end(), [](uint32_t p) { return p != kNoPrimitiveId; });
+      const auto covered =
+          std::count_if(first.prim.begin(), first.prim.end(), [](uint32_t p) { return p != kNoPrimitiveId; });
       EXPECT_GT(covered, 1920 * 1080 / 4);
     } else {
       EXPECT_TRUE(same_gbuffer(g, first));
