@@ -13,6 +13,7 @@
 #include "renderer/error.hpp"
 #include "renderer/io/gltf_loader.hpp"
 #include "renderer/rig.hpp"
+#include "renderer/text.hpp"
 #include "scenes/catalog.hpp"
 #include "scenes/generators.hpp"
 
@@ -41,21 +42,10 @@ struct GenerateArgs {
 
 std::map<std::string, double> parse_params(const std::vector<std::string>& items) {
   std::map<std::string, double> out;
-  for (const std::string& item : items) {
-    const size_t eq = item.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw InputError(fmt::format("--param '{}' is not NAME=VALUE", item));
-    const std::string value = item.substr(eq + 1);
-    size_t used = 0;
-    double v = 0.0;
-    try {
-      v = std::stod(value, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != value.size() || !std::isfinite(v))
-      throw InputError(fmt::format("--param {}: '{}' is not a finite number", item.substr(0, eq), value));
-    out[item.substr(0, eq)] = v;
+  for (const auto& [name, value] : parse_key_values(items, "--param")) {
+    const std::optional<double> v = parse_finite(value);
+    if (!v) throw InputError(fmt::format("--param {}: '{}' is not a finite number", name, value));
+    out[name] = *v;
   }
   return out;
 }

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
+#include "renderer/text.hpp"
 
 namespace sb {
 
@@ -59,17 +60,9 @@ const std::string& PipelineOptions::get(const std::string& name) const {
 }
 
 double PipelineOptions::get_double(const std::string& name) const {
-  const std::string& v = get(name);
-  size_t used = 0;
-  double x = 0.0;
-  try {
-    x = std::stod(v, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != v.size() || !std::isfinite(x))
-    throw InputError(fmt::format("pipeline '{}': option {}={} is not a finite number", pipeline_, name, v));
-  return x;
+  const std::optional<double> x = parse_finite(get(name));
+  if (!x) throw InputError(fmt::format("pipeline '{}': option {}={} is not a finite number", pipeline_, name, get(name)));
+  return *x;
 }
 
 int PipelineOptions::get_int(const std::string& name) const {
