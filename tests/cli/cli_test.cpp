@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "support/mini_gltf.hpp"
 #include "support/scratch_dir.hpp"
 
@@ -91,6 +93,49 @@ TEST(Cli, SceneInfoPrintsRigAndDisparities) {
   EXPECT_NE(r.out.find("1 triangles"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("640x360"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("max disparity 20.00 px"), std::string::npos) << r.out;
+}
+
+TEST(Cli, RenderWritesEveryOutputAndBenchPrintsATable) {
+  test::ScratchDir dir("render");
+  const std::string common = " --scenes-dir '" + (dir / "scenes").string() + "' --resolution 64x36";
+  const CliRun r = run("render --scene box-wall --pipeline plain-raster --out '" + dir.path().string() + "'" + common);
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (const char* suffix : {".exr", "_left.png", "_right.png", "_anaglyph.png", "_sbs.png", "_stats.json"})
+    EXPECT_TRUE(std::filesystem::exists(dir / (std::string("box-wall_plain-raster") + suffix))) << suffix;
+  const std::string stats = test::read_text(dir / "box-wall_plain-raster_stats.json");
+  const auto j = nlohmann::json::parse(stats);
+  EXPECT_GT(j.at("timings_s").at("left_gbuffer").get<double>(), 0.0);
+  EXPECT_GT(j.at("counters").at("shadow_rays").get<uint64_t>(), 0u);
+  EXPECT_EQ(j.at("rig").at("width").get<int>(), 64);
+
+  const CliRun b = run("bench --scene box-wall --pipelines plain-rt,ideal-copy --baseline plain-rt -n 2 -w 0" + common);
+  ASSERT_EQ(b.code, 0) << b.out;
+  EXPECT_NE(b.out.find("ideal-copy"), std::string::npos) << b.out;
+  EXPECT_NE(b.out.find("speed-up"), std::string::npos) << b.out;
+
+  const CliRun l = run("pipelines");
+  EXPECT_EQ(l.code, 0);
+  for (const char* name : {"plain-rt", "plain-raster", "ideal-copy"}) EXPECT_NE(l.out.find(name), std::string::npos);
+}
+
+TEST(Cli, RenderAndBenchRejectBadArguments) {
+  test::ScratchDir dir("renderbad");
+  const std::string bench_common = " --scenes-dir '" + (dir / "scenes").string() + "' --resolution 32x18";
+  const std::string common = bench_common + " --out '" + dir.path().string() + "'";
+  struct Case { std::string args; std::string expect; };
+  const Case cases[] = {
+      {"render --scene box-wall --pipeline warp-drive" + common, "unknown pipeline 'warp-drive'"},
+      {"render --scene box-wall --pipeline plain-raster --option tile=3" + common, "tile=3 is out of range"},
+      {"render --scene box-wall --pipeline plain-raster --option tiles=32" + common, "has no option 'tiles'"},
+      {"render --scene box-wall --pipeline plain-rt --threads -1" + common, "--threads -1 is out of range"},
+      {"bench --scene box-wall -n 0 --pipelines plain-rt --baseline plain-rt" + bench_common, "--repetitions 0"},
+      {"bench --scene box-wall --pipelines plain-rt --baseline plain-rt --option tile=4" + bench_common, "PIPELINE.OPTION"},
+  };
+  for (const Case& c : cases) {
+    const CliRun r = run(c.args);
+    EXPECT_EQ(r.code, 3) << c.args << "\n" << r.out;
+    EXPECT_NE(r.out.find(c.expect), std::string::npos) << c.args << "\nexpected: " << c.expect << "\ngot: " << r.out;
+  }
 }
 
 }  // namespace

@@ -43,4 +43,10 @@ inline std::vector<unsigned char> file_bytes(const std::filesystem::path& p) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
+/// The text of a file (empty if it cannot be read).
+inline std::string read_text(const std::filesystem::path& p) {
+  const std::vector<unsigned char> b = file_bytes(p);
+  return std::string(b.begin(), b.end());
+}
+
 }  // namespace sb::test
