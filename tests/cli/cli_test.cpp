@@ -2,8 +2,6 @@
 // message that says what was wrong.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-
 #include <array>
 #include <cstdio>
 #include <string>
@@ -11,26 +9,15 @@
 #include <nlohmann/json.hpp>
 
 #include "support/mini_gltf.hpp"
+#include "support/run_cli.hpp"
 #include "support/scratch_dir.hpp"
 
 namespace sb {
 namespace {
 
-struct CliRun {
-  int code = -1;
-  std::string out;  ///< stdout and stderr together
-};
+using test::CliRun;
 
-CliRun run(const std::string& args) {
-  const std::string cmd = std::string(SB_CLI_PATH) + " " + args + " 2>&1";
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  CliRun r;
-  std::array<char, 1024> buf{};
-  while (pipe && std::fgets(buf.data(), buf.size(), pipe)) r.out += buf.data();
-  const int status = pipe ? ::pclose(pipe) : -1;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+CliRun run(const std::string& args) { return test::run_cli(args); }
 
 TEST(Cli, VersionAndHelp) {
   const CliRun v = run("--version");

@@ -2,7 +2,6 @@
 // message naming the file and the JSON pointer of the fault — never a crash.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
 
 #include <array>
 #include <cstdio>
@@ -11,6 +10,7 @@
 #include "renderer/error.hpp"
 #include "renderer/io/gltf_loader.hpp"
 #include "support/mini_gltf.hpp"
+#include "support/run_cli.hpp"
 #include "support/scratch_dir.hpp"
 
 namespace sb {
@@ -149,25 +149,23 @@ std::vector<BadCase> corpus() {
   return c;
 }
 
-/// Runs the CLI on a scene and returns (exit code, stderr).
-std::pair<int, std::string> run_cli(const std::filesystem::path& scene) {
-  const std::string cmd = std::string(SB_CLI_PATH) + " scenes info '" + scene.string() + "' 2>&1 >/dev/null";
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 512> buf{};
-  while (pipe && std::fgets(buf.data(), buf.size(), pipe)) out += buf.data();
-  const int status = pipe ? ::pclose(pipe) : -1;
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+/// Writes a case's broken file into its own folder under `dir` and returns its path.
+std::filesystem::path write_case(const ScratchDir& dir, const BadCase& bc) {
+  const auto folder = dir / bc.name;
+  std::filesystem::create_directories(folder);
+  const auto path = folder / bc.file;
+  bc.make(path);
+  return path;
 }
+
+/// Runs `stereobench scenes info` on a scene file.
+test::CliRun scene_info(const std::filesystem::path& scene) { return test::run_cli("scenes info '" + scene.string() + "'"); }
 
 TEST(BadScenes, EveryCaseIsAClearInputError) {
   ScratchDir dir("bad");
   for (const BadCase& bc : corpus()) {
     SCOPED_TRACE(bc.name);
-    const auto folder = dir / bc.name;
-    std::filesystem::create_directories(folder);
-    const auto path = folder / bc.file;
-    bc.make(path);
+    const auto path = write_case(dir, bc);
     try {
       (void)io::load_gltf(path);
       ADD_FAILURE() << bc.name << ": loaded without error";
@@ -185,11 +183,7 @@ TEST(BadScenes, CommandLineExitsWithCode3AndNamesTheFault) {
   ScratchDir dir("badcli");
   for (const BadCase& bc : corpus()) {
     SCOPED_TRACE(bc.name);
-    const auto folder = dir / bc.name;
-    std::filesystem::create_directories(folder);
-    const auto path = folder / bc.file;
-    bc.make(path);
-    const auto [code, err] = run_cli(path);
+    const auto [code, err] = scene_info(write_case(dir, bc));
     EXPECT_EQ(code, 3) << err;
     EXPECT_NE(err.find(bc.expect), std::string::npos) << err;
   }
@@ -199,7 +193,7 @@ TEST(BadScenes, NonExistentPathAndDirectory) {
   ScratchDir dir("nopath");
   EXPECT_THROW((void)io::load_gltf(dir / "missing.gltf"), InputError);
   EXPECT_THROW((void)io::load_gltf(dir.path()), InputError);
-  const auto [code, err] = run_cli(dir / "missing.gltf");
+  const auto [code, err] = scene_info(dir / "missing.gltf");
   EXPECT_EQ(code, 3);
   EXPECT_NE(err.find("does not exist"), std::string::npos) << err;
 }
