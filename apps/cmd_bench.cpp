@@ -58,7 +58,6 @@ void run_bench_command(const BenchArgs& a) {
   config.pipelines = split_names(a.pipelines);
   if (config.pipelines.empty())
     for (const Pipeline* p : pipelines()) config.pipelines.push_back(p->info().name);
-  for (const std::string& n : config.pipelines) (void)find_pipeline(n);
   config.baseline = a.baseline;
   if (std::find(config.pipelines.begin(), config.pipelines.end(), config.baseline) == config.pipelines.end())
     config.pipelines.insert(config.pipelines.begin(), config.baseline);
@@ -70,6 +69,7 @@ void run_bench_command(const BenchArgs& a) {
       throw InputError(fmt::format("--option {}={}: name it PIPELINE.OPTION=VALUE, e.g. plain-raster.tile=32", key, value));
     config.options[key.substr(0, dot)][key.substr(dot + 1)] = value;
   }
+  config.validate();  // before the scene is loaded
   const Executor executor(checked_threads(a.threads));
   const Scene scene = io::load_gltf(scenes::resolve_scene(a.scene, a.scenes_dir));
   const StereoRig rig = resolve_rig(scene, overrides);

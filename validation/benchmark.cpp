@@ -21,12 +21,20 @@ Summary summarize(std::vector<double> v) {
   return s;
 }
 
+void BenchConfig::validate() const {
+  if (repetitions < 1) throw InputError(fmt::format("--repetitions {} must be at least 1", repetitions));
+  if (warmup < 0) throw InputError(fmt::format("--warmup {} must not be negative", warmup));
+  for (const std::string& name : pipelines) (void)find_pipeline(name);
+  if (std::find(pipelines.begin(), pipelines.end(), baseline) == pipelines.end())
+    throw InputError(fmt::format("baseline '{}' is not among the benchmarked pipelines", baseline));
+  for (const auto& [name, o] : options)
+    if (std::find(pipelines.begin(), pipelines.end(), name) == pipelines.end())
+      throw InputError(fmt::format("options given for pipeline '{}', which is not benchmarked", name));
+}
+
 BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const BenchConfig& config,
                       const Executor& executor, const std::function<void(const std::string&)>& progress) {
-  if (config.repetitions < 1) throw InputError(fmt::format("--repetitions {} must be at least 1", config.repetitions));
-  if (config.warmup < 0) throw InputError(fmt::format("--warmup {} must not be negative", config.warmup));
-  if (std::find(config.pipelines.begin(), config.pipelines.end(), config.baseline) == config.pipelines.end())
-    throw InputError(fmt::format("baseline '{}' is not among the benchmarked pipelines", config.baseline));
+  config.validate();
   std::vector<const Pipeline*> ps;
   std::vector<PipelineOptions> opts;
   for (const std::string& name : config.pipelines) {
@@ -34,9 +42,6 @@ BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const Benc
     auto it = config.options.find(name);
     opts.emplace_back(ps.back()->info(), it == config.options.end() ? std::map<std::string, std::string>{} : it->second);
   }
-  for (const auto& [name, o] : config.options)
-    if (std::find(config.pipelines.begin(), config.pipelines.end(), name) == config.pipelines.end())
-      throw InputError(fmt::format("options given for pipeline '{}', which is not benchmarked", name));
 
   BenchResult result;
   result.baseline = config.baseline;

@@ -20,6 +20,10 @@ struct BenchConfig {
   int warmup = 1;
   int repetitions = 5;
   std::map<std::string, std::map<std::string, std::string>> options;  ///< per pipeline
+
+  /// InputError for repetitions < 1, warm-up < 0, unknown pipelines, a baseline not benchmarked,
+  /// or options for a pipeline not benchmarked.
+  void validate() const;
 };
 
 /// Median, minimum and maximum of a sample.

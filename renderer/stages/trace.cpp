@@ -121,12 +121,6 @@ void trace_pixels(const RenderScene& scene, const EyeCamera& eye, const Executor
   counts.pixels_shaded += totals[2];
 }
 
-}  // namespace sb
-
-#include "renderer/stats.hpp"
-
-namespace sb {
-
 void add_counts(Counters& counters, const TraceCounts& counts, const char* eye, bool traced) {
   counters.add("primary_rays", counts.primary_rays);
   counters.add("shadow_rays", counts.shadow_rays);

@@ -9,6 +9,7 @@
 #include "renderer/parallel.hpp"
 #include "renderer/render_scene.hpp"
 #include "renderer/rig.hpp"
+#include "renderer/stats.hpp"
 
 namespace sb {
 
@@ -24,16 +25,11 @@ void trace_eye(const RenderScene& scene, const EyeCamera& eye, const Executor& e
                TraceCounts& counts);
 
 /// Traces and shades the listed pixels (indices y * width + x) only; the others are left as they
-/// are. Pixels are traced in packets of 16 in list order, so any list gives the same result per pixel
-/// as trace_eye.
+/// are. Pixels are traced in packets of 16 in list order by the same code as trace_eye (whether a
+/// pixel's result is bit-identical to trace_eye's is tested by the pipelines that rely on it).
 void trace_pixels(const RenderScene& scene, const EyeCamera& eye, const Executor& executor,
                   std::span<const uint32_t> pixels, Image& image, TraceCounts& counts, Source source = Source::traced);
 
-}  // namespace sb
-
-namespace sb {
-
-class Counters;
 /// Adds trace counts to a pipeline's counters: primary_rays and shadow_rays (totals) and
 /// pixels_shaded_<eye>; with `traced` also pixels_traced_<eye>.
 void add_counts(Counters& counters, const TraceCounts& counts, const char* eye, bool traced);

@@ -129,7 +129,6 @@ TEST(Shading, BoxShadowBoundaryLiesWhereGeometrySays) {
     const int w = r.left.width(), h = r.left.height();
     const uint32_t* prim = r.left.data_u32(planes::primid);
     const float* rgb = r.left.data_f32(planes::rgb);
-    const float* depth = r.left.data_f32(planes::depth);
     // Analytic shadow classification of every floor pixel (from its exact floor point).
     std::vector<int> analytic(static_cast<size_t>(w) * h, -1), rendered(static_cast<size_t>(w) * h, -1);
     const float floor_rho = scene.materials.at(static_cast<size_t>(scene.meshes[static_cast<size_t>(floor_mesh)].material)).base_color.x;
@@ -143,7 +142,6 @@ TEST(Shading, BoxShadowBoundaryLiesWhereGeometrySays) {
         analytic[i] = segment_hits_box(p, light, dvec3(box.lo), dvec3(box.hi)) ? 0 : 1;
         const dvec3 lit = closed_form(scene, p, dvec3(0, 1, 0), cam.origin, floor_rho, floor_rho, floor_rho);
         rendered[i] = rgb[i * 3] > 0.5 * lit.x ? 1 : 0;
-        (void)depth;
       }
     int shadowed = 0, wrong = 0, wrong_far = 0;
     for (int y = 0; y < h; ++y)

@@ -49,7 +49,4 @@ inline double psnr_srgb8(const Image& a, const Image& b) {
   return 10.0 * std::log10(255.0 * 255.0 / (se / double(n)));
 }
 
-/// True when every plane of the two images is bitwise equal.
-inline bool bit_identical(const Image& a, const Image& b) { return a == b; }
-
 }  // namespace sb::test
