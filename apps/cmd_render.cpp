@@ -2,6 +2,8 @@
 // write its images and statistics; list and describe the registered pipelines.
 #include <filesystem>
 #include <memory>
+#include <optional>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -10,6 +12,7 @@
 #include "renderer/io/gltf_loader.hpp"
 #include "renderer/io/render_output.hpp"
 #include "renderer/pipeline.hpp"
+#include "renderer/stages/disocclusion.hpp"
 #include "scenes/catalog.hpp"
 
 namespace sb::cli {
@@ -33,6 +36,14 @@ void print_timings(const StereoResult& r) {
   fmt::print("  {:<22} {:>10.2f} ms\n", "total", r.timings.total() * 1e3);
 }
 
+void print_holes(const HoleAnalysis& h, size_t pixels) {
+  fmt::print("  {:<22} recall {:.2f} %, precision {:.2f} % ({} flagged, {} true positives)\n", "holes",
+             100.0 * h.scores.recall, 100.0 * h.scores.precision, h.scores.hole_pixels, h.scores.true_positives);
+  fmt::print("  {:<22} {} = {:.3f} % of the right eye ({} outside the left frustum, {} hidden), {:.2f} ms\n",
+             "true disocclusions", h.truth.count(), 100.0 * double(h.truth.count()) / double(pixels),
+             h.truth.outside_frustum, h.truth.hidden, h.seconds * 1e3);
+}
+
 void run_render(const RenderArgs& a) {
   const RigOverrides overrides = a.rig.overrides();
   const Pipeline& pipeline = find_pipeline(a.pipeline);
@@ -44,18 +55,22 @@ void run_render(const RenderArgs& a) {
   const StereoRig rig = resolve_rig(scene, overrides);
   const RenderScene prepared(scene);
   const StereoResult result = pipeline.render(prepared, rig, options, RenderContext{executor});
-  const nlohmann::json record = io::result_to_json(pipeline.info().name, prepared, rig, result, executor.threads(), options);
+  // Scored against the true disocclusions outside the pipeline's timings.
+  const std::optional<HoleAnalysis> holes = analyze_holes(prepared, rig, result.right, executor);
+  nlohmann::json record = io::result_to_json(pipeline.info().name, prepared, rig, result, executor.threads(), options);
+  if (holes) record["holes"] = io::holes_to_json(*holes);
   const std::string stem = fmt::format("{}_{}", scene.name, pipeline.info().name);
-  const io::RenderFiles files = io::write_render_outputs(a.out, stem, result, record);
+  const io::RenderFiles files =
+      io::write_render_outputs(a.out, stem, result, record, holes ? &holes->overlay : nullptr);
   fmt::print("{} on {} ({} triangles), {}, {} threads\n", pipeline.info().name, scene.name, scene.triangle_count(),
              describe(rig), executor.threads());
   fmt::print("  {:<22} {:>10.2f} ms ({:.1f} MiB)\n", "bvh build (once)", prepared.bvh_build_seconds() * 1e3,
              prepared.rays().memory_bytes() / 1048576.0);
   print_timings(result);
   for (const auto& [name, value] : result.counters.snapshot()) fmt::print("  {:<22} {:>12}\n", name, value);
-  fmt::print("wrote {}\n      {}\n      {}\n      {}\n      {}\n      {}\n", files.exr.string(), files.left_png.string(),
-             files.right_png.string(), files.anaglyph_png.string(), files.side_by_side_png.string(),
-             files.stats_json.string());
+  if (holes) print_holes(*holes, result.right.pixel_count());
+  const std::vector<fs::path> written = files.all();
+  for (size_t i = 0; i < written.size(); ++i) fmt::print("{}{}\n", i == 0 ? "wrote " : "      ", written[i].string());
 }
 
 void list_pipelines() {

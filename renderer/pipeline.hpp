@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "renderer/image.hpp"
@@ -59,6 +60,9 @@ struct StereoResult {
   Image right;
   Timings timings;
   Counters counters;
+  /// Diagnostic images a pipeline was asked for (e.g. "grid" for the warping-grid overlay), each
+  /// with an "rgb" plane; `stereobench render` writes them as <stem>_<name>.png.
+  std::vector<std::pair<std::string, Image>> extras;
 };
 
 /// What the harness hands a pipeline besides scene, rig and options.

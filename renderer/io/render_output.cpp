@@ -1,9 +1,14 @@
 // Output files of a render run.
 #include "renderer/io/render_output.hpp"
 
+#include <algorithm>
+#include <array>
+#include <string_view>
+
 #include <fmt/format.h>
 
 #include "renderer/embree/ray_scene.hpp"
+#include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/gltf_loader.hpp"
 #include "renderer/io/image_io.hpp"
@@ -46,8 +51,50 @@ json result_to_json(const std::string& pipeline, const RenderScene& scene, const
           {"versions", versions_json()}};
 }
 
+json holes_to_json(const HoleAnalysis& a) {
+  return {{"hole_pixels", a.scores.hole_pixels},
+          {"true_disocclusions", a.truth.count()},
+          {"outside_frustum", a.truth.outside_frustum},
+          {"hidden", a.truth.hidden},
+          {"true_positives", a.scores.true_positives},
+          {"recall", a.scores.recall},
+          {"precision", a.scores.precision},
+          {"analysis_s", a.seconds}};
+}
+
+std::vector<std::filesystem::path> RenderFiles::all() const {
+  std::vector<std::filesystem::path> files{exr, left_png, right_png, anaglyph_png, side_by_side_png};
+  if (holes_png) files.push_back(*holes_png);
+  files.insert(files.end(), extras.begin(), extras.end());
+  files.push_back(stats_json);
+  return files;
+}
+
+namespace {
+
+/// InputError unless every extra's name makes a file name of its own beside the standard outputs.
+void check_extra_names(const StereoResult& result) {
+  static constexpr std::array<std::string_view, 6> reserved = {"left", "right", "anaglyph", "sbs", "stats", "holes"};
+  for (size_t i = 0; i < result.extras.size(); ++i) {
+    const std::string& name = result.extras[i].first;
+    const bool valid = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+      return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+    });
+    if (!valid || std::find(reserved.begin(), reserved.end(), name) != reserved.end())
+      throw InputError(fmt::format("a pipeline returned a diagnostic image named '{}'; names must be lowercase "
+                                   "letters, digits and '_', and not one of left, right, anaglyph, sbs, stats, holes",
+                                   name));
+    for (size_t k = 0; k < i; ++k)
+      if (result.extras[k].first == name)
+        throw InputError(fmt::format("a pipeline returned two diagnostic images named '{}'", name));
+  }
+}
+
+}  // namespace
+
 RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::string& stem,
-                                 const StereoResult& result, const json& record) {
+                                 const StereoResult& result, const json& record, const Image* holes_overlay) {
+  check_extra_names(result);
   RenderFiles f;
   f.exr = dir / (stem + ".exr");
   f.left_png = dir / (stem + "_left.png");
@@ -62,6 +109,14 @@ RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::st
   write_png_preview(f.right_png, result.right);
   write_png_preview(f.anaglyph_png, anaglyph_dubois(result.left, result.right));
   write_png_preview(f.side_by_side_png, side_by_side(result.left, result.right));
+  if (holes_overlay) {
+    f.holes_png = dir / (stem + "_holes.png");
+    write_png_preview(*f.holes_png, *holes_overlay);
+  }
+  for (const auto& [name, image] : result.extras) {
+    f.extras.push_back(dir / (stem + "_" + name + ".png"));
+    write_png_preview(f.extras.back(), image);
+  }
   write_text_atomically(f.stats_json, record.dump(2) + "\n");
   return f;
 }

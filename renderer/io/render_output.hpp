@@ -1,13 +1,17 @@
 // Writes what `stereobench render` produces for one pipeline run: the EXR pair with every AOV,
-// PNG previews of each eye, a Dubois anaglyph, a side-by-side image and a stats JSON.
+// PNG previews of each eye, a Dubois anaglyph, a side-by-side image, the hole overlay and the
+// pipeline's diagnostic images when there are any, and a stats JSON.
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "renderer/pipeline.hpp"
+#include "renderer/stages/disocclusion.hpp"
 
 namespace sb::io {
 
@@ -22,13 +26,27 @@ namespace sb::io {
                                             const StereoRig& rig, const StereoResult& result, int threads,
                                             const PipelineOptions& options);
 
+/// A hole analysis as the "holes" object of a run's record: hole_pixels, true_disocclusions,
+/// outside_frustum, hidden, true_positives, recall, precision, analysis_s.
+[[nodiscard]] nlohmann::json holes_to_json(const HoleAnalysis& analysis);
+
 /// The files written for one run, under `dir` with names starting with `stem`.
 struct RenderFiles {
   std::filesystem::path exr, left_png, right_png, anaglyph_png, side_by_side_png, stats_json;
+  std::optional<std::filesystem::path> holes_png;  ///< <stem>_holes.png, when there was a hole overlay
+  std::vector<std::filesystem::path> extras;       ///< <stem>_<name>.png per StereoResult::extras entry
+
+  /// Every written file, in the order they were written.
+  [[nodiscard]] std::vector<std::filesystem::path> all() const;
 };
 
-/// Writes every output of a run (atomically, file by file) and returns their paths.
+/// Writes every output of a run (atomically, file by file) and returns their paths: with
+/// `holes_overlay` also <stem>_holes.png, and a PNG preview of the "rgb" plane of each of the
+/// result's extras. An extra's name must be lowercase letters, digits and '_' and must not be
+/// one of the standard suffixes (left, right, anaglyph, sbs, stats, holes) nor appear twice;
+/// InputError otherwise, before anything is written.
 RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::string& stem,
-                                 const StereoResult& result, const nlohmann::json& record);
+                                 const StereoResult& result, const nlohmann::json& record,
+                                 const Image* holes_overlay = nullptr);
 
 }  // namespace sb::io

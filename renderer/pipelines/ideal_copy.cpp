@@ -21,10 +21,10 @@ class IdealCopy final : public Pipeline {
   StereoResult render(const RenderScene& scene, const StereoRig& rig, const PipelineOptions&,
                       const RenderContext& ctx) const override {
     StereoResult r;
-    r.left = make_eye_image(rig.params().width, rig.params().height);
     TraceCounts counts;
     {
       ScopedStage stage(r.timings, "left_trace");
+      r.left = make_eye_image(rig.params().width, rig.params().height);
       trace_eye(scene, rig.eye(Eye::left), ctx.executor, r.left, counts);
     }
     add_counts(r.counters, counts, "left", true);

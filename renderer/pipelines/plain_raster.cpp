@@ -4,9 +4,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/pipeline.hpp"
-#include "renderer/raster/rasterizer.hpp"
-#include "renderer/stages/eye_image.hpp"
-#include "renderer/stages/lighting.hpp"
+#include "renderer/stages/raster_eye.hpp"
 
 namespace sb {
 namespace {
@@ -31,26 +29,8 @@ class PlainRaster final : public Pipeline {
     ro.tile = options.get_int("tile");
     if (ro.tile < 8 || ro.tile > 1024)
       throw InputError(fmt::format("plain-raster: option tile={} is out of range 8..1024", ro.tile));
-    for (Eye e : {Eye::left, Eye::right}) {
-      const char* name = eye_name(e);
-      const EyeCamera cam = rig.eye(e);
-      RasterStats rs;
-      GBuffer g;
-      {
-        ScopedStage stage(r.timings, std::string(name) + "_gbuffer");
-        g = rasterize(scene.geometry(), cam, ctx.executor, ro, &rs);
-      }
-      Image image = make_eye_image(cam.width, cam.height);
-      TraceCounts counts;
-      {
-        ScopedStage stage(r.timings, std::string(name) + "_shading");
-        shade_gbuffer(scene, cam, g, ctx.executor, image, counts);
-      }
-      add_counts(r.counters, counts, name, false);
-      r.counters.add(std::string("triangles_rasterized_") + name, rs.triangles_rasterized);
-      r.counters.add(std::string("fragments_") + name, rs.fragments_tested);
-      (e == Eye::left ? r.left : r.right) = std::move(image);
-    }
+    r.left = raster_eye(scene, rig, Eye::left, ro, ctx.executor, r);
+    r.right = raster_eye(scene, rig, Eye::right, ro, ctx.executor, r);
     r.counters.set("hole_pixels", 0);
     return r;
   }

@@ -22,10 +22,11 @@ class PlainRt final : public Pipeline {
     const int w = rig.params().width, h = rig.params().height;
     for (Eye e : {Eye::left, Eye::right}) {
       const char* name = eye_name(e);
-      Image image = make_eye_image(w, h);
+      Image image;
       TraceCounts counts;
       {
         ScopedStage stage(r.timings, std::string(name) + "_trace");
+        image = make_eye_image(w, h);
         trace_eye(scene, rig.eye(e), ctx.executor, image, counts);
       }
       add_counts(r.counters, counts, name, true);

@@ -28,6 +28,25 @@ class EyeWriter {
     prim_[index] = p.prim;
     source_[index] = static_cast<uint32_t>(source);
   }
+  /// A pixel whose values come from elsewhere (a reprojected one).
+  void copy(size_t index, const vec3& radiance, const vec3& normal, const vec3& albedo, float depth, uint32_t prim,
+            Source source) {
+    set3(rgb_, index, radiance);
+    set3(normal_, index, normal);
+    set3(albedo_, index, albedo);
+    depth_[index] = depth;
+    prim_[index] = prim;
+    source_[index] = static_cast<uint32_t>(source);
+  }
+  /// A pixel no stage has a value for yet: radiance 0, depth +inf, tag `hole`.
+  void hole(size_t index) {
+    set3(rgb_, index, vec3(0.0f));
+    set3(normal_, index, vec3(0.0f));
+    set3(albedo_, index, vec3(0.0f));
+    depth_[index] = std::numeric_limits<float>::infinity();
+    prim_[index] = kNoPrimitive;
+    source_[index] = static_cast<uint32_t>(Source::hole);
+  }
   /// A ray or pixel that sees no geometry: the background.
   void background(size_t index, const vec3& background, Source source) {
     set3(rgb_, index, background);

@@ -3,9 +3,14 @@
 
 #include <atomic>
 #include <cmath>
+#include <vector>
 
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
 #include "renderer/shading.hpp"
 #include "renderer/stages/eye_image.hpp"
+#include "renderer/stages/primary_rays.hpp"
 #include "renderer/texture.hpp"
 
 namespace sb {
@@ -18,16 +23,17 @@ class PacketTracer {
   PacketTracer(const RenderScene& scene, const EyeCamera& eye, Image& image)
       : scene_(scene), eye_(eye), writer_(image), width_(image.width()),
         tan_spread_(static_cast<float>(std::tan(ray_cone_spread(2.0 * std::atan(0.5 * eye.height / eye.f_px), eye.height)))),
-        origin_(eye.origin), forward_(-eye.back) {}
+        origin_(eye.origin) {}
 
-  void trace(const uint32_t* pixels, int n, Source source, TraceCounts& counts) {
+  /// Traces the rays of `pixels` as one packet; shades and writes the lanes whose bit is set in
+  /// `wanted` (bit i for pixels[i]).
+  void trace(const uint32_t* pixels, int n, uint32_t wanted, Source source, TraceCounts& counts) {
     RayQuery rays[kRayPacket];
     RayHit hits[kRayPacket];
     for (int i = 0; i < n; ++i) {
       const int x = static_cast<int>(pixels[i] % static_cast<uint32_t>(width_));
       const int y = static_cast<int>(pixels[i] / static_cast<uint32_t>(width_));
-      rays[i].origin = vec3(origin_);
-      rays[i].dir = vec3(eye_.ray_direction(x + 0.5, y + 0.5));
+      rays[i] = primary_ray(eye_, x, y);
     }
     scene_.rays().intersect(std::span<const RayQuery>(rays, static_cast<size_t>(n)),
                             std::span<RayHit>(hits, static_cast<size_t>(n)));
@@ -39,13 +45,15 @@ class PacketTracer {
     uint32_t where[kRayPacket];
     int m = 0;
     for (int i = 0; i < n; ++i) {
+      if ((wanted >> i & 1u) == 0) continue;
+      ++counts.pixels_traced;
       if (hits[i].prim == kNoPrimitiveId) {
         writer_.background(pixels[i], scene_.scene().background, source);
         continue;
       }
       SurfacePoint& p = points[m];
       p = surface_at(scene_, hits[i].prim, hits[i].bary, vec3(origin_));
-      const float cos_axis = glm::dot(rays[i].dir, vec3(forward_));
+      const float cos_axis = cos_to_axis(eye_, rays[i].dir);
       const float width = primary_cone_width(hits[i].t, tan_spread_, cos_axis);
       albedo[m] = albedo_at(scene_, p, ray_cone_lod(scene_, p, width, rays[i].dir));
       depth[m] = hits[i].t * cos_axis;
@@ -67,7 +75,6 @@ class PacketTracer {
   int width_;
   float tan_spread_;
   dvec3 origin_;
-  dvec3 forward_;
 };
 
 /// Adds a task's counts into shared totals.
@@ -75,57 +82,71 @@ void accumulate(std::atomic<uint64_t>* totals, const TraceCounts& c) {
   totals[0] += c.primary_rays;
   totals[1] += c.shadow_rays;
   totals[2] += c.pixels_shaded;
+  totals[3] += c.pixels_traced;
 }
+
+/// Adds the shared totals to a caller's counts.
+void add_totals(TraceCounts& counts, const std::atomic<uint64_t>* totals) {
+  counts.primary_rays += totals[0];
+  counts.shadow_rays += totals[1];
+  counts.pixels_shaded += totals[2];
+  counts.pixels_traced += totals[3];
+}
+
+constexpr uint32_t kAllLanes = (1u << kRayPacket) - 1u;
 
 }  // namespace
 
 void trace_eye(const RenderScene& scene, const EyeCamera& eye, const Executor& executor, Image& image,
                TraceCounts& counts) {
-  std::atomic<uint64_t> totals[3] = {0, 0, 0};
+  std::atomic<uint64_t> totals[4] = {0, 0, 0, 0};
   const int w = image.width(), h = image.height();
-  executor.for_tiles(w, h, 32, [&](const PixelRect& tile) {
+  executor.for_tiles(w, h, kTraceTile, [&](const PixelRect& tile) {
     PacketTracer tracer(scene, eye, image);
     TraceCounts local;
-    uint32_t block[kRayPacket];
-    // 4x4 blocks keep the packets coherent.
-    for (int by = tile.y0; by < tile.y1; by += 4)
-      for (int bx = tile.x0; bx < tile.x1; bx += 4) {
-        int n = 0;
-        for (int y = by; y < std::min(by + 4, tile.y1); ++y)
-          for (int x = bx; x < std::min(bx + 4, tile.x1); ++x) block[n++] = static_cast<uint32_t>(y * w + x);
-        tracer.trace(block, n, Source::traced, local);
-      }
+    for_pixel_blocks(tile, w, [&](const uint32_t* block, int n) { tracer.trace(block, n, kAllLanes, Source::traced, local); });
     accumulate(totals, local);
   });
-  counts.primary_rays += totals[0];
-  counts.shadow_rays += totals[1];
-  counts.pixels_shaded += totals[2];
+  add_totals(counts, totals);
 }
 
 void trace_pixels(const RenderScene& scene, const EyeCamera& eye, const Executor& executor,
                   std::span<const uint32_t> pixels, Image& image, TraceCounts& counts, Source source) {
-  std::atomic<uint64_t> totals[3] = {0, 0, 0};
-  const size_t packets = (pixels.size() + kRayPacket - 1) / kRayPacket;
-  executor.for_range(packets, 64, [&](size_t begin, size_t end) {
+  const int w = image.width(), h = image.height();
+  // The listed pixels as lane masks of trace_eye's 4x4 blocks (4-aligned, clipped at the image).
+  const int blocks_x = (w + 3) / 4, blocks_y = (h + 3) / 4;
+  std::vector<uint32_t> masks(static_cast<size_t>(blocks_x) * static_cast<size_t>(blocks_y), 0);
+  for (const uint32_t p : pixels) {
+    const int x = static_cast<int>(p % static_cast<uint32_t>(w)), y = static_cast<int>(p / static_cast<uint32_t>(w));
+    if (y >= h) throw InputError(fmt::format("trace_pixels: pixel index {} lies outside the {}x{} image", p, w, h));
+    const int bx = x / 4, by = y / 4;
+    const int lane = (y - 4 * by) * std::min(4, w - 4 * bx) + (x - 4 * bx);
+    masks[static_cast<size_t>(by) * blocks_x + bx] |= 1u << lane;
+  }
+  std::vector<uint32_t> blocks;
+  for (size_t b = 0; b < masks.size(); ++b)
+    if (masks[b] != 0) blocks.push_back(static_cast<uint32_t>(b));
+
+  std::atomic<uint64_t> totals[4] = {0, 0, 0, 0};
+  executor.for_range(blocks.size(), 16, [&](size_t begin, size_t end) {
     PacketTracer tracer(scene, eye, image);
     TraceCounts local;
     for (size_t k = begin; k < end; ++k) {
-      const size_t first = k * kRayPacket;
-      const int n = static_cast<int>(std::min<size_t>(kRayPacket, pixels.size() - first));
-      tracer.trace(pixels.data() + first, n, source, local);
+      const int bx = static_cast<int>(blocks[k] % static_cast<uint32_t>(blocks_x));
+      const int by = static_cast<int>(blocks[k] / static_cast<uint32_t>(blocks_x));
+      const PixelRect rect{4 * bx, 4 * by, std::min(4 * bx + 4, w), std::min(4 * by + 4, h)};
+      for_pixel_blocks(rect, w, [&](const uint32_t* block, int n) { tracer.trace(block, n, masks[blocks[k]], source, local); });
     }
     accumulate(totals, local);
   });
-  counts.primary_rays += totals[0];
-  counts.shadow_rays += totals[1];
-  counts.pixels_shaded += totals[2];
+  add_totals(counts, totals);
 }
 
 void add_counts(Counters& counters, const TraceCounts& counts, const char* eye, bool traced) {
   counters.add("primary_rays", counts.primary_rays);
   counters.add("shadow_rays", counts.shadow_rays);
   counters.add(std::string("pixels_shaded_") + eye, counts.pixels_shaded);
-  if (traced) counters.add(std::string("pixels_traced_") + eye, counts.primary_rays);
+  if (traced) counters.add(std::string("pixels_traced_") + eye, counts.pixels_traced);
 }
 
 }  // namespace sb

@@ -18,6 +18,7 @@ struct TraceCounts {
   uint64_t primary_rays = 0;
   uint64_t shadow_rays = 0;
   uint64_t pixels_shaded = 0;
+  uint64_t pixels_traced = 0;  ///< pixels written from a primary ray (surface or background)
 };
 
 /// Traces and shades every pixel of `image` (made by make_eye_image) from `eye`; source = traced.
@@ -25,13 +26,15 @@ void trace_eye(const RenderScene& scene, const EyeCamera& eye, const Executor& e
                TraceCounts& counts);
 
 /// Traces and shades the listed pixels (indices y * width + x) only; the others are left as they
-/// are. Pixels are traced in packets of 16 in list order by the same code as trace_eye (whether a
-/// pixel's result is bit-identical to trace_eye's is tested by the pipelines that rely on it).
+/// are. The rays go in trace_eye's packets — each 4x4 block holding a listed pixel is cast whole —
+/// so that every hit is bit-identical to trace_eye's: Embree's packet traversal treats a packet
+/// with few active rays differently from a full one. Only the listed pixels are shaded and written.
+/// InputError for an index outside the image.
 void trace_pixels(const RenderScene& scene, const EyeCamera& eye, const Executor& executor,
                   std::span<const uint32_t> pixels, Image& image, TraceCounts& counts, Source source = Source::traced);
 
 /// Adds trace counts to a pipeline's counters: primary_rays and shadow_rays (totals) and
-/// pixels_shaded_<eye>; with `traced` also pixels_traced_<eye>.
+/// pixels_shaded_<eye>; with `traced` also pixels_traced_<eye> (pixels written from a primary ray).
 void add_counts(Counters& counters, const TraceCounts& counts, const char* eye, bool traced);
 
 }  // namespace sb

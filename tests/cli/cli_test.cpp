@@ -105,6 +105,33 @@ TEST(Cli, RenderWritesEveryOutputAndBenchPrintsATable) {
   for (const char* name : {"plain-rt", "plain-raster", "ideal-copy"}) EXPECT_NE(l.out.find(name), std::string::npos);
 }
 
+TEST(Cli, RenderScoresHolesOnlyWhenPixelsAreReprojected) {
+  test::ScratchDir dir("holes");
+  const std::string common = " --scenes-dir '" + (dir / "scenes").string() + "' --resolution 64x36 --out '" +
+                             dir.path().string() + "'";
+  // ideal-copy reprojects every right pixel and fills nothing: every true disocclusion is missed.
+  const CliRun r = run("render --scene box-wall --pipeline ideal-copy" + common);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("true disocclusions"), std::string::npos) << r.out;
+  EXPECT_TRUE(std::filesystem::exists(dir / "box-wall_ideal-copy_holes.png"));
+  const auto j = nlohmann::json::parse(test::read_text(dir / "box-wall_ideal-copy_stats.json"));
+  const auto& holes = j.at("holes");
+  EXPECT_EQ(holes.at("hole_pixels").get<uint64_t>(), 0u);
+  EXPECT_GT(holes.at("true_disocclusions").get<uint64_t>(), 0u);
+  EXPECT_EQ(holes.at("true_disocclusions").get<uint64_t>(),
+            holes.at("outside_frustum").get<uint64_t>() + holes.at("hidden").get<uint64_t>());
+  EXPECT_EQ(holes.at("recall").get<double>(), 0.0);
+  EXPECT_EQ(holes.at("precision").get<double>(), 1.0);
+  for (const char* key : {"true_positives", "analysis_s"}) EXPECT_TRUE(holes.contains(key)) << key;
+
+  // plain-rt traces every pixel: no holes section, no overlay.
+  const CliRun p = run("render --scene box-wall --pipeline plain-rt" + common);
+  ASSERT_EQ(p.code, 0) << p.out;
+  EXPECT_EQ(p.out.find("true disocclusions"), std::string::npos) << p.out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "box-wall_plain-rt_holes.png"));
+  EXPECT_FALSE(nlohmann::json::parse(test::read_text(dir / "box-wall_plain-rt_stats.json")).contains("holes"));
+}
+
 TEST(Cli, RenderAndBenchRejectBadArguments) {
   test::ScratchDir dir("renderbad");
   const std::string bench_common = " --scenes-dir '" + (dir / "scenes").string() + "' --resolution 32x18";

@@ -9,31 +9,16 @@
 #include "scenes/generators.hpp"
 #include "renderer/io/image_io.hpp"
 #include "support/render_support.hpp"
+#include "support/scene_lists.hpp"
 #include "support/scratch_dir.hpp"
 
 namespace sb {
 namespace {
 
-std::vector<std::string> registered() {
-  std::vector<std::string> names;
-  for (const Pipeline* p : pipelines()) names.push_back(p->info().name);
-  return names;
-}
-
-std::vector<std::string> analytic_scenes() {
-  std::vector<std::string> names;
-  for (const scenes::GeneratorInfo& g : scenes::generators())
-    if (g.analytic) names.push_back(g.name);
-  return names;
-}
-
-/// A test-name-safe form of a pipeline or scene name.
-std::string test_name(const ::testing::TestParamInfo<std::string>& param) {
-  std::string n = param.param;
-  for (char& c : n)
-    if (c == '-') c = '_';
-  return n;
-}
+using test::analytic_scenes;
+using test::builtin_scenes;
+using test::param_name;
+using test::registered_pipelines;
 
 class Conformance : public ::testing::TestWithParam<std::string> {};
 
@@ -70,8 +55,8 @@ TEST_P(Conformance, BitIdenticalWithOneAndTwoThreads) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Registry, Conformance, ::testing::ValuesIn(registered()),
-                         test_name);
+INSTANTIATE_TEST_SUITE_P(Registry, Conformance, ::testing::ValuesIn(registered_pipelines()),
+                         param_name);
 
 class Visibility : public ::testing::TestWithParam<std::string> {};
 
@@ -131,15 +116,8 @@ TEST_P(Visibility, RasterAndRayTracingAgree) {
   std::printf("%-15s right eye plain-raster vs plain-rt: %.2f dB\n", GetParam().c_str(), psnr);
 }
 
-std::vector<std::string> builtin_scenes() {
-  std::vector<std::string> names;
-  for (const scenes::GeneratorInfo& g : scenes::generators())
-    if (g.builtin) names.push_back(g.name);
-  return names;
-}
-
 INSTANTIATE_TEST_SUITE_P(BuiltinScenes, Visibility, ::testing::ValuesIn(builtin_scenes()),
-                         test_name);
+                         param_name);
 
 }  // namespace
 }  // namespace sb

@@ -1,0 +1,613 @@
+// The adaptive grid warp: parallax metric per cell, grid triangles per cell row, fixed-point
+// rasterization of the warped grid in horizontal bands, and the resolve into the target eye.
+#include "renderer/stages/grid_warp.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
+#include "renderer/stages/eye_image.hpp"
+
+namespace sb {
+
+namespace {
+
+/// Sub-pixel bits of warped vertex positions (1/256 px). Every vertex goes through one snapping
+/// function, so an edge shared by two grid triangles has identical end points in both and the
+/// fill rule covers each pixel centre on it exactly once.
+constexpr int kSubBits = 8;
+constexpr int64_t kSubOne = int64_t{1} << kSubBits;
+constexpr int64_t kSubHalf = kSubOne / 2;
+
+constexpr double kArcminPerRadian = 180.0 * 60.0 / std::numbers::pi;
+
+/// One warped grid vertex.
+struct GridVertex {
+  int32_t x = 0;  ///< target position, fixed point
+  int32_t y = 0;
+  float q = 0.0f;     ///< inverse target depth (0 at infinity)
+  float disc = 0.0f;  ///< discontinuity measure, px
+  float sx = 0.0f;    ///< source position (pixel coordinates)
+  float sy = 0.0f;
+  bool valid = false;
+};
+
+/// The gaps that open between horizontal neighbours of a source row when it is warped to the
+/// other eye, in units of f e (pixels / (f e)): the disparity d = f e (1/c - 1/z) grows with
+/// depth, so the gap between pixels i and i+1 is d(i+1) - d(i) = f e (1/z(i) - 1/z(i+1)).
+class GapMeasure {
+ public:
+  GapMeasure(const float* depth, int width, int height) : depth_(depth), width_(width), height_(height) {}
+
+  /// 1/z of a source pixel, clamped to the image; 0 for background (infinite depth).
+  [[nodiscard]] double inverse_depth(int i, int j) const {
+    i = std::clamp(i, 0, width_ - 1);
+    j = std::clamp(j, 0, height_ - 1);
+    const double z = depth_[static_cast<size_t>(j) * width_ + i];
+    return z > 0.0 && std::isfinite(z) ? 1.0 / z : 0.0;
+  }
+
+  /// How much more the gap between i and i+1 opens than the smaller of the gaps beside it. On a
+  /// plane 1/z is affine in screen space, so all gaps of a row are equal and the excess is 0; at a
+  /// depth discontinuity it is the disparity step. A crease where a surface turns away counts too:
+  /// from three samples it cannot be told from a small step behind a fold. Folds (negative gaps)
+  /// count as no gap. 0 outside the row.
+  [[nodiscard]] double excess_opening(int i, int j) const {
+    if (i < 0 || i + 1 >= width_) return 0.0;
+    j = std::clamp(j, 0, height_ - 1);
+    const double left = i > 0 ? opening(i - 1, j) : opening(i, j);
+    const double right = i + 2 < width_ ? opening(i + 1, j) : opening(i, j);
+    return std::max(0.0, opening(i, j) - std::max(0.0, std::min(left, right)));
+  }
+
+  /// The discontinuity measure of vertex (i, j): the larger excess of the two gaps beside it.
+  [[nodiscard]] double vertex_measure(int i, int j) const {
+    return std::max(excess_opening(i - 1, j), excess_opening(i, j));
+  }
+
+ private:
+  [[nodiscard]] double opening(int i, int j) const { return inverse_depth(i, j) - inverse_depth(i + 1, j); }
+
+  const float* depth_;
+  int width_;
+  int height_;
+};
+
+/// Reprojects source lattice vertices into the target eye with VP_to · VP_from⁻¹. The matrix is
+/// applied to the source point scaled by its inverse depth, (x_c, y_c, −1, 1/z) in the source view
+/// space — the same homogeneous point as the source NDC (x, y, z_ndc, 1) up to the factor z — so a
+/// point at infinity needs no special case and the result does not depend on the near plane.
+class Reprojector {
+ public:
+  Reprojector(const Image& source, const EyeCamera& from, const EyeCamera& to, double interaxial)
+      : gaps_(source.data_f32(planes::depth), source.width(), source.height()),
+        from_(from),
+        to_w_(to.width),
+        to_h_(to.height),
+        step_scale_(from.f_px * interaxial),
+        guard_(4.0 * std::max(to.width, to.height) + 64.0) {
+    const dmat4 view_from = from.view_matrix();
+    matrix_ = to.projection_matrix() * to.view_matrix() * glm::inverse(view_from);
+  }
+
+  /// Target pixel position of source pixel position (x, y) at inverse depth inv_z (0: infinity),
+  /// or nothing when it lies behind the target eye.
+  [[nodiscard]] std::optional<dvec2> position(double x, double y, double inv_z, double* target_w = nullptr) const {
+    const dvec4 c = matrix_ * dvec4((x - from_.cx) / from_.f_px, (from_.cy - y) / from_.f_px, -1.0, inv_z);
+    if (!(c.w > 0.0)) return std::nullopt;
+    if (target_w != nullptr) *target_w = c.w;
+    return dvec2((c.x / c.w + 1.0) * 0.5 * to_w_, (1.0 - c.y / c.w) * 0.5 * to_h_);
+  }
+
+  /// The warped vertex of source pixel centre (i, j).
+  [[nodiscard]] GridVertex vertex(int i, int j) const {
+    GridVertex v;
+    // Lattice points are pixel centres; the extra ring outside the image sits on its edges.
+    const double sx = i < 0 ? 0.0 : i >= from_.width ? from_.width : i + 0.5;
+    const double sy = j < 0 ? 0.0 : j >= from_.height ? from_.height : j + 0.5;
+    v.sx = static_cast<float>(sx);
+    v.sy = static_cast<float>(sy);
+    const double inv_z = gaps_.inverse_depth(i, j);
+    double w = 1.0;
+    const std::optional<dvec2> p = position(sx, sy, inv_z, &w);
+    // A vertex too far outside the target image cannot be rasterized in fixed point.
+    if (!p || !(std::abs(p->x) < guard_ && std::abs(p->y) < guard_)) return v;
+    v.x = static_cast<int32_t>(std::floor(p->x * kSubOne + 0.5));
+    v.y = static_cast<int32_t>(std::floor(p->y * kSubOne + 0.5));
+    v.q = static_cast<float>(inv_z / w);
+    v.disc = static_cast<float>(step_scale_ * gaps_.vertex_measure(i, j));
+    v.valid = true;
+    return v;
+  }
+
+ private:
+  GapMeasure gaps_;
+  EyeCamera from_;
+  int to_w_;
+  int to_h_;
+  double step_scale_;
+  double guard_;
+  dmat4 matrix_{1.0};
+};
+
+/// Calls emit(i0, j0, i1, j1, i2, j2) for every triangle of cell (cx, cy), in source lattice
+/// coordinates and positive orientation (clockwise on screen, y down). A subdivided cell (and one
+/// too thin to have an interior) is split into native-resolution quads; a coarse cell is two
+/// triangles, or, where a neighbour across one of its edges is subdivided, a fan from its centre
+/// through every lattice point on those edges, so that the mesh has no T-junctions.
+template <class Emit>
+void cell_triangles(const WarpGrid& g, int cx, int cy, Emit&& emit) {
+  const int x0 = g.x0(cx), x1 = g.x1(cx), y0 = g.y0(cy), y1 = g.y1(cy);
+  if (x1 <= x0 || y1 <= y0) return;
+  if (g.subdivided[g.cell(cx, cy)] || x1 - x0 < 2 || y1 - y0 < 2) {
+    for (int j = y0; j < y1; ++j)
+      for (int i = x0; i < x1; ++i) {
+        emit(i, j, i + 1, j, i + 1, j + 1);
+        emit(i, j, i + 1, j + 1, i, j + 1);
+      }
+    return;
+  }
+  const bool fine_top = cy > 0 && g.subdivided[g.cell(cx, cy - 1)];
+  const bool fine_right = cx + 1 < g.cells_x && g.subdivided[g.cell(cx + 1, cy)];
+  const bool fine_bottom = cy + 1 < g.cells_y && g.subdivided[g.cell(cx, cy + 1)];
+  const bool fine_left = cx > 0 && g.subdivided[g.cell(cx - 1, cy)];
+  if (!fine_top && !fine_right && !fine_bottom && !fine_left) {
+    emit(x0, y0, x1, y0, x1, y1);
+    emit(x0, y0, x1, y1, x0, y1);
+    return;
+  }
+  const int mi = (x0 + x1) / 2, mj = (y0 + y1) / 2;
+  // Walk the border clockwise from the top-left corner; each edge contributes its start point and,
+  // when fine, every lattice point before its end.
+  int pi = x0, pj = y0;
+  const auto step_to = [&](int ni, int nj) {
+    emit(mi, mj, pi, pj, ni, nj);
+    pi = ni;
+    pj = nj;
+  };
+  for (int i = x0 + 1; i <= x1; ++i)
+    if (fine_top || i == x1) step_to(i, y0);
+  for (int j = y0 + 1; j <= y1; ++j)
+    if (fine_right || j == y1) step_to(x1, j);
+  for (int i = x1 - 1; i >= x0; --i)
+    if (fine_bottom || i == x0) step_to(i, y1);
+  for (int j = y1 - 1; j >= y0; --j)
+    if (fine_left || j == y0) step_to(x0, j);
+}
+
+/// The target-side buffers of a warp: per pixel the nearest kept fragment's inverse depth and
+/// source position, and its WarpPixel state. Cell rows of the same parity write disjoint rows.
+struct WarpTarget {
+  int width = 0;
+  int height = 0;
+  std::vector<float> q;
+  std::vector<vec2> src;
+  std::vector<uint8_t> state;
+};
+
+/// Rasterizes warped grid triangles into the target buffers and counts what it did.
+class GridRasterizer {
+ public:
+  GridRasterizer(WarpTarget& target, const WarpOptions& options)
+      : t_(target), detect_(options.detect_disocclusions), rule_(options.rule), threshold_(options.discontinuity_px) {}
+
+  /// Rasterizes one grid triangle; `detect` enables disocclusion detection for it.
+  void draw(const GridVertex& a, const GridVertex& b, const GridVertex& c, bool detect) {
+    ++triangles;
+    if (!a.valid || !b.valid || !c.valid) {
+      ++culled;
+      return;
+    }
+    const GridVertex* v[3] = {&a, &b, &c};
+    const int64_t area = (int64_t{b.x} - a.x) * (int64_t{c.y} - a.y) - (int64_t{b.y} - a.y) * (int64_t{c.x} - a.x);
+    // A warped triangle that turned over shows a surface the target eye sees from behind or that
+    // lies hidden; the triangles in front of it cover its area.
+    if (area <= 0) {
+      ++culled;
+      return;
+    }
+    // Pixel p's centre is at p * kSubOne + kSubHalf; the box holds every candidate centre.
+    const int32_t min_x = std::min({a.x, b.x, c.x}), max_x = std::max({a.x, b.x, c.x});
+    const int32_t min_y = std::min({a.y, b.y, c.y}), max_y = std::max({a.y, b.y, c.y});
+    const auto first = [](int32_t lo) { return static_cast<int>((int64_t{lo} - kSubHalf + kSubOne - 1) >> kSubBits); };
+    const auto last = [](int32_t hi) { return static_cast<int>((int64_t{hi} - kSubHalf) >> kSubBits); };
+    const int px0 = std::max(first(min_x), 0), px1 = std::min(last(max_x), t_.width - 1);
+    const int py0 = std::max(first(min_y), 0), py1 = std::min(last(max_y), t_.height - 1);
+    if (px0 > px1 || py0 > py1) return;
+
+    int64_t ex[3], ey[3], e0[3], bias[3];
+    const int64_t cx0 = int64_t{px0} * kSubOne + kSubHalf, cy0 = int64_t{py0} * kSubOne + kSubHalf;
+    for (int k = 0; k < 3; ++k) {
+      const int n = k == 2 ? 0 : k + 1;
+      const int64_t dx = int64_t{v[n]->x} - v[k]->x, dy = int64_t{v[n]->y} - v[k]->y;
+      // Fill rule: an edge is inclusive for exactly one of the two triangles that share it.
+      bias[k] = (dy < 0 || (dy == 0 && dx > 0)) ? 0 : -1;
+      e0[k] = dx * (cy0 - v[k]->y) - dy * (cx0 - v[k]->x);
+      ex[k] = -dy * kSubOne;
+      ey[k] = dx * kSubOne;
+    }
+    const double inv_area = 1.0 / static_cast<double>(area);
+    const bool perspective = a.q > 0.0f && b.q > 0.0f && c.q > 0.0f;
+    Detect mode = Detect::off;
+    if (detect && detect_) mode = rule_ == DiscardRule::all_vertices ? Detect::flags : Detect::interpolated;
+    for (int y = py0; y <= py1; ++y) {
+      int64_t e[3] = {e0[0], e0[1], e0[2]};
+      for (int x = px0; x <= px1; ++x) {
+        if (e[0] + bias[0] >= 0 && e[1] + bias[1] >= 0 && e[2] + bias[2] >= 0) fragment(v, e, inv_area, perspective, mode, x, y);
+        for (int k = 0; k < 3; ++k) e[k] += ex[k];
+      }
+      for (int k = 0; k < 3; ++k) e0[k] += ey[k];
+    }
+  }
+
+  uint64_t triangles = 0;
+  uint64_t culled = 0;
+  uint64_t fragments = 0;
+  uint64_t discarded = 0;
+
+ private:
+  enum class Detect { off, interpolated, flags };
+
+  void fragment(const GridVertex* const v[3], const int64_t e[3], double inv_area, bool perspective, Detect mode, int x,
+                int y) {
+    ++fragments;
+    // The weight of vertex k is the edge function of the opposite edge over the area.
+    const double l0 = static_cast<double>(e[1]) * inv_area;
+    const double l1 = static_cast<double>(e[2]) * inv_area;
+    const double l2 = 1.0 - l0 - l1;
+    double w0 = l0, w1 = l1, w2 = l2;
+    if (perspective) {
+      const double p0 = l0 * v[0]->q, p1 = l1 * v[1]->q, p2 = l2 * v[2]->q;
+      const double inv = 1.0 / (p0 + p1 + p2);
+      w0 = p0 * inv;
+      w1 = p1 * inv;
+      w2 = p2 * inv;
+    }
+    const size_t o = static_cast<size_t>(y) * t_.width + x;
+    // The flags interpolate to exactly 1 where every vertex of non-zero weight is flagged; a
+    // weight is zero exactly when the edge function of the opposite edge is.
+    const bool discard =
+        mode == Detect::flags
+            ? (e[1] == 0 || v[0]->disc > threshold_) && (e[2] == 0 || v[1]->disc > threshold_) &&
+                  (e[0] == 0 || v[2]->disc > threshold_)
+            : mode == Detect::interpolated && w0 * v[0]->disc + w1 * v[1]->disc + w2 * v[2]->disc > threshold_;
+    discarded += discard ? 1 : 0;
+    // A discarded fragment still takes part in the depth test: the rubber sheet it belongs to
+    // spans a region the source eye does not see, and warped surfaces behind it there come from
+    // elsewhere in the source image (seen past an occluder that is missing from it).
+    const auto q = static_cast<float>(l0 * v[0]->q + l1 * v[1]->q + l2 * v[2]->q);
+    if (!(q > t_.q[o])) return;
+    t_.q[o] = q;
+    if (discard) {
+      t_.state[o] = static_cast<uint8_t>(WarpPixel::discarded);
+      return;
+    }
+    t_.src[o] = vec2(static_cast<float>(w0 * v[0]->sx + w1 * v[1]->sx + w2 * v[2]->sx),
+                     static_cast<float>(w0 * v[0]->sy + w1 * v[1]->sy + w2 * v[2]->sy));
+    t_.state[o] = static_cast<uint8_t>(WarpPixel::covered);
+  }
+
+  WarpTarget& t_;
+  bool detect_;
+  DiscardRule rule_;
+  double threshold_;
+};
+
+/// The warped vertices of one row of cells: lattice rows y0..y1, every column, computed for the
+/// points the cells' triangles use.
+class CellRowVertices {
+ public:
+  CellRowVertices(const WarpGrid& g, const Reprojector& reproject, int cy)
+      : g_(g), reproject_(reproject), y0_(g.y0(cy)), rows_(std::max(g.y1(cy) - g.y0(cy) + 1, 1)),
+        v_(static_cast<size_t>(rows_) * (g.width + 2)) {}
+
+  /// Computes the vertices cell (cx) uses: its whole block when it is subdivided or thin,
+  /// otherwise its corners, its centre and every point of its edges (the fine ones need them all).
+  void prepare(int cx, int cy) {
+    const int x0 = g_.x0(cx), x1 = g_.x1(cx), y1 = g_.y1(cy);
+    if (g_.subdivided[g_.cell(cx, cy)] || x1 - x0 < 2 || y1 - y0_ < 2) {
+      for (int j = y0_; j <= y1; ++j)
+        for (int i = x0; i <= x1; ++i) set(i, j);
+      return;
+    }
+    for (int i = x0; i <= x1; ++i) {
+      set(i, y0_);
+      set(i, y1);
+    }
+    for (int j = y0_ + 1; j < y1; ++j) {
+      set(x0, j);
+      set(x1, j);
+    }
+    set((x0 + x1) / 2, (y0_ + y1) / 2);
+  }
+
+  [[nodiscard]] const GridVertex& at(int i, int j) const { return v_[index(i, j)]; }
+
+ private:
+  [[nodiscard]] size_t index(int i, int j) const {
+    return static_cast<size_t>(j - y0_) * static_cast<size_t>(g_.width + 2) + static_cast<size_t>(i + 1);
+  }
+  void set(int i, int j) { v_[index(i, j)] = reproject_.vertex(i, j); }
+
+  const WarpGrid& g_;
+  const Reprojector& reproject_;
+  int y0_;
+  int rows_;
+  std::vector<GridVertex> v_;
+};
+
+/// Marks the occluding-edge band of target rows [y0, y1): a covered pixel whose right-hand
+/// neighbour is covered by a surface nearer by more than `step` pixels of disparity. The nearer
+/// surface's silhouette lies somewhere between its last source pixel centre and the one before,
+/// so its warped image may reach up to a pixel further left than its first warped vertex: the
+/// pixel there shows either surface and is left for the hole filler.
+void mark_occluding_edges(WarpTarget& t, int y0, int y1, double disparity_per_inverse_depth, double step) {
+  for (int y = y0; y < y1; ++y) {
+    const size_t row = static_cast<size_t>(y) * t.width;
+    for (int x = 0; x + 1 < t.width; ++x) {
+      const size_t o = row + x;
+      if (t.state[o] != static_cast<uint8_t>(WarpPixel::covered) ||
+          t.state[o + 1] != static_cast<uint8_t>(WarpPixel::covered))
+        continue;
+      if (disparity_per_inverse_depth * (static_cast<double>(t.q[o + 1]) - t.q[o]) > step)
+        t.state[o] = static_cast<uint8_t>(WarpPixel::occluding_edge);
+    }
+  }
+}
+
+/// Writes target rows [y0, y1) from the warp buffers and counts their pixels.
+void resolve_rows(const WarpTarget& t, const Image& source, int y0, int y1, Image& target, WarpStats& stats) {
+  const int sw = source.width(), sh = source.height();
+  const float* s_rgb = source.data_f32(planes::rgb);
+  const float* s_normal = source.data_f32(planes::normal);
+  const float* s_albedo = source.data_f32(planes::albedo);
+  const uint32_t* s_prim = source.data_u32(planes::primid);
+  EyeWriter out(target);
+  for (int y = y0; y < y1; ++y)
+    for (int x = 0; x < t.width; ++x) {
+      const size_t o = static_cast<size_t>(y) * t.width + x;
+      if (t.state[o] != static_cast<uint8_t>(WarpPixel::covered)) {
+        const auto state = static_cast<WarpPixel>(t.state[o]);
+        (state == WarpPixel::discarded        ? stats.pixels_discarded
+         : state == WarpPixel::occluding_edge ? stats.pixels_occluding_edge
+                                              : stats.pixels_uncovered)++;
+        out.hole(o);
+        continue;
+      }
+      ++stats.pixels_covered;
+      // Bilinear lookup: texel centres sit at integer + 0.5, so a source position on a pixel
+      // centre reads that pixel alone.
+      const vec2 s = t.src[o];
+      const float u = s.x - 0.5f, v = s.y - 0.5f;
+      const float fu = std::floor(u), fv = std::floor(v);
+      const float ax = u - fu, ay = v - fv;
+      const int i0 = std::clamp(static_cast<int>(fu), 0, sw - 1), i1 = std::clamp(static_cast<int>(fu) + 1, 0, sw - 1);
+      const int j0 = std::clamp(static_cast<int>(fv), 0, sh - 1), j1 = std::clamp(static_cast<int>(fv) + 1, 0, sh - 1);
+      const float* p00 = s_rgb + 3 * (static_cast<size_t>(j0) * sw + i0);
+      const float* p10 = s_rgb + 3 * (static_cast<size_t>(j0) * sw + i1);
+      const float* p01 = s_rgb + 3 * (static_cast<size_t>(j1) * sw + i0);
+      const float* p11 = s_rgb + 3 * (static_cast<size_t>(j1) * sw + i1);
+      vec3 rgb;
+      for (int c = 0; c < 3; ++c) {
+        const float top = p00[c] + ax * (p10[c] - p00[c]);
+        const float bottom = p01[c] + ax * (p11[c] - p01[c]);
+        rgb[c] = top + ay * (bottom - top);
+      }
+      // The other AOVs come from the source pixel the position falls in.
+      const size_t n = static_cast<size_t>(std::clamp(static_cast<int>(std::floor(s.y)), 0, sh - 1)) * sw +
+                       static_cast<size_t>(std::clamp(static_cast<int>(std::floor(s.x)), 0, sw - 1));
+      const float depth = t.q[o] > 0.0f ? 1.0f / t.q[o] : std::numeric_limits<float>::infinity();
+      out.copy(o, rgb, vec3(s_normal[3 * n], s_normal[3 * n + 1], s_normal[3 * n + 2]),
+               vec3(s_albedo[3 * n], s_albedo[3 * n + 1], s_albedo[3 * n + 2]), depth, s_prim[n], Source::reprojected);
+    }
+}
+
+/// Largest vertical displacement (px) the reprojection gives the source image's corners over all
+/// depths from the near plane to infinity. A stereo rig with a horizontal baseline gives 0.
+double vertical_displacement_bound(const Reprojector& reproject, const EyeCamera& from) {
+  double bound = 0.0;
+  for (const double x : {0.5, from.width - 0.5})
+    for (const double y : {0.5, from.height - 0.5})
+      for (const double inv_z : {0.0, 1.0 / from.znear}) {
+        const std::optional<dvec2> p = reproject.position(x, y, inv_z);
+        bound = p ? std::max(bound, std::abs(p->y - y)) : std::numeric_limits<double>::infinity();
+      }
+  return bound;
+}
+
+}  // namespace
+
+double binocular_parallax(double interaxial, double depth) {
+  if (!std::isfinite(depth)) return 0.0;
+  return 2.0 * std::atan(interaxial / (2.0 * depth));
+}
+
+double parallax_difference_arcmin(double interaxial, double zmin, double zmax) {
+  return std::abs(binocular_parallax(interaxial, zmin) - binocular_parallax(interaxial, zmax)) * kArcminPerRadian;
+}
+
+uint64_t WarpGrid::flagged_count() const {
+  return static_cast<uint64_t>(std::count(flagged.begin(), flagged.end(), uint8_t{1}));
+}
+
+uint64_t WarpGrid::opening_count() const {
+  return static_cast<uint64_t>(std::count(opening.begin(), opening.end(), uint8_t{1}));
+}
+
+uint64_t WarpGrid::subdivided_count() const {
+  return static_cast<uint64_t>(std::count(subdivided.begin(), subdivided.end(), uint8_t{1}));
+}
+
+WarpGrid build_warp_grid(std::span<const float> depth, int width, int height, const GridSettings& settings,
+                         const Executor& executor) {
+  const double threshold_arcmin = settings.threshold_arcmin, interaxial = settings.interaxial;
+  if (!(threshold_arcmin > 0.0) || !std::isfinite(threshold_arcmin))
+    throw InputError(fmt::format("grid warp: parallax threshold {} arcmin must be positive and finite", threshold_arcmin));
+  if (width < 1 || height < 1 || depth.size() != static_cast<size_t>(width) * static_cast<size_t>(height))
+    throw InputError(fmt::format("grid warp: a depth plane of {} values does not fit a {}x{} image", depth.size(), width, height));
+  WarpGrid g;
+  g.width = width;
+  g.height = height;
+  g.cells_x = (width + kGridCell - 1) / kGridCell;
+  g.cells_y = (height + kGridCell - 1) / kGridCell;
+  g.threshold_arcmin = threshold_arcmin;
+  const size_t cells = static_cast<size_t>(g.cells_x) * g.cells_y;
+  g.zmin.assign(cells, std::numeric_limits<float>::infinity());
+  g.zmax.assign(cells, 0.0f);
+  g.parallax_arcmin.assign(cells, 0.0f);
+  g.flagged.assign(cells, 0);
+  g.opening.assign(cells, 0);
+  g.subdivided.assign(cells, 0);
+  const GapMeasure gaps(depth.data(), width, height);
+  // The excess opening, in units of f e, above which a cell opens a gap (none when not asked).
+  const double opening_limit = settings.opening_px > 0.0 ? settings.opening_px / (settings.focal_px * interaxial)
+                                                         : std::numeric_limits<double>::infinity();
+  executor.for_each(static_cast<size_t>(g.cells_y), [&](size_t row) {
+    const int cy = static_cast<int>(row);
+    for (int cx = 0; cx < g.cells_x; ++cx) {
+      float lo = std::numeric_limits<float>::infinity(), hi = 0.0f;
+      for (int y = std::max(g.y0(cy), 0); y <= std::min(g.y1(cy), height - 1); ++y)
+        for (int x = std::max(g.x0(cx), 0); x <= std::min(g.x1(cx), width - 1); ++x) {
+          const float z = depth[static_cast<size_t>(y) * width + x];
+          lo = std::min(lo, z);
+          hi = std::max(hi, z);
+        }
+      const size_t c = g.cell(cx, cy);
+      if (std::isfinite(opening_limit))
+        for (int y = std::max(g.y0(cy), 0); y <= std::min(g.y1(cy), height - 1) && !g.opening[c]; ++y)
+          for (int x = std::max(g.x0(cx), 0); x < std::min(g.x1(cx), width - 1); ++x)
+            if (gaps.excess_opening(x, y) > opening_limit) {
+              g.opening[c] = 1;
+              break;
+            }
+      g.zmin[c] = lo;
+      g.zmax[c] = hi;
+      g.parallax_arcmin[c] = static_cast<float>(parallax_difference_arcmin(interaxial, lo, hi));
+      g.flagged[c] = g.parallax_arcmin[c] > threshold_arcmin ? 1 : 0;
+    }
+  });
+  // The paper's T-junction rule: a flagged cell's 4-neighbours are subdivided too.
+  for (int cy = 0; cy < g.cells_y; ++cy)
+    for (int cx = 0; cx < g.cells_x; ++cx) {
+      const bool s = g.flagged[g.cell(cx, cy)] || g.opening[g.cell(cx, cy)] || (cx > 0 && g.flagged[g.cell(cx - 1, cy)]) ||
+                     (cx + 1 < g.cells_x && g.flagged[g.cell(cx + 1, cy)]) || (cy > 0 && g.flagged[g.cell(cx, cy - 1)]) ||
+                     (cy + 1 < g.cells_y && g.flagged[g.cell(cx, cy + 1)]);
+      g.subdivided[g.cell(cx, cy)] = s ? 1 : 0;
+    }
+  return g;
+}
+
+std::vector<uint8_t> grid_warp(const WarpGrid& grid, const Image& source, const EyeCamera& from, const EyeCamera& to,
+                               double interaxial, const WarpOptions& options, const Executor& executor, Image& target,
+                               WarpStats& stats) {
+  if (source.width() != grid.width || source.height() != grid.height || target.width() != to.width ||
+      target.height() != to.height || from.width != grid.width || from.height != grid.height)
+    throw InputError(fmt::format("grid warp: image sizes disagree (grid {}x{}, source {}x{}, target {}x{})", grid.width,
+                                 grid.height, source.width(), source.height(), target.width(), target.height()));
+  if (options.detect_disocclusions && (!(options.discontinuity_px > 0.0) || !std::isfinite(options.discontinuity_px)))
+    throw InputError(fmt::format("grid warp: discontinuity threshold {} px must be positive and finite",
+                                 options.discontinuity_px));
+  const Reprojector reproject(source, from, to, interaxial);
+  WarpTarget target_buffers{to.width, to.height, std::vector<float>(static_cast<size_t>(to.width) * to.height, -1.0f),
+                            std::vector<vec2>(static_cast<size_t>(to.width) * to.height, vec2(0.0f)),
+                            std::vector<uint8_t>(static_cast<size_t>(to.width) * to.height, 0)};
+  // A cell row of lattice rows [16 cy, 16 cy + 16] writes target rows within 7 px of those when
+  // the reprojection moves nothing further vertically, so rows of one parity never share a pixel
+  // and run in parallel: even rows first, then odd ones — the same order on any thread count.
+  const bool banded = vertical_displacement_bound(reproject, from) < 7.0;
+  std::vector<GridRasterizer> rasterizers(static_cast<size_t>(grid.cells_y), GridRasterizer(target_buffers, options));
+  const auto warp_row = [&](int cy) {
+    CellRowVertices vertices(grid, reproject, cy);
+    GridRasterizer& raster = rasterizers[static_cast<size_t>(cy)];
+    for (int cx = 0; cx < grid.cells_x; ++cx) {
+      vertices.prepare(cx, cy);
+      // A coarse cell is flat in parallax by construction: nothing in it is discarded.
+      const bool detect = grid.subdivided[grid.cell(cx, cy)] != 0;
+      cell_triangles(grid, cx, cy, [&](int i0, int j0, int i1, int j1, int i2, int j2) {
+        raster.draw(vertices.at(i0, j0), vertices.at(i1, j1), vertices.at(i2, j2), detect);
+      });
+    }
+  };
+  for (int parity = 0; parity < 2; ++parity) {
+    const size_t count = static_cast<size_t>(grid.cells_y - parity + 1) / 2;
+    if (banded) {
+      executor.for_each(count, [&](size_t k) { warp_row(static_cast<int>(2 * k) + parity); });
+    } else {
+      for (size_t k = 0; k < count; ++k) warp_row(static_cast<int>(2 * k) + parity);
+    }
+  }
+
+  const int bands = (to.height + kGridCell - 1) / kGridCell;
+  std::vector<WarpStats> band_stats(static_cast<size_t>(bands));
+  executor.for_each(static_cast<size_t>(bands), [&](size_t b) {
+    const int y0 = static_cast<int>(b) * kGridCell;
+    const int y1 = std::min(y0 + kGridCell, to.height);
+    if (options.detect_disocclusions && options.occluding_edge_px > 0.0)
+      mark_occluding_edges(target_buffers, y0, y1, from.f_px * interaxial, options.occluding_edge_px);
+    resolve_rows(target_buffers, source, y0, y1, target, band_stats[b]);
+  });
+
+  stats = WarpStats{};
+  for (const GridRasterizer& r : rasterizers) {
+    stats.triangles += r.triangles;
+    stats.triangles_culled += r.culled;
+    stats.fragments += r.fragments;
+    stats.fragments_discarded += r.discarded;
+  }
+  for (const WarpStats& s : band_stats) {
+    stats.pixels_covered += s.pixels_covered;
+    stats.pixels_discarded += s.pixels_discarded;
+    stats.pixels_occluding_edge += s.pixels_occluding_edge;
+    stats.pixels_uncovered += s.pixels_uncovered;
+  }
+  return std::move(target_buffers.state);
+}
+
+Image grid_overlay(const WarpGrid& grid, const Image& source) {
+  Image out(source.width(), source.height());
+  Plane& rgb = out.add_plane(planes::rgb);
+  const float* src = source.data_f32(planes::rgb);
+  float* dst = rgb.data_f32();
+  const int w = grid.width, h = grid.height;
+  for (size_t i = 0; i < source.pixel_count() * 3; ++i) dst[i] = 0.35f * src[i];
+  const auto tint = [&](int x, int y, const vec3& c, float a) {
+    float* p = dst + 3 * (static_cast<size_t>(y) * w + x);
+    for (int k = 0; k < 3; ++k) p[k] = (1.0f - a) * p[k] + a * c[k];
+  };
+  const vec3 red(1.0f, 0.05f, 0.02f), orange(1.0f, 0.45f, 0.0f), line(0.9f, 0.9f, 0.9f);
+  for (int cy = 0; cy < grid.cells_y; ++cy)
+    for (int cx = 0; cx < grid.cells_x; ++cx) {
+      const size_t c = grid.cell(cx, cy);
+      if (!grid.subdivided[c]) continue;
+      const vec3 colour = grid.flagged[c] ? red : orange;
+      for (int y = cy * kGridCell; y < std::min((cy + 1) * kGridCell, h); ++y)
+        for (int x = cx * kGridCell; x < std::min((cx + 1) * kGridCell, w); ++x) tint(x, y, colour, 0.45f);
+    }
+  // Triangle edges of the coarse cells, drawn between the pixel centres they join.
+  const auto segment = [&](int i0, int j0, int i1, int j1) {
+    const int n = std::max(std::abs(i1 - i0), std::abs(j1 - j0));
+    for (int s = 0; s <= n; ++s) {
+      const int x = n == 0 ? i0 : static_cast<int>(std::lround(i0 + double(i1 - i0) * s / n));
+      const int y = n == 0 ? j0 : static_cast<int>(std::lround(j0 + double(j1 - j0) * s / n));
+      if (x >= 0 && y >= 0 && x < w && y < h) tint(x, y, line, 0.8f);
+    }
+  };
+  for (int cy = 0; cy < grid.cells_y; ++cy)
+    for (int cx = 0; cx < grid.cells_x; ++cx) {
+      if (grid.subdivided[grid.cell(cx, cy)]) continue;
+      cell_triangles(grid, cx, cy, [&](int i0, int j0, int i1, int j1, int i2, int j2) {
+        segment(i0, j0, i1, j1);
+        segment(i1, j1, i2, j2);
+        segment(i2, j2, i0, j0);
+      });
+    }
+  return out;
+}
+
+}  // namespace sb

@@ -1,0 +1,33 @@
+// A rasterized eye: G-buffer and lighting pass, timed and counted.
+#include "renderer/stages/raster_eye.hpp"
+
+#include "renderer/stages/eye_image.hpp"
+#include "renderer/stages/lighting.hpp"
+
+namespace sb {
+
+Image raster_eye(const RenderScene& scene, const StereoRig& rig, Eye which, const RasterOptions& options,
+                 const Executor& executor, StereoResult& result, GBuffer* gbuffer) {
+  const std::string name = eye_name(which);
+  const EyeCamera cam = rig.eye(which);
+  RasterStats rs;
+  GBuffer g;
+  Image image;
+  {
+    ScopedStage stage(result.timings, name + "_gbuffer");
+    g = rasterize(scene.geometry(), cam, executor, options, &rs);
+  }
+  TraceCounts counts;
+  {
+    ScopedStage stage(result.timings, name + "_shading");
+    image = make_eye_image(cam.width, cam.height);
+    shade_gbuffer(scene, cam, g, executor, image, counts);
+  }
+  add_counts(result.counters, counts, name.c_str(), false);
+  result.counters.add("triangles_rasterized_" + name, rs.triangles_rasterized);
+  result.counters.add("fragments_" + name, rs.fragments_tested);
+  if (gbuffer != nullptr) *gbuffer = std::move(g);
+  return image;
+}
+
+}  // namespace sb

@@ -1,0 +1,16 @@
+// One eye rendered by rasterization: the visibility G-buffer, then the deferred lighting pass.
+// plain-raster runs it for both eyes, the reprojecting pipelines for their source eye.
+#pragma once
+
+#include "renderer/pipeline.hpp"
+#include "renderer/raster/rasterizer.hpp"
+
+namespace sb {
+
+/// Rasterizes and shades `which` eye of the rig into a new eye image, timing the stages
+/// "<eye>_gbuffer" and "<eye>_shading" and counting rays, shaded pixels, rasterized triangles and
+/// fragments into `result`. The G-buffer is handed back through `gbuffer` when asked for.
+[[nodiscard]] Image raster_eye(const RenderScene& scene, const StereoRig& rig, Eye which, const RasterOptions& options,
+                               const Executor& executor, StereoResult& result, GBuffer* gbuffer = nullptr);
+
+}  // namespace sb

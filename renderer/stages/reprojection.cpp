@@ -1,0 +1,107 @@
+// Left eye, grid metric and grid warp of the repro-* pipelines.
+#include "renderer/stages/reprojection.hpp"
+
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
+#include "renderer/stages/eye_image.hpp"
+#include "renderer/stages/raster_eye.hpp"
+
+namespace sb {
+
+std::vector<OptionSpec> grid_warp_option_specs(bool with_detection) {
+  std::vector<OptionSpec> specs{
+      {"threshold_arcmin", "1.0",
+       "binocular-parallax difference (minutes of arc) above which a 16x16 cell is subdivided to native resolution"},
+      {"grid_overlay", "false", "also output the warping grid drawn over the left eye (<stem>_grid.png)"},
+      {"tile", "64", "rasterizer tile size in pixels"}};
+  if (with_detection) {
+    specs.push_back({"discontinuity_px", "0.05",
+                     "disocclusion detection: a grid vertex is flagged where a source-row gap beside it opens this many "
+                     "pixels more than its neighbouring gaps (a disparity step)"});
+    specs.push_back({"occluding_edge_px", "0.5",
+                     "also fill the pixel just left of a surface that is nearer than its left neighbour by more than "
+                     "this many pixels of disparity (its silhouette may reach it); 0 = off"});
+    specs.push_back({"discard", "triangle",
+                     "which warped fragments are discarded: 'triangle' (grid triangles whose vertices are all flagged) "
+                     "or 'interpolated' (the paper's: the measure interpolated, fragments above the threshold)"});
+  }
+  return specs;
+}
+
+ReprojectionSettings ReprojectionSettings::from(const PipelineOptions& options, bool with_detection) {
+  ReprojectionSettings s;
+  s.threshold_arcmin = options.get_double("threshold_arcmin");
+  if (!(s.threshold_arcmin > 0.0))
+    throw InputError(fmt::format("option threshold_arcmin={} must be positive (1.0 is the paper's value)", s.threshold_arcmin));
+  s.grid_overlay = options.get_bool("grid_overlay");
+  s.raster.tile = options.get_int("tile");
+  if (s.raster.tile < 8 || s.raster.tile > 1024)
+    throw InputError(fmt::format("option tile={} is out of range 8..1024", s.raster.tile));
+  s.warp.detect_disocclusions = with_detection;
+  if (with_detection) {
+    s.warp.discontinuity_px = options.get_double("discontinuity_px");
+    if (!(s.warp.discontinuity_px > 0.0))
+      throw InputError(fmt::format("option discontinuity_px={} must be positive", s.warp.discontinuity_px));
+    s.warp.occluding_edge_px = options.get_double("occluding_edge_px");
+    if (!(s.warp.occluding_edge_px >= 0.0))
+      throw InputError(fmt::format("option occluding_edge_px={} must be 0 (off) or positive", s.warp.occluding_edge_px));
+    const std::string& rule = options.get("discard");
+    if (rule == "triangle") {
+      s.warp.rule = DiscardRule::all_vertices;
+    } else if (rule == "interpolated") {
+      s.warp.rule = DiscardRule::interpolated;
+    } else {
+      throw InputError(fmt::format("option discard={} is not a rule; use 'triangle' or 'interpolated'", rule));
+    }
+  }
+  return s;
+}
+
+std::vector<uint8_t> warp_left_to_right(const RenderScene& scene, const StereoRig& rig, const ReprojectionSettings& settings,
+                                        const Executor& executor, StereoResult& r) {
+  r.left = raster_eye(scene, rig, Eye::left, settings.raster, executor, r);
+  const EyeCamera left = rig.eye(Eye::left), right = rig.eye(Eye::right);
+  const double e = rig.params().interaxial;
+  WarpGrid grid;
+  {
+    ScopedStage stage(r.timings, "grid_metric");
+    GridSettings gs;
+    gs.interaxial = e;
+    gs.focal_px = left.f_px;
+    gs.threshold_arcmin = settings.threshold_arcmin;
+    gs.opening_px = settings.warp.detect_disocclusions ? settings.warp.discontinuity_px : 0.0;
+    grid = build_warp_grid(r.left.plane(planes::depth).f32(), left.width, left.height, gs, executor);
+  }
+  WarpStats ws;
+  std::vector<uint8_t> states;
+  {
+    ScopedStage stage(r.timings, "grid_warp");
+    r.right = make_eye_image(right.width, right.height);
+    states = grid_warp(grid, r.left, left, right, e, settings.warp, executor, r.right, ws);
+  }
+  r.counters.set("grid_cells", static_cast<uint64_t>(grid.flagged.size()));
+  r.counters.set("grid_cells_flagged", grid.flagged_count());
+  r.counters.set("grid_cells_opening", grid.opening_count());
+  r.counters.set("grid_cells_subdivided", grid.subdivided_count());
+  r.counters.set("grid_triangles", ws.triangles);
+  r.counters.set("grid_triangles_culled", ws.triangles_culled);
+  r.counters.set("grid_fragments", ws.fragments);
+  r.counters.set("grid_fragments_discarded", ws.fragments_discarded);
+  r.counters.set("pixels_reprojected_right", ws.pixels_covered);
+  r.counters.set("hole_pixels", ws.pixels_discarded + ws.pixels_uncovered + ws.pixels_occluding_edge);
+  r.counters.set("hole_pixels_discarded", ws.pixels_discarded);
+  r.counters.set("hole_pixels_occluding_edge", ws.pixels_occluding_edge);
+  r.counters.set("hole_pixels_uncovered", ws.pixels_uncovered);
+  if (settings.grid_overlay) r.extras.emplace_back("grid", grid_overlay(grid, r.left));
+  return states;
+}
+
+std::vector<uint32_t> hole_pixels(const std::vector<uint8_t>& states) {
+  std::vector<uint32_t> out;
+  for (size_t i = 0; i < states.size(); ++i)
+    if (states[i] != static_cast<uint8_t>(WarpPixel::covered)) out.push_back(static_cast<uint32_t>(i));
+  return out;
+}
+
+}  // namespace sb

@@ -1,0 +1,247 @@
+// The adaptive warping grid and the warp: the parallax metric and its subdivision rules on
+// synthetic depth, exact pixel-centre warps of a fronto-parallel plane, no cracks on a slanted
+// plane and on `spheres`, the grid overlay, and option checks.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "renderer/error.hpp"
+#include "renderer/stages/disocclusion.hpp"
+#include "renderer/stages/grid_warp.hpp"
+#include "support/render_support.hpp"
+
+namespace sb {
+namespace {
+
+constexpr double kInteraxial = 0.064;
+
+GridSettings settings(double threshold_arcmin) {
+  GridSettings s;
+  s.interaxial = kInteraxial;
+  s.focal_px = 1000.0;
+  s.threshold_arcmin = threshold_arcmin;
+  return s;
+}
+
+/// A w x h depth plane at `z` everywhere.
+std::vector<float> flat(int w, int h, float z) { return std::vector<float>(static_cast<size_t>(w) * h, z); }
+
+void fill_block(std::vector<float>& depth, int w, int x0, int y0, int x1, int y1, float z) {
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) depth[static_cast<size_t>(y) * w + x] = z;
+}
+
+TEST(GridMetric, ParallaxFollowsTheBinocularAngleFormula) {
+  // θ(z) = 2 atan(e / 2z), in minutes of arc.
+  const double expected = std::abs(2.0 * std::atan(kInteraxial / 4.0) - 2.0 * std::atan(kInteraxial / 6.0)) *
+                          (180.0 * 60.0 / std::numbers::pi);
+  EXPECT_NEAR(parallax_difference_arcmin(kInteraxial, 2.0, 3.0), expected, 1e-12);
+  EXPECT_DOUBLE_EQ(binocular_parallax(kInteraxial, std::numeric_limits<double>::infinity()), 0.0);
+  EXPECT_DOUBLE_EQ(parallax_difference_arcmin(kInteraxial, 7.0, 7.0), 0.0);
+}
+
+TEST(GridMetric, DepthEdgeIsSubdividedFlatWallIsNotNeighboursAre) {
+  const int w = 80, h = 64;  // 5 x 4 cells
+  std::vector<float> depth = flat(w, h, 10.0f);
+  fill_block(depth, w, 36, 20, 44, 28, 2.0f);  // inside cell (2, 1)
+  const Executor executor(2);
+  const WarpGrid g = build_warp_grid(depth, w, h, settings(1.0), executor);
+  ASSERT_EQ(g.cells_x, 5);
+  ASSERT_EQ(g.cells_y, 4);
+  EXPECT_TRUE(g.flagged[g.cell(2, 1)]);
+  EXPECT_EQ(g.flagged_count(), 1u);
+  for (const auto& [cx, cy] : {std::pair{1, 1}, {3, 1}, {2, 0}, {2, 2}}) {
+    EXPECT_TRUE(g.subdivided[g.cell(cx, cy)]) << cx << "," << cy;
+    EXPECT_FALSE(g.flagged[g.cell(cx, cy)]) << cx << "," << cy;
+  }
+  EXPECT_EQ(g.subdivided_count(), 5u);
+  EXPECT_FALSE(g.subdivided[g.cell(1, 0)]);  // a diagonal neighbour
+  EXPECT_FALSE(g.subdivided[g.cell(4, 3)]);  // the flat wall
+  EXPECT_FLOAT_EQ(g.zmin[g.cell(2, 1)], 2.0f);
+  EXPECT_FLOAT_EQ(g.zmax[g.cell(2, 1)], 10.0f);
+}
+
+TEST(GridMetric, PartialCellsCoverTheImageEdges) {
+  const int w = 50, h = 35;  // 4 x 3 cells, the last ones 2 and 3 pixels wide
+  std::vector<float> depth = flat(w, h, 10.0f);
+  fill_block(depth, w, 49, 34, 50, 35, 1.0f);  // the bottom-right pixel
+  const WarpGrid g = build_warp_grid(depth, w, h, settings(1.0), Executor(1));
+  ASSERT_EQ(g.cells_x, 4);
+  ASSERT_EQ(g.cells_y, 3);
+  EXPECT_EQ(g.x1(3), w);
+  EXPECT_EQ(g.y1(2), h);
+  EXPECT_TRUE(g.flagged[g.cell(3, 2)]);
+  EXPECT_EQ(g.flagged_count(), 1u);
+}
+
+TEST(GridMetric, ThresholdChangesTheCountAsTheFormulaPredicts) {
+  // 8 x 4 cells; cell k holds a block at depth z_k inside a 5 m surround, with θΔ = 0.2 (k + 1)′.
+  const int cx_n = 8, cy_n = 4, w = cx_n * kGridCell, h = cy_n * kGridCell;
+  std::vector<float> depth = flat(w, h, 5.0f);
+  std::vector<double> theta;
+  const double arcmin = std::numbers::pi / (180.0 * 60.0);
+  for (int k = 0; k < cx_n * cy_n; ++k) {
+    const double target = 0.2 * (k + 1);
+    const double angle = binocular_parallax(kInteraxial, 5.0) - target * arcmin;
+    const auto z = static_cast<float>(kInteraxial / (2.0 * std::tan(0.5 * angle)));
+    const int x0 = (k % cx_n) * kGridCell + 4, y0 = (k / cx_n) * kGridCell + 4;
+    fill_block(depth, w, x0, y0, x0 + 8, y0 + 8, z);
+    theta.push_back(parallax_difference_arcmin(kInteraxial, 5.0, z));
+  }
+  for (const double threshold : {0.5, 1.0, 1.9, 3.3, 7.0}) {
+    const WarpGrid g = build_warp_grid(depth, w, h, settings(threshold), Executor(2));
+    uint64_t expected = 0;
+    for (const double t : theta) expected += t > threshold ? 1 : 0;
+    EXPECT_EQ(g.flagged_count(), expected) << threshold;
+    for (size_t k = 0; k < theta.size(); ++k) EXPECT_NEAR(g.parallax_arcmin[k], theta[k], 1e-3);
+  }
+  EXPECT_THROW((void)build_warp_grid(depth, w, h, settings(0.0), Executor(1)), InputError);
+  EXPECT_THROW((void)build_warp_grid(std::vector<float>(10), w, h, settings(1.0), Executor(1)), InputError);
+}
+
+TEST(GridMetric, GapsOpeningBelowTheParallaxThresholdAreSubdividedForDetection) {
+  // A 0.1 px disparity step (f e |1/z1 - 1/z2| with f = 1000) is far below 1′ of parallax.
+  const int w = 64, h = 32;
+  std::vector<float> depth = flat(w, h, 20.0f);
+  const auto z_far = static_cast<float>(1.0 / (1.0 / 20.0 - 0.1 / (1000.0 * kInteraxial)));
+  fill_block(depth, w, 40, 0, 64, 32, z_far);  // the far side right of x = 40: a gap opens there
+  GridSettings s = settings(1.0);
+  EXPECT_EQ(build_warp_grid(depth, w, h, s, Executor(1)).subdivided_count(), 0u);
+  s.opening_px = 0.05;
+  const WarpGrid g = build_warp_grid(depth, w, h, s, Executor(1));
+  EXPECT_EQ(g.flagged_count(), 0u);
+  EXPECT_EQ(g.opening_count(), 2u);  // cell column 2 (x 32..47) in both cell rows
+  EXPECT_TRUE(g.subdivided[g.cell(2, 0)]);
+  EXPECT_TRUE(g.subdivided[g.cell(2, 1)]);
+}
+
+/// lit-plane: a fronto-parallel plane 4 m in front of the camera.
+class PlaneWarp : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    scene_ = new Scene(test::load_builtin("lit-plane"));
+    prepared_ = new RenderScene(*scene_);
+  }
+  static void TearDownTestSuite() {
+    delete prepared_;
+    delete scene_;
+  }
+  static Scene* scene_;
+  static RenderScene* prepared_;
+};
+Scene* PlaneWarp::scene_ = nullptr;
+RenderScene* PlaneWarp::prepared_ = nullptr;
+
+TEST_F(PlaneWarp, ZeroDisparityReproducesTheLeftEye) {
+  RigOverrides o;
+  o.width = 320;
+  o.height = 180;
+  o.convergence = 4.0;  // the plane's depth: zero disparity everywhere on it
+  const StereoRig rig = resolve_rig(*scene_, o);
+  const StereoResult r = test::render_with("repro-warp", *prepared_, rig, 2);
+  EXPECT_EQ(r.counters.get("hole_pixels"), 0u);
+  const float* left = r.left.data_f32(planes::rgb);
+  const float* right = r.right.data_f32(planes::rgb);
+  for (size_t i = 0; i < r.left.pixel_count() * 3; ++i)
+    ASSERT_NEAR(right[i], left[i], 1e-5f * std::max(1.0f, left[i])) << "sample " << i;
+}
+
+TEST_F(PlaneWarp, IntegerDisparityShiftsByWholePixels) {
+  // d(Z) = f e (1/c - 1/Z) = 3 px on the plane at Z = 4 m.
+  RigOverrides o;
+  o.width = 320;
+  o.height = 180;
+  const StereoRig base = resolve_rig(*scene_, o);
+  o.convergence = 1.0 / (3.0 / (base.focal_px() * base.params().interaxial) + 1.0 / 4.0);
+  const StereoRig rig = resolve_rig(*scene_, o);
+  ASSERT_NEAR(rig.disparity_px(4.0), 3.0, 1e-9);
+  const StereoResult r = test::render_with("repro-warp", *prepared_, rig, 2);
+  const uint32_t* source = r.right.data_u32(planes::source);
+  for (int y = 0; y < 180; ++y)
+    for (int x = 0; x < 320; ++x) {
+      const size_t i = static_cast<size_t>(y) * 320 + x;
+      if (x < 3) {
+        // Their source lies left of the left image: outside its frustum.
+        EXPECT_EQ(source[i], static_cast<uint32_t>(Source::hole)) << x << "," << y;
+        continue;
+      }
+      ASSERT_EQ(source[i], static_cast<uint32_t>(Source::reprojected)) << x << "," << y;
+      for (int c = 0; c < 3; ++c) {
+        const float expected = r.left.rgb_at(x - 3, y)[static_cast<size_t>(c)];
+        ASSERT_NEAR(r.right.rgb_at(x, y)[static_cast<size_t>(c)], expected, 1e-5f * std::max(1.0f, expected))
+            << x << "," << y;
+      }
+    }
+}
+
+/// repro-warp keeps every rubber sheet, so a watertight warped grid leaves a right-eye pixel
+/// uncovered only where its surface lies outside the left image, or where the left eye does not
+/// see it at all at the image border (a near surface's silhouette, up to a pixel wide, with nothing
+/// warped beside it). Cracks between grid triangles show as uncovered pixels with covered pixels
+/// on both sides in their row.
+struct Coverage {
+  uint64_t uncovered_visible = 0;  ///< uncovered although the left eye sees the surface
+  uint64_t slivers = 0;            ///< uncovered between two covered pixels of the row
+};
+
+Coverage coverage(const std::string& scene_name, int width, int height) {
+  const Scene scene = test::load_builtin(scene_name);
+  const RenderScene prepared(scene);
+  const StereoRig rig = test::rig_at(scene, width, height);
+  const StereoResult r = test::render_with("repro-warp", prepared, rig, 2);
+  const Executor executor(2);
+  const TrueDisocclusions truth =
+      true_disocclusions(prepared, rig, trace_visible_surfaces(prepared, rig.eye(Eye::right), executor), executor);
+  const uint32_t* source = r.right.data_u32(planes::source);
+  const auto covered = [&](size_t i) { return source[i] == static_cast<uint32_t>(Source::reprojected); };
+  Coverage c;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const size_t i = static_cast<size_t>(y) * width + x;
+      if (covered(i)) continue;
+      c.uncovered_visible += truth.mask[i] == static_cast<uint8_t>(Disocclusion::visible) ? 1 : 0;
+      c.slivers += x > 0 && x + 1 < width && covered(i - 1) && covered(i + 1) ? 1 : 0;
+    }
+  return c;
+}
+
+TEST(GridWarp, NoCracksOnASlantedPlane) {
+  const Coverage c = coverage("slanted-plane", 480, 270);
+  EXPECT_EQ(c.uncovered_visible, 0u);
+  EXPECT_EQ(c.slivers, 0u);
+}
+
+TEST(GridWarp, NoCracksOnSpheres) {
+  const Coverage c = coverage("spheres", 1920, 1080);
+  EXPECT_EQ(c.slivers, 0u);
+}
+
+TEST(GridWarp, OverlayTintsFlaggedCells) {
+  const int w = 64, h = 48;
+  std::vector<float> depth = flat(w, h, 10.0f);
+  fill_block(depth, w, 20, 20, 28, 28, 2.0f);  // inside cell (1, 1)
+  const WarpGrid g = build_warp_grid(depth, w, h, settings(1.0), Executor(1));
+  Image source(w, h);
+  source.add_plane(planes::rgb).fill(0.0f);
+  const Image overlay = grid_overlay(g, source);
+  const auto inside = overlay.rgb_at(24, 17);  // flagged cell, off its coarse neighbours' edges
+  EXPECT_GT(inside[0], 0.3f);
+  EXPECT_LT(inside[1], 0.1f);
+  const auto neighbour = overlay.rgb_at(40, 24);  // cell (2, 1): subdivided as a neighbour
+  EXPECT_GT(neighbour[1], 0.1f);
+}
+
+TEST(GridWarp, OptionsAreChecked) {
+  const Scene scene = test::load_builtin("lit-plane");
+  const RenderScene prepared(scene);
+  const StereoRig rig = test::rig_at(scene, 64, 36);
+  for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
+           {"threshold_arcmin", "0"}, {"threshold_arcmin", "-1"}, {"discontinuity_px", "0"},
+           {"discard", "sometimes"}, {"occluding_edge_px", "-1"}, {"tile", "2"}})
+    EXPECT_THROW((void)test::render_with("repro-rt", prepared, rig, 1, {{key, value}}), InputError) << key << "=" << value;
+  EXPECT_THROW((void)test::render_with("repro-warp", prepared, rig, 1, {{"discontinuity_px", "0.1"}}), InputError);
+}
+
+}  // namespace
+}  // namespace sb
