@@ -38,46 +38,25 @@ struct GridVertex {
   bool valid = false;
 };
 
-/// The gaps that open between horizontal neighbours of a source row when it is warped to the
-/// other eye, in units of f e (pixels / (f e)): the disparity d = f e (1/c - 1/z) grows with
-/// depth, so the gap between pixels i and i+1 is d(i+1) - d(i) = f e (1/z(i) - 1/z(i+1)).
-class GapMeasure {
- public:
-  GapMeasure(const float* depth, int width, int height) : depth_(depth), width_(width), height_(height) {}
+/// 1/z of a linear depth; 0 for background (infinite depth).
+float inverse_depth(float z) { return z > 0.0f && std::isfinite(z) ? 1.0f / z : 0.0f; }
 
-  /// 1/z of a source pixel, clamped to the image; 0 for background (infinite depth).
-  [[nodiscard]] double inverse_depth(int i, int j) const {
-    i = std::clamp(i, 0, width_ - 1);
-    j = std::clamp(j, 0, height_ - 1);
-    const double z = depth_[static_cast<size_t>(j) * width_ + i];
-    return z > 0.0 && std::isfinite(z) ? 1.0 / z : 0.0;
+/// Fills row j of the inverse-depth and excess-opening planes (see WarpGrid).
+void gap_row(std::span<const float> depth, int width, int j, float* inv, float* excess) {
+  const size_t row = static_cast<size_t>(j) * width;
+  for (int i = 0; i < width; ++i) inv[row + i] = inverse_depth(depth[row + i]);
+  // The gap between i and i+1 opens by d(i+1) - d(i) = f e (1/z(i) - 1/z(i+1)).
+  const auto opening = [&](int i) { return inv[row + i] - inv[row + i + 1]; };
+  for (int i = 0; i < width; ++i) {
+    if (i + 1 >= width) {
+      excess[row + i] = 0.0f;
+      continue;
+    }
+    const float left = i > 0 ? opening(i - 1) : opening(i);
+    const float right = i + 2 < width ? opening(i + 1) : opening(i);
+    excess[row + i] = std::max(0.0f, opening(i) - std::max(0.0f, std::min(left, right)));
   }
-
-  /// How much more the gap between i and i+1 opens than the smaller of the gaps beside it. On a
-  /// plane 1/z is affine in screen space, so all gaps of a row are equal and the excess is 0; at a
-  /// depth discontinuity it is the disparity step. A crease where a surface turns away counts too:
-  /// from three samples it cannot be told from a small step behind a fold. Folds (negative gaps)
-  /// count as no gap. 0 outside the row.
-  [[nodiscard]] double excess_opening(int i, int j) const {
-    if (i < 0 || i + 1 >= width_) return 0.0;
-    j = std::clamp(j, 0, height_ - 1);
-    const double left = i > 0 ? opening(i - 1, j) : opening(i, j);
-    const double right = i + 2 < width_ ? opening(i + 1, j) : opening(i, j);
-    return std::max(0.0, opening(i, j) - std::max(0.0, std::min(left, right)));
-  }
-
-  /// The discontinuity measure of vertex (i, j): the larger excess of the two gaps beside it.
-  [[nodiscard]] double vertex_measure(int i, int j) const {
-    return std::max(excess_opening(i - 1, j), excess_opening(i, j));
-  }
-
- private:
-  [[nodiscard]] double opening(int i, int j) const { return inverse_depth(i, j) - inverse_depth(i + 1, j); }
-
-  const float* depth_;
-  int width_;
-  int height_;
-};
+}
 
 /// Reprojects source lattice vertices into the target eye with VP_to · VP_from⁻¹. The matrix is
 /// applied to the source point scaled by its inverse depth, (x_c, y_c, −1, 1/z) in the source view
@@ -85,8 +64,8 @@ class GapMeasure {
 /// point at infinity needs no special case and the result does not depend on the near plane.
 class Reprojector {
  public:
-  Reprojector(const Image& source, const EyeCamera& from, const EyeCamera& to, double interaxial)
-      : gaps_(source.data_f32(planes::depth), source.width(), source.height()),
+  Reprojector(const WarpGrid& grid, const EyeCamera& from, const EyeCamera& to, double interaxial)
+      : grid_(grid),
         from_(from),
         to_w_(to.width),
         to_h_(to.height),
@@ -113,21 +92,27 @@ class Reprojector {
     const double sy = j < 0 ? 0.0 : j >= from_.height ? from_.height : j + 0.5;
     v.sx = static_cast<float>(sx);
     v.sy = static_cast<float>(sy);
-    const double inv_z = gaps_.inverse_depth(i, j);
+    const size_t p = static_cast<size_t>(std::clamp(j, 0, grid_.height - 1)) * grid_.width +
+                     static_cast<size_t>(std::clamp(i, 0, grid_.width - 1));
+    const double inv_z = grid_.inverse_depth[p];
     double w = 1.0;
-    const std::optional<dvec2> p = position(sx, sy, inv_z, &w);
+    const std::optional<dvec2> at = position(sx, sy, inv_z, &w);
     // A vertex too far outside the target image cannot be rasterized in fixed point.
-    if (!p || !(std::abs(p->x) < guard_ && std::abs(p->y) < guard_)) return v;
-    v.x = static_cast<int32_t>(std::floor(p->x * kSubOne + 0.5));
-    v.y = static_cast<int32_t>(std::floor(p->y * kSubOne + 0.5));
+    if (!at || !(std::abs(at->x) < guard_ && std::abs(at->y) < guard_)) return v;
+    v.x = static_cast<int32_t>(std::floor(at->x * kSubOne + 0.5));
+    v.y = static_cast<int32_t>(std::floor(at->y * kSubOne + 0.5));
     v.q = static_cast<float>(inv_z / w);
-    v.disc = static_cast<float>(step_scale_ * gaps_.vertex_measure(i, j));
+    // The discontinuity measure: the larger excess opening of the two source gaps beside the vertex.
+    const bool inside_row = i >= 0 && i < grid_.width;
+    const float left_gap = inside_row && i > 0 ? grid_.excess[p - 1] : 0.0f;
+    const float right_gap = inside_row ? grid_.excess[p] : 0.0f;
+    v.disc = static_cast<float>(step_scale_ * std::max(left_gap, right_gap));
     v.valid = true;
     return v;
   }
 
  private:
-  GapMeasure gaps_;
+  const WarpGrid& grid_;
   EyeCamera from_;
   int to_w_;
   int to_h_;
@@ -464,7 +449,11 @@ WarpGrid build_warp_grid(std::span<const float> depth, int width, int height, co
   g.flagged.assign(cells, 0);
   g.opening.assign(cells, 0);
   g.subdivided.assign(cells, 0);
-  const GapMeasure gaps(depth.data(), width, height);
+  g.inverse_depth.resize(depth.size());
+  g.excess.resize(depth.size());
+  executor.for_range(static_cast<size_t>(height), 8, [&](size_t begin, size_t end) {
+    for (size_t j = begin; j < end; ++j) gap_row(depth, width, static_cast<int>(j), g.inverse_depth.data(), g.excess.data());
+  });
   // The excess opening, in units of f e, above which a cell opens a gap (none when not asked).
   const double opening_limit = settings.opening_px > 0.0 ? settings.opening_px / (settings.focal_px * interaxial)
                                                          : std::numeric_limits<double>::infinity();
@@ -482,7 +471,7 @@ WarpGrid build_warp_grid(std::span<const float> depth, int width, int height, co
       if (std::isfinite(opening_limit))
         for (int y = std::max(g.y0(cy), 0); y <= std::min(g.y1(cy), height - 1) && !g.opening[c]; ++y)
           for (int x = std::max(g.x0(cx), 0); x < std::min(g.x1(cx), width - 1); ++x)
-            if (gaps.excess_opening(x, y) > opening_limit) {
+            if (g.excess[static_cast<size_t>(y) * width + x] > opening_limit) {
               g.opening[c] = 1;
               break;
             }
@@ -513,7 +502,7 @@ std::vector<uint8_t> grid_warp(const WarpGrid& grid, const Image& source, const 
   if (options.detect_disocclusions && (!(options.discontinuity_px > 0.0) || !std::isfinite(options.discontinuity_px)))
     throw InputError(fmt::format("grid warp: discontinuity threshold {} px must be positive and finite",
                                  options.discontinuity_px));
-  const Reprojector reproject(source, from, to, interaxial);
+  const Reprojector reproject(grid, from, to, interaxial);
   WarpTarget target_buffers{to.width, to.height, std::vector<float>(static_cast<size_t>(to.width) * to.height, -1.0f),
                             std::vector<vec2>(static_cast<size_t>(to.width) * to.height, vec2(0.0f)),
                             std::vector<uint8_t>(static_cast<size_t>(to.width) * to.height, 0)};

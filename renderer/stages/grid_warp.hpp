@@ -46,6 +46,15 @@ struct WarpGrid {
   std::vector<uint8_t> flagged;        ///< θΔ above the threshold
   std::vector<uint8_t> opening;        ///< a gap opens in it (GridSettings::opening_px)
   std::vector<uint8_t> subdivided;     ///< flagged, a 4-neighbour of a flagged cell, or opening
+  /// Per source pixel: 1/z (0 for background), and the excess opening of the gap between it and
+  /// its right-hand neighbour in units of f e: warped to the other eye, the gap between pixels i and
+  /// i+1 opens by d(i+1) - d(i) = f e (1/z(i) - 1/z(i+1)); its excess is how much more it opens than
+  /// the smaller of the gaps beside it (folds count as no gap). On a plane 1/z is affine in screen
+  /// space, so all gaps of a row are equal and the excess is 0; at a depth discontinuity it is the
+  /// disparity step. A crease where a surface turns away counts too: from three samples it cannot
+  /// be told from a small step behind a fold.
+  std::vector<float> inverse_depth;
+  std::vector<float> excess;
 
   [[nodiscard]] size_t cell(int cx, int cy) const { return static_cast<size_t>(cy) * cells_x + cx; }
   [[nodiscard]] int x0(int cx) const { return cx == 0 ? -1 : cx * kGridCell; }

@@ -17,17 +17,20 @@ namespace sb {
 
 namespace {
 
-/// Traces one packet of up to 16 pixels and writes them.
+/// Traces packets of up to 16 pixels; the surfaces they hit are shaded in batches of up to 16.
 class PacketTracer {
  public:
-  PacketTracer(const RenderScene& scene, const EyeCamera& eye, Image& image)
+  PacketTracer(const RenderScene& scene, const EyeCamera& eye, Image& image, Source source, TraceCounts& counts)
       : scene_(scene), eye_(eye), writer_(image), width_(image.width()),
         tan_spread_(static_cast<float>(std::tan(ray_cone_spread(2.0 * std::atan(0.5 * eye.height / eye.f_px), eye.height)))),
-        origin_(eye.origin) {}
+        origin_(eye.origin), source_(source), counts_(counts) {}
+  PacketTracer(const PacketTracer&) = delete;
+  PacketTracer& operator=(const PacketTracer&) = delete;
+  ~PacketTracer() { flush(); }
 
-  /// Traces the rays of `pixels` as one packet; shades and writes the lanes whose bit is set in
-  /// `wanted` (bit i for pixels[i]).
-  void trace(const uint32_t* pixels, int n, uint32_t wanted, Source source, TraceCounts& counts) {
+  /// Traces the rays of `pixels` as one packet and queues the lanes whose bit is set in `wanted`
+  /// (bit i for pixels[i]) for shading; background lanes are written at once.
+  void trace(const uint32_t* pixels, int n, uint32_t wanted) {
     RayQuery rays[kRayPacket];
     RayHit hits[kRayPacket];
     for (int i = 0; i < n; ++i) {
@@ -37,35 +40,37 @@ class PacketTracer {
     }
     scene_.rays().intersect(std::span<const RayQuery>(rays, static_cast<size_t>(n)),
                             std::span<RayHit>(hits, static_cast<size_t>(n)));
-    counts.primary_rays += static_cast<uint64_t>(n);
-    SurfacePoint points[kRayPacket];
-    vec3 albedo[kRayPacket];
-    vec3 radiance[kRayPacket];
-    float depth[kRayPacket];
-    uint32_t where[kRayPacket];
-    int m = 0;
+    counts_.primary_rays += static_cast<uint64_t>(n);
     for (int i = 0; i < n; ++i) {
       if ((wanted >> i & 1u) == 0) continue;
-      ++counts.pixels_traced;
+      ++counts_.pixels_traced;
       if (hits[i].prim == kNoPrimitiveId) {
-        writer_.background(pixels[i], scene_.scene().background, source);
+        writer_.background(pixels[i], scene_.scene().background, source_);
         continue;
       }
-      SurfacePoint& p = points[m];
+      SurfacePoint& p = points_[m_];
       p = surface_at(scene_, hits[i].prim, hits[i].bary, vec3(origin_));
       const float cos_axis = cos_to_axis(eye_, rays[i].dir);
       const float width = primary_cone_width(hits[i].t, tan_spread_, cos_axis);
-      albedo[m] = albedo_at(scene_, p, ray_cone_lod(scene_, p, width, rays[i].dir));
-      depth[m] = hits[i].t * cos_axis;
-      where[m] = pixels[i];
-      ++m;
+      albedo_[m_] = albedo_at(scene_, p, ray_cone_lod(scene_, p, width, rays[i].dir));
+      depth_[m_] = hits[i].t * cos_axis;
+      where_[m_] = pixels[i];
+      if (++m_ == kRayPacket) flush();
     }
+  }
+
+  /// Shades and writes the queued surfaces.
+  void flush() {
+    if (m_ == 0) return;
+    vec3 radiance[kRayPacket];
     ShadeCounts sc;
-    shade(scene_, std::span<const SurfacePoint>(points, static_cast<size_t>(m)),
-          std::span<const vec3>(albedo, static_cast<size_t>(m)), std::span<vec3>(radiance, static_cast<size_t>(m)), sc);
-    counts.shadow_rays += sc.shadow_rays;
-    counts.pixels_shaded += sc.pixels_shaded;
-    for (int k = 0; k < m; ++k) writer_.surface(where[k], points[k], radiance[k], albedo[k], depth[k], source);
+    const auto m = static_cast<size_t>(m_);
+    shade(scene_, std::span<const SurfacePoint>(points_, m), std::span<const vec3>(albedo_, m),
+          std::span<vec3>(radiance, m), sc);
+    counts_.shadow_rays += sc.shadow_rays;
+    counts_.pixels_shaded += sc.pixels_shaded;
+    for (size_t k = 0; k < m; ++k) writer_.surface(where_[k], points_[k], radiance[k], albedo_[k], depth_[k], source_);
+    m_ = 0;
   }
 
  private:
@@ -75,6 +80,13 @@ class PacketTracer {
   int width_;
   float tan_spread_;
   dvec3 origin_;
+  Source source_;
+  TraceCounts& counts_;
+  SurfacePoint points_[kRayPacket];
+  vec3 albedo_[kRayPacket];
+  float depth_[kRayPacket] = {};
+  uint32_t where_[kRayPacket] = {};
+  int m_ = 0;
 };
 
 /// Adds a task's counts into shared totals.
@@ -102,9 +114,15 @@ void trace_eye(const RenderScene& scene, const EyeCamera& eye, const Executor& e
   std::atomic<uint64_t> totals[4] = {0, 0, 0, 0};
   const int w = image.width(), h = image.height();
   executor.for_tiles(w, h, kTraceTile, [&](const PixelRect& tile) {
-    PacketTracer tracer(scene, eye, image);
     TraceCounts local;
-    for_pixel_blocks(tile, w, [&](const uint32_t* block, int n) { tracer.trace(block, n, kAllLanes, Source::traced, local); });
+    {
+      PacketTracer tracer(scene, eye, image, Source::traced, local);
+      // One shading batch per block: a block's surfaces are shaded together.
+      for_pixel_blocks(tile, w, [&](const uint32_t* block, int n) {
+        tracer.trace(block, n, kAllLanes);
+        tracer.flush();
+      });
+    }
     accumulate(totals, local);
   });
   add_totals(counts, totals);
@@ -129,13 +147,16 @@ void trace_pixels(const RenderScene& scene, const EyeCamera& eye, const Executor
 
   std::atomic<uint64_t> totals[4] = {0, 0, 0, 0};
   executor.for_range(blocks.size(), 16, [&](size_t begin, size_t end) {
-    PacketTracer tracer(scene, eye, image);
     TraceCounts local;
-    for (size_t k = begin; k < end; ++k) {
-      const int bx = static_cast<int>(blocks[k] % static_cast<uint32_t>(blocks_x));
-      const int by = static_cast<int>(blocks[k] / static_cast<uint32_t>(blocks_x));
-      const PixelRect rect{4 * bx, 4 * by, std::min(4 * bx + 4, w), std::min(4 * by + 4, h)};
-      for_pixel_blocks(rect, w, [&](const uint32_t* block, int n) { tracer.trace(block, n, masks[blocks[k]], source, local); });
+    {
+      // The listed pixels of consecutive blocks fill the shading batches.
+      PacketTracer tracer(scene, eye, image, source, local);
+      for (size_t k = begin; k < end; ++k) {
+        const int bx = static_cast<int>(blocks[k] % static_cast<uint32_t>(blocks_x));
+        const int by = static_cast<int>(blocks[k] / static_cast<uint32_t>(blocks_x));
+        const PixelRect rect{4 * bx, 4 * by, std::min(4 * bx + 4, w), std::min(4 * by + 4, h)};
+        for_pixel_blocks(rect, w, [&](const uint32_t* block, int n) { tracer.trace(block, n, masks[blocks[k]]); });
+      }
     }
     accumulate(totals, local);
   });
