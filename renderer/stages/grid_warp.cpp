@@ -126,11 +126,16 @@ class Reprojector {
 /// too thin to have an interior) is split into native-resolution quads; a coarse cell is two
 /// triangles, or, where a neighbour across one of its edges is subdivided, a fan from its centre
 /// through every lattice point on those edges, so that the mesh has no T-junctions.
+/// Whether cell (cx, cy) is warped at native resolution: subdivided, or too thin for an interior.
+bool native_cell(const WarpGrid& g, int cx, int cy) {
+  return g.subdivided[g.cell(cx, cy)] || g.x1(cx) - g.x0(cx) < 2 || g.y1(cy) - g.y0(cy) < 2;
+}
+
 template <class Emit>
 void cell_triangles(const WarpGrid& g, int cx, int cy, Emit&& emit) {
   const int x0 = g.x0(cx), x1 = g.x1(cx), y0 = g.y0(cy), y1 = g.y1(cy);
   if (x1 <= x0 || y1 <= y0) return;
-  if (g.subdivided[g.cell(cx, cy)] || x1 - x0 < 2 || y1 - y0 < 2) {
+  if (native_cell(g, cx, cy)) {
     for (int j = y0; j < y1; ++j)
       for (int i = x0; i < x1; ++i) {
         emit(i, j, i + 1, j, i + 1, j + 1);
@@ -179,6 +184,8 @@ struct WarpTarget {
 /// Rasterizes warped grid triangles into the target buffers and counts what it did.
 class GridRasterizer {
  public:
+  enum class Detect { off, interpolated, flags };
+
   GridRasterizer(WarpTarget& target, const WarpOptions& options)
       : t_(target), detect_(options.detect_disocclusions), rule_(options.rule), threshold_(options.discontinuity_px) {}
 
@@ -231,14 +238,44 @@ class GridRasterizer {
     }
   }
 
+  /// The native quad (a, b, c, d) = ((i, j), (i+1, j), (i+1, j+1), (i, j+1)) when a and b lie
+  /// exactly on a row of pixel centres (a reprojection without vertical motion): its two triangles
+  /// cover pixel centres of that row only, on the top edge a-b, which the fill rule includes from a
+  /// up to, not including, b — the half-open span [x_a, x_b). Drawn as that span, with the
+  /// triangles' interpolation restricted to the edge (c's weight is 0 there). Returns false, and
+  /// draws nothing, when a and b are not on one pixel-centre row.
+  bool top_edge_span(const GridVertex& a, const GridVertex& b, bool detect) {
+    if (a.y != b.y || !a.valid || !b.valid || ((int64_t{a.y} - kSubHalf) & (kSubOne - 1)) != 0) return false;
+    const int64_t row = (int64_t{a.y} - kSubHalf) >> kSubBits;
+    triangles += 2;
+    if (b.x <= a.x) {
+      ++culled;  // turned over: the triangle on this edge is culled
+      return true;
+    }
+    if (row < 0 || row >= t_.height) return true;
+    // Pixel centres p * kSubOne + kSubHalf in [a.x, b.x).
+    const int p0 = std::max(static_cast<int>((int64_t{a.x} - kSubHalf + kSubOne - 1) >> kSubBits), 0);
+    const int p1 = std::min(static_cast<int>((int64_t{b.x} - kSubHalf - 1) >> kSubBits), t_.width - 1);
+    const double inv_len = 1.0 / static_cast<double>(int64_t{b.x} - a.x);
+    const GridVertex* v[3] = {&a, &b, &a};
+    const Detect mode = detect && detect_ ? (rule_ == DiscardRule::all_vertices ? Detect::flags : Detect::interpolated)
+                                          : Detect::off;
+    const bool perspective = a.q > 0.0f && b.q > 0.0f;
+    for (int p = p0; p <= p1; ++p) {
+      const int64_t along = int64_t{p} * kSubOne + kSubHalf - a.x;
+      // As edge-function weights: b's share of the edge, a's the rest, nothing for the third vertex.
+      const int64_t e[3] = {0, int64_t{b.x} - a.x - along, along};
+      fragment(v, e, inv_len, perspective, mode, p, static_cast<int>(row));
+    }
+    return true;
+  }
+
   uint64_t triangles = 0;
   uint64_t culled = 0;
   uint64_t fragments = 0;
   uint64_t discarded = 0;
 
  private:
-  enum class Detect { off, interpolated, flags };
-
   void fragment(const GridVertex* const v[3], const int64_t e[3], double inv_area, bool perspective, Detect mode, int x,
                 int y) {
     ++fragments;
@@ -518,6 +555,17 @@ std::vector<uint8_t> grid_warp(const WarpGrid& grid, const Image& source, const 
       vertices.prepare(cx, cy);
       // A coarse cell is flat in parallax by construction: nothing in it is discarded.
       const bool detect = grid.subdivided[grid.cell(cx, cy)] != 0;
+      if (native_cell(grid, cx, cy)) {
+        for (int j = grid.y0(cy); j < grid.y1(cy); ++j)
+          for (int i = grid.x0(cx); i < grid.x1(cx); ++i) {
+            const GridVertex &a = vertices.at(i, j), &b = vertices.at(i + 1, j);
+            if (raster.top_edge_span(a, b, detect)) continue;
+            const GridVertex &c = vertices.at(i + 1, j + 1), &d = vertices.at(i, j + 1);
+            raster.draw(a, b, c, detect);
+            raster.draw(a, c, d, detect);
+          }
+        continue;
+      }
       cell_triangles(grid, cx, cy, [&](int i0, int j0, int i1, int j1, int i2, int j2) {
         raster.draw(vertices.at(i0, j0), vertices.at(i1, j1), vertices.at(i2, j2), detect);
       });
