@@ -9,9 +9,11 @@ namespace {
 class ReproWarp final : public Pipeline {
  public:
   const PipelineInfo& info() const override {
+    // Right eye against plain-rt on the analytic scenes: the rubber sheets stay where surfaces are
+    // disoccluded; lowest measured 26.73 dB (textured-plane, 320x180). Hence 26 dB.
     static const PipelineInfo i{"repro-warp", "Wißmann et al. 2020", "3.1-3.2, Fig. 6a (grid warp only)",
                                 "left eye rasterized, adaptive grid warp to the right eye, no hole handling (rubber sheets)",
-                                grid_warp_option_specs(false), 48.0, 20.0};
+                                grid_warp_option_specs(false), 48.0, 26.0};
     return i;
   }
 

@@ -107,22 +107,64 @@ void add_totals(TraceCounts& counts, const std::atomic<uint64_t>* totals) {
 
 constexpr uint32_t kAllLanes = (1u << kRayPacket) - 1u;
 
+/// The listed pixels as lane masks of trace_eye's 4x4 blocks (4-aligned, clipped at the image):
+/// the blocks holding a listed pixel, in ascending order, and each one's mask.
+struct PixelBlocks {
+  int blocks_x = 0;
+  std::vector<uint32_t> masks;   ///< per block of the image
+  std::vector<uint32_t> listed;  ///< blocks with a listed pixel
+};
+
+PixelBlocks pixel_blocks(std::span<const uint32_t> pixels, int w, int h) {
+  PixelBlocks b;
+  b.blocks_x = (w + 3) / 4;
+  const int blocks_y = (h + 3) / 4;
+  b.masks.assign(static_cast<size_t>(b.blocks_x) * static_cast<size_t>(blocks_y), 0);
+  for (const uint32_t p : pixels) {
+    const int x = static_cast<int>(p % static_cast<uint32_t>(w)), y = static_cast<int>(p / static_cast<uint32_t>(w));
+    if (y >= h) throw InputError(fmt::format("trace_pixels: pixel index {} lies outside the {}x{} image", p, w, h));
+    const int bx = x / 4, by = y / 4;
+    const int lane = (y - 4 * by) * std::min(4, w - 4 * bx) + (x - 4 * bx);
+    b.masks[static_cast<size_t>(by) * b.blocks_x + bx] |= 1u << lane;
+  }
+  for (size_t k = 0; k < b.masks.size(); ++k)
+    if (b.masks[k] != 0) b.listed.push_back(static_cast<uint32_t>(k));
+  return b;
+}
+
+/// Traces blocks listed[begin, end) in the calling thread; the listed pixels of consecutive blocks
+/// fill the shading batches.
+void trace_blocks(const RenderScene& scene, const EyeCamera& eye, const PixelBlocks& b, size_t begin, size_t end,
+                  Image& image, Source source, TraceCounts& counts) {
+  const int w = image.width(), h = image.height();
+  PacketTracer tracer(scene, eye, image, source, counts);
+  for (size_t k = begin; k < end; ++k) {
+    const uint32_t block = b.listed[k];
+    const int bx = static_cast<int>(block % static_cast<uint32_t>(b.blocks_x));
+    const int by = static_cast<int>(block / static_cast<uint32_t>(b.blocks_x));
+    const PixelRect rect{4 * bx, 4 * by, std::min(4 * bx + 4, w), std::min(4 * by + 4, h)};
+    for_pixel_blocks(rect, w, [&](const uint32_t* pixels, int n) { tracer.trace(pixels, n, b.masks[block]); });
+  }
+}
+
 }  // namespace
+
+void trace_rect(const RenderScene& scene, const EyeCamera& eye, const PixelRect& rect, Image& image,
+                TraceCounts& counts) {
+  PacketTracer tracer(scene, eye, image, Source::traced, counts);
+  // One shading batch per block: a block's surfaces are shaded together.
+  for_pixel_blocks(rect, image.width(), [&](const uint32_t* block, int n) {
+    tracer.trace(block, n, kAllLanes);
+    tracer.flush();
+  });
+}
 
 void trace_eye(const RenderScene& scene, const EyeCamera& eye, const Executor& executor, Image& image,
                TraceCounts& counts) {
   std::atomic<uint64_t> totals[4] = {0, 0, 0, 0};
-  const int w = image.width(), h = image.height();
-  executor.for_tiles(w, h, kTraceTile, [&](const PixelRect& tile) {
+  executor.for_tiles(image.width(), image.height(), kTraceTile, [&](const PixelRect& tile) {
     TraceCounts local;
-    {
-      PacketTracer tracer(scene, eye, image, Source::traced, local);
-      // One shading batch per block: a block's surfaces are shaded together.
-      for_pixel_blocks(tile, w, [&](const uint32_t* block, int n) {
-        tracer.trace(block, n, kAllLanes);
-        tracer.flush();
-      });
-    }
+    trace_rect(scene, eye, tile, image, local);
     accumulate(totals, local);
   });
   add_totals(counts, totals);
@@ -130,37 +172,20 @@ void trace_eye(const RenderScene& scene, const EyeCamera& eye, const Executor& e
 
 void trace_pixels(const RenderScene& scene, const EyeCamera& eye, const Executor& executor,
                   std::span<const uint32_t> pixels, Image& image, TraceCounts& counts, Source source) {
-  const int w = image.width(), h = image.height();
-  // The listed pixels as lane masks of trace_eye's 4x4 blocks (4-aligned, clipped at the image).
-  const int blocks_x = (w + 3) / 4, blocks_y = (h + 3) / 4;
-  std::vector<uint32_t> masks(static_cast<size_t>(blocks_x) * static_cast<size_t>(blocks_y), 0);
-  for (const uint32_t p : pixels) {
-    const int x = static_cast<int>(p % static_cast<uint32_t>(w)), y = static_cast<int>(p / static_cast<uint32_t>(w));
-    if (y >= h) throw InputError(fmt::format("trace_pixels: pixel index {} lies outside the {}x{} image", p, w, h));
-    const int bx = x / 4, by = y / 4;
-    const int lane = (y - 4 * by) * std::min(4, w - 4 * bx) + (x - 4 * bx);
-    masks[static_cast<size_t>(by) * blocks_x + bx] |= 1u << lane;
-  }
-  std::vector<uint32_t> blocks;
-  for (size_t b = 0; b < masks.size(); ++b)
-    if (masks[b] != 0) blocks.push_back(static_cast<uint32_t>(b));
-
+  const PixelBlocks blocks = pixel_blocks(pixels, image.width(), image.height());
   std::atomic<uint64_t> totals[4] = {0, 0, 0, 0};
-  executor.for_range(blocks.size(), 16, [&](size_t begin, size_t end) {
+  executor.for_range(blocks.listed.size(), 16, [&](size_t begin, size_t end) {
     TraceCounts local;
-    {
-      // The listed pixels of consecutive blocks fill the shading batches.
-      PacketTracer tracer(scene, eye, image, source, local);
-      for (size_t k = begin; k < end; ++k) {
-        const int bx = static_cast<int>(blocks[k] % static_cast<uint32_t>(blocks_x));
-        const int by = static_cast<int>(blocks[k] / static_cast<uint32_t>(blocks_x));
-        const PixelRect rect{4 * bx, 4 * by, std::min(4 * bx + 4, w), std::min(4 * by + 4, h)};
-        for_pixel_blocks(rect, w, [&](const uint32_t* block, int n) { tracer.trace(block, n, masks[blocks[k]]); });
-      }
-    }
+    trace_blocks(scene, eye, blocks, begin, end, image, source, local);
     accumulate(totals, local);
   });
   add_totals(counts, totals);
+}
+
+void trace_pixels_here(const RenderScene& scene, const EyeCamera& eye, std::span<const uint32_t> pixels, Image& image,
+                       TraceCounts& counts, Source source) {
+  const PixelBlocks blocks = pixel_blocks(pixels, image.width(), image.height());
+  trace_blocks(scene, eye, blocks, 0, blocks.listed.size(), image, source, counts);
 }
 
 void add_counts(Counters& counters, const TraceCounts& counts, const char* eye, bool traced) {

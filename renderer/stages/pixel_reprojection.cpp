@@ -1,0 +1,208 @@
+// Pixel reprojection along scan-lines, restricted-ray validation and the Lemma 1 write counts.
+#include "renderer/stages/pixel_reprojection.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
+#include "renderer/stages/eye_image.hpp"
+#include "renderer/stages/primary_rays.hpp"
+
+namespace sb {
+
+namespace {
+
+enum class RightState : uint8_t { missed = 0, reprojected = 1, blocked = 2 };
+
+}  // namespace
+
+PixelReprojector::PixelReprojector(const StereoRig& rig) : left_(rig.eye(Eye::left)), right_(rig.eye(Eye::right)) {}
+
+int32_t PixelReprojector::target(int x, int y, float depth) const {
+  if (!(depth > 0.0f) || !std::isfinite(depth)) return kNoSource;
+  const dvec3 p = right_.project(left_.unproject(x + 0.5, y + 0.5, depth));
+  if (!(p.z > 0.0)) return kNoSource;
+  const double column = std::floor(p.x);
+  if (!(column >= 0.0 && column < right_.width)) return kNoSource;
+  return static_cast<int32_t>(column);
+}
+
+PixelCopier::PixelCopier(const Image& left, Image& right)
+    : width_(left.width()),
+      rgb_(left.data_f32(planes::rgb)),
+      normal_(left.data_f32(planes::normal)),
+      albedo_(left.data_f32(planes::albedo)),
+      depth_(left.data_f32(planes::depth)),
+      prim_(left.data_u32(planes::primid)),
+      out_(right) {}
+
+void PixelCopier::copy(int source_x, int x, int y) {
+  const size_t s = static_cast<size_t>(y) * width_ + source_x;
+  out_.copy(static_cast<size_t>(y) * width_ + x, vec3(rgb_[3 * s], rgb_[3 * s + 1], rgb_[3 * s + 2]),
+            vec3(normal_[3 * s], normal_[3 * s + 1], normal_[3 * s + 2]),
+            vec3(albedo_[3 * s], albedo_[3 * s + 1], albedo_[3 * s + 2]), depth_[s], prim_[s], Source::reprojected);
+}
+
+Validation validate_and_copy(const RenderScene& scene, const PixelReprojector& reprojector, const RightSources& sources,
+                             const Image& left, const ValidationSettings& settings, const Executor& executor,
+                             Image& right) {
+  const double margin = settings.margin;
+  const int w = sources.width, h = sources.height;
+  std::vector<uint8_t> state(static_cast<size_t>(w) * h, static_cast<uint8_t>(RightState::missed));
+  std::atomic<uint64_t> rays{0}, absent{0};
+  const float* left_depth = left.data_f32(planes::depth);
+  const EyeCamera& eye = reprojector.right();
+  const auto length = static_cast<float>(1.0 - margin);
+  executor.for_tiles(w, h, kTraceTile, [&](const PixelRect& tile) {
+    PixelCopier copier(left, right);
+    RayQuery queries[kRayPacket];
+    uint32_t where[kRayPacket];
+    uint64_t local = 0, local_absent = 0;
+    for_pixel_blocks(tile, w, [&](const uint32_t* pixels, int n) {
+      int m = 0;
+      for (int i = 0; i < n; ++i) {
+        const int x = static_cast<int>(pixels[i] % static_cast<uint32_t>(w));
+        const int y = static_cast<int>(pixels[i] / static_cast<uint32_t>(w));
+        const int32_t src = sources.column[pixels[i]];
+        if (src == kNoSource) continue;
+        RayQuery q = primary_ray(eye, x, y);
+        q.tfar = length * left_depth[static_cast<size_t>(y) * w + src] / cos_to_axis(eye, q.dir);
+        queries[m] = q;
+        where[m++] = pixels[i];
+      }
+      if (m == 0) return;
+      uint8_t blocked[kRayPacket];
+      scene.rays().occluded(std::span<const RayQuery>(queries, static_cast<size_t>(m)),
+                            std::span<uint8_t>(blocked, static_cast<size_t>(m)));
+      local += static_cast<uint64_t>(m);
+      if (settings.confirm_surface) {
+        // The segment just beyond: the reprojected surface must be there, within the margin.
+        RayQuery beyond[kRayPacket];
+        uint8_t present[kRayPacket];
+        int b = 0;
+        int lane[kRayPacket];
+        for (int k = 0; k < m; ++k) {
+          if (blocked[k]) continue;
+          beyond[b] = queries[k];
+          beyond[b].tnear = queries[k].tfar;
+          beyond[b].tfar = queries[k].tfar * static_cast<float>((1.0 + margin) / (1.0 - margin));
+          lane[b++] = k;
+        }
+        scene.rays().occluded(std::span<const RayQuery>(beyond, static_cast<size_t>(b)),
+                              std::span<uint8_t>(present, static_cast<size_t>(b)));
+        local += static_cast<uint64_t>(b);
+        for (int k = 0; k < b; ++k)
+          if (!present[k]) {
+            blocked[lane[k]] = 1;
+            ++local_absent;
+          }
+      }
+      for (int k = 0; k < m; ++k) {
+        const uint32_t p = where[k];
+        if (blocked[k]) {
+          state[p] = static_cast<uint8_t>(RightState::blocked);
+          continue;
+        }
+        state[p] = static_cast<uint8_t>(RightState::reprojected);
+        copier.copy(sources.column[p], static_cast<int>(p % static_cast<uint32_t>(w)),
+                    static_cast<int>(p / static_cast<uint32_t>(w)));
+      }
+    });
+    rays += local;
+    absent += local_absent;
+  });
+  Validation v;
+  v.restricted_rays = rays;
+  v.absent = absent;
+  for (size_t p = 0; p < state.size(); ++p) {
+    if (state[p] == static_cast<uint8_t>(RightState::reprojected)) continue;
+    (state[p] == static_cast<uint8_t>(RightState::missed) ? v.missed : v.blocked)++;
+    v.to_trace.push_back(static_cast<uint32_t>(p));
+  }
+  return v;
+}
+
+void complete_right_eye(const RenderScene& scene, const StereoRig& rig, const PixelReprojector& reprojector,
+                        const RightSources& sources, const ValidationSettings& settings, const Executor& executor,
+                        StereoResult& r) {
+  Validation v;
+  {
+    ScopedStage stage(r.timings, "validate");
+    r.right = make_eye_image(sources.width, sources.height);
+    v = validate_and_copy(scene, reprojector, sources, r.left, settings, executor, r.right);
+  }
+  TraceCounts counts;
+  {
+    ScopedStage stage(r.timings, "right_trace");
+    trace_pixels(scene, rig.eye(Eye::right), executor, v.to_trace, r.right, counts, Source::reshaded_traced);
+  }
+  add_counts(r.counters, counts, "right", true);
+  r.counters.set("missed", v.missed);
+  r.counters.set("bad", v.blocked - v.absent);
+  if (settings.confirm_surface) r.counters.set("absent", v.absent);
+  r.counters.set("restricted_rays", v.restricted_rays);
+  r.counters.set("hole_pixels", v.missed + v.blocked);
+  r.counters.set("pixels_reprojected_right", static_cast<uint64_t>(r.right.pixel_count()) - v.missed - v.blocked);
+}
+
+std::vector<uint64_t> reprojection_writes(const PixelReprojector& reprojector, const Image& left,
+                                          const Executor& executor) {
+  const int w = left.width(), h = left.height();
+  const float* depth = left.data_f32(planes::depth);
+  std::vector<uint32_t> writes(static_cast<size_t>(w) * h, 0);
+  // A row's reprojections stay in that row: rows are independent.
+  executor.for_range(static_cast<size_t>(h), 4, [&](size_t begin, size_t end) {
+    for (size_t y = begin; y < end; ++y)
+      for (int x = 0; x < w; ++x) {
+        const int32_t t = reprojector.target(x, static_cast<int>(y), depth[y * w + x]);
+        if (t != kNoSource) ++writes[y * w + static_cast<size_t>(t)];
+      }
+  });
+  std::vector<uint64_t> histogram(1, 0);
+  for (const uint32_t n : writes) {
+    if (n >= histogram.size()) histogram.resize(n + 1, 0);
+    ++histogram[n];
+  }
+  return histogram;
+}
+
+uint64_t lemma1_bound(const StereoRig& rig, double z_min) {
+  const double range = rig.focal_px() * rig.params().interaxial / z_min;
+  return static_cast<uint64_t>(std::ceil(range)) + 1;
+}
+
+void add_write_counters(Counters& counters, const std::vector<uint64_t>& histogram, const StereoRig& rig,
+                        const Image& left) {
+  counters.set("writes_max", histogram.size() - 1);
+  for (size_t k = 0; k < histogram.size(); ++k)
+    if (histogram[k] > 0) counters.set(fmt::format("writes_per_pixel_{}", k), histogram[k]);
+  const std::span<const float> depth = left.plane(planes::depth).f32();
+  float z_min = std::numeric_limits<float>::infinity();
+  for (const float z : depth)
+    if (z > 0.0f) z_min = std::min(z_min, z);
+  if (std::isfinite(z_min)) counters.set("writes_bound", lemma1_bound(rig, z_min));
+}
+
+std::vector<OptionSpec> validation_option_specs() {
+  return {{"margin", "0.01", "the validation ray stops this fraction short of the reprojected surface's depth"},
+          {"confirm", "false",
+           "also require the reprojected surface within the margin beyond (a second short ray); not in the thesis: "
+           "it catches reprojections that land past a silhouette"}};
+}
+
+ValidationSettings ValidationSettings::from(const std::string& pipeline, const PipelineOptions& options) {
+  ValidationSettings s;
+  s.margin = options.get_double("margin");
+  if (!(s.margin >= 0.0 && s.margin < 1.0))
+    throw InputError(fmt::format("{}: option margin={} must lie in [0, 1): the restricted ray stops that fraction "
+                                 "short of the reprojected surface",
+                                 pipeline, s.margin));
+  s.confirm_surface = options.get_bool("confirm");
+  return s;
+}
+
+}  // namespace sb

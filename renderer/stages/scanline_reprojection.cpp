@@ -1,0 +1,101 @@
+// Algorithm 1 of Al-Hagri's thesis (after Adelson and Hodges) for one band of scan-lines.
+#include "renderer/stages/scanline_reprojection.hpp"
+
+#include <chrono>
+#include <vector>
+
+namespace sb {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+/// Algorithm 1 for row y: the winning source column per right pixel (kNoSource: NoHit).
+void reproject_row(const PixelReprojector& reprojector, const float* left_depth, int width, int y,
+                   std::vector<int32_t>& source, ScanlineCounts& counts) {
+  source.assign(static_cast<size_t>(width), kNoSource);
+  std::vector<uint8_t> bad(static_cast<size_t>(width), 0);
+  int32_t old_r = -1;
+  for (int x = 0; x < width; ++x) {
+    const int32_t r = reprojector.target(x, y, left_depth[static_cast<size_t>(y) * width + x]);
+    if (r == kNoSource) continue;
+    // A jump of more than one pixel after an earlier reprojection leaves a gap: its pixels are NoHit,
+    // whatever reached them before.
+    if (old_r >= 0 && r - old_r > 1)
+      for (int32_t k = old_r + 1; k < r; ++k) {
+        source[static_cast<size_t>(k)] = kNoSource;
+        bad[static_cast<size_t>(k)] = 1;
+      }
+    // Later pixels (larger source x) overwrite: the nearer surface for a right eye to the right.
+    if (source[static_cast<size_t>(r)] != kNoSource) ++counts.overlapped;
+    source[static_cast<size_t>(r)] = x;
+    bad[static_cast<size_t>(r)] = 0;
+    old_r = r;
+  }
+  for (int x = 0; x < width; ++x) {
+    if (source[static_cast<size_t>(x)] != kNoSource) continue;
+    (bad[static_cast<size_t>(x)] ? counts.bad : counts.missed)++;
+  }
+}
+
+}  // namespace
+
+void ScanlineCounts::add(const ScanlineCounts& o) {
+  for (auto [mine, theirs] : {std::pair{&left, &o.left}, std::pair{&right, &o.right}}) {
+    mine->primary_rays += theirs->primary_rays;
+    mine->shadow_rays += theirs->shadow_rays;
+    mine->pixels_shaded += theirs->pixels_shaded;
+    mine->pixels_traced += theirs->pixels_traced;
+  }
+  overlapped += o.overlapped;
+  bad += o.bad;
+  missed += o.missed;
+  left_seconds += o.left_seconds;
+  reproject_seconds += o.reproject_seconds;
+  right_seconds += o.right_seconds;
+}
+
+void add_scanline_counters(StereoResult& r, const ScanlineCounts& counts, const StereoRig& rig) {
+  add_counts(r.counters, counts.left, "left", true);
+  add_counts(r.counters, counts.right, "right", true);
+  r.counters.set("overlapped", counts.overlapped);
+  r.counters.set("bad", counts.bad);
+  r.counters.set("missed", counts.missed);
+  r.counters.set("hole_pixels", counts.bad + counts.missed);
+  r.counters.set("pixels_reprojected_right", static_cast<uint64_t>(r.right.pixel_count()) - counts.bad - counts.missed);
+  // The write histogram is counted apart, on one thread, outside every timed stage.
+  add_write_counters(r.counters, reprojection_writes(PixelReprojector(rig), r.left, Executor(1)), rig, r.left);
+}
+
+void scanline_band(const RenderScene& scene, const PixelReprojector& reprojector, int y0, int y1, Image& left,
+                   Image& right, ScanlineCounts& counts) {
+  const int w = left.width();
+  auto start = Clock::now();
+  trace_rect(scene, reprojector.left(), PixelRect{0, y0, w, y1}, left, counts.left);
+  counts.left_seconds += since(start);
+
+  start = Clock::now();
+  const float* depth = left.data_f32(planes::depth);
+  std::vector<int32_t> source;
+  std::vector<uint32_t> no_hit;
+  PixelCopier copier(left, right);
+  for (int y = y0; y < y1; ++y) {
+    reproject_row(reprojector, depth, w, y, source, counts);
+    for (int x = 0; x < w; ++x) {
+      const size_t p = static_cast<size_t>(y) * w + x;
+      if (source[static_cast<size_t>(x)] == kNoSource)
+        no_hit.push_back(static_cast<uint32_t>(p));
+      else
+        copier.copy(source[static_cast<size_t>(x)], x, y);
+    }
+  }
+  counts.reproject_seconds += since(start);
+
+  start = Clock::now();
+  trace_pixels_here(scene, reprojector.right(), no_hit, right, counts.right, Source::reshaded_traced);
+  counts.right_seconds += since(start);
+}
+
+}  // namespace sb
