@@ -1,14 +1,17 @@
 // `stereobench bench`: time pipelines side by side on one scene and rig; medians, min/max per stage,
-// ray throughput and speed-ups against a baseline from the same run.
+// ray throughput and speed-ups against a baseline from the same run. With --preset, a series of
+// such runs (apps/bench_presets.hpp).
 #include <sys/resource.h>
 
 #include <algorithm>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include <fmt/format.h>
 
+#include "apps/bench_presets.hpp"
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
@@ -32,6 +35,9 @@ struct BenchArgs {
   std::vector<std::string> options;
   std::string json_out;
   std::string scenes_dir;
+  std::optional<int> lights;
+  std::string preset;
+  int preset_rows = 0;
   RigCli rig;
 };
 
@@ -52,12 +58,11 @@ double peak_rss_mib() {
   return u.ru_maxrss / 1024.0;
 }
 
-void run_bench_command(const BenchArgs& a) {
-  const RigOverrides overrides = a.rig.overrides();
+/// Pipelines, baseline, repetitions and options from the command line.
+BenchConfig bench_config(const BenchArgs& a, const std::vector<std::string>& default_pipelines) {
   BenchConfig config;
   config.pipelines = split_names(a.pipelines);
-  if (config.pipelines.empty())
-    for (const Pipeline* p : pipelines()) config.pipelines.push_back(p->info().name);
+  if (config.pipelines.empty()) config.pipelines = default_pipelines;
   config.baseline = a.baseline;
   if (std::find(config.pipelines.begin(), config.pipelines.end(), config.baseline) == config.pipelines.end())
     config.pipelines.insert(config.pipelines.begin(), config.baseline);
@@ -70,12 +75,37 @@ void run_bench_command(const BenchArgs& a) {
     config.options[key.substr(0, dot)][key.substr(dot + 1)] = value;
   }
   config.validate();  // before the scene is loaded
+  return config;
+}
+
+void run_preset_command(const BenchArgs& a) {
+  PresetRun run;
+  run.preset = &find_bench_preset(a.preset);
+  if (a.preset_rows < 0)
+    throw InputError(fmt::format("--preset-rows {} must not be negative (0 = every row)", a.preset_rows));
+  run.overrides = a.rig.overrides();
+  run.config = bench_config(a, preset_default_pipelines());
+  run.rows_per_series = a.preset_rows;
+  run.scenes_dir = a.scenes_dir;
+  run.json_out = a.json_out;
   const Executor executor(checked_threads(a.threads));
-  const Scene scene = io::load_gltf(scenes::resolve_scene(a.scene, a.scenes_dir));
+  run_bench_preset(run, executor);
+}
+
+void run_bench_command(const BenchArgs& a) {
+  const RigOverrides overrides = a.rig.overrides();
+  std::vector<std::string> all;
+  for (const Pipeline* p : pipelines()) all.push_back(p->info().name);
+  const BenchConfig config = bench_config(a, all);
+  const Executor executor(checked_threads(a.threads));
+  Scene scene = io::load_gltf(scenes::resolve_scene(a.scene, a.scenes_dir));
+  const size_t lights_in_file = scene.lights.size();
+  if (a.lights) keep_first_lights(scene, *a.lights);
   const StereoRig rig = resolve_rig(scene, overrides);
   const RenderScene prepared(scene);
-  fmt::print("scene {} ({} triangles), {}, {} threads, {} warm-up + {} repetitions\n", scene.name,
-             scene.triangle_count(), describe(rig), executor.threads(), a.warmup, a.repetitions);
+  fmt::print("scene {} ({} triangles, {}), {}, {} threads, {} warm-up + {} repetitions\n", scene.name,
+             scene.triangle_count(), describe_lights(scene.lights.size(), lights_in_file), describe(rig),
+             executor.threads(), a.warmup, a.repetitions);
   fmt::print("bvh build {:.1f} ms, {:.1f} MiB\n", prepared.bvh_build_seconds() * 1e3,
              prepared.rays().memory_bytes() / 1048576.0);
   const BenchResult r = run_bench(prepared, rig, config, executor,
@@ -104,7 +134,11 @@ void run_bench_command(const BenchArgs& a) {
   fmt::print("peak resident memory {:.0f} MiB\n", peak_rss_mib());
   if (!a.json_out.empty()) {
     nlohmann::json j = bench_to_json(r);
-    j["scene"] = {{"name", scene.name}, {"path", scene.path}, {"triangles", scene.triangle_count()}};
+    j["scene"] = {{"name", scene.name},
+                  {"path", scene.path},
+                  {"triangles", scene.triangle_count()},
+                  {"lights", scene.lights.size()},
+                  {"lights_in_file", lights_in_file}};
     j["rig"] = io::rig_to_json(rig);
     j["bvh"] = {{"build_s", prepared.bvh_build_seconds()}, {"memory_bytes", prepared.rays().memory_bytes()}};
     j["peak_rss_mib"] = peak_rss_mib();
@@ -120,16 +154,40 @@ void register_bench_command(CLI::App& root) {
   auto a = std::make_shared<BenchArgs>();
   CLI::App* b = root.add_subcommand("bench", "Time pipelines side by side: medians per stage, throughput, speed-ups");
   b->add_option("--scene,-s", a->scene, "Scene file (.gltf/.glb) or built-in scene name")->capture_default_str();
-  b->add_option("--pipelines,-p", a->pipelines, "Pipelines to time, comma-separated (default: all registered)");
-  b->add_option("--baseline,-b", a->baseline, "Pipeline the speed-ups are measured against")->capture_default_str();
+  b->add_option("--pipelines,-p", a->pipelines,
+                "Pipelines to time, comma-separated (default: all registered; with --preset, the preset's)");
+  CLI::Option* baseline = b->add_option("--baseline,-b", a->baseline,
+                                        "Pipeline the speed-ups are measured against (with --preset: plain-rt)")
+                              ->capture_default_str();
   b->add_option("--repetitions,-n", a->repetitions, "Timed repetitions per pipeline")->capture_default_str();
   b->add_option("--warmup,-w", a->warmup, "Untimed warm-up runs per pipeline")->capture_default_str();
   b->add_option("--threads,-t", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
   b->add_option("--option,-o", a->options, "Pipeline option PIPELINE.NAME=VALUE");
   b->add_option("--json", a->json_out, "Also write the results (with raw samples) to this JSON file");
   add_scenes_dir_option(*b, a->scenes_dir);
+  add_lights_option(*b, a->lights);
+  CLI::Option* preset = b->add_option("--preset", a->preset, "Run a benchmark series of Al-Hagri's thesis (see below)");
+  CLI::Option* preset_rows =
+      b->add_option("--preset-rows", a->preset_rows, "With --preset: only the first K rows of each series (0 = all)")
+          ->capture_default_str();
   a->rig.add_to(*b);
-  b->callback([a] { run_bench_command(*a); });
+  b->footer(presets_help());
+  b->callback([a, b, baseline, preset, preset_rows] {
+    if (preset->count() == 0) {
+      if (preset_rows->count() > 0) throw InputError("--preset-rows needs --preset NAME");
+      run_bench_command(*a);
+      return;
+    }
+    // A preset sets the scene, image size, disparity and light count of each row itself.
+    for (const char* name : {"--scene", "--resolution", "--interaxial", "--max-disparity", "--lights"})
+      if (b->count(name) > 0)
+        throw InputError(fmt::format("--preset {} sets the scene, image size, disparity and lights of every row; "
+                                     "drop {} (or run without --preset)",
+                                     a->preset, name));
+    BenchArgs args = *a;
+    if (baseline->count() == 0) args.baseline = "plain-rt";
+    run_preset_command(args);
+  });
 }
 
 }  // namespace sb::cli

@@ -28,6 +28,7 @@ struct RenderArgs {
   std::string scenes_dir;
   std::string out = "out/render";
   int threads = 0;
+  std::optional<int> lights;
   RigCli rig;
 };
 
@@ -50,8 +51,10 @@ void run_render(const RenderArgs& a) {
   const PipelineOptions options(pipeline.info(), parse_key_values(a.options, "--option"));
   const Executor executor(checked_threads(a.threads));
   const fs::path path = scenes::resolve_scene(a.scene, a.scenes_dir);
-  const Scene scene = io::load_gltf(path);
+  Scene scene = io::load_gltf(path);
   for (const std::string& w : scene.warnings) fmt::print(stderr, "warning: {}\n", w);
+  const size_t lights_in_file = scene.lights.size();
+  if (a.lights) keep_first_lights(scene, *a.lights);
   const StereoRig rig = resolve_rig(scene, overrides);
   const RenderScene prepared(scene);
   const StereoResult result = pipeline.render(prepared, rig, options, RenderContext{executor});
@@ -59,11 +62,14 @@ void run_render(const RenderArgs& a) {
   const std::optional<HoleAnalysis> holes = analyze_holes(prepared, rig, result.right, executor);
   nlohmann::json record = io::result_to_json(pipeline.info().name, prepared, rig, result, executor.threads(), options);
   if (holes) record["holes"] = io::holes_to_json(*holes);
+  record["scene"]["lights"] = scene.lights.size();
+  record["scene"]["lights_in_file"] = lights_in_file;
   const std::string stem = fmt::format("{}_{}", scene.name, pipeline.info().name);
   const io::RenderFiles files =
       io::write_render_outputs(a.out, stem, result, record, holes ? &holes->overlay : nullptr);
-  fmt::print("{} on {} ({} triangles), {}, {} threads\n", pipeline.info().name, scene.name, scene.triangle_count(),
-             describe(rig), executor.threads());
+  fmt::print("{} on {} ({} triangles, {}), {}, {} threads\n", pipeline.info().name, scene.name,
+             scene.triangle_count(), describe_lights(scene.lights.size(), lights_in_file), describe(rig),
+             executor.threads());
   fmt::print("  {:<22} {:>10.2f} ms ({:.1f} MiB)\n", "bvh build (once)", prepared.bvh_build_seconds() * 1e3,
              prepared.rays().memory_bytes() / 1048576.0);
   print_timings(result);
@@ -91,6 +97,7 @@ void register_render_command(CLI::App& root) {
   r->add_option("--option,-o", a->options, "Pipeline option NAME=VALUE (see `stereobench pipelines`)");
   r->add_option("--threads,-t", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
   r->add_option("--out", a->out, "Output folder")->capture_default_str();
+  add_lights_option(*r, a->lights);
   add_scenes_dir_option(*r, a->scenes_dir);
   a->rig.add_to(*r);
   r->callback([a] { run_render(*a); });

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <string>
 
 #include "scenes/generators.hpp"
@@ -22,5 +23,12 @@ namespace sb::scenes {
 /// Generates a built-in scene with its default seed and parameters into `scenes_dir` and stamps it,
 /// so that resolve_scene() reuses it until the generator's version changes.
 GenerateResult generate_builtin(const std::string& name, const std::filesystem::path& scenes_dir);
+
+/// A built-in scene with seed 1 and these parameter overrides (checked like `scenes generate
+/// --param`), cached like the default one as `<scenes_dir>/<stem>_<param>-<value>....<ext>`, e.g.
+/// `dragon_lights-10.glb`, beside a stamp of its own. Without overrides it is resolve_scene(name).
+[[nodiscard]] std::filesystem::path resolve_builtin(const std::string& name,
+                                                    const std::map<std::string, double>& params,
+                                                    const std::filesystem::path& scenes_dir);
 
 }  // namespace sb::scenes

@@ -1,6 +1,6 @@
 // `dragon`: a single high-polygon organic mesh — a serpentine dragon swept along a smooth 3-D
 // curve, with head, tapering tail, dorsal spikes, scales, legs, claws, horns and whiskers — on a
-// ground plane with five point lights; it stands in for the Stanford Dragon.
+// ground plane with one to ten point lights (five by default); it stands in for the Stanford Dragon.
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -312,12 +312,34 @@ void build(const GeneratorContext& ctx, GltfBuilder& b) {
   b.add_node("ground", b.add_mesh("ground", ground, ground_mat));
 
   // Key, fill, rim and two low lights, 2.5-4 m from the dragon: the key gives E = 30/3.2^2 =
-  // 2.9 W/m^2 (L = 0.57 on the 0.62 albedo), the others 0.5-1.5 W/m^2 each.
-  b.add_point_light("key", {2.4f, 3.2f, 2.6f}, {1.0f, 0.96f, 0.9f}, 30.0f);
-  b.add_point_light("fill", {-2.8f, 2.2f, 2.4f}, {0.85f, 0.9f, 1.0f}, 12.0f);
-  b.add_point_light("rim", {0.5f, 3.0f, -3.0f}, {1.0f, 1.0f, 1.0f}, 18.0f);
-  b.add_point_light("low_left", {-2.5f, 0.6f, -1.2f}, {1.0f, 0.9f, 0.8f}, 5.0f);
-  b.add_point_light("low_right", {2.8f, 0.5f, -0.2f}, {0.9f, 1.0f, 0.9f}, 5.0f);
+  // 2.9 W/m^2 (L = 0.57 on the 0.62 albedo), the others 0.5-1.5 W/m^2 each. Lights 6-10 (for
+  // light-count sweeps) fill the widest gaps in azimuth around the dragon, and one hangs overhead;
+  // they stand 3.3-3.8 m from its middle and give 0.35-0.95 W/m^2 there, like the fill and low
+  // lights. `lights` = N keeps the first N of the list: each N adds one light to the scene of
+  // N - 1, and the default five never change.
+  struct PointLight {
+    const char* name;
+    vec3 position;
+    vec3 color;
+    float intensity;
+  };
+  static const PointLight kLights[] = {
+      {"key", {2.4f, 3.2f, 2.6f}, {1.0f, 0.96f, 0.9f}, 30.0f},
+      {"fill", {-2.8f, 2.2f, 2.4f}, {0.85f, 0.9f, 1.0f}, 12.0f},
+      {"rim", {0.5f, 3.0f, -3.0f}, {1.0f, 1.0f, 1.0f}, 18.0f},
+      {"low_left", {-2.5f, 0.6f, -1.2f}, {1.0f, 0.9f, 0.8f}, 5.0f},
+      {"low_right", {2.8f, 0.5f, -0.2f}, {0.9f, 1.0f, 0.9f}, 5.0f},
+      {"front", {-0.2f, 1.6f, 3.3f}, {1.0f, 0.95f, 0.9f}, 10.0f},
+      {"overhead", {0.2f, 4.2f, 0.0f}, {1.0f, 1.0f, 0.95f}, 11.0f},
+      {"back_left", {-1.45f, 2.4f, -2.85f}, {0.85f, 0.9f, 1.0f}, 12.0f},
+      {"back_right", {2.4f, 2.0f, -2.15f}, {1.0f, 0.95f, 0.85f}, 10.0f},
+      {"side_low", {-3.4f, 0.8f, 0.8f}, {0.95f, 1.0f, 0.95f}, 5.0f},
+  };
+  const int light_count = ctx.int_param("lights");
+  for (int i = 0; i < light_count; ++i) {
+    const PointLight& l = kLights[static_cast<size_t>(i)];
+    b.add_point_light(l.name, l.position, l.color, l.intensity);
+  }
 
   b.set_background(vec3(0.05f, 0.05f, 0.06f));
   b.set_ambient(0.02);
@@ -329,9 +351,11 @@ void build(const GeneratorContext& ctx, GltfBuilder& b) {
 GeneratorEntry dragon_generator() {
   GeneratorInfo info;
   info.name = "dragon";
-  info.description = "a single ~1.1 M-triangle organic mesh (a scaly serpentine dragon) on a ground plane, 5 point lights";
+  info.description = "a single ~1.1 M-triangle organic mesh (a scaly serpentine dragon) on a ground plane, 5 point lights by default";
   info.file_name = "dragon.glb";
-  info.params = {{"triangles", 1100000, 50000, 20000000, "triangles of the dragon mesh (within 1 %)", true}};
+  info.params = {{"triangles", 1100000, 50000, 20000000, "triangles of the dragon mesh (within 1 %)", true},
+                 {"lights", 5, 1, 10, "point lights: the first N of key, fill, rim, two low lights, then front, "
+                  "overhead, two back lights and a low side light", true}};
   return {info, build};
 }
 

@@ -114,6 +114,36 @@ TEST(SceneParams, TriangleCountsFollowTheParameter) {
   EXPECT_NEAR(static_cast<double>(largest), 3e5, 3e3);
 }
 
+TEST(SceneParams, DragonLightsAddToTheDefaultFive) {
+  const ScratchDir dir;
+  // Lights 1..10: the first N of one list, so N lights are the first N of any larger count and the
+  // geometry never changes with the count.
+  std::vector<std::vector<vec3>> positions;
+  std::vector<unsigned char> payload;
+  for (const double n : {1.0, 5.0, 10.0}) {
+    GenerateOptions o;
+    o.params = {{"triangles", 50000.0}, {"lights", n}};
+    const fs::path path = dir / ("dragon_" + std::to_string(static_cast<int>(n)) + ".glb");
+    const GenerateResult r = generate("dragon", o, path);
+    EXPECT_EQ(r.lights, static_cast<size_t>(n));
+    const test::ReadGltf g = test::read_gltf(path);
+    EXPECT_EQ(g.light_count("point"), static_cast<size_t>(n));
+    positions.push_back(g.point_light_positions());
+    if (payload.empty()) payload = test::read_binary_payload(path);
+    EXPECT_EQ(test::read_binary_payload(path), payload) << n;
+    // The added lights stay around the dragon: within 5 m of its middle, above the ground.
+    for (const vec3& p : positions.back()) {
+      EXPECT_LT(glm::length(p - vec3(0.25f, 0.8f, 0.0f)), 5.0f);
+      EXPECT_GT(p.y, 0.3f);
+    }
+  }
+  for (size_t k = 1; k < positions.size(); ++k)
+    for (size_t i = 0; i < positions[k - 1].size(); ++i) EXPECT_EQ(positions[k][i], positions[k - 1][i]) << i;
+  GenerateOptions o;
+  o.params = {{"lights", 11.0}};
+  expect_input_error([&] { (void)generate("dragon", o, dir / "d.glb"); }, {"lights", "11", "[1, 10]"});
+}
+
 // ---------------------------------------------------------------------------------------------
 // Determinism: every generator, with parameters that keep it quick.
 
