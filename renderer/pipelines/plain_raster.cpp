@@ -18,17 +18,14 @@ class PlainRaster final : public Pipeline {
     static const PipelineInfo i{
         "plain-raster", "Wißmann et al. 2020; Kim", "Plain Stereo; 2-Pass",
         "rasterize a G-buffer and run the lighting pass for each eye",
-        {{"tile", "64", "rasterizer tile size in pixels"}}, 48.0, 48.0};
+        {tile_option_spec()}, 48.0, 48.0};
     return i;
   }
 
   StereoResult render(const RenderScene& scene, const StereoRig& rig, const PipelineOptions& options,
                       const RenderContext& ctx) const override {
     StereoResult r;
-    RasterOptions ro;
-    ro.tile = options.get_int("tile");
-    if (ro.tile < 8 || ro.tile > 1024)
-      throw InputError(fmt::format("plain-raster: option tile={} is out of range 8..1024", ro.tile));
+    const RasterOptions ro = raster_options("plain-raster", options);
     r.left = raster_eye(scene, rig, Eye::left, ro, ctx.executor, r);
     r.right = raster_eye(scene, rig, Eye::right, ro, ctx.executor, r);
     r.counters.set("hole_pixels", 0);

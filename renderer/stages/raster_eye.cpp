@@ -1,6 +1,9 @@
 // A rasterized eye: G-buffer and lighting pass, timed and counted.
 #include "renderer/stages/raster_eye.hpp"
 
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
 #include "renderer/stages/eye_image.hpp"
 #include "renderer/stages/lighting.hpp"
 
@@ -28,6 +31,16 @@ Image raster_eye(const RenderScene& scene, const StereoRig& rig, Eye which, cons
   result.counters.add("fragments_" + name, rs.fragments_tested);
   if (gbuffer != nullptr) *gbuffer = std::move(g);
   return image;
+}
+
+OptionSpec tile_option_spec() { return {"tile", "64", "rasterizer tile size in pixels (the image does not depend on it)"}; }
+
+RasterOptions raster_options(const std::string& pipeline, const PipelineOptions& options) {
+  RasterOptions ro;
+  ro.tile = options.get_int("tile");
+  if (ro.tile < 8 || ro.tile > 1024)
+    throw InputError(fmt::format("{}: option tile={} is out of range 8..1024", pipeline, ro.tile));
+  return ro;
 }
 
 }  // namespace sb

@@ -13,4 +13,9 @@ namespace sb {
 [[nodiscard]] Image raster_eye(const RenderScene& scene, const StereoRig& rig, Eye which, const RasterOptions& options,
                                const Executor& executor, StereoResult& result, GBuffer* gbuffer = nullptr);
 
+/// The "tile" option every rasterizing pipeline declares, and its value checked (8..1024;
+/// InputError naming the pipeline otherwise).
+[[nodiscard]] OptionSpec tile_option_spec();
+[[nodiscard]] RasterOptions raster_options(const std::string& pipeline, const PipelineOptions& options);
+
 }  // namespace sb

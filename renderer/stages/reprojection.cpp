@@ -14,7 +14,7 @@ std::vector<OptionSpec> grid_warp_option_specs(bool with_detection) {
       {"threshold_arcmin", "1.0",
        "binocular-parallax difference (minutes of arc) above which a 16x16 cell is subdivided to native resolution"},
       {"grid_overlay", "false", "also output the warping grid drawn over the left eye (<stem>_grid.png)"},
-      {"tile", "64", "rasterizer tile size in pixels"}};
+      tile_option_spec()};
   if (with_detection) {
     specs.push_back({"discontinuity_px", "0.05",
                      "disocclusion detection: a grid vertex is flagged where a source-row gap beside it opens this many "
@@ -35,9 +35,7 @@ ReprojectionSettings ReprojectionSettings::from(const PipelineOptions& options, 
   if (!(s.threshold_arcmin > 0.0))
     throw InputError(fmt::format("option threshold_arcmin={} must be positive (1.0 is the paper's value)", s.threshold_arcmin));
   s.grid_overlay = options.get_bool("grid_overlay");
-  s.raster.tile = options.get_int("tile");
-  if (s.raster.tile < 8 || s.raster.tile > 1024)
-    throw InputError(fmt::format("option tile={} is out of range 8..1024", s.raster.tile));
+  s.raster = raster_options(with_detection ? "repro-rt/repro-reraster" : "repro-warp", options);
   s.warp.detect_disocclusions = with_detection;
   if (with_detection) {
     s.warp.discontinuity_px = options.get_double("discontinuity_px");
