@@ -253,6 +253,10 @@ void setup_triangles(const SetupInputs& in, uint32_t begin, uint32_t end, std::v
     const uint32_t i0 = m.indices[3 * size_t{local}], i1 = m.indices[3 * size_t{local} + 1],
                    i2 = m.indices[3 * size_t{local} + 2];
     ++counts.submitted;
+    if (in.triangle_mask != nullptr && (in.triangle_mask[id] & in.triangle_bit) == 0) {
+      ++counts.skipped;
+      continue;
+    }
 
     // Invalid indices are the loader's to reject, but they must never read out of bounds here.
     const size_t vertex_count = m.positions.size();

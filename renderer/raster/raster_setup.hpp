@@ -118,6 +118,7 @@ struct SetupCounts {
   uint64_t culled_frustum = 0;
   uint64_t clipped_near = 0;
   uint64_t emitted = 0;
+  uint64_t skipped = 0;  ///< left out by the triangle mask
 };
 
 /// The inputs every chunk of the setup stage shares.
@@ -127,6 +128,8 @@ struct SetupInputs {
   const ProjectedVertex* vertices = nullptr;  ///< all meshes' vertices, mesh m from vertex_base[m]
   const size_t* vertex_base = nullptr;        ///< per mesh, prefix sums of the vertex counts
   dvec3 eye_origin{0.0};
+  const uint8_t* triangle_mask = nullptr;  ///< per global triangle id; see RasterOptions
+  uint8_t triangle_bit = 0;
 };
 
 /// Projects the vertices [begin, end) of the global vertex numbering (mesh m's vertex k is

@@ -260,7 +260,8 @@ GBuffer rasterize(const SceneGeometry& geometry, const EyeCamera& eye, const Exe
   const size_t vertex_count = vertex_base.back();
   const auto vertices = std::make_unique_for_overwrite<raster::ProjectedVertex[]>(vertex_count);
   const raster::VertexTransform transform(eye);
-  const raster::SetupInputs inputs{&geometry, &transform, vertices.get(), vertex_base.data(), eye.origin};
+  const raster::SetupInputs inputs{&geometry,  &transform, vertices.get(), vertex_base.data(), eye.origin,
+                                   options.triangle_mask, options.triangle_bit};
   executor.for_range(vertex_count, 8192,
                      [&](size_t begin, size_t end) { raster::project_vertices(inputs, begin, end, vertices.get()); });
 
@@ -322,6 +323,7 @@ GBuffer rasterize(const SceneGeometry& geometry, const EyeCamera& eye, const Exe
       stats->culled_frustum += chunk.counts.culled_frustum;
       stats->clipped_near += chunk.counts.clipped_near;
       stats->triangles_rasterized += chunk.counts.emitted;
+      stats->triangles_skipped += chunk.counts.skipped;
     }
     for (const TileCounts& t : tile_counts) {
       stats->fragments_tested += t.tested;

@@ -33,6 +33,7 @@ struct RasterStats {
   uint64_t triangles_rasterized = 0;  ///< triangles (after clipping) that reached the tiles
   uint64_t fragments_tested = 0;      ///< covered pixel centres that reached the depth test (write mask passed)
   uint64_t fragments_written = 0;     ///< fragments that passed the depth test when tested
+  uint64_t triangles_skipped = 0;     ///< left out by the triangle mask
 };
 
 struct RasterOptions {
@@ -40,6 +41,10 @@ struct RasterOptions {
   /// When set (width*height entries), only pixels whose mask is non-zero are written: the stencil
   /// of re-rasterized hole filling. Every triangle is still processed.
   const uint8_t* write_mask = nullptr;
+  /// When set (one entry per global triangle id), only triangles whose entry has `triangle_bit`
+  /// set are rasterized: an eye's share of the scene (Kim's visibility redirection).
+  const uint8_t* triangle_mask = nullptr;
+  uint8_t triangle_bit = 0;
 };
 
 /// Rasterizes every triangle of the scene from `eye`. Deterministic for any thread count: the

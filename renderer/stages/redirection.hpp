@@ -1,0 +1,50 @@
+// Kim's visibility redirection (§3.1-3.2): every triangle goes to the eye that sees it best, so
+// that each eye rasterizes and shades only its share and the two partial images, warped into each
+// other, sample every surface from the side that sees more of it.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "renderer/math.hpp"
+#include "renderer/parallel.hpp"
+#include "renderer/rig.hpp"
+#include "renderer/scene_geometry.hpp"
+
+namespace sb {
+
+/// Bits of a triangle's redirection: which eyes rasterize it.
+enum RedirectBits : uint8_t {
+  kRedirectLeft = 1,
+  kRedirectRight = 2,
+  kRedirectBoth = kRedirectLeft | kRedirectRight,
+};
+
+/// Kim's eq. (1): 1 while the triangle lies within the eye's frustum horizontally
+/// (|x_ndc| <= 1 for the vertex with the largest |x_ndc|), decreasing as 1 / |x_ndc| beyond; 0 when
+/// a vertex lies at or behind the eye's plane.
+[[nodiscard]] double frustum_visibility(const EyeCamera& eye, const dvec3& v0, const dvec3& v1, const dvec3& v2);
+
+/// Kim's eq. (3): |n · (c − p)| / |c − p| for the unit normal n, the eye's position c and the
+/// triangle's centroid p — the cosine that scales its projected area. For a single-sided triangle
+/// the signed form (eq. 4), so that a back face loses to a front face.
+[[nodiscard]] double facing_visibility(const EyeCamera& eye, const dvec3& v0, const dvec3& v1, const dvec3& v2,
+                                       bool single_sided);
+
+/// The eye(s) a triangle goes to: the larger frustum visibility wins; on a tie, the larger facing
+/// visibility; on an exact tie, both.
+[[nodiscard]] uint8_t redirect(const EyeCamera& left, const EyeCamera& right, const dvec3& v0, const dvec3& v1,
+                               const dvec3& v2, bool single_sided);
+
+/// Triangles sent to each eye.
+struct RedirectionCounts {
+  uint64_t left = 0;
+  uint64_t right = 0;
+  uint64_t both = 0;
+};
+
+/// The RedirectBits of every triangle of the scene, by global triangle id.
+[[nodiscard]] std::vector<uint8_t> redirect_triangles(const SceneGeometry& geometry, const StereoRig& rig,
+                                                      const Executor& executor, RedirectionCounts& counts);
+
+}  // namespace sb

@@ -1,0 +1,88 @@
+// Kim's visibility redirection: the frustum comparison first, then the facing comparison, both
+// eyes on exact ties; and the rasterizer's triangle mask that renders an eye's share.
+#include <gtest/gtest.h>
+
+#include "renderer/raster/rasterizer.hpp"
+#include "renderer/stages/redirection.hpp"
+#include "support/render_support.hpp"
+
+namespace sb {
+namespace {
+
+/// A rig at the origin looking down -Z: eyes at x = -/+0.032 m, 320x180, convergence 2 m.
+StereoRig test_rig() {
+  RigParams p;
+  p.width = 320;
+  p.height = 180;
+  return StereoRig(CameraPose{}, p);
+}
+
+TEST(Redirection, TriangleFacingTheLeftEyeGoesLeft) {
+  const StereoRig rig = test_rig();
+  const EyeCamera l = rig.eye(Eye::left), r = rig.eye(Eye::right);
+  // Inside both frusta, 1 m ahead, its normal turned towards -X: the left eye (at x = -0.032)
+  // sees it more squarely than the right one.
+  const dvec3 n = glm::normalize(dvec3(-1.0, 0.0, 1.0));
+  const dvec3 up(0.0, 1.0, 0.0), side = glm::normalize(glm::cross(up, n));
+  const dvec3 c(0.0, 0.0, -1.0);
+  const dvec3 v0 = c - 0.05 * side - 0.05 * up, v1 = c + 0.05 * side - 0.05 * up, v2 = c + 0.05 * up;
+  ASSERT_EQ(frustum_visibility(l, v0, v1, v2), 1.0);
+  ASSERT_EQ(frustum_visibility(r, v0, v1, v2), 1.0);
+  EXPECT_GT(facing_visibility(l, v0, v1, v2, false), facing_visibility(r, v0, v1, v2, false));
+  EXPECT_EQ(redirect(l, r, v0, v1, v2, false), kRedirectLeft);
+  // Mirrored about x = 0, it faces the right eye.
+  const dvec3 m0(-v0.x, v0.y, v0.z), m1(-v1.x, v1.y, v1.z), m2(-v2.x, v2.y, v2.z);
+  EXPECT_EQ(redirect(l, r, m0, m2, m1, false), kRedirectRight);
+}
+
+TEST(Redirection, TriangleLeavingTheRightFrustumGoesLeft) {
+  const StereoRig rig = test_rig();
+  const EyeCamera l = rig.eye(Eye::left), r = rig.eye(Eye::right);
+  // A small triangle near the right border of the left image, 10 m away: beyond the convergence
+  // distance its disparity is positive (about 6 px here), so the right eye sees it further right,
+  // past its right border.
+  const double depth = 10.0;
+  const dvec3 p = l.unproject(317.0, 90.0, depth);
+  const dvec3 v0 = p, v1 = p + dvec3(0.01, 0.0, 0.0), v2 = p + dvec3(0.0, 0.01, 0.0);
+  ASSERT_EQ(frustum_visibility(l, v0, v1, v2), 1.0);
+  EXPECT_LT(frustum_visibility(r, v0, v1, v2), frustum_visibility(l, v0, v1, v2));
+  EXPECT_EQ(redirect(l, r, v0, v1, v2, false), kRedirectLeft);
+}
+
+TEST(Redirection, ExactTiesGoToBothEyes) {
+  const StereoRig rig = test_rig();
+  const EyeCamera l = rig.eye(Eye::left), r = rig.eye(Eye::right);
+  // Symmetric about x = 0 and facing the rig squarely: same frustum and facing visibility.
+  const dvec3 v0(-0.1, -0.1, -2.0), v1(0.1, -0.1, -2.0), v2(0.0, 0.1, -2.0);
+  EXPECT_EQ(frustum_visibility(l, v0, v1, v2), frustum_visibility(r, v0, v1, v2));
+  EXPECT_EQ(facing_visibility(l, v0, v1, v2, false), facing_visibility(r, v0, v1, v2, false));
+  EXPECT_EQ(redirect(l, r, v0, v1, v2, false), kRedirectBoth);
+}
+
+TEST(Redirection, EachEyeRasterizesOnlyItsShare) {
+  const Scene scene = test::load_builtin("box-wall");
+  const RenderScene prepared(scene);
+  const StereoRig rig = test::rig_at(scene, 160, 90);
+  const Executor executor(2);
+  RedirectionCounts counts;
+  const std::vector<uint8_t> bits = redirect_triangles(prepared.geometry(), rig, executor, counts);
+  ASSERT_EQ(bits.size(), prepared.geometry().triangle_count());
+  EXPECT_EQ(counts.left + counts.right + counts.both, bits.size());
+  EXPECT_GT(counts.left, 0u);
+  EXPECT_GT(counts.right, 0u);
+  for (const Eye e : {Eye::left, Eye::right}) {
+    RasterOptions o;
+    o.triangle_mask = bits.data();
+    o.triangle_bit = e == Eye::left ? kRedirectLeft : kRedirectRight;
+    RasterStats stats;
+    const GBuffer g = rasterize(prepared.geometry(), rig.eye(e), executor, o, &stats);
+    EXPECT_EQ(stats.triangles_skipped, e == Eye::left ? counts.right : counts.left);
+    for (const uint32_t prim : g.prim) {
+      if (prim == kNoPrimitiveId) continue;
+      ASSERT_NE(bits[prim] & o.triangle_bit, 0) << "triangle " << prim;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace sb
