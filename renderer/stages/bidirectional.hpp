@@ -1,0 +1,42 @@
+// Kim's bidirectional warping (§3): the scene split between the eyes by visibility redirection,
+// each eye rasterizing and shading its share into a partial image, each partial image warped
+// row-wise into the other eye where it competes by depth with that eye's own pixels (the
+// composition), and cracks of up to a few pixels filled along the rows. Shared by bidir-warp and
+// bidir-warp-rt.
+#pragma once
+
+#include "renderer/pipeline.hpp"
+#include "renderer/raster/rasterizer.hpp"
+#include "renderer/stages/crack_fill.hpp"
+#include "renderer/stages/row_warp.hpp"
+
+namespace sb {
+
+/// Settings of the bidirectional stages.
+struct BidirSettings {
+  RasterOptions raster;
+  int max_crack = 2;
+  RowWarpOptions warp{256, false};  ///< partial images: only surfaces are warped
+
+  /// From the options of bidir_option_specs(); InputError for values out of range.
+  static BidirSettings from(const std::string& pipeline, const PipelineOptions& options);
+};
+
+/// The options both bidirectional pipelines declare.
+[[nodiscard]] std::vector<OptionSpec> bidir_option_specs();
+
+/// Renders both eyes of `result` (stages redirect, left_gbuffer, left_shading, right_gbuffer,
+/// right_shading, motion, warp, crack_fill). Pixels no partial image covers stay tagged `hole`
+/// (radiance 0, depth +inf) for the caller to fill. Counts triangles sent left, right and both,
+/// pixels warped into each eye and the crack fill of each eye.
+void render_bidirectional(const RenderScene& scene, const StereoRig& rig, const BidirSettings& settings,
+                          const Executor& executor, StereoResult& result);
+
+/// Gives the pixels still tagged `hole` the scene's background radiance (what a cleared render
+/// target shows there) and keeps their tag, so that hole statistics still see them. Returns them.
+uint64_t show_background_in_holes(const RenderScene& scene, Image& image);
+
+/// Indices (ascending) of the pixels tagged `hole`.
+[[nodiscard]] std::vector<uint32_t> hole_list(const Image& image);
+
+}  // namespace sb
