@@ -48,7 +48,8 @@ Image partial_eye(const RenderScene& scene, const StereoRig& rig, Eye which, con
 std::vector<OptionSpec> bidir_option_specs() {
   return {tile_option_spec(),
           {"max_crack", "2", "widest run of hole pixels in a row filled by linear interpolation after the composition"},
-          {"segment", "256", "target-row segment length of the row warp in pixels (the image does not depend on it)"}};
+          {"segment", "256", "target-row segment length of the row warp in pixels (the image does not depend on it)"},
+          {"partials", "false", "also output each eye's partial image (<stem>_left_partial.png, <stem>_right_partial.png)"}};
 }
 
 BidirSettings BidirSettings::from(const std::string& pipeline, const PipelineOptions& options) {
@@ -56,6 +57,7 @@ BidirSettings BidirSettings::from(const std::string& pipeline, const PipelineOpt
   s.raster = raster_options(pipeline, options);
   s.max_crack = max_crack_option(pipeline, options);
   s.warp.segment = options.get_int("segment");
+  s.keep_partials = options.get_bool("partials");
   if (s.warp.segment < 1)
     throw InputError(fmt::format("{}: option segment={} must be at least 1 pixel", pipeline, s.warp.segment));
   return s;
@@ -88,6 +90,10 @@ void render_bidirectional(const RenderScene& scene, const StereoRig& rig, const 
     into_right = row_warp(left, to_right, settings.warp, executor, r.right);
     r.left = left;
     into_left = row_warp(right, to_left, settings.warp, executor, r.left);
+  }
+  if (settings.keep_partials) {
+    r.extras.emplace_back("left_partial", left);
+    r.extras.emplace_back("right_partial", right);
   }
   r.counters.set("pixels_warped_right", into_right.written);
   r.counters.set("pixels_warped_left", into_left.written);

@@ -17,6 +17,7 @@ struct BidirSettings {
   RasterOptions raster;
   int max_crack = 2;
   RowWarpOptions warp{256, false};  ///< partial images: only surfaces are warped
+  bool keep_partials = false;       ///< add the partial images to the result's extras
 
   /// From the options of bidir_option_specs(); InputError for values out of range.
   static BidirSettings from(const std::string& pipeline, const PipelineOptions& options);
@@ -28,7 +29,8 @@ struct BidirSettings {
 /// Renders both eyes of `result` (stages redirect, left_gbuffer, left_shading, right_gbuffer,
 /// right_shading, motion, warp, crack_fill). Pixels no partial image covers stay tagged `hole`
 /// (radiance 0, depth +inf) for the caller to fill. Counts triangles sent left, right and both,
-/// pixels warped into each eye and the crack fill of each eye.
+/// pixels warped into each eye and the crack fill of each eye. With keep_partials, the partial
+/// images go to result.extras as "left_partial" and "right_partial" (the paper's Fig. 3).
 void render_bidirectional(const RenderScene& scene, const StereoRig& rig, const BidirSettings& settings,
                           const Executor& executor, StereoResult& result);
 
