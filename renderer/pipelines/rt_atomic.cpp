@@ -31,13 +31,7 @@ class RtAtomic final : public Pipeline {
     const ValidationSettings validation = ValidationSettings::from("rt-atomic", options);
     StereoResult r;
     const int w = rig.params().width, h = rig.params().height;
-    TraceCounts left;
-    {
-      ScopedStage stage(r.timings, "left_trace");
-      r.left = make_eye_image(w, h);
-      trace_eye(scene, rig.eye(Eye::left), ctx.executor, r.left, left);
-    }
-    add_counts(r.counters, left, "left", true);
+    trace_left_eye(scene, rig, ctx.executor, r);
     const PixelReprojector reprojector(rig);
     RightSources sources{w, h, {}};
     {
@@ -58,11 +52,7 @@ class RtAtomic final : public Pipeline {
       });
     }
     complete_right_eye(scene, rig, reprojector, sources, validation, ctx.executor, r);
-    const std::vector<uint64_t> writes = reprojection_writes(reprojector, r.left, ctx.executor);
-    add_write_counters(r.counters, writes, rig, r.left);
-    uint64_t overlapped = 0;
-    for (size_t k = 2; k < writes.size(); ++k) overlapped += (k - 1) * writes[k];
-    r.counters.set("overlapped", overlapped);
+    add_reprojection_counters(reprojector, rig, ctx.executor, r);
     return r;
   }
 };

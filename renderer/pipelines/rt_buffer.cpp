@@ -44,13 +44,7 @@ class RtBuffer final : public Pipeline {
     const int w = rig.params().width, h = rig.params().height;
     const int t = buffer_depth(options.get_int("depth"), rig);
     StereoResult r;
-    TraceCounts left;
-    {
-      ScopedStage stage(r.timings, "left_trace");
-      r.left = make_eye_image(w, h);
-      trace_eye(scene, rig.eye(Eye::left), ctx.executor, r.left, left);
-    }
-    add_counts(r.counters, left, "left", true);
+    trace_left_eye(scene, rig, ctx.executor, r);
     const PixelReprojector reprojector(rig);
     const size_t slots = static_cast<size_t>(t);
     std::vector<int32_t> buffer;
@@ -87,12 +81,9 @@ class RtBuffer final : public Pipeline {
       });
     }
     complete_right_eye(scene, rig, reprojector, sources, validation, ctx.executor, r);
-    const std::vector<uint64_t> writes = reprojection_writes(reprojector, r.left, ctx.executor);
-    add_write_counters(r.counters, writes, rig, r.left);
-    uint64_t overlapped = 0, lost = 0;
-    for (size_t k = 2; k < writes.size(); ++k) overlapped += (k - 1) * writes[k];
+    add_reprojection_counters(reprojector, rig, ctx.executor, r);
+    uint64_t lost = 0;
     for (const uint64_t c : collisions) lost += c;
-    r.counters.set("overlapped", overlapped);
     r.counters.set("buffer_depth", static_cast<uint64_t>(t));
     r.counters.set("buffer_collisions", lost);
     return r;

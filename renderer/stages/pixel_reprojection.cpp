@@ -126,6 +126,25 @@ Validation validate_and_copy(const RenderScene& scene, const PixelReprojector& r
   return v;
 }
 
+void trace_left_eye(const RenderScene& scene, const StereoRig& rig, const Executor& executor, StereoResult& r) {
+  TraceCounts left;
+  {
+    ScopedStage stage(r.timings, "left_trace");
+    r.left = make_eye_image(rig.params().width, rig.params().height);
+    trace_eye(scene, rig.eye(Eye::left), executor, r.left, left);
+  }
+  add_counts(r.counters, left, "left", true);
+}
+
+void add_reprojection_counters(const PixelReprojector& reprojector, const StereoRig& rig, const Executor& executor,
+                               StereoResult& r) {
+  const std::vector<uint64_t> writes = reprojection_writes(reprojector, r.left, executor);
+  add_write_counters(r.counters, writes, rig, r.left);
+  uint64_t overlapped = 0;
+  for (size_t k = 2; k < writes.size(); ++k) overlapped += (k - 1) * writes[k];
+  r.counters.set("overlapped", overlapped);
+}
+
 void complete_right_eye(const RenderScene& scene, const StereoRig& rig, const PixelReprojector& reprojector,
                         const RightSources& sources, const ValidationSettings& settings, const Executor& executor,
                         StereoResult& r) {

@@ -83,6 +83,15 @@ struct Validation {
                                            const RightSources& sources, const Image& left,
                                            const ValidationSettings& settings, const Executor& executor, Image& right);
 
+/// The left eye of the parallel pipelines: traced whole into a new result.left (stage
+/// "left_trace"), counted.
+void trace_left_eye(const RenderScene& scene, const StereoRig& rig, const Executor& executor, StereoResult& result);
+
+/// The write histogram of the parallel pipelines' reprojection (add_write_counters) and
+/// "overlapped": writes onto a right pixel beyond its first. Outside every timed stage.
+void add_reprojection_counters(const PixelReprojector& reprojector, const StereoRig& rig, const Executor& executor,
+                               StereoResult& result);
+
 /// The right eye of the parallel pipelines (rt-buffer, rt-atomic) from the winning sources:
 /// validate_and_copy into a new result.right (stage "validate"), then the missed and blocked
 /// pixels traced in full with trace_pixels, tag `reshaded_traced` (stage "right_trace"). Counts

@@ -9,6 +9,7 @@
 #include "renderer/error.hpp"
 #include "renderer/stages/disocclusion.hpp"
 #include "renderer/stages/grid_warp.hpp"
+#include "support/lit_plane.hpp"
 #include "support/render_support.hpp"
 
 namespace sb {
@@ -116,29 +117,10 @@ TEST(GridMetric, GapsOpeningBelowTheParallaxThresholdAreSubdividedForDetection) 
   EXPECT_TRUE(g.subdivided[g.cell(2, 1)]);
 }
 
-/// lit-plane: a fronto-parallel plane 4 m in front of the camera.
-class PlaneWarp : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    scene_ = new Scene(test::load_builtin("lit-plane"));
-    prepared_ = new RenderScene(*scene_);
-  }
-  static void TearDownTestSuite() {
-    delete prepared_;
-    delete scene_;
-  }
-  static Scene* scene_;
-  static RenderScene* prepared_;
-};
-Scene* PlaneWarp::scene_ = nullptr;
-RenderScene* PlaneWarp::prepared_ = nullptr;
+using PlaneWarp = test::LitPlane;
 
 TEST_F(PlaneWarp, ZeroDisparityReproducesTheLeftEye) {
-  RigOverrides o;
-  o.width = 320;
-  o.height = 180;
-  o.convergence = 4.0;  // the plane's depth: zero disparity everywhere on it
-  const StereoRig rig = resolve_rig(*scene_, o);
+  const StereoRig rig = rig_with_plane_disparity(0.0);  // converged on the plane
   const StereoResult r = test::render_with("repro-warp", *prepared_, rig, 2);
   EXPECT_EQ(r.counters.get("hole_pixels"), 0u);
   const float* left = r.left.data_f32(planes::rgb);
@@ -148,13 +130,7 @@ TEST_F(PlaneWarp, ZeroDisparityReproducesTheLeftEye) {
 }
 
 TEST_F(PlaneWarp, IntegerDisparityShiftsByWholePixels) {
-  // d(Z) = f e (1/c - 1/Z) = 3 px on the plane at Z = 4 m.
-  RigOverrides o;
-  o.width = 320;
-  o.height = 180;
-  const StereoRig base = resolve_rig(*scene_, o);
-  o.convergence = 1.0 / (3.0 / (base.focal_px() * base.params().interaxial) + 1.0 / 4.0);
-  const StereoRig rig = resolve_rig(*scene_, o);
+  const StereoRig rig = rig_with_plane_disparity(3.0);
   ASSERT_NEAR(rig.disparity_px(4.0), 3.0, 1e-9);
   const StereoResult r = test::render_with("repro-warp", *prepared_, rig, 2);
   const uint32_t* source = r.right.data_u32(planes::source);

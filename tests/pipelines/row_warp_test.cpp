@@ -12,6 +12,7 @@
 #include "renderer/stages/eye_image.hpp"
 #include "renderer/stages/row_warp.hpp"
 #include "support/image_metrics.hpp"
+#include "support/lit_plane.hpp"
 #include "support/render_support.hpp"
 
 namespace sb {
@@ -268,31 +269,7 @@ TEST(CrackFill, FillsNarrowCracksAndCountsTheRest) {
   EXPECT_THROW((void)fill_cracks(none, -1, Executor(1)), InputError);
 }
 
-/// lit-plane: a fronto-parallel plane 4 m in front of the camera.
-class KimPlane : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    scene_ = new Scene(test::load_builtin("lit-plane"));
-    prepared_ = new RenderScene(*scene_);
-  }
-  static void TearDownTestSuite() {
-    delete prepared_;
-    delete scene_;
-  }
-  /// The rig at 320x180 whose disparity on the plane is `disparity` px.
-  static StereoRig rig_with_plane_disparity(double disparity) {
-    RigOverrides o;
-    o.width = 320;
-    o.height = 180;
-    const StereoRig base = resolve_rig(*scene_, o);
-    o.convergence = 1.0 / (disparity / (base.focal_px() * base.params().interaxial) + 1.0 / 4.0);
-    return resolve_rig(*scene_, o);
-  }
-  static Scene* scene_;
-  static RenderScene* prepared_;
-};
-Scene* KimPlane::scene_ = nullptr;
-RenderScene* KimPlane::prepared_ = nullptr;
+using KimPlane = test::LitPlane;
 
 /// The right eye is the left eye shifted by `shift` whole pixels; the `shift` columns at the left
 /// edge, whose sources lie outside the left image, are holes.
