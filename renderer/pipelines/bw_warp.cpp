@@ -126,14 +126,9 @@ class LeftRow {
 BackwardCounts backward_warp(const Image& left, const StereoRig& rig, const BwSettings& settings,
                              const Executor& executor, Image& right) {
   const int w = left.width(), h = left.height();
-  const float* rgb = left.data_f32(planes::rgb);
-  const float* normal = left.data_f32(planes::normal);
-  const float* albedo = left.data_f32(planes::albedo);
-  const float* depth = left.data_f32(planes::depth);
-  const uint32_t* prim = left.data_u32(planes::primid);
+  const EyeReader from(left);
   const DisparityMotion motion(rig, Eye::left);
   EyeWriter out(right);
-  const auto load3 = [](const float* p, size_t i) { return vec3(p[3 * i], p[3 * i + 1], p[3 * i + 2]); };
   std::atomic<uint64_t> converged{0}, fallback{0}, holes{0}, steps{0};
 
   executor.for_range(static_cast<size_t>(h), 4, [&](size_t begin, size_t end) {
@@ -145,7 +140,7 @@ BackwardCounts backward_warp(const Image& left, const StereoRig& rig, const BwSe
       float* d = lrow.disparity();
       float d_min = std::numeric_limits<float>::infinity(), d_max = -std::numeric_limits<float>::infinity();
       for (int x = 0; x < w; ++x) {
-        d[x] = motion(depth[row + x]);
+        d[x] = motion(from.depth(row + x));
         d_min = std::min(d_min, d[x]);
         d_max = std::max(d_max, d[x]);
       }
@@ -173,7 +168,7 @@ BackwardCounts backward_warp(const Image& left, const StereoRig& rig, const BwSe
           // A disocclusion: the iteration jumps between the two sides of the gap. Take the farther
           // of the last two positions that lie in the left image: the background side.
           const bool a = inside(previous), b = inside(x);
-          if (a && (!b || depth[row + lrow.pixel(previous)] > depth[row + lrow.pixel(x)])) x = previous;
+          if (a && (!b || from.depth(row + lrow.pixel(previous)) > from.depth(row + lrow.pixel(x)))) x = previous;
           found = a || b;
           tag = Source::inpainted;
         }
@@ -185,14 +180,14 @@ BackwardCounts backward_warp(const Image& left, const StereoRig& rig, const BwSe
         }
         (tag == Source::reprojected ? c.converged : c.fallback)++;
         const size_t s = row + static_cast<size_t>(lrow.pixel(x));
-        vec3 radiance = load3(rgb, s);
+        vec3 radiance = from.rgb(s);
         if (settings.filter == Filter::linear) {
           int a = 0, b = 0;
           float t = 0.0f;
           lrow.neighbours(x, a, b, t);
-          radiance = load3(rgb, row + a) * (1.0f - t) + load3(rgb, row + b) * t;
+          radiance = from.rgb(row + a) * (1.0f - t) + from.rgb(row + b) * t;
         }
-        out.copy(i, radiance, load3(normal, s), load3(albedo, s), depth[s], prim[s], tag);
+        out.copy(i, radiance, from.normal(s), from.albedo(s), from.depth(s), from.prim(s), tag);
       }
     }
     converged += c.converged;

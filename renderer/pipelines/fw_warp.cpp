@@ -98,14 +98,9 @@ std::vector<uint64_t> splat_depth(const Image& left, const StereoRig& rig, bool 
 /// becomes a hole.
 uint64_t splat_color(const Image& left, const std::vector<uint64_t>& keys, const Executor& executor, Image& right) {
   const int w = left.width(), h = left.height();
-  const float* rgb = left.data_f32(planes::rgb);
-  const float* normal = left.data_f32(planes::normal);
-  const float* albedo = left.data_f32(planes::albedo);
-  const float* depth = left.data_f32(planes::depth);
-  const uint32_t* prim = left.data_u32(planes::primid);
+  const EyeReader from(left);
   EyeWriter out(right);
   std::atomic<uint64_t> total{0};
-  const auto load3 = [](const float* p, size_t i) { return vec3(p[3 * i], p[3 * i + 1], p[3 * i + 2]); };
   executor.for_tiles(w, h, kWarpTile, [&](const PixelRect& tile) {
     uint64_t count = 0;
     for (int y = tile.y0; y < tile.y1; ++y)
@@ -115,8 +110,7 @@ uint64_t splat_color(const Image& left, const std::vector<uint64_t>& keys, const
           out.hole(i);
           continue;
         }
-        const size_t s = static_cast<size_t>(y) * w + key_column(keys[i]);
-        out.copy(i, load3(rgb, s), load3(normal, s), load3(albedo, s), depth[s], prim[s], Source::reprojected);
+        out.copy(i, from, static_cast<size_t>(y) * w + key_column(keys[i]), Source::reprojected);
         ++count;
       }
     total += count;

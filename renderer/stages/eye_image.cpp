@@ -10,6 +10,14 @@ Image make_eye_image(int width, int height) {
   return image;
 }
 
+EyeReader::EyeReader(const Image& image)
+    : rgb_(image.data_f32(planes::rgb)),
+      normal_(image.data_f32(planes::normal)),
+      albedo_(image.data_f32(planes::albedo)),
+      depth_(image.data_f32(planes::depth)),
+      prim_(image.data_u32(planes::primid)),
+      source_(image.data_u32(planes::source)) {}
+
 EyeWriter::EyeWriter(Image& image)
     : rgb_(image.data_f32(planes::rgb)),
       normal_(image.data_f32(planes::normal)),

@@ -1,5 +1,5 @@
-// An eye's output image with the standard AOV planes, and a writer that fills one pixel of all of
-// them at once.
+// An eye's output image with the standard AOV planes, a reader that looks its planes up once, and
+// a writer that fills one pixel of all of them at once.
 #pragma once
 
 #include <limits>
@@ -11,6 +11,28 @@ namespace sb {
 
 /// A width x height image with planes rgb, depth, normal, albedo, primid and source.
 [[nodiscard]] Image make_eye_image(int width, int height);
+
+/// Cached plane pointers of an eye image (made by make_eye_image) for per-pixel reads in hot loops.
+class EyeReader {
+ public:
+  explicit EyeReader(const Image& image);
+
+  [[nodiscard]] vec3 rgb(size_t i) const { return load3(rgb_, i); }
+  [[nodiscard]] vec3 normal(size_t i) const { return load3(normal_, i); }
+  [[nodiscard]] vec3 albedo(size_t i) const { return load3(albedo_, i); }
+  [[nodiscard]] float depth(size_t i) const { return depth_[i]; }
+  [[nodiscard]] uint32_t prim(size_t i) const { return prim_[i]; }
+  [[nodiscard]] uint32_t source(size_t i) const { return source_[i]; }
+
+ private:
+  static vec3 load3(const float* plane, size_t i) { return {plane[3 * i], plane[3 * i + 1], plane[3 * i + 2]}; }
+  const float* rgb_;
+  const float* normal_;
+  const float* albedo_;
+  const float* depth_;
+  const uint32_t* prim_;
+  const uint32_t* source_;
+};
 
 /// Cached plane pointers of an eye image for per-pixel writes from parallel loops (each pixel is
 /// written by one task only).
@@ -37,6 +59,12 @@ class EyeWriter {
     depth_[index] = depth;
     prim_[index] = prim;
     source_[index] = static_cast<uint32_t>(source);
+  }
+  /// Pixel `index` takes every value of pixel `from_index` of `from` (another eye image), with tag
+  /// `source`: a reprojected or warped pixel.
+  void copy(size_t index, const EyeReader& from, size_t from_index, Source source) {
+    copy(index, from.rgb(from_index), from.normal(from_index), from.albedo(from_index), from.depth(from_index),
+         from.prim(from_index), source);
   }
   /// A pixel no stage has a value for yet: radiance 0, depth +inf, tag `hole`.
   void hole(size_t index) {

@@ -386,10 +386,7 @@ void mark_occluding_edges(WarpTarget& t, int y0, int y1, double disparity_per_in
 /// Writes target rows [y0, y1) from the warp buffers and counts their pixels.
 void resolve_rows(const WarpTarget& t, const Image& source, int y0, int y1, Image& target, WarpStats& stats) {
   const int sw = source.width(), sh = source.height();
-  const float* s_rgb = source.data_f32(planes::rgb);
-  const float* s_normal = source.data_f32(planes::normal);
-  const float* s_albedo = source.data_f32(planes::albedo);
-  const uint32_t* s_prim = source.data_u32(planes::primid);
+  const EyeReader from(source);
   EyeWriter out(target);
   for (int y = y0; y < y1; ++y)
     for (int x = 0; x < t.width; ++x) {
@@ -409,24 +406,18 @@ void resolve_rows(const WarpTarget& t, const Image& source, int y0, int y1, Imag
       const float u = s.x - 0.5f, v = s.y - 0.5f;
       const float fu = std::floor(u), fv = std::floor(v);
       const float ax = u - fu, ay = v - fv;
-      const int i0 = std::clamp(static_cast<int>(fu), 0, sw - 1), i1 = std::clamp(static_cast<int>(fu) + 1, 0, sw - 1);
-      const int j0 = std::clamp(static_cast<int>(fv), 0, sh - 1), j1 = std::clamp(static_cast<int>(fv) + 1, 0, sh - 1);
-      const float* p00 = s_rgb + 3 * (static_cast<size_t>(j0) * sw + i0);
-      const float* p10 = s_rgb + 3 * (static_cast<size_t>(j0) * sw + i1);
-      const float* p01 = s_rgb + 3 * (static_cast<size_t>(j1) * sw + i0);
-      const float* p11 = s_rgb + 3 * (static_cast<size_t>(j1) * sw + i1);
-      vec3 rgb;
-      for (int c = 0; c < 3; ++c) {
-        const float top = p00[c] + ax * (p10[c] - p00[c]);
-        const float bottom = p01[c] + ax * (p11[c] - p01[c]);
-        rgb[c] = top + ay * (bottom - top);
-      }
+      const auto at = [&](int i, int j) {
+        return from.rgb(static_cast<size_t>(std::clamp(j, 0, sh - 1)) * sw + static_cast<size_t>(std::clamp(i, 0, sw - 1)));
+      };
+      const int i0 = static_cast<int>(fu), j0 = static_cast<int>(fv);
+      const vec3 top = at(i0, j0) + ax * (at(i0 + 1, j0) - at(i0, j0));
+      const vec3 bottom = at(i0, j0 + 1) + ax * (at(i0 + 1, j0 + 1) - at(i0, j0 + 1));
+      const vec3 rgb = top + ay * (bottom - top);
       // The other AOVs come from the source pixel the position falls in.
       const size_t n = static_cast<size_t>(std::clamp(static_cast<int>(std::floor(s.y)), 0, sh - 1)) * sw +
                        static_cast<size_t>(std::clamp(static_cast<int>(std::floor(s.x)), 0, sw - 1));
       const float depth = t.q[o] > 0.0f ? 1.0f / t.q[o] : std::numeric_limits<float>::infinity();
-      out.copy(o, rgb, vec3(s_normal[3 * n], s_normal[3 * n + 1], s_normal[3 * n + 2]),
-               vec3(s_albedo[3 * n], s_albedo[3 * n + 1], s_albedo[3 * n + 2]), depth, s_prim[n], Source::reprojected);
+      out.copy(o, rgb, from.normal(n), from.albedo(n), depth, from.prim(n), Source::reprojected);
     }
 }
 

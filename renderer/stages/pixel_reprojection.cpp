@@ -31,22 +31,6 @@ int32_t PixelReprojector::target(int x, int y, float depth) const {
   return static_cast<int32_t>(column);
 }
 
-PixelCopier::PixelCopier(const Image& left, Image& right)
-    : width_(left.width()),
-      rgb_(left.data_f32(planes::rgb)),
-      normal_(left.data_f32(planes::normal)),
-      albedo_(left.data_f32(planes::albedo)),
-      depth_(left.data_f32(planes::depth)),
-      prim_(left.data_u32(planes::primid)),
-      out_(right) {}
-
-void PixelCopier::copy(int source_x, int x, int y) {
-  const size_t s = static_cast<size_t>(y) * width_ + source_x;
-  out_.copy(static_cast<size_t>(y) * width_ + x, vec3(rgb_[3 * s], rgb_[3 * s + 1], rgb_[3 * s + 2]),
-            vec3(normal_[3 * s], normal_[3 * s + 1], normal_[3 * s + 2]),
-            vec3(albedo_[3 * s], albedo_[3 * s + 1], albedo_[3 * s + 2]), depth_[s], prim_[s], Source::reprojected);
-}
-
 Validation validate_and_copy(const RenderScene& scene, const PixelReprojector& reprojector, const RightSources& sources,
                              const Image& left, const ValidationSettings& settings, const Executor& executor,
                              Image& right) {
@@ -58,7 +42,8 @@ Validation validate_and_copy(const RenderScene& scene, const PixelReprojector& r
   const EyeCamera& eye = reprojector.right();
   const auto length = static_cast<float>(1.0 - margin);
   executor.for_tiles(w, h, kTraceTile, [&](const PixelRect& tile) {
-    PixelCopier copier(left, right);
+    const EyeReader from(left);
+    EyeWriter out(right);
     RayQuery queries[kRayPacket];
     uint32_t where[kRayPacket];
     uint64_t local = 0, local_absent = 0;
@@ -108,8 +93,9 @@ Validation validate_and_copy(const RenderScene& scene, const PixelReprojector& r
           continue;
         }
         state[p] = static_cast<uint8_t>(RightState::reprojected);
-        copier.copy(sources.column[p], static_cast<int>(p % static_cast<uint32_t>(w)),
-                    static_cast<int>(p / static_cast<uint32_t>(w)));
+        // Same row: the rig's baseline is horizontal.
+        out.copy(p, from, p - p % static_cast<uint32_t>(w) + static_cast<uint32_t>(sources.column[p]),
+                 Source::reprojected);
       }
     });
     rays += local;

@@ -100,23 +100,6 @@ void complete_right_eye(const RenderScene& scene, const StereoRig& rig, const Pi
                         const RightSources& sources, const ValidationSettings& settings, const Executor& executor,
                         StereoResult& result);
 
-/// Copies left pixels to right pixels of the same row (radiance, normal, albedo, primitive id and
-/// depth, which the rig's parallel axes keep; tag `reprojected`), with the planes looked up once.
-class PixelCopier {
- public:
-  PixelCopier(const Image& left, Image& right);
-  /// Right pixel (x, y) from left pixel (source_x, y).
-  void copy(int source_x, int x, int y);
-
- private:
-  int width_;
-  const float* rgb_;
-  const float* normal_;
-  const float* albedo_;
-  const float* depth_;
-  const uint32_t* prim_;
-  EyeWriter out_;
-};
 
 /// How many left pixels reproject to each right pixel, as a histogram: entry k counts the right
 /// pixels written k times (DESIGN §4.2, Lemma 1). For the counters; not part of any timed stage.

@@ -28,24 +28,6 @@ void require_eye_planes(const Image& image, const char* role) {
                                    role, name, image.plane_list()));
 }
 
-/// Read-only plane pointers of a source image.
-struct SourcePlanes {
-  const float* rgb;
-  const float* depth;
-  const float* normal;
-  const float* albedo;
-  const uint32_t* prim;
-  const uint32_t* tag;
-  explicit SourcePlanes(const Image& image)
-      : rgb(image.data_f32(planes::rgb)),
-        depth(image.data_f32(planes::depth)),
-        normal(image.data_f32(planes::normal)),
-        albedo(image.data_f32(planes::albedo)),
-        prim(image.data_u32(planes::primid)),
-        tag(image.data_u32(planes::source)) {}
-};
-
-vec3 load3(const float* plane, size_t index) { return {plane[3 * index], plane[3 * index + 1], plane[3 * index + 2]}; }
 
 }  // namespace
 
@@ -135,7 +117,7 @@ RowWarpStats row_warp(const Image& source, const MotionField& motion, const RowW
   if (options.segment < 1)
     throw InputError(fmt::format("row warp: segment length {} must be at least 1 pixel", options.segment));
 
-  const SourcePlanes src(source);
+  const EyeReader src(source);
   const float* native_depth = target.data_f32(planes::depth);
   const uint32_t* native_tag = target.data_u32(planes::source);
   EyeWriter out(target);
@@ -176,8 +158,8 @@ RowWarpStats row_warp(const Image& source, const MotionField& motion, const RowW
       // sources, and a native pixel keeps an exact tie.
       for (int x = x_begin; x < x_end; ++x) {
         const size_t i = row + x;
-        const float z = src.depth[i];
-        if (!takes_part(src.tag[i], z, options.warp_background)) continue;
+        const float z = src.depth(i);
+        if (!takes_part(src.source(i), z, options.warp_background)) continue;
         const int t = target_column(x, motion.motion[i]);
         if (t < 0 || t >= w) {
           // Counted once: by the first segment for the left side, by the last for the right.
@@ -202,8 +184,7 @@ RowWarpStats row_warp(const Image& source, const MotionField& motion, const RowW
         const int32_t x = best_x[t - s0];
         if (x < 0) continue;
         const size_t i = row + x;
-        out.copy(row + t, load3(src.rgb, i), load3(src.normal, i), load3(src.albedo, i), src.depth[i], src.prim[i],
-                 Source::reprojected);
+        out.copy(row + t, src, i, Source::reprojected);
         ++written;
       }
     }

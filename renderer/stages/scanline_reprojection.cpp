@@ -80,7 +80,8 @@ void scanline_band(const RenderScene& scene, const PixelReprojector& reprojector
   const float* depth = left.data_f32(planes::depth);
   std::vector<int32_t> source;
   std::vector<uint32_t> no_hit;
-  PixelCopier copier(left, right);
+  const EyeReader from(left);
+  EyeWriter out(right);
   for (int y = y0; y < y1; ++y) {
     reproject_row(reprojector, depth, w, y, source, counts);
     for (int x = 0; x < w; ++x) {
@@ -88,7 +89,7 @@ void scanline_band(const RenderScene& scene, const PixelReprojector& reprojector
       if (source[static_cast<size_t>(x)] == kNoSource)
         no_hit.push_back(static_cast<uint32_t>(p));
       else
-        copier.copy(source[static_cast<size_t>(x)], x, y);
+        out.copy(p, from, p - x + static_cast<size_t>(source[static_cast<size_t>(x)]), Source::reprojected);
     }
   }
   counts.reproject_seconds += since(start);
