@@ -1,11 +1,17 @@
 // Benchmark presets of `stereobench bench --preset`: the performance series of Al-Hagri's thesis
-// (Table 5) as tables of benchmark rows, each row timed side by side like a plain `bench` run.
+// (Table 5) and the quality and complexity tables of Kim's paper (Tables 2 and 3) as tables of
+// benchmark rows, each row timed side by side like a plain `bench` run.
 #pragma once
 
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "renderer/error.hpp"
 #include "renderer/parallel.hpp"
 #include "renderer/rig.hpp"
 #include "validation/benchmark.hpp"
@@ -20,7 +26,11 @@ struct PresetRow {
   int width = 0;
   int height = 0;
   double max_disparity_px = 0.0;  ///< the thesis' "interaxial distance e in pixels"
-  int lights = 0;                 ///< the scene's first `lights` lights; a scene with fewer keeps all of its own
+  /// The scene's first `lights` lights (a scene with fewer keeps all of its own); unused by Kim's
+  /// presets, which keep every light of the scene.
+  int lights = 0;
+  std::optional<double> interaxial = std::nullopt;   ///< meters; instead of max_disparity_px when set
+  std::optional<double> convergence = std::nullopt;  ///< meters; unset = the scene's (or --convergence)
 };
 
 /// One table: rows that sweep one setting while the others stay fixed.
@@ -31,20 +41,35 @@ struct PresetSeries {
   std::vector<PresetRow> rows;
 };
 
+/// What a preset measures, and so how its rows are run and printed.
+enum class PresetKind {
+  speed,       ///< median totals and speed-ups per row (Al-Hagri, Table 5)
+  quality,     ///< SSIM/PSNR of every right eye against the reference's, plus times (Kim, Table 2)
+  complexity,  ///< rendering/warping split per triangle count, memory-checked rows, crossover (Kim, Table 3)
+};
+
 /// A named set of series.
 struct BenchPreset {
   std::string name;
   std::string summary;  ///< for --help
   std::vector<PresetSeries> series;
+  PresetKind kind = PresetKind::speed;
+  std::vector<std::string> pipelines;  ///< timed unless --pipelines says otherwise; empty = preset_default_pipelines()
+  std::string baseline = "plain-rt";   ///< speed-ups against it unless --baseline says otherwise
+  /// Command-line options the preset sets itself in every row; giving one with it is an InputError.
+  std::vector<std::string> fixed_options = {"--scene", "--resolution", "--interaxial", "--max-disparity", "--lights"};
+  bool resolution_open = false;  ///< --resolution replaces the rows' image size
 };
 
-/// The presets: al-hagri-dimensions, al-hagri-interaxial, al-hagri-lights.
+/// The presets: al-hagri-dimensions, al-hagri-interaxial, al-hagri-lights, kim-focal, kim-complexity.
 [[nodiscard]] const std::vector<BenchPreset>& bench_presets();
 /// The preset of that name; InputError listing the presets otherwise.
 [[nodiscard]] const BenchPreset& find_bench_preset(const std::string& name);
-/// The pipelines a preset times unless --pipelines says otherwise: the thesis' five ray tracers
-/// (naive, ideal copy, Es-Isler, buffer-based, atomic-based) plus Adelson-Hodges reprojection.
+/// The pipelines the Al-Hagri presets time unless --pipelines says otherwise: the thesis' five ray
+/// tracers (naive, ideal copy, Es-Isler, buffer-based, atomic-based) plus Adelson-Hodges reprojection.
 [[nodiscard]] const std::vector<std::string>& preset_default_pipelines();
+/// The pipelines `preset` times unless --pipelines says otherwise.
+[[nodiscard]] const std::vector<std::string>& preset_pipelines(const BenchPreset& preset);
 /// A few lines describing every preset, for `bench --help`.
 [[nodiscard]] std::string presets_help();
 
@@ -53,12 +78,109 @@ struct PresetRun {
   const BenchPreset* preset = nullptr;
   BenchConfig config;        ///< pipelines, baseline, warm-up, repetitions, options: applied to every row
   int rows_per_series = 0;   ///< run only the first N rows of each series; 0 = all
-  RigOverrides overrides;    ///< rig settings the preset leaves open (convergence, vertical field of view)
+  /// Rig settings the preset leaves open (convergence, vertical field of view; the image size when
+  /// the preset's resolution_open).
+  RigOverrides overrides;
   std::string scenes_dir;
   std::string json_out;      ///< rewritten after every row; empty = none
 };
 
 /// Runs every series, printing one table per series (a row as soon as it is measured).
 void run_bench_preset(const PresetRun& run, const Executor& executor);
+
+// ---- Kim's tables (apps/bench_presets_kim.cpp) ----
+
+/// kim-focal: the atrium at 960x540, e = 64 mm, convergence 6 m, 2 m and 0.3 m (Kim's focal
+/// distances 6000, 2000 and 300 mm).
+[[nodiscard]] BenchPreset kim_focal_preset();
+/// kim-complexity: the `complexity` scene with 1e5, 1e6, 1e7 and 1e8 triangles at 1920x1080 (FHD).
+[[nodiscard]] BenchPreset kim_complexity_preset();
+/// Runs kim-focal: per row, every pipeline's right eye once (untimed) for SSIM/PSNR against the
+/// reference plain-raster's, then the side-by-side timing. Prints Kim's Table 2 layout and a time table.
+void run_kim_focal(const PresetRun& run, const Executor& executor);
+/// Runs kim-complexity: per row a memory check, the scene generated or loaded, the timing split
+/// into rendering and warping stages, the measured peak resident memory; then the crossover.
+void run_kim_complexity(const PresetRun& run, const Executor& executor);
+
+// The decisions of kim-complexity below are pure and defined here, inline, so that the tests use
+// them without the command-line application.
+
+/// How a pipeline stage counts in Kim's Table 3.
+enum class StageGroup {
+  rendering,  ///< rasterization and shading: "redirect", "*_gbuffer", "*_shading", "*_trace"
+  warping,    ///< reprojection and its repairs: warps, motion, crack and hole filling, background
+  other,      ///< a stage of neither kind (listed separately, never folded into either)
+};
+[[nodiscard]] inline StageGroup stage_group(const std::string& stage) {
+  const auto ends_with = [&stage](const std::string& suffix) {
+    return stage.size() >= suffix.size() && stage.compare(stage.size() - suffix.size(), suffix.size(), suffix) == 0;
+  };
+  if (stage == "redirect" || ends_with("_gbuffer") || ends_with("_shading") || ends_with("_trace"))
+    return StageGroup::rendering;
+  for (const char* w : {"motion", "warp", "warp_depth", "warp_color", "backward_warp", "row_warp", "reproject",
+                        "crack_fill", "hole_fill", "background"})
+    if (stage == w) return StageGroup::warping;
+  return StageGroup::other;
+}
+
+/// Share of MemAvailable a row may plan to use; the rest is left to the system and other processes.
+inline constexpr double kMemoryUsableShare = 0.9;
+
+/// Whether a row that needs `needed_bytes` more resident memory fits into `available_bytes`
+/// (MemAvailable): needed <= kMemoryUsableShare * available.
+[[nodiscard]] inline bool memory_fits(uint64_t needed_bytes, uint64_t available_bytes) {
+  return static_cast<double>(needed_bytes) <= kMemoryUsableShare * static_cast<double>(available_bytes);
+}
+
+/// The peak resident memory a measured row reached.
+struct MeasuredPeak {
+  double triangles = 0.0;
+  uint64_t peak_bytes = 0;
+};
+
+/// Estimated peak resident bytes of a row with `triangles`, from the rows measured so far (in any
+/// order) and the resident bytes `base_bytes` before the first row. With two or more rows: the
+/// line through the two largest, its slope at least that of the largest row's share above the base
+/// divided by ten (so noise cannot make it flat); with one: proportional to its share above the
+/// base; with none: base + prior_fixed_bytes + prior_bytes_per_triangle * triangles.
+[[nodiscard]] inline uint64_t estimate_peak_bytes(std::vector<MeasuredPeak> measured, uint64_t base_bytes,
+                                                  double triangles, double prior_fixed_bytes,
+                                                  double prior_bytes_per_triangle) {
+  const double base = static_cast<double>(base_bytes);
+  double estimate = base + prior_fixed_bytes + prior_bytes_per_triangle * triangles;
+  if (!measured.empty()) {
+    std::sort(measured.begin(), measured.end(),
+              [](const MeasuredPeak& a, const MeasuredPeak& b) { return a.triangles < b.triangles; });
+    const MeasuredPeak& top = measured.back();
+    const double above = std::max(0.0, static_cast<double>(top.peak_bytes) - base);
+    const double proportional = top.triangles > 0.0 ? above / top.triangles : 0.0;
+    if (measured.size() == 1) {
+      estimate = base + proportional * triangles;
+    } else {
+      const MeasuredPeak& next = measured[measured.size() - 2];
+      const double dn = top.triangles - next.triangles;
+      double slope = dn > 0.0 ? (static_cast<double>(top.peak_bytes) - static_cast<double>(next.peak_bytes)) / dn : 0.0;
+      slope = std::max(slope, 0.1 * proportional);
+      estimate = static_cast<double>(top.peak_bytes) + slope * (triangles - top.triangles);
+    }
+  }
+  return static_cast<uint64_t>(std::max(estimate, base));
+}
+
+/// Index of the crossover row: the first row from which `method_ms` is below `baseline_ms` in that
+/// row and every later one (rows in increasing complexity); nullopt when there is none. InputError
+/// for vectors of different sizes.
+[[nodiscard]] inline std::optional<size_t> crossover_row(const std::vector<double>& baseline_ms,
+                                                         const std::vector<double>& method_ms) {
+  if (baseline_ms.size() != method_ms.size())
+    throw InputError("crossover_row: " + std::to_string(baseline_ms.size()) + " baseline times but " +
+                     std::to_string(method_ms.size()) + " method times; pass one of each per row");
+  std::optional<size_t> first;
+  for (size_t i = baseline_ms.size(); i-- > 0;) {
+    if (!(method_ms[i] < baseline_ms[i])) break;
+    first = i;
+  }
+  return first;
+}
 
 }  // namespace sb::cli

@@ -65,17 +65,6 @@ CLI::Option* add_lights_option(CLI::App& app, std::optional<int>& lights) {
                         "(default: all)");
 }
 
-void keep_first_lights(Scene& scene, int count) {
-  const size_t available = scene.lights.size();
-  if (available == 0)
-    throw InputError(fmt::format("--lights {}: scene '{}' ({}) has 0 lights; drop --lights", count, scene.name,
-                                 scene.path));
-  if (count < 1 || static_cast<size_t>(count) > available)
-    throw InputError(fmt::format("--lights {}: scene '{}' ({}) has {} light{}; give 1..{}", count, scene.name,
-                                 scene.path, available, available == 1 ? "" : "s", available));
-  scene.lights.resize(static_cast<size_t>(count));
-}
-
 std::string describe_lights(size_t used, size_t in_file) {
   if (used == in_file) return fmt::format("{} light{}", used, used == 1 ? "" : "s");
   return fmt::format("first {} of {} lights", used, in_file);

@@ -29,13 +29,8 @@ struct RigCli {
 /// --scenes-dir: where built-in scenes are generated and cached.
 void add_scenes_dir_option(CLI::App& app, std::string& dir);
 
-/// --lights N: render the scene with its first N lights only (see keep_first_lights).
+/// --lights N: render the scene with its first N lights only (see scenes::load_scene).
 CLI::Option* add_lights_option(CLI::App& app, std::optional<int>& lights);
-
-/// Keeps the scene's first `count` lights in file order and drops the rest; call it after loading
-/// and before building the RenderScene. InputError naming the scene, the count and the scene's
-/// number of lights when `count` < 1 or more than the scene has.
-void keep_first_lights(Scene& scene, int count);
 
 /// "5 lights", or "first 3 of 5 lights" when some were dropped.
 [[nodiscard]] std::string describe_lights(size_t used, size_t in_file);

@@ -16,7 +16,6 @@
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
-#include "renderer/io/gltf_loader.hpp"
 #include "renderer/io/render_output.hpp"
 #include "scenes/catalog.hpp"
 #include "validation/benchmark.hpp"
@@ -84,7 +83,7 @@ void run_preset_command(const BenchArgs& a) {
   if (a.preset_rows < 0)
     throw InputError(fmt::format("--preset-rows {} must not be negative (0 = every row)", a.preset_rows));
   run.overrides = a.rig.overrides();
-  run.config = bench_config(a, preset_default_pipelines());
+  run.config = bench_config(a, preset_pipelines(*run.preset));
   run.rows_per_series = a.preset_rows;
   run.scenes_dir = a.scenes_dir;
   run.json_out = a.json_out;
@@ -98,9 +97,9 @@ void run_bench_command(const BenchArgs& a) {
   for (const Pipeline* p : pipelines()) all.push_back(p->info().name);
   const BenchConfig config = bench_config(a, all);
   const Executor executor(checked_threads(a.threads));
-  Scene scene = io::load_gltf(scenes::resolve_scene(a.scene, a.scenes_dir));
-  const size_t lights_in_file = scene.lights.size();
-  if (a.lights) keep_first_lights(scene, *a.lights);
+  const scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
+  const Scene& scene = loaded.scene;
+  const size_t lights_in_file = loaded.lights_in_file;
   const StereoRig rig = resolve_rig(scene, overrides);
   const RenderScene prepared(scene);
   fmt::print("scene {} ({} triangles, {}), {}, {} threads, {} warm-up + {} repetitions\n", scene.name,
@@ -157,7 +156,7 @@ void register_bench_command(CLI::App& root) {
   b->add_option("--pipelines,-p", a->pipelines,
                 "Pipelines to time, comma-separated (default: all registered; with --preset, the preset's)");
   CLI::Option* baseline = b->add_option("--baseline,-b", a->baseline,
-                                        "Pipeline the speed-ups are measured against (with --preset: plain-rt)")
+                                        "Pipeline the speed-ups are measured against (with --preset: the preset's)")
                               ->capture_default_str();
   b->add_option("--repetitions,-n", a->repetitions, "Timed repetitions per pipeline")->capture_default_str();
   b->add_option("--warmup,-w", a->warmup, "Untimed warm-up runs per pipeline")->capture_default_str();
@@ -166,7 +165,8 @@ void register_bench_command(CLI::App& root) {
   b->add_option("--json", a->json_out, "Also write the results (with raw samples) to this JSON file");
   add_scenes_dir_option(*b, a->scenes_dir);
   add_lights_option(*b, a->lights);
-  CLI::Option* preset = b->add_option("--preset", a->preset, "Run a benchmark series of Al-Hagri's thesis (see below)");
+  CLI::Option* preset =
+      b->add_option("--preset", a->preset, "Run a benchmark table of Al-Hagri's thesis or Kim's paper (see below)");
   CLI::Option* preset_rows =
       b->add_option("--preset-rows", a->preset_rows, "With --preset: only the first K rows of each series (0 = all)")
           ->capture_default_str();
@@ -178,14 +178,16 @@ void register_bench_command(CLI::App& root) {
       run_bench_command(*a);
       return;
     }
-    // A preset sets the scene, image size, disparity and light count of each row itself.
-    for (const char* name : {"--scene", "--resolution", "--interaxial", "--max-disparity", "--lights"})
+    // A preset sets the scene, rig and light count of each row itself, as far as it says.
+    const BenchPreset& chosen = find_bench_preset(a->preset);
+    std::string fixed;
+    for (const std::string& o : chosen.fixed_options) fixed += (fixed.empty() ? "" : ", ") + o;
+    for (const std::string& name : chosen.fixed_options)
       if (b->count(name) > 0)
-        throw InputError(fmt::format("--preset {} sets the scene, image size, disparity and lights of every row; "
-                                     "drop {} (or run without --preset)",
-                                     a->preset, name));
+        throw InputError(fmt::format("--preset {} sets {} of every row itself; drop {} (or run without --preset)",
+                                     a->preset, fixed, name));
     BenchArgs args = *a;
-    if (baseline->count() == 0) args.baseline = "plain-rt";
+    if (baseline->count() == 0) args.baseline = chosen.baseline;
     run_preset_command(args);
   });
 }

@@ -9,7 +9,6 @@
 
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
-#include "renderer/io/gltf_loader.hpp"
 #include "renderer/io/render_output.hpp"
 #include "renderer/pipeline.hpp"
 #include "renderer/stages/disocclusion.hpp"
@@ -50,11 +49,9 @@ void run_render(const RenderArgs& a) {
   const Pipeline& pipeline = find_pipeline(a.pipeline);
   const PipelineOptions options(pipeline.info(), parse_key_values(a.options, "--option"));
   const Executor executor(checked_threads(a.threads));
-  const fs::path path = scenes::resolve_scene(a.scene, a.scenes_dir);
-  Scene scene = io::load_gltf(path);
-  for (const std::string& w : scene.warnings) fmt::print(stderr, "warning: {}\n", w);
-  const size_t lights_in_file = scene.lights.size();
-  if (a.lights) keep_first_lights(scene, *a.lights);
+  const scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
+  const Scene& scene = loaded.scene;
+  const size_t lights_in_file = loaded.lights_in_file;
   const StereoRig rig = resolve_rig(scene, overrides);
   const RenderScene prepared(scene);
   const StereoResult result = pipeline.render(prepared, rig, options, RenderContext{executor});

@@ -1,9 +1,17 @@
 // Registration of the stereobench subcommands; each lives in its own apps/cmd_*.cpp.
 #pragma once
 
+#include <string>
+
 #include <CLI/CLI.hpp>
 
 namespace sb::cli {
+
+/// A verdict a subcommand ends with (gate warning 1, failure 2, missing tool 4), thrown from its
+/// callback once everything it writes is complete; main() returns the code.
+struct VerdictExit {
+  int code = 0;
+};
 
 /// `stereobench scenes list|generate|info`.
 void register_scenes_command(CLI::App& root);
@@ -11,5 +19,13 @@ void register_scenes_command(CLI::App& root);
 void register_render_command(CLI::App& root);
 /// `stereobench bench`.
 void register_bench_command(CLI::App& root);
+/// `stereobench compare A B`.
+void register_compare_command(CLI::App& root);
+
+/// `stereobench validate`.
+void register_validate_command(CLI::App& root);
+
+/// `stereobench reference generate|verify|update|list`; `command_line` is recorded in provenance.
+void register_reference_command(CLI::App& root, const std::string& command_line);
 
 }  // namespace sb::cli

@@ -2,6 +2,7 @@
 #include <climits>
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include <malloc.h>
 
@@ -26,6 +27,24 @@ void keep_freed_memory() {
   mallopt(M_TRIM_THRESHOLD, INT_MAX);
 }
 
+/// The command line as typed, arguments with spaces or quotes single-quoted (for provenance).
+std::string command_line(int argc, char** argv) {
+  std::string out;
+  for (int i = 0; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (i > 0) out += ' ';
+    const bool plain = !arg.empty() && arg.find_first_of(" \t'\"$\\") == std::string::npos;
+    if (plain) {
+      out += arg;
+      continue;
+    }
+    out += '\'';
+    for (char c : arg) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    out += '\'';
+  }
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -42,9 +61,14 @@ int main(int argc, char** argv) {
   sb::cli::register_scenes_command(app);
   sb::cli::register_render_command(app);
   sb::cli::register_bench_command(app);
+  sb::cli::register_validate_command(app);
+  sb::cli::register_compare_command(app);
+  sb::cli::register_reference_command(app, command_line(argc, argv));
 
   try {
     app.parse(argc, argv);
+  } catch (const sb::cli::VerdictExit& verdict) {
+    return verdict.code;
   } catch (const CLI::Success& e) {
     return app.exit(e);  // --help, --version
   } catch (const CLI::ParseError& e) {

@@ -18,7 +18,7 @@ root=$(dirname "$here")
 core=(cmake make g++ pkg-config git ca-certificates
       libembree-dev libtbb-dev
       libopenimageio-dev openimageio-tools libopenexr-dev
-      libopencv-dev
+      libopencv-dev libssl-dev
       libtinygltf-dev nlohmann-json3-dev libstb-dev
       libcli11-dev libfmt-dev libtomlplusplus-dev libglm-dev
       libgtest-dev libgmock-dev libbenchmark-dev)

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main job: installs what is needed, builds stereobench, generates the built-in scenes,
-# renders the default scene with every registered pipeline (images under out/render) and prints
-# a side-by-side timing table.
+# validates every registered pipeline on the default scene against the built-in ground truth
+# (records and images under out/validate, a table on the terminal) and prints a side-by-side
+# timing table.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
@@ -15,9 +16,9 @@ sb=./build/apps/stereobench
 $sb scenes generate --all --out out/scenes
 scene=bistro
 resolution=960x540
-for p in $($sb pipelines | awk '/^[a-z]/ {print $1}'); do
-  $sb render --scene "$scene" --pipeline "$p" --resolution "$resolution" --out out/render >/dev/null
-  echo "rendered $p -> out/render/${scene}_${p}_*.png"
-done
+# Every registered pipeline's right eye against the built-in ground truth (full ray tracing):
+# metrics, hole statistics, images and one JSON record per pipeline under out/validate.
+$sb validate --scene "$scene" --resolution "$resolution" --pipelines all --truth full --out out/validate
+# Their timings side by side, medians over repetitions, speed-ups against plain-raster.
 $sb bench --scene "$scene" --resolution "$resolution" --baseline plain-raster --repetitions 3 --warmup 1 \
-  --json out/render/bench.json
+  --json out/validate/bench.json

@@ -7,7 +7,8 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
 jobs=$(nproc)
 
-bash ci/install-deps.sh validator
+# The ground-truth provider tests run Blender and POV-Ray, the metric tests scikit-image.
+bash ci/install-deps.sh validator blender povray skimage
 
 echo "== build (Release, warnings as errors)"
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DSB_WERROR=ON >/dev/null

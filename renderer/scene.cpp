@@ -1,6 +1,10 @@
 // Scene summaries.
 #include "renderer/scene.hpp"
 
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
+
 namespace sb {
 
 size_t Scene::triangle_count() const {
@@ -20,6 +24,17 @@ Bounds3 Scene::bounds() const {
   for (const Mesh& m : meshes)
     for (const vec3& p : m.positions) b.extend(p);
   return b;
+}
+
+void keep_first_lights(Scene& scene, int count) {
+  const size_t available = scene.lights.size();
+  if (available == 0)
+    throw InputError(fmt::format("--lights {}: scene '{}' ({}) has 0 lights; drop --lights", count, scene.name,
+                                 scene.path));
+  if (count < 1 || static_cast<size_t>(count) > available)
+    throw InputError(fmt::format("--lights {}: scene '{}' ({}) has {} light{}; give 1..{}", count, scene.name,
+                                 scene.path, available, available == 1 ? "" : "s", available));
+  scene.lights.resize(static_cast<size_t>(count));
 }
 
 }  // namespace sb

@@ -97,4 +97,9 @@ struct Scene {
   [[nodiscard]] Bounds3 bounds() const;
 };
 
+/// Keeps the scene's first `count` lights in file order and drops the rest; call it after loading
+/// and before building the RenderScene. InputError naming the scene, the count and the scene's
+/// number of lights when `count` < 1 or more than the scene has.
+void keep_first_lights(Scene& scene, int count);
+
 }  // namespace sb

@@ -35,7 +35,11 @@ SurfacePoint surface_at(const RenderScene& scene, uint32_t prim, vec2 bary, cons
     vec3 ns = b0 * mesh.normals[i0] + b1 * mesh.normals[i1] + b2 * mesh.normals[i2];
     const float nl = glm::length(ns);
     ns = nl > 0.0f ? ns / nl : ng;
-    if (glm::dot(ns, ng) < 0.0f) ns = -ns;  // shading normal on the viewer's side
+    // The shading normal turned to the viewer. Near silhouettes of a smooth mesh the interpolated
+    // normal can face away from the eye while the triangle faces it; POV-Ray turns such a normal
+    // to the viewer and cannot be told otherwise, and the Blender export does the same with a
+    // node (docs/truth_blender.md), so all three ground truths shade these pixels alike.
+    if (glm::dot(ns, to_eye) < 0.0f) ns = -ns;
     p.shading_normal = ns;
   } else {
     p.shading_normal = ng;

@@ -9,6 +9,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/io/gltf_loader.hpp"
 #include "sb_scenes_hash.hpp"
 #include "sb_version.hpp"
 #include "scenes/generators.hpp"
@@ -102,6 +103,16 @@ fs::path resolve_builtin(const std::string& name, const std::map<std::string, do
   const GenerateResult r = generate(info.name, options, path);
   io::write_text_atomically(stamp_path(r.path), stamp);
   return r.path;
+}
+
+LoadedScene load_scene(const std::string& spec, const std::filesystem::path& scenes_dir, std::optional<int> lights) {
+  LoadedScene out;
+  out.file = resolve_scene(spec, scenes_dir);
+  out.scene = io::load_gltf(out.file);
+  for (const std::string& w : out.scene.warnings) fmt::print(stderr, "warning: {}\n", w);
+  out.lights_in_file = out.scene.lights.size();
+  if (lights) keep_first_lights(out.scene, *lights);
+  return out;
 }
 
 }  // namespace sb::scenes

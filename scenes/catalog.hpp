@@ -4,8 +4,10 @@
 
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 
+#include "renderer/scene.hpp"
 #include "scenes/generators.hpp"
 
 namespace sb::scenes {
@@ -30,5 +32,17 @@ GenerateResult generate_builtin(const std::string& name, const std::filesystem::
 [[nodiscard]] std::filesystem::path resolve_builtin(const std::string& name,
                                                     const std::map<std::string, double>& params,
                                                     const std::filesystem::path& scenes_dir);
+
+/// A scene loaded for rendering, with what the command line chose of it.
+struct LoadedScene {
+  Scene scene;
+  std::filesystem::path file;  ///< the glTF file it came from
+  size_t lights_in_file = 0;   ///< lights before a --lights selection
+};
+
+/// resolve_scene + load_gltf, the loader's warnings printed to stderr, and with `lights` the
+/// scene's first N lights kept (keep_first_lights).
+[[nodiscard]] LoadedScene load_scene(const std::string& spec, const std::filesystem::path& scenes_dir,
+                                     std::optional<int> lights = std::nullopt);
 
 }  // namespace sb::scenes

@@ -1,11 +1,15 @@
 // `stereobench bench --preset` and `--lights`: each preset runs its first rows and prints a table per
 // series, the JSON holds every row, and bad presets or light counts exit with code 3 and say why.
-// Timings are never asserted, only that they were measured.
+// Timings are never asserted, only that they were measured. Kim's presets add image quality
+// against the reference and the memory check, crossover and stage grouping of the complexity table.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 #include <nlohmann/json.hpp>
+
+#include "apps/bench_presets.hpp"
 
 #include "support/run_cli.hpp"
 #include "support/scratch_dir.hpp"
@@ -103,7 +107,8 @@ TEST(BenchPreset, HelpExplainsThePresets) {
   const CliRun h = test::run_cli("bench --help");
   EXPECT_EQ(h.code, 0);
   for (const char* part : {"--preset", "--preset-rows", "--lights", "al-hagri-dimensions", "al-hagri-interaxial",
-                           "al-hagri-lights", "Table 5"})
+                           "al-hagri-lights", "Table 5", "kim-focal", "kim-complexity", "Table 2", "Table 3",
+                           "--resolution replaces the image size"})
     EXPECT_NE(h.out.find(part), std::string::npos) << part << "\n" << h.out;
 }
 
@@ -120,6 +125,12 @@ TEST(BenchPreset, BadPresetsAndLightCountsExitWith3AndSayWhy) {
       {"bench --preset al-hagri-interaxial --interaxial 0.1" + quick, {"drop --interaxial"}},
       {"bench --preset al-hagri-dimensions --max-disparity 20" + quick, {"drop --max-disparity"}},
       {"bench --preset al-hagri-lights --lights 3" + quick, {"drop --lights"}},
+      {"bench --preset kim-focal --convergence 2 -n 1 -w 0" + sd, {"--preset kim-focal", "drop --convergence"}},
+      {"bench --preset kim-focal --scene atrium -n 1 -w 0" + sd, {"drop --scene"}},
+      {"bench --preset kim-complexity --interaxial 0.1 -n 1 -w 0" + sd, {"drop --interaxial"}},
+      {"bench --preset kim-focal --pipelines bidir-warp --baseline bidir-warp -n 1 -w 0" + sd,
+       {"kim-focal compares every right eye with plain-raster's", "add plain-raster to --pipelines"}},
+      {"bench --preset kim-complexity --pipelines plain-raster -n 1 -w 0" + sd, {"add bidir-warp to --pipelines"}},
       {"bench --preset-rows 1 --scene box-wall" + quick, {"--preset-rows needs --preset"}},
       {"bench --preset al-hagri-lights --pipelines plain-rt,warp-drive" + sd, {"unknown pipeline 'warp-drive'"}},
       {"bench --scene box-wall --resolution 32x18 --lights 0" + quick, {"--lights 0", "'box-wall'", "has 1 light", "1..1"}},
@@ -133,7 +144,13 @@ TEST(BenchPreset, BadPresetsAndLightCountsExitWith3AndSayWhy) {
     for (const std::string& e : c.expect)
       EXPECT_NE(r.out.find(e), std::string::npos) << c.args << "\nexpected: " << e << "\ngot: " << r.out;
   }
-  EXPECT_FALSE(std::filesystem::exists(dir / "scenes" / "dragon_lights-10.glb"));  // nothing generated on bad input
+  // Nothing of a preset is generated on bad input (box-wall is, by the --lights cases).
+  EXPECT_FALSE(std::filesystem::exists(dir / "scenes" / "dragon_lights-10.glb"));
+  if (std::filesystem::exists(dir / "scenes"))
+    for (const auto& f : std::filesystem::directory_iterator(dir / "scenes")) {
+      const std::string name = f.path().filename().string();
+      EXPECT_TRUE(name.rfind("atrium", 0) != 0 && name.rfind("complexity", 0) != 0) << name;
+    }
 }
 
 TEST(BenchLights, TheLightCountUsedIsPrintedAndRecorded) {
@@ -157,6 +174,145 @@ TEST(BenchLights, TheLightCountUsedIsPrintedAndRecorded) {
   const json s = json::parse(test::read_text(dir / "complexity_plain-rt_stats.json"));
   EXPECT_EQ(s.at("scene").at("lights").get<int>(), 1);
   EXPECT_GT(s.at("counters").at("shadow_rays").get<uint64_t>(), 0u);
+}
+
+// ---- Kim's presets ----
+
+TEST(BenchPresetKim, FocalComparesEveryMethodWithPlainRasterAtThreeDistances) {
+  test::ScratchDir dir("kimfocal");
+  const CliRun r = test::run_cli("bench --preset kim-focal --resolution 160x90 --repetitions 1 --warmup 0 --scenes-dir '" +
+                                 (dir / "scenes").string() + "' --json '" + (dir / "focal.json").string() + "'");
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (const char* part : {"atrium by focal distance", "Kim, Table 2", "DF mm", "6000", "2000", "300", "bidir-warp",
+                           "bw-warp", "fw-warp", "bidir-warp-rt", "plain-raster ms", "speed-up", "160x90"})
+    EXPECT_NE(r.out.find(part), std::string::npos) << part << "\n" << r.out;
+
+  const json j = json::parse(test::read_text(dir / "focal.json"));
+  EXPECT_TRUE(j.at("complete").get<bool>());
+  EXPECT_EQ(j.at("reference"), "plain-raster");
+  EXPECT_EQ(j.at("baseline"), "plain-raster");
+  const json& rows = j.at("rows");
+  ASSERT_EQ(rows.size(), 3u);
+  const double distances[] = {6.0, 2.0, 0.3};
+  for (size_t i = 0; i < 3; ++i) {
+    const json& row = rows[i];
+    SCOPED_TRACE(row.at("value").get<std::string>());
+    EXPECT_EQ(row.at("scene").at("name"), "atrium");
+    EXPECT_NEAR(row.at("rig").at("convergence_m").get<double>(), distances[i], 1e-12);
+    EXPECT_NEAR(row.at("rig").at("interaxial_m").get<double>(), 0.064, 1e-12);
+    EXPECT_EQ(row.at("rig").at("width").get<int>(), 160);
+    EXPECT_EQ(row.at("rig").at("height").get<int>(), 90);
+    for (const char* p : {"bidir-warp", "bw-warp", "fw-warp", "bidir-warp-rt"}) {
+      const json& q = row.at("quality").at(p);
+      const double ssim = q.at("ssim").get<double>();
+      EXPECT_GT(ssim, 0.0) << p;
+      EXPECT_LE(ssim, 1.0) << p;
+      // Every method reprojects some pixels wrongly at 160x90: PSNR is finite (a number, not "inf").
+      EXPECT_GT(q.at("psnr").get<double>(), 0.0) << p;
+      EXPECT_GT(row.at("median_total_ms").at(p).get<double>(), 0.0) << p;
+      EXPECT_GT(row.at("speedup_median").at(p).get<double>(), 0.0) << p;
+    }
+    EXPECT_FALSE(row.at("quality").contains("plain-raster"));  // the reference itself is not a method
+    EXPECT_GT(row.at("median_total_ms").at("plain-raster").get<double>(), 0.0);
+    EXPECT_EQ(row.at("speedup_median").at("plain-raster").get<double>(), 1.0);
+  }
+  // Kim's finding at the nearest focal distance (300 mm): bidirectional warping keeps the quality
+  // that single-view backward and forward warping lose. Measured at 160x90: SSIM 0.908 against
+  // 0.769 (bw-warp) and 0.778 (fw-warp); Kim reports 0.995 against 0.779 and 0.781.
+  const json& near = rows[2].at("quality");
+  EXPECT_GT(near.at("bidir-warp").at("ssim").get<double>(), near.at("bw-warp").at("ssim").get<double>());
+  EXPECT_GT(near.at("bidir-warp").at("ssim").get<double>(), near.at("fw-warp").at("ssim").get<double>());
+}
+
+TEST(BenchPresetKim, ComplexityFirstRowSplitsRenderingAndWarping) {
+  test::ScratchDir dir("kimcomplexity");
+  const CliRun r = test::run_cli("bench --preset kim-complexity --preset-rows 1 --resolution 160x90 --repetitions 1 "
+                                 "--warmup 0 --scenes-dir '" + (dir / "scenes").string() + "' --json '" +
+                                 (dir / "complexity.json").string() + "'");
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (const char* part : {"complexity by triangle count", "rendering ms", "warping ms", "peak MiB", "1e5 (",
+                           "plain-raster", "bidir-warp", "crossover:", "MemAvailable"})
+    EXPECT_NE(r.out.find(part), std::string::npos) << part << "\n" << r.out;
+  EXPECT_EQ(r.out.find("\n1e6 ("), std::string::npos) << r.out;  // --preset-rows 1: the 1e5 row only
+
+  const json j = json::parse(test::read_text(dir / "complexity.json"));
+  EXPECT_TRUE(j.at("complete").get<bool>());
+  ASSERT_EQ(j.at("rows").size(), 1u);
+  const json& row = j.at("rows")[0];
+  EXPECT_FALSE(row.at("skipped").get<bool>());
+  // The generator meets N within 1 % (scenes/complexity.cpp).
+  EXPECT_NEAR(row.at("scene").at("triangles").get<double>(), 1e5, 1e3);
+  EXPECT_EQ(row.at("rig").at("width").get<int>(), 160);
+  EXPECT_NEAR(row.at("rig").at("interaxial_m").get<double>(), 0.064, 1e-12);
+  EXPECT_GT(row.at("memory").at("peak_bytes").get<double>(), 0.0);
+  const json& groups = row.at("stage_groups");
+  for (const char* p : {"plain-raster", "bidir-warp"}) {
+    SCOPED_TRACE(p);
+    const json& g = groups.at(p);
+    EXPECT_GT(g.at("rendering_ms").get<double>(), 0.0);
+    EXPECT_EQ(g.at("other_ms").get<double>(), 0.0);
+    EXPECT_TRUE(g.at("other_stages").empty());
+    // One repetition: the medians are that repetition's sums, which add up to its total.
+    EXPECT_NEAR(g.at("rendering_ms").get<double>() + g.at("warping_ms").get<double>(), g.at("total_ms").get<double>(),
+                1e-9 * g.at("total_ms").get<double>());
+  }
+  EXPECT_EQ(groups.at("plain-raster").at("warping_ms").get<double>(), 0.0);  // 2-pass: no warp stage
+  EXPECT_GT(groups.at("bidir-warp").at("warping_ms").get<double>(), 0.0);
+  // The crossover follows the measured totals of the one row.
+  const bool faster = groups.at("bidir-warp").at("total_ms").get<double>() < groups.at("plain-raster").at("total_ms").get<double>();
+  const json& cross = j.at("crossover");
+  if (faster) {
+    EXPECT_EQ(cross.at("value"), "1e5");
+    EXPECT_NE(r.out.find("from 1e5 triangles on"), std::string::npos) << r.out;
+  } else {
+    EXPECT_TRUE(cross.at("value").is_null());
+    EXPECT_NE(r.out.find("none in the measured range (1e5)"), std::string::npos) << r.out;
+  }
+}
+
+TEST(BenchPresetKim, MemoryCheckRunsWhatFitsInNinetyPercentOfMemAvailable) {
+  constexpr uint64_t GiB = uint64_t{1} << 30;
+  EXPECT_TRUE(cli::memory_fits(0, 0));
+  EXPECT_TRUE(cli::memory_fits(9 * GiB, 10 * GiB));  // exactly the usable share
+  EXPECT_FALSE(cli::memory_fits(9 * GiB + 1, 10 * GiB));
+  EXPECT_FALSE(cli::memory_fits(1, 0));
+  EXPECT_FALSE(cli::memory_fits(30 * GiB, 22 * GiB));  // a 1e8 row as extrapolated on a 24 GiB machine
+}
+
+TEST(BenchPresetKim, PeakEstimateExtrapolatesFromTheLargestMeasuredRows) {
+  const uint64_t base = 100;
+  // No row measured: the prior.
+  EXPECT_EQ(cli::estimate_peak_bytes({}, base, 1e5, 1000.0, 2.0), 100u + 1000u + 200000u);
+  // One row: proportional to its share above the base (here 10 bytes per triangle).
+  EXPECT_EQ(cli::estimate_peak_bytes({{1e3, 10100}}, base, 1e4, 1000.0, 2.0), 100u + 100000u);
+  // Two or more rows (any order): the line through the two largest, 5 bytes per triangle from 1e4.
+  EXPECT_EQ(cli::estimate_peak_bytes({{1e4, 60100}, {1e2, 5000}, {1e3, 15100}}, base, 1e5, 0.0, 0.0),
+            60100u + 5u * 90000u);
+  // A flat or falling line is held at a tenth of the proportional rate (noise must not make a
+  // larger row look free): (60100 - 100) / 1e4 / 10 = 0.6 bytes per triangle.
+  EXPECT_EQ(cli::estimate_peak_bytes({{1e3, 70000}, {1e4, 60100}}, base, 1e5, 0.0, 0.0), 60100u + 54000u);
+  // Never below the base.
+  EXPECT_EQ(cli::estimate_peak_bytes({{1e3, 50}}, base, 1e4, 0.0, 0.0), base);
+}
+
+TEST(BenchPresetKim, CrossoverIsWhereTheMethodStaysFaster) {
+  EXPECT_EQ(cli::crossover_row({10, 20, 30}, {12, 19, 25}), std::optional<size_t>(1));
+  EXPECT_EQ(cli::crossover_row({10, 20, 30}, {9, 19, 25}), std::optional<size_t>(0));
+  EXPECT_EQ(cli::crossover_row({10, 20, 30}, {9, 21, 25}), std::optional<size_t>(2));  // must stay faster
+  EXPECT_EQ(cli::crossover_row({10, 20, 30}, {9, 19, 30}), std::nullopt);  // equal is not faster
+  EXPECT_EQ(cli::crossover_row({}, {}), std::nullopt);
+  EXPECT_THROW((void)cli::crossover_row({1, 2}, {1}), InputError);
+}
+
+TEST(BenchPresetKim, StagesGroupAsRenderingOrWarping) {
+  using cli::StageGroup;
+  // The stages plain-raster, bidir-warp, bidir-warp-rt, fw-warp and bw-warp report.
+  for (const char* s : {"redirect", "left_gbuffer", "left_shading", "right_gbuffer", "right_shading", "left_trace"})
+    EXPECT_EQ(cli::stage_group(s), StageGroup::rendering) << s;
+  for (const char* s : {"motion", "warp", "crack_fill", "background", "hole_fill", "warp_depth", "warp_color",
+                        "backward_warp"})
+    EXPECT_EQ(cli::stage_group(s), StageGroup::warping) << s;
+  for (const char* s : {"allocate", "scanlines", "shading"}) EXPECT_EQ(cli::stage_group(s), StageGroup::other) << s;
 }
 
 }  // namespace

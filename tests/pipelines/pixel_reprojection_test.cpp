@@ -78,13 +78,16 @@ INSTANTIATE_TEST_SUITE_P(AnalyticScenes, PairAgreement, ::testing::ValuesIn(test
 
 /// The right eye's PSNR against plain-rt that a scene must reach at 600x600, e = 15 px. The aim is
 /// 38 dB; measured below it:
-/// - dragon 36.48 dB (scan-line pair) and 36.72 dB (parallel pair); spheres 32.35 and 32.77 dB. A
+/// - dragon 36.32 dB (scan-line pair) and 36.56 dB (parallel pair); spheres 31.79 and 32.17 dB. A
 ///   reprojected pixel carries the colour of a left pixel centre that lands up to half a pixel from
 ///   the right pixel centre (the thesis rounds x, §2.2.2): on the dragon's scales and the spheres'
 ///   facets and shadow edges that is another surface sample. And a reprojection that lands just
 ///   past a silhouette is not caught by the restricted ray, which only looks for occluders in front.
 /// - With confirm=true (a second short ray requiring the surface to be there; not in the thesis):
-///   37.94 dB on dragon, 37.58 dB on spheres.
+///   37.80 dB on dragon, 35.99 dB on spheres.
+/// - Spheres lost 0.6 dB (1.6 dB confirmed), dragon 0.15 dB, when the shading normal was turned to the viewer
+///   (renderer/shading.cpp, so that Blender and POV-Ray shade like us): a silhouette pixel of a
+///   smooth sphere can be shaded differently by the two eyes, and the reprojection keeps the left's.
 struct PsnrFloor {
   double scanline;
   double parallel;
@@ -92,7 +95,7 @@ struct PsnrFloor {
 };
 
 PsnrFloor psnr_floor(const std::string& scene) {
-  return scene == "dragon" ? PsnrFloor{36.2, 36.5, 37.7} : PsnrFloor{32.1, 32.5, 37.3};
+  return scene == "dragon" ? PsnrFloor{36.0, 36.3, 37.5} : PsnrFloor{31.5, 31.9, 35.7};
 }
 
 class AgainstPlainRt : public ::testing::TestWithParam<std::string> {};

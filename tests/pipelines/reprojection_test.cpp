@@ -35,14 +35,17 @@ struct Floors {
 /// - PSNR and SSIM: most of the remaining error sits in reprojected pixels on hard radiance edges
 ///   (shadow boundaries, texture detail, fluting, silhouettes): the bilinear lookup into the
 ///   point-sampled left eye blends the two sides where plain-rt's own sample falls on one.
+/// - Since the shading normal is turned to the viewer (renderer/shading.cpp, so that Blender and
+///   POV-Ray shade like us), a silhouette pixel of a smooth mesh can be shaded differently by the
+///   two eyes; that cost 0.4 dB on spheres, 0.5 dB on complexity, 0.15-0.35 dB elsewhere.
 Floors floors(const std::string& scene) {
   static const std::map<std::string, Floors> measured{
-      {"spheres", {0.998, 38.5, 0.99}},     // 0.9989, 38.88 dB, 0.9926
-      {"atrium", {0.981, 37.0, 0.984}},     // 0.9821, 37.27 dB, 0.9846
-      {"bistro", {0.992, 37.0, 0.988}},     // 0.9932, 37.38 dB, 0.9888
-      {"temple", {0.974, 34.3, 0.985}},     // 0.9746, 34.64 dB, 0.9860
-      {"dragon", {0.995, 40.0, 0.99}},      // 0.9961, 40.54 dB, 0.9904
-      {"complexity", {0.999, 37.8, 0.99}},  // 0.9998, 38.15 dB, 0.9942
+      {"spheres", {0.998, 38.2, 0.99}},     // 0.9989, 38.50 dB, 0.9918
+      {"atrium", {0.981, 36.8, 0.983}},     // 0.9821, 37.12 dB, 0.9839
+      {"bistro", {0.992, 36.7, 0.987}},     // 0.9932, 37.04 dB, 0.9884
+      {"temple", {0.974, 34.2, 0.985}},     // 0.9746, 34.54 dB, 0.9859
+      {"dragon", {0.995, 40.0, 0.99}},      // 0.9961, 40.47 dB, 0.9902
+      {"complexity", {0.999, 37.3, 0.99}},  // 0.9998, 37.61 dB, 0.9931
   };
   const auto it = measured.find(scene);
   return it == measured.end() ? Floors{} : it->second;

@@ -1,16 +1,18 @@
 // Test helpers for rendering: built-in scenes from a shared cache under the build tree, a pipeline
-// run at a chosen resolution and thread count, and a simple PSNR on sRGB-encoded 8-bit values.
+// run at a chosen resolution and thread count, and PSNR on sRGB-encoded 8-bit values.
 #pragma once
 
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <string>
 
 #include "renderer/color.hpp"
 #include "renderer/io/gltf_loader.hpp"
 #include "renderer/pipeline.hpp"
 #include "scenes/catalog.hpp"
+#include "validation/metrics.hpp"
 
 namespace sb::test {
 
@@ -35,18 +37,11 @@ inline StereoResult render_with(const std::string& pipeline, const RenderScene& 
   return p.render(scene, rig, PipelineOptions(p.info(), options), RenderContext{executor});
 }
 
-/// PSNR of the sRGB-encoded 8-bit rgb planes (infinity for identical images).
+/// PSNR of the sRGB-encoded 8-bit rgb planes (validation::encode_srgb8, mse and psnr_from_mse):
+/// infinity for identical images.
 inline double psnr_srgb8(const Image& a, const Image& b) {
-  const float* pa = a.data_f32(planes::rgb);
-  const float* pb = b.data_f32(planes::rgb);
-  const size_t n = a.pixel_count() * 3;
-  double se = 0.0;
-  for (size_t i = 0; i < n; ++i) {
-    const double d = double(linear_to_srgb8(pa[i])) - double(linear_to_srgb8(pb[i]));
-    se += d * d;
-  }
-  if (se == 0.0) return std::numeric_limits<double>::infinity();
-  return 10.0 * std::log10(255.0 * 255.0 / (se / double(n)));
+  return validation::psnr_from_mse(
+      validation::mse(validation::encode_srgb8(a, "image A"), validation::encode_srgb8(b, "image B")));
 }
 
 }  // namespace sb::test

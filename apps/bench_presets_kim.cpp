@@ -1,0 +1,546 @@
+// Kim's tables as benchmark presets: kim-focal (Table 2, SSIM/PSNR of the warped right eyes against
+// the 2-pass reference at three focal distances, plus times) and kim-complexity (Table 3, rendering
+// and warping time against the triangle count, with a memory check before every row).
+#include <malloc.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "apps/bench_presets.hpp"
+#include "apps/cli_common.hpp"
+#include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
+#include "renderer/io/gltf_loader.hpp"
+#include "renderer/io/render_output.hpp"
+#include "scenes/catalog.hpp"
+#include "validation/metrics.hpp"
+
+namespace sb::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Kim's 2-pass reference, and the method of the crossover.
+constexpr const char* kReference = "plain-raster";
+constexpr const char* kBidirectional = "bidir-warp";
+/// Kim's interpupillary distance, 64 mm.
+constexpr double kKimInteraxial = 0.064;
+
+/// Before the first row of kim-complexity has been measured its peak is estimated as the resident
+/// memory before it plus 1 GiB (image buffers: 0.55 GiB measured at 1920x1080) plus 1 KiB per
+/// triangle (about 4x the 265 B per triangle measured between 1e5 and 1e6 triangles at 1920x1080).
+constexpr double kPriorFixedBytes = 1024.0 * 1024.0 * 1024.0;
+constexpr double kPriorBytesPerTriangle = 1024.0;
+
+constexpr double kMiB = 1024.0 * 1024.0;
+constexpr double kGiB = 1024.0 * kMiB;
+
+/// A "Key:   123 kB" field of a /proc file, in bytes; nullopt when the file or field is missing.
+std::optional<uint64_t> proc_kib_field(const char* file, const std::string& key) {
+  std::ifstream in(file);
+  for (std::string line; std::getline(in, line);) {
+    if (line.compare(0, key.size() + 1, key + ":") != 0) continue;
+    std::istringstream fields(line.substr(key.size() + 1));
+    uint64_t kib = 0;
+    if (fields >> kib) return kib * 1024;
+  }
+  return std::nullopt;
+}
+
+uint64_t resident_bytes() { return proc_kib_field("/proc/self/status", "VmRSS").value_or(0); }
+uint64_t peak_resident_bytes() { return proc_kib_field("/proc/self/status", "VmHWM").value_or(0); }
+
+/// MemAvailable of /proc/meminfo; IoError when it cannot be read (the memory check needs it).
+uint64_t mem_available_bytes() {
+  const std::optional<uint64_t> v = proc_kib_field("/proc/meminfo", "MemAvailable");
+  if (!v)
+    throw IoError("cannot read MemAvailable from /proc/meminfo, which kim-complexity needs to decide whether a "
+                  "row fits in memory; run it on Linux 3.14 or later");
+  return *v;
+}
+
+/// Resets the process's peak resident size (VmHWM) to its current size, so that the next reading
+/// is the peak of what follows (Linux 4.0+: "5" to /proc/self/clear_refs). False when refused.
+bool reset_peak_resident() {
+  std::ofstream out("/proc/self/clear_refs");
+  out << "5";
+  out.flush();
+  return static_cast<bool>(out);
+}
+
+std::string join(const std::vector<std::string>& items, const char* sep) {
+  std::string out;
+  for (const std::string& s : items) out += (out.empty() ? "" : sep) + s;
+  return out;
+}
+
+bool contains(const std::vector<std::string>& items, const std::string& name) {
+  return std::find(items.begin(), items.end(), name) != items.end();
+}
+
+size_t rows_to_run(const PresetRun& run, const PresetSeries& s) {
+  return run.rows_per_series > 0 ? std::min(s.rows.size(), static_cast<size_t>(run.rows_per_series)) : s.rows.size();
+}
+
+/// The rig of a Kim row: the preset's interaxial and convergence, the row's image size unless
+/// --resolution replaced it, and what else the command line left open (--vfov, --convergence).
+StereoRig row_rig(const Scene& scene, const PresetRun& run, const PresetRow& row) {
+  RigOverrides o = run.overrides;
+  if (!o.width || !run.preset->resolution_open) {
+    o.width = row.width;
+    o.height = row.height;
+  }
+  o.max_disparity_px.reset();
+  o.interaxial = row.interaxial;
+  if (row.convergence) o.convergence = row.convergence;
+  return resolve_rig(scene, o);
+}
+
+/// The JSON head both Kim presets share.
+nlohmann::json preset_json(const PresetRun& run, const Executor& executor) {
+  return {{"preset", run.preset->name},
+          {"summary", run.preset->summary},
+          {"pipelines", run.config.pipelines},
+          {"baseline", run.config.baseline},
+          {"warmup", run.config.warmup},
+          {"repetitions", run.config.repetitions},
+          {"threads", executor.threads()},
+          {"rows_per_series", run.rows_per_series},
+          {"complete", false},
+          {"rows", nlohmann::json::array()},
+          {"versions", io::versions_json()}};
+}
+
+nlohmann::json scene_json(const Scene& scene, const PresetRow& row) {
+  return {{"name", scene.name},
+          {"path", scene.path},
+          {"params", row.scene_params.empty() ? nlohmann::json::object() : nlohmann::json(row.scene_params)},
+          {"triangles", scene.triangle_count()},
+          {"vertices", scene.vertex_count()},
+          {"lights", scene.lights.size()}};
+}
+
+void print_run_head(const PresetRun& run, const Executor& executor) {
+  fmt::print("preset {}: {}\n", run.preset->name, run.preset->summary);
+  fmt::print("{}; baseline {}; {} threads, {} warm-up + {} repetitions per row\n", join(run.config.pipelines, ", "),
+             run.config.baseline, executor.threads(), run.config.warmup, run.config.repetitions);
+  fmt::print("times: median over repetitions of each pipeline's total; speed-up = median over repetitions of {}'s "
+             "total / the pipeline's total, paired per repetition\n",
+             run.config.baseline);
+}
+
+std::string psnr_text(double psnr) { return std::isinf(psnr) ? std::string("inf") : fmt::format("{:.2f}", psnr); }
+
+// ---- kim-focal ----
+
+/// What one kim-focal row measured.
+struct FocalRow {
+  std::string value;
+  std::vector<std::pair<std::string, validation::ImageMetrics>> quality;  ///< per method, in pipeline order
+  BenchResult bench;
+};
+
+void print_focal_tables(const PresetSeries& series, const std::vector<FocalRow>& rows, const BenchConfig& config) {
+  const size_t first = std::max<size_t>(8, series.swept.size());
+  // Kim's Table 2: rows = distances, columns = methods, "SSIM/PSNR".
+  fmt::print("\nSSIM/PSNR (dB) of each right eye against {}'s right eye (Kim, Table 2)\n", kReference);
+  std::string head = fmt::format("{:<{}}", series.swept, first);
+  for (const auto& [name, m] : rows.front().quality) head += fmt::format("  {:>{}}", name, std::max<size_t>(14, name.size()));
+  fmt::print("{}\n", head);
+  for (const FocalRow& r : rows) {
+    std::string line = fmt::format("{:<{}}", r.value, first);
+    for (const auto& [name, m] : r.quality)
+      line += fmt::format("  {:>{}}", fmt::format("{:.4f}/{}", m.ssim, psnr_text(m.psnr)), std::max<size_t>(14, name.size()));
+    fmt::print("{}\n", line);
+  }
+  // Times of the same rows.
+  fmt::print("\nmedian total ms and speed-up against {}\n", config.baseline);
+  head = fmt::format("{:<{}}", series.swept, first);
+  for (const std::string& p : config.pipelines)
+    head += fmt::format("  {:>{}} {:>9}", p + " ms", std::max<size_t>(10, p.size() + 3), "speed-up");
+  fmt::print("{}\n", head);
+  for (const FocalRow& r : rows) {
+    std::string line = fmt::format("{:<{}}", r.value, first);
+    for (const PipelineBench& b : r.bench.pipelines)
+      line += fmt::format("  {:>{}.2f} {:>9}", summarize(b.total_seconds).median * 1e3, std::max<size_t>(10, b.name.size() + 3),
+                          fmt::format("{:.2f}x", b.speedup.median));
+    fmt::print("{}\n", line);
+  }
+  std::fflush(stdout);
+}
+
+// ---- kim-complexity ----
+
+/// Medians of one pipeline's stage groups over the repetitions (each repetition's stages summed
+/// by group first).
+struct GroupTimes {
+  double rendering_ms = 0.0, warping_ms = 0.0, other_ms = 0.0, total_ms = 0.0;
+  std::vector<std::string> other_stages;
+};
+
+GroupTimes group_times(const PipelineBench& b) {
+  const size_t reps = b.total_seconds.size();
+  std::vector<double> rendering(reps, 0.0), warping(reps, 0.0), other(reps, 0.0);
+  GroupTimes g;
+  for (const std::string& stage : b.stage_order) {
+    const StageGroup group = stage_group(stage);
+    std::vector<double>& sums = group == StageGroup::rendering ? rendering : group == StageGroup::warping ? warping : other;
+    if (group == StageGroup::other) g.other_stages.push_back(stage);
+    const std::vector<double>& s = b.stage_seconds.at(stage);
+    for (size_t i = 0; i < reps && i < s.size(); ++i) sums[i] += s[i];
+  }
+  g.rendering_ms = summarize(rendering).median * 1e3;
+  g.warping_ms = summarize(warping).median * 1e3;
+  g.other_ms = summarize(other).median * 1e3;
+  g.total_ms = summarize(b.total_seconds).median * 1e3;
+  return g;
+}
+
+/// Seconds since `start`.
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::string gib(uint64_t bytes) { return fmt::format("{:.2f} GiB", static_cast<double>(bytes) / kGiB); }
+
+/// "1e7" from 10000000.
+std::string power_of_ten(double n) {
+  const double e = std::log10(n);
+  return std::abs(e - std::round(e)) < 1e-9 ? fmt::format("1e{}", static_cast<int>(std::lround(e))) : fmt::format("{:g}", n);
+}
+
+constexpr const char* kComplexityHead = "{:<14} {:>10}  {:<14} {:>12} {:>10} {:>10} {:>9} {:>9}\n";
+
+}  // namespace
+
+BenchPreset kim_focal_preset() {
+  BenchPreset p;
+  p.name = "kim-focal";
+  p.summary =
+      "Kim's Table 2: atrium at 960x540, e = 64 mm, focal distance (convergence) 6 m, 2 m and 0.3 m; each method's "
+      "right eye against plain-raster's by SSIM/PSNR, and every pipeline's median time and speed-up.";
+  p.kind = PresetKind::quality;
+  p.pipelines = {kReference, kBidirectional, "bw-warp", "fw-warp", "bidir-warp-rt"};
+  p.baseline = kReference;
+  p.fixed_options = {"--scene", "--interaxial", "--max-disparity", "--convergence", "--lights"};
+  p.resolution_open = true;
+  PresetSeries s{"atrium by focal distance", "DF mm", "e = 64 mm, every light of the scene", {}};
+  for (const double c_mm : {6000.0, 2000.0, 300.0}) {
+    PresetRow row;
+    row.value = fmt::format("{:g}", c_mm);
+    row.scene = "atrium";
+    row.width = 960;
+    row.height = 540;
+    row.interaxial = kKimInteraxial;
+    row.convergence = c_mm * 1e-3;
+    s.rows.push_back(row);
+  }
+  p.series.push_back(std::move(s));
+  return p;
+}
+
+BenchPreset kim_complexity_preset() {
+  BenchPreset p;
+  p.name = "kim-complexity";
+  p.summary =
+      "Kim's Table 3: the complexity scene with 1e5, 1e6, 1e7 and 1e8 triangles at 1920x1080 (FHD), e = 64 mm; median "
+      "rendering and warping time per pipeline, peak memory per row, and the crossover where bidir-warp beats "
+      "plain-raster. A row that would not fit in MemAvailable is skipped with the reason.";
+  p.kind = PresetKind::complexity;
+  p.pipelines = {kReference, kBidirectional};
+  p.baseline = kReference;
+  p.fixed_options = {"--scene", "--interaxial", "--max-disparity", "--lights"};
+  p.resolution_open = true;
+  PresetSeries s{"complexity by triangle count", "triangles", "e = 64 mm, every light of the scene", {}};
+  for (const double n : {1e5, 1e6, 1e7, 1e8}) {
+    PresetRow row;
+    row.value = power_of_ten(n);
+    row.scene = "complexity";
+    row.scene_params = {{"triangles", n}};
+    row.width = 1920;
+    row.height = 1080;
+    row.interaxial = kKimInteraxial;
+    s.rows.push_back(row);
+  }
+  p.series.push_back(std::move(s));
+  return p;
+}
+
+void run_kim_focal(const PresetRun& run, const Executor& executor) {
+  const BenchPreset& preset = *run.preset;
+  run.config.validate();
+  if (!contains(run.config.pipelines, kReference))
+    throw InputError(fmt::format("--preset {} compares every right eye with {}'s; add {} to --pipelines", preset.name,
+                                 kReference, kReference));
+  print_run_head(run, executor);
+  fmt::print("quality: each pipeline renders the row once more, untimed, and its right eye is compared with {}'s "
+             "(8-bit sRGB, SSIM as scikit-image, PSNR over RGB)\n",
+             kReference);
+
+  nlohmann::json out = preset_json(run, executor);
+  out["reference"] = kReference;
+  out["metrics_version"] = validation::kMetricsVersion;
+  const auto write_json = [&] {
+    if (!run.json_out.empty()) io::write_text_atomically(run.json_out, out.dump(2) + "\n");
+  };
+
+  const RenderContext ctx{executor};
+  fs::path loaded_path;
+  std::unique_ptr<Scene> scene;
+  std::unique_ptr<RenderScene> prepared;
+  for (const PresetSeries& series : preset.series) {
+    const size_t n = rows_to_run(run, series);
+    std::vector<FocalRow> measured;
+    for (size_t i = 0; i < n; ++i) {
+      const PresetRow& row = series.rows[i];
+      const fs::path path = scenes::resolve_builtin(row.scene, row.scene_params, run.scenes_dir);
+      if (!scene || path != loaded_path) {
+        prepared.reset();
+        scene = std::make_unique<Scene>(io::load_gltf(path));
+        for (const std::string& w : scene->warnings) fmt::print(stderr, "warning: {}\n", w);
+        prepared = std::make_unique<RenderScene>(*scene);
+        loaded_path = path;
+      }
+      if (i == 0)
+        fmt::print("\n{}: {} ({} triangles, {} lights), {}\n", series.name, scene->name, scene->triangle_count(),
+                   scene->lights.size(), series.fixed);
+      const StereoRig rig = row_rig(*scene, run, row);
+      fmt::print("{} = {}: {}\n", series.swept, row.value, describe(rig));
+      std::fflush(stdout);
+
+      // Quality: one untimed render per pipeline; rendering is deterministic, so these are the
+      // images the timed repetitions produce.
+      std::vector<std::pair<std::string, validation::Srgb8Image>> right_eyes;
+      for (const std::string& name : run.config.pipelines) {
+        const Pipeline& p = find_pipeline(name);
+        const auto it = run.config.options.find(name);
+        const PipelineOptions opts(p.info(), it == run.config.options.end() ? std::map<std::string, std::string>{} : it->second);
+        const StereoResult r = p.render(*prepared, rig, opts, ctx);
+        right_eyes.emplace_back(name, validation::encode_srgb8(r.right, name + " right eye"));
+      }
+      const auto ref = std::find_if(right_eyes.begin(), right_eyes.end(), [](const auto& e) { return e.first == kReference; });
+      FocalRow result;
+      result.value = row.value;
+      nlohmann::json quality = nlohmann::json::object();
+      for (const auto& [name, image] : right_eyes) {
+        if (name == kReference) continue;
+        result.quality.emplace_back(name, validation::compare_images(image, ref->second));
+        quality[name] = validation::to_json(result.quality.back().second);
+      }
+      result.bench = run_bench(*prepared, rig, run.config, executor);
+
+      nlohmann::json median_ms = nlohmann::json::object(), speedup = nlohmann::json::object();
+      for (const PipelineBench& b : result.bench.pipelines) {
+        median_ms[b.name] = summarize(b.total_seconds).median * 1e3;
+        speedup[b.name] = b.speedup.median;
+      }
+      out["rows"].push_back({{"series", series.name},
+                             {"swept", series.swept},
+                             {"value", row.value},
+                             {"focal_distance_m", rig.params().convergence},
+                             {"scene", scene_json(*scene, row)},
+                             {"rig", io::rig_to_json(rig)},
+                             {"bvh", {{"build_s", prepared->bvh_build_seconds()},
+                                      {"memory_bytes", prepared->rays().memory_bytes()}}},
+                             {"reference", kReference},
+                             {"quality", quality},
+                             {"median_total_ms", median_ms},
+                             {"speedup_median", speedup},
+                             {"bench", bench_to_json(result.bench)}});
+      measured.push_back(std::move(result));
+      write_json();  // after every row, so an interrupted run keeps what it measured
+    }
+    if (!measured.empty()) print_focal_tables(series, measured, run.config);
+  }
+  out["complete"] = true;
+  write_json();
+  if (!run.json_out.empty()) fmt::print("\nwrote {}\n", run.json_out);
+}
+
+void run_kim_complexity(const PresetRun& run, const Executor& executor) {
+  const BenchPreset& preset = *run.preset;
+  run.config.validate();
+  for (const char* needed : {kReference, kBidirectional})
+    if (!contains(run.config.pipelines, needed))
+      throw InputError(fmt::format("--preset {} compares {} with {}; add {} to --pipelines", preset.name, kBidirectional,
+                                   kReference, needed));
+  const uint64_t base_rss = resident_bytes();
+  print_run_head(run, executor);
+  fmt::print("rendering = stages redirect, *_gbuffer, *_shading, *_trace; warping = motion, warps, crack and hole "
+             "filling, background; medians of each repetition's sums\n");
+  fmt::print("memory: a row runs when its estimated peak minus the resident memory before it is at most {:.0f} % of "
+             "MemAvailable ({} now); peak = VmHWM of the row\n",
+             kMemoryUsableShare * 100.0, gib(mem_available_bytes()));
+
+  nlohmann::json out = preset_json(run, executor);
+  out["memory_usable_share"] = kMemoryUsableShare;
+  const auto write_json = [&] {
+    if (!run.json_out.empty()) io::write_text_atomically(run.json_out, out.dump(2) + "\n");
+  };
+
+  for (const PresetSeries& series : preset.series) {
+    const size_t n = rows_to_run(run, series);
+    if (n == 0) continue;
+    fmt::print("\n{}: {}\n", series.name, series.fixed);
+    bool header_printed = false;
+    const auto print_header = [&header_printed, &series] {
+      if (header_printed) return;
+      fmt::print(kComplexityHead, series.swept, "vertices", "method", "rendering ms", "warping ms", "total ms",
+                 "speed-up", "peak MiB");
+      header_printed = true;
+    };
+    std::vector<MeasuredPeak> peaks;
+    std::vector<std::string> measured_values, skipped;
+    std::vector<double> measured_triangles;
+    std::vector<double> reference_ms, bidir_ms;
+    for (size_t i = 0; i < n; ++i) {
+      const PresetRow& row = series.rows[i];
+      const double triangles = row.scene_params.at("triangles");
+
+      // Memory check before anything of the row is generated or loaded.
+      malloc_trim(0);
+      const uint64_t rss_before = resident_bytes();
+      const uint64_t available = mem_available_bytes();
+      const uint64_t estimate = estimate_peak_bytes(peaks, base_rss, triangles, kPriorFixedBytes, kPriorBytesPerTriangle);
+      std::string basis = "prior (1 GiB + 1 KiB per triangle)";
+      if (peaks.size() == 1) basis = "proportional to the " + measured_values.back() + " row";
+      if (peaks.size() >= 2)
+        basis = "line through the " + measured_values[measured_values.size() - 2] + " and " + measured_values.back() + " rows";
+      const uint64_t extra = estimate > rss_before ? estimate - rss_before : 0;
+      nlohmann::json memory = {{"estimated_peak_bytes", estimate},
+                               {"estimate_basis", basis},
+                               {"resident_before_bytes", rss_before},
+                               {"mem_available_bytes", available}};
+      if (!memory_fits(extra, available)) {
+        const std::string reason =
+            fmt::format("estimated peak {} ({}) needs {} more, over {:.0f} % of MemAvailable {}", gib(estimate), basis,
+                        gib(extra), kMemoryUsableShare * 100.0, gib(available));
+        print_header();
+        fmt::print("{:<14} skipped: {}\n", row.value, reason);
+        std::fflush(stdout);
+        skipped.push_back(row.value);
+        out["rows"].push_back({{"series", series.name},
+                               {"swept", series.swept},
+                               {"value", row.value},
+                               {"triangles_requested", triangles},
+                               {"skipped", true},
+                               {"reason", reason},
+                               {"memory", memory}});
+        write_json();
+        continue;
+      }
+
+      const bool peak_reset = reset_peak_resident();
+      nlohmann::json row_json;
+      GroupTimes reference_times, bidir_times;
+      {
+        const auto resolve_start = std::chrono::steady_clock::now();
+        const fs::path path = scenes::resolve_builtin(row.scene, row.scene_params, run.scenes_dir);
+        const double resolve_s = seconds_since(resolve_start);
+        const auto load_start = std::chrono::steady_clock::now();
+        const Scene scene = io::load_gltf(path);
+        for (const std::string& w : scene.warnings) fmt::print(stderr, "warning: {}\n", w);
+        const double load_s = seconds_since(load_start);
+        const RenderScene prepared(scene);
+        fmt::print(stderr, "{}: scene ready in {:.1f} s (generated or cached), loaded in {:.1f} s, bvh {:.1f} s, {:.0f} MiB\n",
+                   row.value, resolve_s, load_s, prepared.bvh_build_seconds(),
+                   static_cast<double>(prepared.rays().memory_bytes()) / kMiB);
+        const StereoRig rig = row_rig(scene, run, row);
+        if (!header_printed) fmt::print("rig {}\n", describe(rig));
+        print_header();
+        const BenchResult r = run_bench(prepared, rig, run.config, executor);
+        const uint64_t peak = peak_resident_bytes();
+        memory["peak_bytes"] = peak;
+        memory["peak_reset"] = peak_reset;
+
+        nlohmann::json groups = nlohmann::json::object(), median_ms = nlohmann::json::object(),
+                       speedup = nlohmann::json::object();
+        for (size_t k = 0; k < r.pipelines.size(); ++k) {
+          const PipelineBench& b = r.pipelines[k];
+          const GroupTimes g = group_times(b);
+          if (b.name == kReference) reference_times = g;
+          if (b.name == kBidirectional) bidir_times = g;
+          const std::string label = k == 0 ? fmt::format("{} ({})", row.value, scene.triangle_count()) : "";
+          const std::string vertices = k == 0 ? fmt::format("{}", scene.vertex_count()) : "";
+          const std::string peak_text = k == 0 ? fmt::format("{:.0f}", static_cast<double>(peak) / kMiB) : "";
+          fmt::print(kComplexityHead, label, vertices, b.name, fmt::format("{:.2f}", g.rendering_ms),
+                     fmt::format("{:.2f}", g.warping_ms), fmt::format("{:.2f}", g.total_ms),
+                     fmt::format("{:.2f}x", b.speedup.median), peak_text);
+          if (!g.other_stages.empty())
+            fmt::print("{:<14} note: {} has stages of neither group ({}), {:.2f} ms, in its total only\n", "", b.name,
+                       join(g.other_stages, ", "), g.other_ms);
+          groups[b.name] = {{"rendering_ms", g.rendering_ms},
+                            {"warping_ms", g.warping_ms},
+                            {"other_ms", g.other_ms},
+                            {"other_stages", g.other_stages},
+                            {"total_ms", g.total_ms}};
+          median_ms[b.name] = g.total_ms;
+          speedup[b.name] = b.speedup.median;
+        }
+        std::fflush(stdout);
+        row_json = {{"series", series.name},
+                    {"swept", series.swept},
+                    {"value", row.value},
+                    {"triangles_requested", triangles},
+                    {"skipped", false},
+                    {"scene", scene_json(scene, row)},
+                    {"scene_resolve_s", resolve_s},
+                    {"scene_load_s", load_s},
+                    {"rig", io::rig_to_json(rig)},
+                    {"bvh", {{"build_s", prepared.bvh_build_seconds()}, {"memory_bytes", prepared.rays().memory_bytes()}}},
+                    {"memory", memory},
+                    {"stage_groups", groups},
+                    {"median_total_ms", median_ms},
+                    {"speedup_median", speedup},
+                    {"bench", bench_to_json(r)}};
+        peaks.push_back({triangles, peak});
+      }  // the row's scene is freed here, before the next row's memory check
+      measured_values.push_back(row.value);
+      measured_triangles.push_back(triangles);
+      reference_ms.push_back(reference_times.total_ms);
+      bidir_ms.push_back(bidir_times.total_ms);
+      out["rows"].push_back(row_json);
+      write_json();  // after every row, so an interrupted run keeps what it measured
+    }
+
+    // The crossover of Table 3: from which triangle count on bidir-warp is faster than 2-pass, and
+    // (when that differs) the rows in which it is.
+    const std::optional<size_t> cross = crossover_row(reference_ms, bidir_ms);
+    std::vector<std::string> faster;
+    for (size_t k = 0; k < measured_values.size(); ++k)
+      if (bidir_ms[k] < reference_ms[k]) faster.push_back(measured_values[k]);
+    std::string range = measured_values.empty() ? std::string("no row measured")
+                        : measured_values.size() == 1
+                            ? measured_values.front()
+                            : measured_values.front() + " to " + measured_values.back();
+    if (!skipped.empty()) range += "; skipped for memory: " + join(skipped, ", ");
+    std::string line;
+    if (cross) {
+      line = fmt::format("crossover: {}'s median total is below {}'s from {} triangles on (measured: {})",
+                         kBidirectional, kReference, measured_values[*cross], range);
+    } else {
+      line = fmt::format("crossover: none in the measured range ({}): {}'s median total is below {}'s {}",
+                         range, kBidirectional, kReference,
+                         faster.empty() ? std::string("in no measured row")
+                                        : fmt::format("at {} but not in the largest measured row", join(faster, ", ")));
+    }
+    fmt::print("\n{}\n", line);
+    out["crossover"] = {{"triangles", cross ? nlohmann::json(measured_triangles[*cross]) : nlohmann::json()},
+                        {"value", cross ? nlohmann::json(measured_values[*cross]) : nlohmann::json()},
+                        {"faster_rows", faster},
+                        {"text", line}};
+  }
+  out["complete"] = true;
+  write_json();
+  if (!run.json_out.empty()) fmt::print("\nwrote {}\n", run.json_out);
+}
+
+}  // namespace sb::cli

@@ -1,0 +1,183 @@
+// `stereobench reference generate|verify|update|list`: the reference store of DESIGN §6.4.
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "apps/cli_common.hpp"
+#include "apps/commands.hpp"
+#include "reference/store.hpp"
+#include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
+
+namespace sb::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct ReferenceArgs {
+  std::string store = reference::default_store_dir().string();
+  std::string scenes_dir;
+  int threads = 0;
+  // generate
+  std::string scene = "box-wall";
+  std::string truth = "full";
+  std::optional<int> lights;
+  RigCli rig;
+  // verify / update
+  std::vector<std::string> ids;
+  bool no_render = false;
+  double min_psnr = INFINITY;
+  bool only_failing = false;
+  std::string json_out;
+  std::string command_line;
+};
+
+std::vector<std::string> chosen_ids(const reference::ReferenceStore& store, const std::vector<std::string>& ids) {
+  if (!ids.empty()) return ids;
+  std::vector<std::string> all = store.ids();
+  if (all.empty()) throw InputError(fmt::format("the reference store {} is empty; run `stereobench reference generate`",
+                                                store.root().string()));
+  return all;
+}
+
+void run_generate(const ReferenceArgs& a) {
+  const reference::ReferenceStore store(a.store);
+  const reference::ReferenceSpec spec{a.scene, a.lights, a.rig.overrides(), a.truth};
+  const Executor executor(checked_threads(a.threads));
+  const std::string id = store.generate(spec, a.scenes_dir, a.command_line, executor);
+  fmt::print("wrote {}\n", (store.root() / id).string());
+}
+
+/// Verifies the chosen entries, prints one line each, and returns the results.
+std::vector<reference::VerifyResult> verify_all(const ReferenceArgs& a, const reference::ReferenceStore& store) {
+  const Executor executor(checked_threads(a.threads));
+  const reference::VerifyOptions options{!a.no_render, a.min_psnr};
+  std::vector<reference::VerifyResult> results;
+  for (const std::string& id : chosen_ids(store, a.ids)) {
+    results.push_back(store.verify(id, a.scenes_dir, options, executor));
+    const reference::VerifyResult& r = results.back();
+    fmt::print("{:<14} {}: {}\n", reference::to_string(r.status), r.id, r.detail);
+  }
+  return results;
+}
+
+/// Exit status of a verification: 2 when a reference failed, 4 when some could not be checked
+/// because a tool is missing, else 0.
+int verdict(const std::vector<reference::VerifyResult>& results) {
+  bool failed = false, unavailable = false;
+  for (const auto& r : results) {
+    if (r.status == reference::Status::unavailable) unavailable = true;
+    else if (reference::failed(r.status)) failed = true;
+  }
+  if (failed) return static_cast<int>(ExitCode::gate_failure);
+  if (unavailable) return static_cast<int>(ExitCode::environment);
+  return 0;
+}
+
+int run_verify(const ReferenceArgs& a) {
+  const reference::ReferenceStore store(a.store);
+  const std::vector<reference::VerifyResult> results = verify_all(a, store);
+  if (!a.json_out.empty()) {
+    json j = json::array();
+    for (const auto& r : results)
+      j.push_back({{"id", r.id}, {"status", reference::to_string(r.status)}, {"detail", r.detail},
+                   {"bit_identical", r.bit_identical},
+                   {"metrics", r.metrics ? validation::to_json(*r.metrics) : json(nullptr)}});
+    io::write_text_atomically(a.json_out, j.dump(2) + "\n");
+  }
+  const int code = verdict(results);
+  size_t failures = 0;
+  for (const auto& r : results) failures += reference::failed(r.status) ? 1 : 0;
+  fmt::print("{} of {} reference(s) verified{}\n", results.size() - failures, results.size(),
+             failures == 0 ? "" : fmt::format("; {} did not (run `stereobench reference update --only-failing`)", failures));
+  return code;
+}
+
+int run_update(const ReferenceArgs& a) {
+  const reference::ReferenceStore store(a.store);
+  const Executor executor(checked_threads(a.threads));
+  std::vector<std::string> targets;
+  if (a.only_failing) {
+    for (const reference::VerifyResult& r : verify_all(a, store)) {
+      if (r.status == reference::Status::unavailable)
+        throw ToolError(fmt::format("cannot update '{}': {}", r.id, r.detail));
+      if (reference::failed(r.status)) targets.push_back(r.id);
+    }
+  } else {
+    targets = chosen_ids(store, a.ids);
+  }
+  for (const std::string& id : targets) {
+    const std::string written = store.generate(store.spec_of(id), a.scenes_dir, a.command_line, executor);
+    fmt::print("updated {}\n", (store.root() / written).string());
+  }
+  fmt::print("{} reference(s) rewritten\n", targets.size());
+  return 0;
+}
+
+void run_list(const ReferenceArgs& a) {
+  const reference::ReferenceStore store(a.store);
+  const std::vector<std::string> ids = store.ids();
+  fmt::print("{} reference(s) in {}\n", ids.size(), store.root().string());
+  for (const std::string& id : ids) {
+    const json p = store.provenance(id);
+    fmt::print("  {:<48} {:<22} {}\n", id, p.at("provider").value("tool_version", "?"), p.value("date", "?"));
+  }
+}
+
+}  // namespace
+
+void register_reference_command(CLI::App& root, const std::string& command_line) {
+  auto a = std::make_shared<ReferenceArgs>();
+  a->command_line = command_line;
+  CLI::App* ref = root.add_subcommand(
+      "reference",
+      "Reference images with provenance (DESIGN §6.4): ground-truth right eyes stored as EXR with a\n"
+      "provenance.json (provider and tool version, scene hash, rig, command line, date, image hash)");
+  ref->require_subcommand(1);
+  // Options every subcommand takes (after its name).
+  const auto add_common = [&](CLI::App* c) {
+    c->add_option("--store", a->store, "The reference store folder")->capture_default_str();
+    c->add_option("--threads,-t", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
+    add_scenes_dir_option(*c, a->scenes_dir);
+  };
+
+  CLI::App* gen = ref->add_subcommand("generate", "Render a reference right eye and store it (replacing one of the same id)");
+  add_common(gen);
+  gen->add_option("--scene,-s", a->scene, "Scene file (.gltf/.glb) or built-in scene name")->capture_default_str();
+  gen->add_option("--truth", a->truth, "Provider: full, blender or povray")->capture_default_str();
+  add_lights_option(*gen, a->lights);
+  a->rig.add_to(*gen);
+  gen->callback([a] { run_generate(*a); });
+
+  const auto add_selection = [&](CLI::App* c) {
+    add_common(c);
+    c->add_option("ids", a->ids, "Reference ids (default: every reference in the store)");
+    c->add_flag("--no-render", a->no_render, "Check hashes only (image file and scene), do not render again");
+    c->add_option("--min-psnr", a->min_psnr,
+                  "Accept a new render this close to the stored one (dB, 8-bit sRGB); default: identical");
+  };
+  CLI::App* ver = ref->add_subcommand(
+      "verify",
+      "Re-hash each reference and its scene, render it again and report drift. Exit 0 when all hold,\n"
+      "2 when any drifted, is corrupt or its scene changed, 4 when a provider's tool is missing");
+  add_selection(ver);
+  ver->add_option("--json", a->json_out, "Also write the verdicts as JSON to this file");
+  ver->callback([a] { throw VerdictExit{run_verify(*a)}; });
+
+  CLI::App* upd = ref->add_subcommand("update", "Render references again and rewrite them");
+  add_selection(upd);
+  upd->add_flag("--only-failing", a->only_failing, "Verify first and rewrite only the references that failed");
+  upd->callback([a] { throw VerdictExit{run_update(*a)}; });
+
+  CLI::App* list = ref->add_subcommand("list", "List the stored references");
+  add_common(list);
+  list->callback([a] { run_list(*a); });
+}
+
+}  // namespace sb::cli

@@ -1,0 +1,155 @@
+// `stereobench validate`: render the right eye with each chosen pipeline and measure it against a
+// ground-truth right eye (full ray tracing, Blender Cycles or POV-Ray): metrics, hole statistics,
+// images and a result record per pipeline, and a table on the terminal.
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <vector>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "apps/cli_common.hpp"
+#include "apps/commands.hpp"
+#include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
+#include "scenes/catalog.hpp"
+#include "validation/validation_images.hpp"
+
+namespace sb::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct ValidateArgs {
+  std::string scene = "spheres";
+  std::vector<std::string> pipelines{"all"};
+  std::string truth = "full";
+  std::string scenes_dir;
+  std::string out = "out/validate";
+  std::string cache = "out/truth-cache";
+  bool no_cache = false;
+  int threads = 0;
+  int error_threshold = 2;
+  std::optional<int> lights;
+  RigCli rig;
+};
+
+/// The pipelines named (comma-separated or repeated), "all" for every registered one.
+std::vector<const Pipeline*> chosen_pipelines(const std::vector<std::string>& names) {
+  std::vector<const Pipeline*> out;
+  for (const std::string& item : names) {
+    std::stringstream list(item);
+    std::string name;
+    while (std::getline(list, name, ',')) {
+      if (name.empty()) continue;
+      if (name == "all") {
+        for (const Pipeline* p : pipelines())
+          if (std::find(out.begin(), out.end(), p) == out.end()) out.push_back(p);
+        continue;
+      }
+      const Pipeline* p = &find_pipeline(name);
+      if (std::find(out.begin(), out.end(), p) == out.end()) out.push_back(p);
+    }
+  }
+  if (out.empty()) throw InputError("--pipelines names no pipeline; give names (see `stereobench pipelines`) or 'all'");
+  return out;
+}
+
+std::string number(double v, const char* format) {
+  if (std::isnan(v)) return "-";
+  if (std::isinf(v)) return "inf";
+  return fmt::format(fmt::runtime(format), v);
+}
+
+void run_validate(const ValidateArgs& a) {
+  const RigOverrides overrides = a.rig.overrides();
+  const std::vector<const Pipeline*> chosen = chosen_pipelines(a.pipelines);
+  if (a.error_threshold < 0 || a.error_threshold > 255)
+    throw InputError(fmt::format("--error-threshold {} is outside 0..255 (8-bit codes)", a.error_threshold));
+  const std::unique_ptr<validation::TruthProvider> provider = validation::make_truth_provider(a.truth);
+  if (auto why = provider->unavailable_reason())
+    throw ToolError(fmt::format("--truth {}: the provider is unavailable: {}", a.truth, *why));
+  const Executor executor(checked_threads(a.threads));
+  const scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
+  const Scene& scene = loaded.scene;
+  const size_t lights_in_file = loaded.lights_in_file;
+  const StereoRig rig = resolve_rig(scene, overrides);
+  const RenderScene prepared(scene);
+  fmt::print("validating {} pipeline(s) on {} ({} triangles, {}), {}, {} threads, truth: {}\n", chosen.size(),
+             scene.name, scene.triangle_count(), describe_lights(scene.lights.size(), lights_in_file),
+             describe(rig), executor.threads(), provider->name());
+
+  const fs::path out = a.out;
+  const std::optional<validation::TruthCache> cache =
+      a.no_cache ? std::nullopt : std::optional<validation::TruthCache>(validation::TruthCache(a.cache));
+  const validation::ValidationTarget target = validation::prepare_target(
+      prepared, loaded.file, rig, *provider, cache ? &*cache : nullptr, out / "work" / provider->name(), executor);
+  fmt::print("truth: {} ({}), {}{:.2f} s; true disocclusions {:.3f} % of the image\n", provider->name(),
+             target.truth.render.tool_version, target.truth.cached ? "from the cache, rendered in " : "",
+             target.truth.render.seconds,
+             100.0 * double(target.disocclusions.count()) / double(target.truth_srgb8.pixel_count()));
+  const std::string scene_stem = fmt::format("{}_{}", scene.name, provider->name());
+  const json shared_images = validation::write_target_images(out, scene.name, target);
+
+  const validation::MetricOptions metric_options{a.error_threshold};
+  json records = json::array();
+  fmt::print("\n{:<16} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10}\n", "pipeline", "PSNR dB", "SSIM", "MSE",
+             "err %", "holes %", "recall", "prec.", "time ms");
+  for (const Pipeline* pipeline : chosen) {
+    const PipelineOptions options(pipeline->info(), {});
+    const validation::PipelineValidation v = validation::validate_pipeline(target, *pipeline, options, executor, metric_options);
+    const std::string stem = fmt::format("{}_{}", scene_stem, v.pipeline);
+    json images = validation::write_pipeline_images(out, stem, target, v);
+    images.update(shared_images);
+    const json record = validation::validation_record(target, v, executor.threads(), images);
+    io::write_text_atomically(out / (stem + ".json"), record.dump(2) + "\n");
+    records.push_back(record);
+    const validation::HoleStatistics& h = v.holes;
+    fmt::print("{:<16} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10.1f}\n", v.pipeline, number(v.whole.psnr, "{:.2f}"),
+               number(v.whole.ssim, "{:.4f}"), number(v.whole.mse, "{:.3f}"), number(100.0 * v.whole.error_fraction, "{:.3f}"),
+               number(100.0 * h.hole_fraction, "{:.3f}"), number(h.scores.recall, "{:.4f}"),
+               number(h.scores.precision, "{:.4f}"), v.result.timings.total() * 1e3);
+  }
+  const fs::path summary = out / fmt::format("{}_summary.json", scene_stem);
+  io::write_text_atomically(summary, json{{"kind", "stereobench.validation_summary"}, {"records", records}}.dump(2) + "\n");
+  fmt::print("\nwrote {} (one record per pipeline beside it, images under {})\n", summary.string(), out.string());
+}
+
+}  // namespace
+
+void register_validate_command(CLI::App& root) {
+  auto a = std::make_shared<ValidateArgs>();
+  CLI::App* v = root.add_subcommand(
+      "validate",
+      "Measure pipelines' right eyes against a ground-truth right eye: MSE, PSNR, SSIM, error pixels\n"
+      "(whole image and per region: reprojected, filled, true disocclusions), hole statistics\n"
+      "against the true disocclusions, and time. Writes a JSON record and images per pipeline\n"
+      "(right eye, difference and SSIM maps, hole mask) and prints a table. Schema: docs/results.md.");
+  v->add_option("--scene,-s", a->scene, "Scene file (.gltf/.glb) or built-in scene name")->capture_default_str();
+  v->add_option("--pipelines,-p", a->pipelines,
+                "Pipelines to validate: names, comma-separated or repeated, or 'all' (see `stereobench pipelines`)")
+      ->capture_default_str();
+  v->add_option("--truth", a->truth,
+                "Ground truth: full (this suite's ray tracer), blender (Cycles) or povray; an unavailable\n"
+                "tool is an error (exit 4)")
+      ->capture_default_str();
+  v->add_option("--threads,-t", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
+  v->add_option("--out", a->out, "Output folder")->capture_default_str();
+  v->add_option("--cache", a->cache, "Folder of cached external ground-truth renders (keyed by content hash)")
+      ->capture_default_str();
+  v->add_flag("--no-cache", a->no_cache, "Render the ground truth again and do not store it");
+  v->add_option("--error-threshold", a->error_threshold,
+                "Error pixel: largest channel difference above this many 8-bit codes")
+      ->capture_default_str();
+  add_lights_option(*v, a->lights);
+  add_scenes_dir_option(*v, a->scenes_dir);
+  a->rig.add_to(*v);
+  v->callback([a] { run_validate(*a); });
+}
+
+}  // namespace sb::cli

@@ -1,0 +1,293 @@
+// The reference store: generate, read back and verify reference right eyes.
+#include "reference/store.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <unistd.h>
+
+#include <fmt/chrono.h>
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
+#include "renderer/io/image_io.hpp"
+#include "renderer/io/render_output.hpp"
+#include "renderer/render_scene.hpp"
+#include "sb_version.hpp"
+#include "scenes/catalog.hpp"
+#include "validation/content_hash.hpp"
+#include "validation/metric_images.hpp"
+#include "validation/truth.hpp"
+
+namespace sb::reference {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+constexpr const char* kProvenance = "provenance.json";
+constexpr const char* kImage = "right.exr";
+constexpr const char* kPreview = "right.png";
+
+template <class T>
+json optional_json(const std::optional<T>& v) {
+  return v ? json(*v) : json(nullptr);
+}
+
+template <class T>
+std::optional<T> optional_from(const json& j, const char* key) {
+  if (!j.contains(key) || j.at(key).is_null()) return std::nullopt;
+  return j.at(key).get<T>();
+}
+
+json spec_to_json(const ReferenceSpec& s) {
+  return {{"scene", s.scene},
+          {"lights", optional_json(s.lights)},
+          {"provider", s.provider},
+          {"rig_overrides",
+           {{"interaxial_m", optional_json(s.rig.interaxial)},
+            {"max_disparity_px", optional_json(s.rig.max_disparity_px)},
+            {"convergence_m", optional_json(s.rig.convergence)},
+            {"width", optional_json(s.rig.width)},
+            {"height", optional_json(s.rig.height)},
+            {"vfov_rad", optional_json(s.rig.vfov)}}}};
+}
+
+ReferenceSpec spec_from_json(const json& j) {
+  ReferenceSpec s;
+  s.scene = j.at("scene").get<std::string>();
+  s.lights = optional_from<int>(j, "lights");
+  s.provider = j.at("provider").get<std::string>();
+  const json& r = j.at("rig_overrides");
+  s.rig.interaxial = optional_from<double>(r, "interaxial_m");
+  s.rig.max_disparity_px = optional_from<double>(r, "max_disparity_px");
+  s.rig.convergence = optional_from<double>(r, "convergence_m");
+  s.rig.width = optional_from<int>(r, "width");
+  s.rig.height = optional_from<int>(r, "height");
+  s.rig.vfov = optional_from<double>(r, "vfov_rad");
+  return s;
+}
+
+std::string reference_id(const Scene& scene, const ReferenceSpec& spec, const StereoRig& rig) {
+  const RigParams& p = rig.params();
+  std::string id = fmt::format("{}_{}_{}x{}_e{:.1f}mm_c{:.3g}m", scene.name, spec.provider, p.width, p.height,
+                               p.interaxial * 1e3, p.convergence);
+  if (spec.lights) id += fmt::format("_l{}", *spec.lights);
+  return id;
+}
+
+std::string utc_now() {
+  return fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", fmt::gmtime(std::chrono::system_clock::to_time_t(std::chrono::system_clock::now())));
+}
+
+/// Replaces `dir` by `staged` (a complete folder beside it) with renames only.
+void replace_folder(const fs::path& staged, const fs::path& dir) {
+  std::error_code ec;
+  const fs::path old = dir.parent_path() / fmt::format(".{}.old-{}", dir.filename().string(), getpid());
+  if (fs::exists(dir)) {
+    fs::rename(dir, old, ec);
+    if (ec) throw IoError(fmt::format("cannot move the old reference '{}' aside: {}", dir.string(), ec.message()));
+  }
+  fs::rename(staged, dir, ec);
+  if (ec) {
+    std::error_code restore;
+    if (fs::exists(old)) fs::rename(old, dir, restore);
+    throw IoError(fmt::format("cannot move the new reference into '{}': {}", dir.string(), ec.message()));
+  }
+  fs::remove_all(old, ec);
+}
+
+struct Prepared {
+  scenes::LoadedScene loaded;
+  std::optional<StereoRig> rig;
+};
+
+Prepared prepare(const ReferenceSpec& spec, const fs::path& scenes_dir) {
+  Prepared p{scenes::load_scene(spec.scene, scenes_dir, spec.lights), std::nullopt};
+  p.rig.emplace(resolve_rig(p.loaded.scene, spec.rig));
+  return p;
+}
+
+}  // namespace
+
+fs::path default_store_dir() { return fs::path(SB_SOURCE_DIR) / "reference" / "store"; }
+
+const char* to_string(Status s) {
+  switch (s) {
+    case Status::ok: return "ok";
+    case Status::drift: return "drift";
+    case Status::corrupt: return "corrupt";
+    case Status::scene_changed: return "scene-changed";
+    case Status::unavailable: return "unavailable";
+  }
+  return "?";
+}
+
+std::vector<std::string> ReferenceStore::ids() const {
+  std::vector<std::string> out;
+  std::error_code ec;
+  if (!fs::is_directory(root_, ec)) return out;
+  for (const fs::directory_entry& e : fs::directory_iterator(root_)) {
+    const std::string name = e.path().filename().string();
+    if (e.is_directory() && name[0] != '.' && fs::exists(e.path() / kProvenance)) out.push_back(name);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+json ReferenceStore::provenance(const std::string& id) const {
+  const fs::path file = root_ / id / kProvenance;
+  if (!fs::exists(file)) {
+    const std::vector<std::string> known = ids();
+    throw InputError(fmt::format("no reference '{}' in {} ({}); run `stereobench reference list`", id, root_.string(),
+                                 known.empty() ? "the store is empty" : fmt::format("it holds {} references", known.size())));
+  }
+  try {
+    return json::parse(io::read_file(file));
+  } catch (const json::exception& e) {
+    throw InputError(fmt::format("{} is not valid JSON ({}); regenerate it with `stereobench reference update`",
+                                 file.string(), e.what()));
+  }
+}
+
+ReferenceSpec ReferenceStore::spec_of(const std::string& id) const {
+  const json p = provenance(id);
+  try {
+    return spec_from_json(p.at("spec"));
+  } catch (const json::exception& e) {
+    throw InputError(fmt::format("{}: field 'spec' is malformed ({})", (root_ / id / kProvenance).string(), e.what()));
+  }
+}
+
+std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& scenes_dir,
+                                     const std::string& command_line, const Executor& executor) const {
+  const std::unique_ptr<validation::TruthProvider> provider = validation::make_truth_provider(spec.provider);
+  if (auto why = provider->unavailable_reason())
+    throw ToolError(fmt::format("cannot generate a '{}' reference: {}", spec.provider, *why));
+  const Prepared p = prepare(spec, scenes_dir);
+  const Scene& scene = p.loaded.scene;
+  const std::string id = reference_id(scene, spec, *p.rig);
+  const fs::path staged = root_ / fmt::format(".{}.new-{}", id, getpid());
+  std::error_code ec;
+  fs::remove_all(staged, ec);
+  fs::create_directories(staged, ec);
+  if (ec) throw IoError(fmt::format("cannot create '{}': {}", staged.string(), ec.message()));
+  try {
+    const RenderScene prepared(scene);
+    const validation::TruthRequest request{prepared, p.loaded.file, *p.rig, staged / "work", executor.threads()};
+    const validation::TruthRender render = provider->render(request);
+    const Image right = validation::rgb_plane_only(render.right);
+    io::write_exr(staged / kImage, right);
+    validation::write_png(staged / kPreview, validation::encode_srgb8(right, "the reference"));
+    fs::remove_all(staged / "work", ec);
+    json rig = io::rig_to_json(*p.rig);
+    const CameraPose& pose = p.rig->pose();
+    rig["pose"] = {{"position", {pose.position.x, pose.position.y, pose.position.z}},
+                   {"right", {pose.right.x, pose.right.y, pose.right.z}},
+                   {"up", {pose.up.x, pose.up.y, pose.up.z}},
+                   {"back", {pose.back.x, pose.back.y, pose.back.z}}};
+    const json provenance = {
+        {"kind", "stereobench.reference"},
+        {"version", 1},
+        {"id", id},
+        {"spec", spec_to_json(spec)},
+        {"provider",
+         {{"name", render.provider}, {"tool_version", render.tool_version}, {"revision", provider->revision()},
+          {"settings", render.settings}, {"command", render.command}, {"seconds", render.seconds}}},
+        {"scene",
+         {{"name", scene.name}, {"file", p.loaded.file.string()}, {"file_sha256", validation::hash_file(p.loaded.file)},
+          {"content_sha256", validation::hash_scene(scene)}, {"triangles", scene.triangle_count()},
+          {"lights", scene.lights.size()}, {"lights_in_file", p.loaded.lights_in_file}}},
+        {"rig", rig},
+        {"image",
+         {{"file", kImage}, {"preview", kPreview}, {"width", right.width()}, {"height", right.height()},
+          {"sha256", validation::hash_file(staged / kImage)}, {"content_sha256", validation::hash_image(right)}}},
+        {"command_line", command_line},
+        {"date", utc_now()},
+        {"stereobench_version", SB_VERSION_STRING},
+        {"versions", io::versions_json()}};
+    io::write_text_atomically(staged / kProvenance, provenance.dump(2) + "\n");
+    replace_folder(staged, root_ / id);
+  } catch (...) {
+    fs::remove_all(staged, ec);
+    throw;
+  }
+  return id;
+}
+
+VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scenes_dir, const VerifyOptions& options,
+                                    const Executor& executor) const {
+  VerifyResult r;
+  r.id = id;
+  const json prov = provenance(id);
+  const fs::path image_file = root_ / id / kImage;
+  std::string stored_hash;
+  try {
+    stored_hash = prov.at("image").at("sha256").get<std::string>();
+  } catch (const json::exception&) {
+    r.status = Status::corrupt;
+    r.detail = "the provenance has no image hash";
+    return r;
+  }
+  std::error_code ec;
+  if (!fs::exists(image_file, ec)) {
+    r.status = Status::corrupt;
+    r.detail = fmt::format("{} is missing", image_file.string());
+    return r;
+  }
+  const std::string file_hash = validation::hash_file(image_file);
+  if (file_hash != stored_hash) {
+    r.status = Status::corrupt;
+    r.detail = fmt::format("{} has hash {} but its provenance records {}", image_file.string(), file_hash.substr(0, 12),
+                           stored_hash.substr(0, 12));
+    return r;
+  }
+  const ReferenceSpec spec = spec_of(id);
+  const Prepared p = prepare(spec, scenes_dir);
+  const std::string scene_hash = validation::hash_scene(p.loaded.scene);
+  const std::string recorded_scene = prov.at("scene").value("content_sha256", "");
+  if (scene_hash != recorded_scene) {
+    r.status = Status::scene_changed;
+    r.detail = fmt::format("scene '{}' ({}) now hashes to {}, the reference was rendered from {}; regenerate it",
+                           spec.scene, p.loaded.file.string(), scene_hash.substr(0, 12), recorded_scene.substr(0, 12));
+    return r;
+  }
+  if (!options.rerender) {
+    r.detail = "image and scene hashes match (not rendered again)";
+    return r;
+  }
+  const std::unique_ptr<validation::TruthProvider> provider = validation::make_truth_provider(spec.provider);
+  if (auto why = provider->unavailable_reason()) {
+    r.status = Status::unavailable;
+    r.detail = *why;
+    return r;
+  }
+  const Image stored = validation::rgb_plane_only(io::read_exr(image_file));
+  const RenderScene prepared(p.loaded.scene);
+  const fs::path work = root_ / fmt::format(".{}.verify-{}", id, getpid());
+  const validation::TruthRequest request{prepared, p.loaded.file, *p.rig, work, executor.threads()};
+  Image fresh;
+  try {
+    fresh = validation::rgb_plane_only(provider->render(request).right);
+  } catch (...) {
+    fs::remove_all(work, ec);
+    throw;
+  }
+  fs::remove_all(work, ec);
+  r.bit_identical = fresh == stored;
+  r.metrics = validation::compare_images(validation::encode_srgb8(fresh, "the new render"),
+                                         validation::encode_srgb8(stored, "the stored reference"));
+  const double psnr = r.metrics->psnr;
+  const bool within = r.bit_identical || psnr >= options.min_psnr;
+  r.status = within ? Status::ok : Status::drift;
+  r.detail = r.bit_identical ? "a new render is bit-identical"
+                             : fmt::format("a new render differs: PSNR {:.2f} dB, max error {} at ({}, {}), {:.4f} % error pixels{}",
+                                           psnr, r.metrics->max_error, r.metrics->max_x, r.metrics->max_y,
+                                           100.0 * r.metrics->error_fraction,
+                                           within ? fmt::format(" (within --min-psnr {})", options.min_psnr) : "");
+  return r;
+}
+
+}  // namespace sb::reference

@@ -1,0 +1,220 @@
+// `stereobench compare`: metrics of two image files, idiff-style thresholds with the exit codes of
+// DESIGN §2, the JSON record, the pictures, and clear errors for inputs that cannot be compared.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "renderer/color.hpp"
+#include "renderer/io/atomic_file.hpp"
+#include "renderer/io/image_io.hpp"
+#include "support/run_cli.hpp"
+#include "support/scratch_dir.hpp"
+#include "validation/image_files.hpp"
+#include "validation/metric_images.hpp"
+#include "validation/metrics.hpp"
+
+namespace sb {
+namespace {
+
+using test::CliRun;
+using validation::Srgb8Image;
+
+/// A 48 x 32 pattern; `noise` adds up to +-noise codes per channel at every `every`-th pixel.
+Srgb8Image picture(int noise = 0, int every = 1, int w = 48, int h = 32) {
+  Srgb8Image im{w, h, std::vector<uint8_t>(size_t(w) * size_t(h) * 3)};
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        int v = int(std::lround(127.5 + 100.0 * std::sin(0.2 * x + 0.8 * c) * std::cos(0.15 * y)));
+        const int i = y * w + x;
+        if (noise > 0 && i % every == 0) v += ((i * 37 + c * 11) % (2 * noise + 1)) - noise;
+        im.rgb[(size_t(i)) * 3 + size_t(c)] = uint8_t(std::clamp(v, 0, 255));
+      }
+  return im;
+}
+
+std::string q(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
+
+CliRun compare(const std::string& args) { return test::run_cli("compare " + args); }
+
+/// Runs stereobench with stderr discarded, to read what it prints on stdout alone.
+std::string stdout_of(const std::string& args) {
+  const std::string cmd = std::string(SB_CLI_PATH) + " " + args + " 2>/dev/null";
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 1024> buf{};
+  while (pipe && std::fgets(buf.data(), buf.size(), pipe)) out += buf.data();
+  if (pipe) ::pclose(pipe);
+  return out;
+}
+
+class Compare : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    validation::write_png(dir_ / "a.png", picture());
+    // 1 in 7 pixels off by up to 6 codes.
+    validation::write_png(dir_ / "b.png", picture(6, 7));
+  }
+  std::filesystem::path path(const std::string& name) const { return dir_ / name; }
+  std::string ab() const { return q(path("a.png")) + " " + q(path("b.png")); }
+
+  test::ScratchDir dir_{"compare"};
+};
+
+TEST_F(Compare, IdenticalImagesPass) {
+  const CliRun r = compare(q(path("a.png")) + " " + q(path("a.png")) + " --fail-psnr 60 --fail-ssim 0.999");
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("inf dB"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("0 (identical)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("verdict: PASS"), std::string::npos) << r.out;
+}
+
+TEST_F(Compare, ThresholdsGiveFailAndWarnExitCodes) {
+  // The metrics of this pair, from the library: the limits below are placed around them.
+  const validation::ImageMetrics m = validation::compare_images(picture(), picture(6, 7));
+  ASSERT_GT(m.psnr, 30.0);
+  ASSERT_LT(m.psnr, 60.0);
+  ASSERT_GT(m.error_fraction, 0.0);
+  const std::string psnr_above = std::to_string(m.psnr + 1.0), psnr_below = std::to_string(m.psnr - 1.0);
+
+  CliRun r = compare(ab() + " --fail-psnr " + psnr_below + " --warn-psnr " + psnr_below);
+  EXPECT_EQ(r.code, 0) << r.out;
+  r = compare(ab() + " --warn-psnr " + psnr_above);
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("warning: PSNR"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("verdict: WARN"), std::string::npos) << r.out;
+  r = compare(ab() + " --fail-psnr " + psnr_above + " --warn-psnr " + psnr_above);
+  EXPECT_EQ(r.code, 2) << r.out;  // a failure outranks a warning
+  EXPECT_NE(r.out.find("failure: PSNR"), std::string::npos) << r.out;
+  r = compare(ab() + " --fail-ssim 1");
+  EXPECT_EQ(r.code, 2) << r.out;
+  r = compare(ab() + " --warn-ssim 1 --fail-ssim 0.5");
+  EXPECT_EQ(r.code, 1) << r.out;
+  r = compare(ab() + " --fail-percent 0");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("error pixels"), std::string::npos) << r.out;
+  r = compare(ab() + " --fail-percent 100 --warn-percent 100");
+  EXPECT_EQ(r.code, 0) << r.out;
+  // Differences of up to 6 codes are no error pixels at --error-threshold 6.
+  r = compare(ab() + " --fail-percent 0 --error-threshold 6");
+  EXPECT_EQ(r.code, 0) << r.out;
+  // Impossible limits are usage errors.
+  for (const char* bad :
+       {" --fail-ssim 2", " --warn-percent 101", " --fail-psnr -1", " --error-threshold 256", " --eye middle"}) {
+    r = compare(ab() + bad);
+    EXPECT_EQ(r.code, 3) << bad << ": " << r.out;
+  }
+}
+
+TEST_F(Compare, MismatchedAndMissingInputsAreBadInput) {
+  validation::write_png(path("small.png"), picture(0, 1, 40, 30));
+  CliRun r = compare(q(path("a.png")) + " " + q(path("small.png")));
+  EXPECT_EQ(r.code, 3) << r.out;
+  EXPECT_NE(r.out.find("48x32"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("40x30"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("small.png"), std::string::npos) << r.out;
+
+  r = compare(q(path("a.png")) + " " + q(path("nothere.png")));
+  EXPECT_EQ(r.code, 3) << r.out;
+  EXPECT_NE(r.out.find("nothere.png: no such file"), std::string::npos) << r.out;
+
+  std::vector<uint8_t> grey(48 * 32, 128);
+  io::write_file_atomically(path("grey.png"), io::encode_png(grey.data(), 48, 32, 1));
+  r = compare(q(path("a.png")) + " " + q(path("grey.png")));
+  EXPECT_EQ(r.code, 3) << r.out;
+  EXPECT_NE(r.out.find("channel"), std::string::npos) << r.out;
+
+  r = compare(q(path("a.png")));
+  EXPECT_EQ(r.code, 3) << r.out;  // B is required
+}
+
+TEST_F(Compare, JsonRecord) {
+  const CliRun r = compare(ab() + " --json " + q(path("out/metrics.json")) + " --warn-ssim 1");
+  EXPECT_EQ(r.code, 1) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(test::read_text(path("out/metrics.json")));
+  const validation::ImageMetrics m = validation::compare_images(picture(), picture(6, 7));
+  EXPECT_EQ(j["metrics_version"], validation::kMetricsVersion);
+  EXPECT_EQ(j["metrics"], validation::to_json(m));
+  EXPECT_EQ(j["a"]["width"], 48);
+  EXPECT_EQ(j["b"]["path"], path("b.png").string());
+  EXPECT_TRUE(j["mask"].is_null());
+  EXPECT_EQ(j["verdict"], "warn");
+  EXPECT_EQ(j["exit_code"], 1);
+  EXPECT_EQ(j["thresholds"]["warn_ssim"], 1.0);
+  EXPECT_TRUE(j["thresholds"]["fail_psnr"].is_null());
+  ASSERT_EQ(j["warnings"].size(), 1u);
+
+  // --json - puts the record alone on stdout; identical images give PSNR "inf".
+  const nlohmann::json same =
+      nlohmann::json::parse(stdout_of("compare " + q(path("a.png")) + " " + q(path("a.png")) + " --json -"));
+  EXPECT_EQ(same["metrics"]["psnr"], "inf");
+  EXPECT_EQ(same["metrics"]["mse"], 0.0);
+  EXPECT_EQ(same["verdict"], "pass");
+}
+
+TEST_F(Compare, MaskAndPictures) {
+  // Mask: the left half.
+  std::vector<uint8_t> mask(48 * 32, 0);
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 24; ++x) mask[size_t(y) * 48 + size_t(x)] = 255;
+  io::write_file_atomically(path("mask.png"), io::encode_png(mask.data(), 48, 32, 1));
+  const CliRun r = compare(ab() + " --mask " + q(path("mask.png")) + " --json " + q(path("m.json")) + " --diff " +
+                           q(path("pics/diff.png")) + " --ssim-map " + q(path("pics/ssim.png")));
+  EXPECT_EQ(r.code, 0) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(test::read_text(path("m.json")));
+  EXPECT_EQ(j["mask"]["pixels"], 24 * 32);
+  EXPECT_EQ(j["metrics"]["pixels"], 24 * 32);
+  validation::RegionMask region = validation::read_region_mask(path("mask.png"));
+  const Srgb8Image a = picture(), b = picture(6, 7);
+  EXPECT_EQ(j["metrics"], validation::to_json(validation::compare_images(a, b, &region)));
+  // The pictures are the library's, written as PNG.
+  EXPECT_EQ(validation::read_srgb8_file(path("pics/diff.png")).image.rgb,
+            validation::difference_image(a, b, &region).rgb);
+  EXPECT_EQ(validation::read_srgb8_file(path("pics/ssim.png")).image.rgb,
+            validation::ssim_image(validation::ssim_map(a, b), &region).rgb);
+
+  // An empty mask is refused rather than reported as a perfect match.
+  std::fill(mask.begin(), mask.end(), uint8_t{0});
+  io::write_file_atomically(path("empty.png"), io::encode_png(mask.data(), 48, 32, 1));
+  const CliRun e = compare(ab() + " --mask " + q(path("empty.png")));
+  EXPECT_EQ(e.code, 3) << e.out;
+  EXPECT_NE(e.out.find("empty"), std::string::npos) << e.out;
+}
+
+TEST_F(Compare, StereoExrNeedsAnEye) {
+  const auto linear = [](const Srgb8Image& s) {
+    Image im(s.width, s.height);
+    float* v = im.add_plane(planes::rgb).data_f32();
+    for (size_t i = 0; i < s.rgb.size(); ++i) v[i] = srgb8_to_linear(s.rgb[i]);
+    return im;
+  };
+  io::write_exr_stereo(path("pair.exr"), linear(picture(6, 7)), linear(picture()));
+  CliRun r = compare(q(path("pair.exr")) + " " + q(path("a.png")));
+  EXPECT_EQ(r.code, 3) << r.out;
+  EXPECT_NE(r.out.find("--eye left|right"), std::string::npos) << r.out;
+  // The right eye is exactly a.png after encoding.
+  r = compare(q(path("pair.exr")) + " " + q(path("a.png")) + " --eye right --fail-psnr 1000");
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("inf dB"), std::string::npos) << r.out;
+  r = compare(q(path("pair.exr")) + " " + q(path("a.png")) + " --eye left --fail-psnr 1000");
+  EXPECT_EQ(r.code, 2) << r.out;
+}
+
+TEST(CompareHelp, ExplainsMetricsAndExitCodes) {
+  const CliRun h = test::run_cli("compare --help");
+  EXPECT_EQ(h.code, 0);
+  for (const char* s : {"--fail-psnr", "--warn-percent", "--ssim-map", "--eye", "Exit codes", "scikit-image", "sRGB"})
+    EXPECT_NE(h.out.find(s), std::string::npos) << s << "\n" << h.out;
+}
+
+}  // namespace
+}  // namespace sb

@@ -1,0 +1,68 @@
+// `stereobench validate`: records, images and the terminal table for a plain and a reprojecting
+// pipeline against the built-in ground truth; bad input and a missing provider tool.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "support/run_cli.hpp"
+#include "support/scratch_dir.hpp"
+
+namespace sb {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::string base_args(const test::ScratchDir& dir) {
+  return "validate --scene box-wall --resolution 160x90 --threads 2 --scenes-dir '" +
+         (fs::path(SB_BINARY_DIR) / "Testing" / "scenes-cache").string() + "' --out '" + (dir / "out").string() +
+         "' --cache '" + (dir / "cache").string() + "'";
+}
+
+TEST(Validate, WritesRecordsImagesAndTable) {
+  test::ScratchDir dir;
+  const test::CliRun r = test::run_cli(base_args(dir) + " --pipelines plain-rt,repro-rt --pipelines fw-warp");
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (const char* p : {"plain-rt", "repro-rt", "fw-warp"}) EXPECT_NE(r.out.find(p), std::string::npos) << r.out;
+  const fs::path out = dir / "out";
+  const json plain = json::parse(test::read_text(out / "box-wall_full_plain-rt.json"));
+  EXPECT_EQ(plain["kind"], "stereobench.validation");
+  EXPECT_EQ(plain["truth"]["provider"], "full");
+  EXPECT_EQ(plain["metrics"]["psnr"], "inf") << "plain-rt's right eye is the built-in ground truth";
+  EXPECT_EQ(plain["metrics"]["ssim"], 1.0);
+  EXPECT_EQ(plain["regions"]["reprojected"]["pixels"], 0);
+  EXPECT_TRUE(plain["regions"]["reprojected"]["psnr"].is_null());
+
+  const json repro = json::parse(test::read_text(out / "box-wall_full_repro-rt.json"));
+  EXPECT_GT(repro["regions"]["reprojected"]["pixels"].get<int>(), 10000);
+  EXPECT_GT(repro["holes"]["true_disocclusions"]["pixels"].get<int>(), 0);
+  EXPECT_GT(repro["holes"]["not_reprojected"]["recall"].get<double>(), 0.9);
+  EXPECT_EQ(repro["regions"]["true_disocclusions"]["pixels"], repro["holes"]["true_disocclusions"]["pixels"]);
+  EXPECT_GT(repro["total_s"].get<double>(), 0.0);
+  EXPECT_FALSE(repro["metrics_version"].get<std::string>().empty());
+  for (const auto& [name, path] : repro["images"].items()) EXPECT_TRUE(fs::exists(path.get<std::string>())) << name;
+  const json summary = json::parse(test::read_text(out / "box-wall_full_summary.json"));
+  EXPECT_EQ(summary["records"].size(), 3u);
+}
+
+TEST(Validate, BadInputAndMissingTools) {
+  test::ScratchDir dir;
+  const test::CliRun unknown = test::run_cli(base_args(dir) + " --pipelines plain-rt,no-such-pipeline");
+  EXPECT_EQ(unknown.code, 3) << unknown.out;
+  EXPECT_NE(unknown.out.find("no-such-pipeline"), std::string::npos) << unknown.out;
+  const test::CliRun truth = test::run_cli(base_args(dir) + " --truth mitsuba");
+  EXPECT_EQ(truth.code, 3) << truth.out;
+  EXPECT_NE(truth.out.find("full, blender, povray"), std::string::npos) << truth.out;
+  ::setenv("STEREOBENCH_BLENDER", "/nonexistent/blender", 1);
+  const test::CliRun missing = test::run_cli(base_args(dir) + " --truth blender --pipelines plain-rt");
+  ::unsetenv("STEREOBENCH_BLENDER");
+  EXPECT_EQ(missing.code, 4) << missing.out;
+  EXPECT_NE(missing.out.find("unavailable"), std::string::npos) << missing.out;
+  EXPECT_FALSE(fs::exists(dir / "out" / "box-wall_blender_plain-rt.json")) << "no record for a truth that was not rendered";
+}
+
+}  // namespace
+}  // namespace sb

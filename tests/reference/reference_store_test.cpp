@@ -1,0 +1,129 @@
+// The reference store: generate with provenance, verify bit for bit, detect a damaged image and a
+// changed scene, rewrite only failing references, and report a missing tool as unavailable.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "reference/store.hpp"
+#include "scenes/catalog.hpp"
+#include "support/run_cli.hpp"
+#include "support/scratch_dir.hpp"
+
+namespace sb::reference {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const fs::path kScenes = fs::path(SB_BINARY_DIR) / "Testing" / "scenes-cache";
+
+std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
+
+/// `stereobench reference <sub> ...` on the test's own store.
+std::string ref(const test::ScratchDir& dir, const std::string& sub) {
+  return "reference " + sub + " --store " + quoted(dir / "store") + " --scenes-dir " + quoted(kScenes);
+}
+
+void damage(const fs::path& file) {
+  std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+  f.seekp(-8, std::ios::end);
+  f.write("damaged!", 8);
+}
+
+TEST(ReferenceStore, GenerateWritesImageAndProvenance) {
+  test::ScratchDir dir;
+  const test::CliRun gen = test::run_cli(ref(dir, "generate") + " --scene box-wall --resolution 64x36 --threads 1");
+  ASSERT_EQ(gen.code, 0) << gen.out;
+  const ReferenceStore store(dir / "store");
+  ASSERT_EQ(store.ids().size(), 1u);
+  const std::string id = store.ids()[0];
+  EXPECT_EQ(id, "box-wall_full_64x36_e64.0mm_c4.08m");
+  EXPECT_TRUE(fs::exists(dir / "store" / id / "right.exr"));
+  EXPECT_TRUE(fs::exists(dir / "store" / id / "right.png"));
+  const json p = store.provenance(id);
+  EXPECT_EQ(p["provider"]["name"], "full");
+  EXPECT_FALSE(p["provider"]["tool_version"].get<std::string>().empty());
+  EXPECT_EQ(p["scene"]["content_sha256"].get<std::string>().size(), 64u);
+  EXPECT_EQ(p["scene"]["file_sha256"].get<std::string>().size(), 64u);
+  EXPECT_EQ(p["image"]["sha256"].get<std::string>().size(), 64u);
+  EXPECT_EQ(p["rig"]["width"], 64);
+  EXPECT_NE(p["command_line"].get<std::string>().find("--scene box-wall"), std::string::npos);
+  EXPECT_EQ(p["date"].get<std::string>().size(), 20u);  // 2026-01-02T03:04:05Z
+  // Nothing but complete entries in the store.
+  for (const auto& e : fs::directory_iterator(dir / "store")) EXPECT_EQ(e.path().filename().string(), id);
+}
+
+TEST(ReferenceStore, VerifyUpdateOnlyFailingAndCorruption) {
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene box-wall --resolution 64x36").code, 0);
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene thin-pole --resolution 48x32").code, 0);
+  const ReferenceStore store(dir / "store");
+  ASSERT_EQ(store.ids().size(), 2u);
+
+  const test::CliRun ok = test::run_cli(ref(dir, "verify") + " --json " + quoted(dir / "verdicts.json"));
+  EXPECT_EQ(ok.code, 0) << ok.out;
+  const json verdicts = json::parse(test::read_text(dir / "verdicts.json"));
+  ASSERT_EQ(verdicts.size(), 2u);
+  for (const json& v : verdicts) {
+    EXPECT_EQ(v["status"], "ok");
+    EXPECT_TRUE(v["bit_identical"].get<bool>()) << "the built-in provider is deterministic";
+  }
+
+  const std::string pole = "thin-pole_full_48x32_e64.0mm_c2m";
+  const std::string box = "box-wall_full_64x36_e64.0mm_c4.08m";
+  const std::string box_date = store.provenance(box)["date"];
+  const auto box_time = fs::last_write_time(dir / "store" / box / "provenance.json");
+  damage(dir / "store" / pole / "right.exr");
+  const test::CliRun bad = test::run_cli(ref(dir, "verify") + " --no-render");
+  EXPECT_EQ(bad.code, 2) << bad.out;
+  EXPECT_NE(bad.out.find("corrupt"), std::string::npos) << bad.out;
+  EXPECT_NE(bad.out.find(pole), std::string::npos) << bad.out;
+
+  const test::CliRun upd = test::run_cli(ref(dir, "update") + " --only-failing");
+  EXPECT_EQ(upd.code, 0) << upd.out;
+  EXPECT_NE(upd.out.find("1 reference(s) rewritten"), std::string::npos) << upd.out;
+  EXPECT_EQ(fs::last_write_time(dir / "store" / box / "provenance.json"), box_time) << "a passing reference was rewritten";
+  EXPECT_EQ(store.provenance(box)["date"], box_date);
+  EXPECT_EQ(test::run_cli(ref(dir, "verify")).code, 0);
+}
+
+TEST(ReferenceStore, ChangedSceneIsReported) {
+  test::ScratchDir dir;
+  // A scene file of our own, changed after the reference was made.
+  const fs::path scene = dir / "plane.gltf";
+  fs::copy_file(scenes::resolve_scene("lit-plane", kScenes), scene);
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene " + quoted(scene) + " --resolution 32x18").code, 0);
+  std::string text = test::read_text(scene);
+  const size_t at = text.find("\"intensity\"");
+  ASSERT_NE(at, std::string::npos);
+  const size_t colon = text.find(':', at);
+  const size_t end = text.find_first_of(",}", colon);
+  text.replace(colon + 1, end - colon - 1, "123.5");
+  std::ofstream(scene, std::ios::binary | std::ios::trunc) << text;
+  const test::CliRun r = test::run_cli(ref(dir, "verify"));
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("scene-changed"), std::string::npos) << r.out;
+}
+
+TEST(ReferenceStore, MissingToolIsUnavailableNotAPass) {
+  test::ScratchDir dir;
+  EXPECT_EQ(test::run_cli(ref(dir, "verify")).code, 3) << "an empty store is not a pass";
+  EXPECT_EQ(test::run_cli(ref(dir, "generate") + " --scene box-wall --truth nosuchtool --resolution 32x18").code, 3);
+  // A POV-Ray reference, then POV-Ray gone: generating is an error, verifying is "unavailable".
+  const test::CliRun gen = test::run_cli(ref(dir, "generate") + " --scene box-wall --truth povray --resolution 32x18");
+  ASSERT_EQ(gen.code, 0) << gen.out << "\n(POV-Ray is installed by ci/install-deps.sh povray)";
+  ::setenv("STEREOBENCH_POVRAY", "/nonexistent/povray", 1);
+  const test::CliRun again = test::run_cli(ref(dir, "generate") + " --scene box-wall --truth povray --resolution 32x18");
+  const test::CliRun verify = test::run_cli(ref(dir, "verify"));
+  ::unsetenv("STEREOBENCH_POVRAY");
+  EXPECT_EQ(again.code, 4) << again.out;
+  EXPECT_EQ(verify.code, 4) << verify.out;
+  EXPECT_NE(verify.out.find("unavailable"), std::string::npos) << verify.out;
+  EXPECT_NE(verify.out.find("0 of 1 reference(s) verified"), std::string::npos) << verify.out;
+}
+
+}  // namespace
+}  // namespace sb::reference

@@ -1,0 +1,162 @@
+// The truth cache and content hashes: a cached ground truth is rendered once per content, its key
+// follows everything that changes the image, a damaged entry is rendered again, and the built-in
+// provider is never cached.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "renderer/error.hpp"
+#include "renderer/stages/eye_image.hpp"
+#include "support/render_support.hpp"
+#include "support/scratch_dir.hpp"
+#include "validation/content_hash.hpp"
+#include "validation/truth_cache.hpp"
+
+namespace sb::validation {
+namespace {
+
+/// A provider that paints a constant image and counts its renders.
+class CountingProvider final : public TruthProvider {
+ public:
+  explicit CountingProvider(std::string name = "counting", bool available = true)
+      : name_(std::move(name)), available_(available) {}
+  std::string name() const override { return name_; }
+  std::string description() const override { return "test provider"; }
+  std::optional<std::string> unavailable_reason() const override {
+    return available_ ? std::nullopt : std::optional<std::string>("not installed here");
+  }
+  std::string tool_version() const override { return "counting 1.0"; }
+  std::string revision() const override { return revision_; }
+  TruthRender render(const TruthRequest& request) const override {
+    ++renders;
+    TruthRender r;
+    r.provider = name_;
+    r.tool_version = tool_version();
+    r.right = make_eye_image(request.rig.params().width, request.rig.params().height);
+    for (int y = 0; y < r.right.height(); ++y)
+      for (int x = 0; x < r.right.width(); ++x) r.right.set_rgb(x, y, {0.25f, 0.5f, float(x) / 64.0f});
+    r.settings = {{"constant", true}};
+    r.command = "counting --render";
+    r.seconds = 0.5;
+    return r;
+  }
+  mutable int renders = 0;
+  std::string revision_ = "r1";
+
+ private:
+  std::string name_;
+  bool available_;
+};
+
+TEST(Sha256, MatchesTheStandardTestVector) {
+  Sha256 sha;
+  const std::string abc = "abc";
+  sha.add(std::as_bytes(std::span<const char>(abc.data(), abc.size())));
+  EXPECT_EQ(sha.hex(), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+}
+
+TEST(Sha256, FileHashMatchesByteHashAndMissingFileIsAnIoError) {
+  test::ScratchDir dir;
+  std::ofstream(dir / "f.txt", std::ios::binary) << "abc";
+  EXPECT_EQ(hash_file(dir / "f.txt"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_THROW((void)hash_file(dir / "missing.txt"), IoError);
+}
+
+TEST(SceneHash, FollowsContentNotNames) {
+  Scene a = test::load_builtin("box-wall");
+  Scene b = a;
+  b.name = "renamed";
+  b.path = "/elsewhere.gltf";
+  EXPECT_EQ(hash_scene(a), hash_scene(b));
+  b.lights[0].intensity *= 1.0001f;
+  EXPECT_NE(hash_scene(a), hash_scene(b));
+  Scene c = a;
+  c.meshes[0].positions[0].x += 1e-6f;
+  EXPECT_NE(hash_scene(a), hash_scene(c));
+  Scene d = a;
+  d.background.y += 0.01f;
+  EXPECT_NE(hash_scene(a), hash_scene(d));
+}
+
+TEST(TruthCache, RendersOncePerContentAndKeysFollowTheRig) {
+  test::ScratchDir dir;
+  const Scene scene = test::load_builtin("box-wall");
+  const RenderScene prepared(scene);
+  const TruthCache cache(dir / "cache");
+  CountingProvider provider;
+  const TruthRequest request{prepared, scene.path, test::rig_at(scene, 64, 36), dir / "work", 1};
+
+  const ResolvedTruth first = resolve_truth(provider, request, &cache);
+  EXPECT_FALSE(first.cached);
+  EXPECT_EQ(provider.renders, 1);
+  const ResolvedTruth second = resolve_truth(provider, request, &cache);
+  EXPECT_TRUE(second.cached);
+  EXPECT_EQ(provider.renders, 1);
+  EXPECT_EQ(second.key, first.key);
+  EXPECT_EQ(hash_image(second.render.right), hash_image(rgb_plane_only(first.render.right)));
+  EXPECT_EQ(second.render.settings, first.render.settings);
+  EXPECT_EQ(second.render.command, "counting --render");
+  EXPECT_EQ(second.render.tool_version, "counting 1.0");
+
+  RigOverrides wider;
+  wider.width = 64;
+  wider.height = 36;
+  wider.interaxial = 0.07;
+  const TruthRequest other_rig{prepared, scene.path, resolve_rig(scene, wider), dir / "work", 1};
+  EXPECT_NE(truth_key(provider, other_rig), first.key);
+  provider.revision_ = "r2";
+  EXPECT_NE(truth_key(provider, request), first.key) << "a new provider revision must not reuse old renders";
+}
+
+TEST(TruthCache, DamagedEntryIsRenderedAgain) {
+  test::ScratchDir dir;
+  const Scene scene = test::load_builtin("box-wall");
+  const RenderScene prepared(scene);
+  const TruthCache cache(dir / "cache");
+  CountingProvider provider;
+  const TruthRequest request{prepared, scene.path, test::rig_at(scene, 64, 36), dir / "work", 1};
+  const ResolvedTruth first = resolve_truth(provider, request, &cache);
+  {
+    std::fstream f(cache.image_path("counting", first.key), std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(-16, std::ios::end);
+    f.write("garbage-garbage!", 16);
+  }
+  const ResolvedTruth again = resolve_truth(provider, request, &cache);
+  EXPECT_FALSE(again.cached);
+  EXPECT_EQ(provider.renders, 2);
+  EXPECT_TRUE(resolve_truth(provider, request, &cache).cached);
+}
+
+TEST(TruthCache, FullProviderIsNeverCachedAndUnavailableProviderIsAToolError) {
+  test::ScratchDir dir;
+  const Scene scene = test::load_builtin("box-wall");
+  const RenderScene prepared(scene);
+  const TruthCache cache(dir / "cache");
+  const TruthRequest request{prepared, scene.path, test::rig_at(scene, 64, 36), dir / "work", 1};
+  const auto full = make_truth_provider("full");
+  EXPECT_FALSE(resolve_truth(*full, request, &cache).cached);
+  EXPECT_FALSE(resolve_truth(*full, request, &cache).cached);
+  EXPECT_FALSE(std::filesystem::exists(dir / "cache" / "full"));
+
+  const CountingProvider missing("missing", false);
+  try {
+    (void)resolve_truth(missing, request, &cache);
+    FAIL() << "an unavailable provider must not pass";
+  } catch (const ToolError& e) {
+    EXPECT_NE(std::string(e.what()).find("unavailable"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW((void)make_truth_provider("mitsuba"), InputError);
+}
+
+TEST(FullProvider, EqualsPlainRtRightEye) {
+  const Scene scene = test::load_builtin("spheres");
+  const RenderScene prepared(scene);
+  const StereoRig rig = test::rig_at(scene, 96, 54);
+  const TruthRequest request{prepared, scene.path, rig, {}, 2};
+  const TruthRender truth = make_truth_provider("full")->render(request);
+  const StereoResult plain = test::render_with("plain-rt", prepared, rig, 1);
+  EXPECT_EQ(rgb_plane_only(truth.right), rgb_plane_only(plain.right));
+}
+
+}  // namespace
+}  // namespace sb::validation

@@ -1,0 +1,137 @@
+// Reading image files for the metrics: format detection, stereo EXR eye selection, 8-bit sRGB
+// conversion and region masks.
+#include "validation/image_files.hpp"
+
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <optional>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
+#include "renderer/io/image_io.hpp"
+
+namespace sb::validation {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Checks that `path` names a readable file; returns whether it is an OpenEXR file (by its magic
+/// number). Missing: InputError; present but unreadable: IoError.
+bool open_and_sniff_exr(const fs::path& path) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (!fs::exists(status)) throw InputError(fmt::format("{}: no such file; check the path", path.string()));
+  if (fs::is_directory(status)) throw InputError(fmt::format("{} is a folder, not an image file", path.string()));
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    throw IoError(fmt::format("{} exists but cannot be opened for reading; check its permissions", path.string()));
+  std::array<char, 4> magic{};
+  in.read(magic.data(), magic.size());
+  return in.gcount() == 4 && magic == std::array<char, 4>{'\x76', '\x2f', '\x31', '\x01'};
+}
+
+void check_eye(std::string_view eye) {
+  if (!eye.empty() && eye != "left" && eye != "right")
+    throw InputError(fmt::format("eye '{}' is unknown; give left or right", eye));
+}
+
+/// A single image from an EXR file: the file itself when it holds one image, the chosen eye when
+/// it holds a stereo pair (InputError without a choice).
+Image read_exr_image(const fs::path& path, std::string_view eye, std::string& taken_eye) {
+  check_eye(eye);
+  std::optional<std::pair<Image, Image>> pair;
+  try {
+    return io::read_exr(path);
+  } catch (const InputError&) {
+    // Either a stereo pair or an unreadable file: tell them apart by reading it as a pair.
+    try {
+      pair = io::read_exr_stereo(path);
+    } catch (const Error&) {
+      pair.reset();
+    }
+    if (!pair) throw;
+  }
+  if (eye.empty())
+    throw InputError(
+        fmt::format("{} is a stereo EXR (left and right eyes); choose one with --eye left|right", path.string()));
+  taken_eye = std::string(eye);
+  return eye == "left" ? std::move(pair->first) : std::move(pair->second);
+}
+
+/// 8-bit codes of an sRGB-encoded sample scaled to [0, 1] (8-bit exactly, 16-bit rounded).
+uint8_t code_of(float encoded) {
+  const float c = encoded > 0.0f ? (encoded < 1.0f ? encoded : 1.0f) : 0.0f;
+  return static_cast<uint8_t>(std::lround(c * 255.0f));
+}
+
+}  // namespace
+
+Srgb8File read_srgb8_file(const fs::path& path, std::string_view eye) {
+  Srgb8File file;
+  if (open_and_sniff_exr(path)) {
+    const Image image = read_exr_image(path, eye, file.eye);
+    if (!image.has_plane(planes::rgb))
+      throw InputError(fmt::format("{} has no R, G, B channels (planes: {}); the metrics compare colour images",
+                                   path.string(), image.plane_list()));
+    file.image = encode_srgb8(image, path.string());
+    file.encoding = "openexr, linear float encoded to sRGB";
+    return file;
+  }
+
+  const io::DecodedImage d = io::read_image(path);
+  if (d.channels != 1 && d.channels != 3 && d.channels != 4)
+    throw InputError(fmt::format("{} has {} channels; compare reads grey (1), RGB (3) or RGBA (4) images",
+                                 path.string(), d.channels));
+  file.colour_channels = d.channels == 1 ? 1 : 3;
+  const std::size_t n = static_cast<std::size_t>(d.width) * static_cast<std::size_t>(d.height);
+  const std::size_t stride = static_cast<std::size_t>(d.channels);
+  // The colour of pixel i, channel c (grey replicated).
+  const auto sample = [&](std::size_t i, std::size_t c) { return d.values[i * stride + (d.channels == 1 ? 0 : c)]; };
+  if (d.srgb) {
+    file.image = {d.width, d.height, std::vector<uint8_t>(n * 3)};
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t c = 0; c < 3; ++c) file.image.rgb[i * 3 + c] = code_of(sample(i, c));
+    file.encoding = fmt::format("{}, sRGB as stored", d.format);
+  } else {
+    Image linear(d.width, d.height);
+    float* rgb = linear.add_plane(planes::rgb).data_f32();
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t c = 0; c < 3; ++c) rgb[i * 3 + c] = sample(i, c);
+    file.image = encode_srgb8(linear, path.string());
+    file.encoding = fmt::format("{}, linear float encoded to sRGB", d.format);
+  }
+  return file;
+}
+
+RegionMask read_region_mask(const fs::path& path, std::string_view eye) {
+  RegionMask mask;
+  // Marks pixel i inside when a sample of it is non-zero; NaN is refused with its place.
+  const auto mark = [&](std::span<const float> values, int channels) {
+    for (std::size_t k = 0; k < values.size(); ++k) {
+      const std::size_t i = k / static_cast<std::size_t>(channels);
+      if (std::isnan(values[k]))
+        throw InputError(fmt::format("mask {} has a NaN sample at pixel ({}, {}); a mask needs finite values",
+                                     path.string(), i % static_cast<std::size_t>(mask.width),
+                                     i / static_cast<std::size_t>(mask.width)));
+      if (values[k] != 0.0f) mask.inside[i] = 1;
+    }
+  };
+  if (open_and_sniff_exr(path)) {
+    std::string taken;
+    const Image image = read_exr_image(path, eye, taken);
+    mask = RegionMask::filled(image.width(), image.height(), false);
+    for (const Plane& p : image.planes())
+      if (p.type() == PlaneType::f32) mark(p.f32(), p.channels());
+    return mask;
+  }
+  const io::DecodedImage d = io::read_image(path);
+  mask = RegionMask::filled(d.width, d.height, false);
+  mark(d.values, d.channels);
+  return mask;
+}
+
+}  // namespace sb::validation

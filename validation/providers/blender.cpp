@@ -1,0 +1,475 @@
+// `blender`: the right eye rendered by Blender Cycles, headless on the CPU (DESIGN §6.1). Blender's
+// glTF importer brings in the meshes; a generated script (validation/providers/blender_script.cpp
+// plus the numbers of the in-memory scene) replaces lights, materials, world and camera and renders
+// one EXR per light; the passes are summed here. docs/truth_blender.md derives every constant.
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <system_error>
+
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
+#include "renderer/io/image_io.hpp"
+#include "validation/providers/blender_script.hpp"
+#include "validation/providers/providers.hpp"
+
+extern char** environ;
+
+namespace sb::validation {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Bumped whenever the export, the script or the settings change.
+constexpr const char* kRevision = "blender-export-3";
+/// Environment variable naming the Blender executable (a path, or a name looked up on PATH).
+constexpr const char* kExecutableVariable = "STEREOBENCH_BLENDER";
+
+// Calibration (docs/truth_blender.md). A Cycles point light of power P watts and radius 0 has
+// radiant intensity P / (4 pi) W/sr; a sun of strength S gives irradiance S W/m^2 on a surface
+// facing it. Both verified to float precision by tests/blender/lit_plane_test.cpp.
+constexpr double kPointPowerPerIntensity = 4.0 * kPi;
+constexpr double kSunStrengthPerIrradiance = 1.0;
+/// Sensor height of the exported camera; any value works, the lens is scaled with it.
+constexpr double kSensorHeightMm = 24.0;
+/// Box filter width in pixels (Blender's minimum): the single sample lands within 0.005 px of the
+/// pixel centre (measured: 0.0005 px, see docs/truth_blender.md).
+constexpr double kFilterWidthPx = 0.01;
+constexpr int kSeed = 0;
+/// Our tracer clips nothing; Blender's camera needs a positive near and a finite far plane.
+constexpr double kClipStart = 1e-6;
+constexpr double kClipEnd = 1e9;
+/// Lines of Blender's output quoted in an error message.
+constexpr size_t kQuotedLines = 25;
+
+/// The output of a finished process.
+struct ProcessResult {
+  int exit_code = -1;     ///< exit status, or -1 when killed by a signal
+  int signal = 0;         ///< the signal that ended it, or 0
+  std::string output;     ///< stdout and stderr, interleaved
+};
+
+/// Runs argv[0] (a path) with stdin from /dev/null and stdout + stderr captured. ToolError when it
+/// cannot be started.
+ProcessResult run_process(const std::vector<std::string>& argv) {
+  int pipe_fds[2];
+  if (::pipe(pipe_fds) != 0)
+    throw ToolError(fmt::format("cannot create a pipe to run {}: {}", argv.at(0), std::strerror(errno)));
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], 1);
+  posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], 2);
+  posix_spawn_file_actions_addclose(&actions, pipe_fds[0]);
+  posix_spawn_file_actions_addclose(&actions, pipe_fds[1]);
+  std::vector<char*> args;
+  args.reserve(argv.size() + 1);
+  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  pid_t pid = 0;
+  const int spawn_error = ::posix_spawn(&pid, argv[0].c_str(), &actions, nullptr, args.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  ::close(pipe_fds[1]);
+  if (spawn_error != 0) {
+    ::close(pipe_fds[0]);
+    throw ToolError(fmt::format("cannot start {}: {}", argv[0], std::strerror(spawn_error)));
+  }
+  ProcessResult result;
+  char buffer[65536];
+  for (;;) {
+    const ssize_t n = ::read(pipe_fds[0], buffer, sizeof buffer);
+    if (n > 0) {
+      result.output.append(buffer, static_cast<size_t>(n));
+    } else if (n == 0 || errno != EINTR) {
+      break;
+    }
+  }
+  ::close(pipe_fds[0]);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) throw ToolError(fmt::format("lost track of {}: {}", argv[0], std::strerror(errno)));
+  }
+  if (WIFEXITED(status)) {
+    result.exit_code = WEXITSTATUS(status);
+  } else if (WIFSIGNALED(status)) {
+    result.signal = WTERMSIG(status);
+  }
+  return result;
+}
+
+/// The last `count` lines of a text, indented for an error message.
+std::string last_lines(const std::string& text, size_t count) {
+  std::deque<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    lines.push_back(line);
+    if (lines.size() > count) lines.pop_front();
+  }
+  std::string out;
+  for (const std::string& l : lines) out += "\n  | " + l;
+  return out.empty() ? "\n  | (no output)" : out;
+}
+
+bool is_executable_file(const fs::path& p) {
+  std::error_code ec;
+  return fs::is_regular_file(p, ec) && ::access(p.c_str(), X_OK) == 0;
+}
+
+/// Where the Blender executable is, or why it cannot be found.
+struct Located {
+  fs::path executable;
+  std::string problem;  ///< empty when found
+};
+
+Located locate_blender() {
+  const char* configured = std::getenv(kExecutableVariable);
+  const std::string name = configured != nullptr && *configured != '\0' ? configured : "blender";
+  const std::string origin =
+      configured != nullptr && *configured != '\0' ? fmt::format(" (from ${})", kExecutableVariable) : "";
+  if (name.find('/') != std::string::npos) {
+    if (is_executable_file(name)) return {fs::absolute(name), ""};
+    return {{}, fmt::format("the Blender executable '{}'{} does not exist or is not executable; point ${} at "
+                            "Blender 3.4 or unset it and install Blender with `ci/install-deps.sh blender`",
+                            name, origin, kExecutableVariable)};
+  }
+  const char* path_env = std::getenv("PATH");
+  std::string_view path = path_env != nullptr ? path_env : "";
+  while (!path.empty()) {
+    const size_t colon = path.find(':');
+    const std::string_view dir = path.substr(0, colon);
+    if (!dir.empty()) {
+      const fs::path candidate = fs::path(std::string(dir)) / name;
+      if (is_executable_file(candidate)) return {candidate, ""};
+    }
+    if (colon == std::string_view::npos) break;
+    path.remove_prefix(colon + 1);
+  }
+  return {{}, fmt::format("'{}'{} not found on PATH; install Blender with `ci/install-deps.sh blender` or set "
+                          "${} to the Blender executable",
+                          name, origin, kExecutableVariable)};
+}
+
+/// The first line of `blender --version`, e.g. "Blender 3.4.1", cached per executable.
+std::string query_version(const fs::path& executable) {
+  static std::mutex mutex;
+  static std::map<std::string, std::string> cache;
+  const std::lock_guard lock(mutex);
+  if (auto it = cache.find(executable.string()); it != cache.end()) return it->second;
+  const ProcessResult r = run_process({executable.string(), "--factory-startup", "--version"});
+  std::istringstream in(r.output);
+  std::string version;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("Blender ", 0) == 0) {
+      version = line;
+      break;
+    }
+  }
+  while (!version.empty() && std::isspace(static_cast<unsigned char>(version.back()))) version.pop_back();
+  if (r.exit_code != 0 || version.empty())
+    throw ToolError(fmt::format("'{} --version' failed (exit code {}){}; check the Blender installation "
+                                "(`ci/install-deps.sh blender`)",
+                                executable.string(), r.exit_code, last_lines(r.output, kQuotedLines)));
+  cache.emplace(executable.string(), version);
+  return version;
+}
+
+nlohmann::json vec_json(const vec3& v) { return {double(v.x), double(v.y), double(v.z)}; }
+nlohmann::json vec_json(const dvec3& v) { return {v.x, v.y, v.z}; }
+
+/// Lights that contribute (positive intensity), with their Blender parameters. InputError for a
+/// light type Cycles cannot reproduce exactly.
+nlohmann::json export_lights(const Scene& scene) {
+  nlohmann::json lights = nlohmann::json::array();
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const Light& l = scene.lights[i];
+    const std::string label = l.name.empty() ? fmt::format("#{}", i) : fmt::format("'{}' (#{})", l.name, i);
+    if (l.type == Light::Type::spot)
+      throw InputError(fmt::format(
+          "scene {}: spot light {} cannot be exported to Blender: Cycles' spot cone (cosine times smoothstep) "
+          "differs from the KHR_lights_punctual falloff of DESIGN §3; use the `full` or `povray` provider, or "
+          "replace the spot by a point light",
+          scene.path, label));
+    const float max_colour = std::max({l.color.x, l.color.y, l.color.z});
+    const float min_colour = std::min({l.color.x, l.color.y, l.color.z});
+    if (!(l.intensity > 0.0f) || max_colour <= 0.0f) continue;  // lights nothing, here as in ours
+    if (min_colour < 0.0f)
+      throw InputError(fmt::format("scene {}: light {} has a negative colour, which Blender cannot represent",
+                                   scene.path, label));
+    nlohmann::json j = {{"name", l.name}, {"color", vec_json(l.color)}};
+    if (l.type == Light::Type::point) {
+      j["type"] = "point";
+      j["position"] = vec_json(l.position);
+      j["power_w"] = kPointPowerPerIntensity * double(l.intensity);
+    } else {
+      j["type"] = "directional";
+      j["direction"] = vec_json(glm::normalize(l.direction));
+      j["strength"] = kSunStrengthPerIrradiance * double(l.intensity);
+    }
+    lights.push_back(std::move(j));
+  }
+  return lights;
+}
+
+/// Writes the textures that materials use as linear float EXRs (RGB), so that Cycles reads exactly
+/// the decoded values of the in-memory scene; returns their PARAMS entries (null for unused ones).
+nlohmann::json export_textures(const Scene& scene, const fs::path& work_dir) {
+  std::vector<bool> used(scene.textures.size(), false);
+  for (const Material& m : scene.materials)
+    if (m.base_color_texture >= 0 && static_cast<size_t>(m.base_color_texture) < scene.textures.size())
+      used[static_cast<size_t>(m.base_color_texture)] = true;
+  nlohmann::json textures = nlohmann::json::array();
+  for (size_t t = 0; t < scene.textures.size(); ++t) {
+    if (!used[t]) {
+      textures.push_back(nullptr);
+      continue;
+    }
+    const Texture& tex = scene.textures[t];
+    Image image(tex.width, tex.height);
+    float* rgb = image.add_plane(planes::rgb).data_f32();
+    const size_t n = static_cast<size_t>(tex.width) * static_cast<size_t>(tex.height);
+    for (size_t i = 0; i < n; ++i)
+      for (size_t c = 0; c < 3; ++c) rgb[3 * i + c] = tex.rgba[4 * i + c];
+    const fs::path file = work_dir / fmt::format("texture_{}.exr", t);
+    io::write_exr(file, image);
+    // Blender has one extension mode for both axes; a texture that repeats along one axis only is
+    // repeated along both (reported as a known gap in docs/truth_blender.md).
+    const bool repeat = tex.repeat_s || tex.repeat_t;
+    textures.push_back({{"file", fs::absolute(file).string()},
+                        {"extension", repeat ? "REPEAT" : "EXTEND"},
+                        {"mixed_wrap", tex.repeat_s != tex.repeat_t}});
+  }
+  return textures;
+}
+
+nlohmann::json material_json(const Material& m, int texture_count) {
+  const int texture = m.base_color_texture >= 0 && m.base_color_texture < texture_count ? m.base_color_texture : -1;
+  return {{"name", m.name},
+          {"base_color", {double(m.base_color.x), double(m.base_color.y), double(m.base_color.z)}},
+          {"texture", texture},
+          {"texcoord", m.texcoord}};
+}
+
+/// The Cycles and colour-management settings the script applies (recorded in TruthRender).
+nlohmann::json cycles_settings(int threads) {
+  return {{"engine", "CYCLES"},
+          {"device", "CPU"},
+          {"samples", 1},
+          {"adaptive_sampling", false},
+          {"denoising", false},
+          {"seed", kSeed},
+          {"max_bounces", 0},
+          {"diffuse_glossy_transmission_volume_transparent_bounces", 0},
+          {"direct_light_sampling_type", "NEXT_EVENT_ESTIMATION"},
+          {"light_sampling_threshold", 0.0},
+          {"sample_clamp_direct", 0.0},
+          {"sample_clamp_indirect", 0.0},
+          {"path_guiding", false},
+          {"pixel_filter_type", "BOX"},
+          {"filter_width_px", kFilterWidthPx},
+          {"film_transparent", false},
+          {"film_exposure", 1.0},
+          {"view_transform", "Standard"},
+          {"look", "None"},
+          {"exposure", 0.0},
+          {"gamma", 1.0},
+          {"output", "OPEN_EXR RGBA 32-bit float, ZIP"},
+          {"threads", threads > 0 ? nlohmann::json(threads) : nlohmann::json("auto")},
+          {"materials", "Diffuse BSDF roughness 0 of the albedo in light passes; Emission of albedo x ambient, no BSDF, in the ambient pass"},
+          {"world", "Background visible to camera rays only (Light Path 'Is Camera Ray'), sampling_method NONE"},
+          {"importer", "import_scene.gltf import_shading=NORMALS (glTF normals as custom split normals) merge_vertices=False"},
+          {"shadow_terminator_offsets", 0.0},
+          {"texture_interpolation", "Linear (bilinear, no mip-mapping)"},
+          {"pass_plan", "ambient term alone (if nonzero), then one render per light; background in the first; summed in that order"}};
+}
+
+class BlenderProvider final : public TruthProvider {
+ public:
+  std::string name() const override { return "blender"; }
+  std::string description() const override {
+    return "Blender Cycles on the CPU, headless: glTF import plus a generated script, direct light only, one "
+           "sample at the pixel centre, one render per light";
+  }
+  std::optional<std::string> unavailable_reason() const override {
+    const Located found = locate_blender();
+    if (!found.problem.empty()) return found.problem;
+    return std::nullopt;
+  }
+  std::string tool_version() const override { return query_version(executable()); }
+  std::string revision() const override { return kRevision; }
+
+  TruthRender render(const TruthRequest& request) const override {
+    const auto start = std::chrono::steady_clock::now();
+    const Scene& scene = request.scene.scene();
+    nlohmann::json params;
+    params["lights"] = export_lights(scene);  // InputError for what Cycles cannot reproduce
+    const fs::path blender = executable();
+    const std::string version = query_version(blender);
+    const EyeCamera eye = request.rig.eye(Eye::right);
+
+    if (request.scene_file.empty() || !fs::is_regular_file(request.scene_file))
+      throw InputError(fmt::format("the blender provider imports the scene's glTF file, but '{}' is not a file; "
+                                   "render a scene loaded from a .gltf/.glb file",
+                                   request.scene_file.string()));
+    std::error_code ec;
+    fs::create_directories(request.work_dir, ec);
+    if (ec)
+      throw IoError(fmt::format("cannot create the work folder {}: {}", request.work_dir.string(), ec.message()));
+    const fs::path work_dir = fs::absolute(request.work_dir);
+
+    // Everything the script needs, from the in-memory scene and rig.
+    params["scene_file"] = fs::absolute(request.scene_file).string();
+    params["textures"] = export_textures(scene, work_dir);
+    params["materials"] = nlohmann::json::array();
+    for (const Material& m : scene.materials)
+      params["materials"].push_back(material_json(m, static_cast<int>(scene.textures.size())));
+    Material white;
+    white.name = "default";
+    params["default_material"] = material_json(white, 0);
+    params["background"] = vec_json(scene.background);
+    params["ambient"] = double(scene.ambient);
+    const double shift_x = (0.5 * eye.width - eye.cx) / eye.height;
+    const double shift_y = (eye.cy - 0.5 * eye.height) / eye.height;
+    params["camera"] = {{"origin", vec_json(eye.origin)},
+                        {"right", vec_json(eye.right)},
+                        {"up", vec_json(eye.up)},
+                        {"back", vec_json(eye.back)},
+                        {"sensor_height_mm", kSensorHeightMm},
+                        {"lens_mm", eye.f_px * kSensorHeightMm / eye.height},
+                        {"shift_x", shift_x},
+                        {"shift_y", shift_y},
+                        {"clip_start", kClipStart},
+                        {"clip_end", kClipEnd}};
+    params["width"] = eye.width;
+    params["height"] = eye.height;
+    params["threads"] = std::max(0, request.threads);
+    params["seed"] = kSeed;
+    params["filter_width"] = kFilterWidthPx;
+    // The passes, summed in this order (the order in which our shading adds its terms): the
+    // ambient term if any, then each light alone. The background goes with the first pass.
+    struct Pass {
+      int light = -1;  ///< index into params["lights"], -1 for none
+      bool ambient = false;
+    };
+    std::vector<Pass> plan;
+    if (scene.ambient != 0.0f) plan.push_back({-1, true});
+    for (size_t k = 0; k < params["lights"].size(); ++k) plan.push_back({static_cast<int>(k), false});
+    if (plan.empty()) plan.push_back({-1, false});  // the background alone
+    std::vector<fs::path> passes;
+    params["passes"] = nlohmann::json::array();
+    for (size_t k = 0; k < plan.size(); ++k) {
+      passes.push_back(work_dir / fmt::format("pass_{:03}.exr", k));
+      fs::remove(passes.back(), ec);  // a stale image must never pass for a new one
+      params["passes"].push_back({{"file", passes.back().string()},
+                                  {"light", plan[k].light},
+                                  {"ambient", plan[k].ambient},
+                                  {"background", k == 0}});
+    }
+
+    // The script: PARAMS above the fixed body.
+    const fs::path script = work_dir / "blender_render.py";
+    const std::vector<std::string> argv = {blender.string(), "-b", "--factory-startup", "-noaudio",
+                                           "--python-exit-code", "1", "--python", script.string()};
+    std::string command;
+    for (const std::string& a : argv) command += (command.empty() ? "" : " ") + a;
+    std::string text;
+    text += "# Generated by stereobench (validation/providers/blender.cpp, " + std::string(kRevision) + ").\n";
+    text += "# Renders the right eye of a stereo rig with Blender Cycles; re-run it by hand with:\n";
+    text += "#   " + command + "\n";
+    text += "import json\n\nPARAMS = json.loads(r\"\"\"" + params.dump(2) + "\"\"\")\n";
+    text += blender_script_body();
+    io::write_text_atomically(script, text);
+
+    const ProcessResult run = run_process(argv);
+    const fs::path log = work_dir / "blender_output.txt";
+    io::write_text_atomically(log, run.output);
+    if (run.exit_code != 0) {
+      const std::string how = run.signal != 0 ? fmt::format("was killed by signal {}", run.signal)
+                                              : fmt::format("exited with code {}", run.exit_code);
+      throw ToolError(fmt::format("{} {} rendering {}; the script is kept in {} and the full output in {}; "
+                                  "last lines of the output:{}",
+                                  version, how, request.scene_file.string(), script.string(), log.string(),
+                                  last_lines(run.output, kQuotedLines)));
+    }
+
+    // Sum the passes in light order (the order in which our shading adds the lights).
+    TruthRender out;
+    out.provider = name();
+    out.tool_version = version;
+    out.right = Image(eye.width, eye.height);
+    float* sum = out.right.add_plane(planes::rgb).data_f32();
+    const size_t n = out.right.pixel_count() * 3;
+    for (size_t k = 0; k < passes.size(); ++k) {
+      if (!fs::is_regular_file(passes[k]))
+        throw ToolError(fmt::format("{} exited normally but wrote no image {}; the script is kept in {}, its "
+                                    "output in {}{}",
+                                    version, passes[k].string(), script.string(), log.string(),
+                                    last_lines(run.output, kQuotedLines)));
+      const Image pass = io::read_exr(passes[k]);
+      if (pass.width() != eye.width || pass.height() != eye.height || !pass.has_plane(planes::rgb))
+        throw ToolError(fmt::format("{} wrote {} as {}x{} with planes [{}]; expected {}x{} with rgb", version,
+                                    passes[k].string(), pass.width(), pass.height(), pass.plane_list(), eye.width,
+                                    eye.height));
+      const float* p = pass.data_f32(planes::rgb);
+      if (k == 0) {
+        std::copy(p, p + n, sum);
+      } else {
+        for (size_t i = 0; i < n; ++i) sum[i] += p[i];
+      }
+    }
+
+    out.command = command;
+    nlohmann::json mixed = nlohmann::json::array();
+    for (size_t t = 0; t < params["textures"].size(); ++t)
+      if (!params["textures"][t].is_null() && params["textures"][t]["mixed_wrap"].get<bool>())
+        mixed.push_back(t);
+    out.settings = cycles_settings(request.threads);
+    out.settings["revision"] = kRevision;
+    out.settings["script"] = script.string();
+    out.settings["passes"] = params["passes"];
+    out.settings["camera"] = {{"type", "PERSP"},
+                              {"sensor_fit", "VERTICAL"},
+                              {"sensor_height_mm", kSensorHeightMm},
+                              {"lens_mm", params["camera"]["lens_mm"]},
+                              {"shift_x", shift_x},
+                              {"shift_y", shift_y},
+                              {"shift_units", "image height (sensor_fit VERTICAL)"},
+                              {"clip_start", kClipStart},
+                              {"clip_end", kClipEnd},
+                              {"axes", "Blender (x, y, z) = glTF (x, -z, y)"}};
+    out.settings["calibration"] = {
+        {"point_power_w_per_intensity_w_sr", kPointPowerPerIntensity},
+        {"sun_strength_per_irradiance", kSunStrengthPerIrradiance},
+        {"sample_offset_px", "about +0.0005 right and up (box filter 0.01 px; measured on lit-plane)"},
+        {"ambient", "Emission of the albedo with strength = ambient (radiance = strength x colour)"}};
+    if (!mixed.empty()) out.settings["textures_wrapped_on_both_axes"] = mixed;
+    out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return out;
+  }
+
+ private:
+  static fs::path executable() {
+    Located found = locate_blender();
+    if (!found.problem.empty()) throw ToolError("blender provider unavailable: " + found.problem);
+    return found.executable;
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<TruthProvider> make_blender_provider() { return std::make_unique<BlenderProvider>(); }
+
+}  // namespace sb::validation

@@ -1,0 +1,363 @@
+// The Python run inside Blender by the `blender` ground-truth provider (DESIGN §6.1). It reads every
+// number from PARAMS, which the provider writes above this text; see docs/truth_blender.md.
+#include "validation/providers/blender_script.hpp"
+
+namespace sb::validation {
+
+std::string_view blender_script_body() {
+  static constexpr std::string_view kBody = R"PY(
+import os
+
+import bpy
+
+
+def fail(message):
+    raise RuntimeError("stereobench: " + message)
+
+
+def gltf_to_blender(v):
+    # glTF is +Y up, Blender +Z up: the importer maps (x, y, z) to (x, -z, y).
+    return (v[0], -v[2], v[1])
+
+
+def matrix_from_columns(x, y, z, t):
+    from mathutils import Matrix
+    return Matrix(((x[0], y[0], z[0], t[0]),
+                   (x[1], y[1], z[1], t[1]),
+                   (x[2], y[2], z[2], t[2]),
+                   (0.0, 0.0, 0.0, 1.0)))
+
+
+def import_scene():
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    # Record the glTF material index of every material the importer creates, so that materials
+    # are matched to the in-memory scene by index, never by (possibly duplicated) name.
+    from io_scene_gltf2.blender.imp import gltf2_blender_material as material_module
+    importer = material_module.BlenderMaterial
+    if not hasattr(importer, "create"):
+        fail("the glTF importer of this Blender has no BlenderMaterial.create; "
+             "this script supports Blender 3.4")
+    original_create = importer.create
+
+    def create(gltf, material_idx, vertex_color):
+        original_create(gltf, material_idx, vertex_color)
+        name = gltf.data.materials[material_idx].blender_material[vertex_color]
+        bpy.data.materials[name]["stereobench_material"] = int(material_idx)
+
+    importer.create = staticmethod(create)
+    # The importer sets glTF vertex normals as custom normals only with import_shading="NORMALS",
+    # whose code uses numpy.bool, an alias that numpy 1.24 removed (Debian's Blender 3.4 runs on
+    # the system numpy): restore the alias, which is the builtin bool.
+    import numpy
+    if "bool" not in numpy.__dict__:
+        numpy.bool = bool
+    try:
+        result = bpy.ops.import_scene.gltf(filepath=PARAMS["scene_file"], import_shading="NORMALS",
+                                           merge_vertices=False, import_pack_images=False)
+    finally:
+        importer.create = staticmethod(original_create)
+    if "FINISHED" not in result:
+        fail("the glTF importer did not finish on " + PARAMS["scene_file"])
+    for obj in list(bpy.data.objects):
+        if obj.type in {"LIGHT", "CAMERA"}:
+            bpy.data.objects.remove(obj, do_unlink=True)
+
+
+def uv_map_name(texcoord):
+    # The importer's names of the TEXCOORD_n sets.
+    return "UVMap" if texcoord == 0 else "UVMap.%03d" % texcoord
+
+
+def make_material(name, spec, textures, switches):
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    mat.cycles.sample_as_light = False  # ambient emission must light nothing
+    tree = mat.node_tree
+    nodes = tree.nodes
+    while nodes:
+        nodes.remove(nodes[0])
+    out = nodes.new("ShaderNodeOutputMaterial")
+    out.target = "CYCLES"
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Roughness"].default_value = 0.0
+    # The shading normal turned to the viewer (DESIGN §3): N * (N . incoming < 0 ? -1 : 1).
+    geometry = nodes.new("ShaderNodeNewGeometry")
+    facing = nodes.new("ShaderNodeVectorMath")
+    facing.operation = "DOT_PRODUCT"
+    tree.links.new(geometry.outputs["Normal"], facing.inputs[0])
+    tree.links.new(geometry.outputs["Incoming"], facing.inputs[1])
+    away = nodes.new("ShaderNodeMath")
+    away.operation = "LESS_THAN"
+    tree.links.new(facing.outputs["Value"], away.inputs[0])
+    away.inputs[1].default_value = 0.0
+    sign = nodes.new("ShaderNodeMath")
+    sign.operation = "MULTIPLY_ADD"
+    tree.links.new(away.outputs["Value"], sign.inputs[0])
+    sign.inputs[1].default_value = -2.0
+    sign.inputs[2].default_value = 1.0
+    turned = nodes.new("ShaderNodeVectorMath")
+    turned.operation = "SCALE"
+    tree.links.new(geometry.outputs["Normal"], turned.inputs[0])
+    tree.links.new(sign.outputs["Value"], turned.inputs["Scale"])
+    tree.links.new(turned.outputs["Vector"], diffuse.inputs["Normal"])
+    factor = spec["base_color"]
+    rgba = (factor[0], factor[1], factor[2], 1.0)
+    colour_socket = None
+    if spec["texture"] >= 0:
+        tex = textures[spec["texture"]]
+        image_node = nodes.new("ShaderNodeTexImage")
+        image_node.image = tex["image"]
+        image_node.interpolation = "Linear"
+        image_node.extension = tex["extension"]
+        uv = nodes.new("ShaderNodeUVMap")
+        uv.uv_map = uv_map_name(spec["texcoord"])
+        tree.links.new(uv.outputs["UV"], image_node.inputs["Vector"])
+        multiply = nodes.new("ShaderNodeVectorMath")
+        multiply.operation = "MULTIPLY"
+        tree.links.new(image_node.outputs["Color"], multiply.inputs[0])
+        multiply.inputs[1].default_value = (factor[0], factor[1], factor[2])
+        colour_socket = multiply.outputs["Vector"]
+        tree.links.new(colour_socket, diffuse.inputs["Color"])
+    else:
+        diffuse.inputs["Color"].default_value = rgba
+    # The ambient term: an emission of the albedo times `ambient`, rendered in a pass of its own
+    # in which the material has no BSDF, so that nothing is lit by it (an emissive mesh would
+    # otherwise join Cycles' light distribution).
+    emission = nodes.new("ShaderNodeEmission")
+    emission.inputs["Strength"].default_value = PARAMS["ambient"]
+    if colour_socket is not None:
+        tree.links.new(colour_socket, emission.inputs["Color"])
+    else:
+        emission.inputs["Color"].default_value = rgba
+    switches.append((tree, out.inputs["Surface"], diffuse.outputs["BSDF"], emission.outputs["Emission"]))
+    return mat
+
+
+def setup_materials():
+    textures = []
+    for t in PARAMS["textures"]:
+        if t is None:  # not used by any material
+            textures.append(None)
+            continue
+        image = bpy.data.images.load(t["file"], check_existing=False)
+        image.colorspace_settings.name = "Non-Color"
+        image.alpha_mode = "STRAIGHT"
+        textures.append({"image": image, "extension": t["extension"]})
+    switches = []
+    ours = [make_material("stereobench_%d" % i, m, textures, switches)
+            for i, m in enumerate(PARAMS["materials"])]
+    default = make_material("stereobench_default", PARAMS["default_material"], textures, switches)
+    plain = {}
+    unmatched = set()
+    for obj in bpy.data.objects:
+        if obj.type != "MESH":
+            continue
+        # Shadow rays start at the surface as ours do (no terminator offsets).
+        obj.cycles.shadow_terminator_offset = 0.0
+        obj.cycles.shadow_terminator_geometry_offset = 0.0
+        mesh = obj.data
+        if len(mesh.materials) == 0:
+            mesh.materials.append(default)
+            continue
+        for slot, imported in enumerate(mesh.materials):
+            if imported is None:
+                mesh.materials[slot] = default
+                continue
+            index = imported.get("stereobench_material")
+            if index is None or index >= len(ours):
+                unmatched.add(imported.name)
+                continue
+            spec = PARAMS["materials"][index]
+            if spec["texture"] >= 0 and mesh.uv_layers.get(uv_map_name(spec["texcoord"])) is None:
+                # Without texture coordinates the albedo is the base colour factor alone.
+                if index not in plain:
+                    untextured = dict(spec, texture=-1)
+                    plain[index] = make_material("stereobench_%d_untextured" % index, untextured,
+                                                 textures, switches)
+                mesh.materials[slot] = plain[index]
+            else:
+                mesh.materials[slot] = ours[index]
+    if unmatched:
+        fail("imported materials without a glTF material index: " + ", ".join(sorted(unmatched)))
+    return switches
+
+
+def setup_world():
+    world = bpy.data.worlds.new("stereobench_world")
+    bpy.context.scene.world = world
+    world.use_nodes = True
+    world.cycles.sampling_method = "NONE"  # the background lights nothing
+    tree = world.node_tree
+    nodes = tree.nodes
+    while nodes:
+        nodes.remove(nodes[0])
+    out = nodes.new("ShaderNodeOutputWorld")
+    dark = nodes.new("ShaderNodeBackground")
+    dark.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+    dark.inputs["Strength"].default_value = 0.0
+    seen = nodes.new("ShaderNodeBackground")
+    bg = PARAMS["background"]
+    seen.inputs["Color"].default_value = (bg[0], bg[1], bg[2], 1.0)
+    seen.inputs["Strength"].default_value = 1.0
+    path = nodes.new("ShaderNodeLightPath")
+    mix = nodes.new("ShaderNodeMixShader")
+    tree.links.new(path.outputs["Is Camera Ray"], mix.inputs["Fac"])
+    tree.links.new(dark.outputs["Background"], mix.inputs[1])
+    tree.links.new(seen.outputs["Background"], mix.inputs[2])
+    tree.links.new(mix.outputs["Shader"], out.inputs["Surface"])
+    return seen.inputs["Strength"]
+
+
+def setup_lights():
+    objects = []
+    collection = bpy.context.scene.collection
+    for i, l in enumerate(PARAMS["lights"]):
+        if l["type"] == "point":
+            data = bpy.data.lights.new("stereobench_light_%d" % i, "POINT")
+            data.shadow_soft_size = 0.0
+            data.energy = l["power_w"]
+            p = gltf_to_blender(l["position"])
+            matrix = matrix_from_columns((1, 0, 0), (0, 1, 0), (0, 0, 1), p)
+        elif l["type"] == "directional":
+            data = bpy.data.lights.new("stereobench_light_%d" % i, "SUN")
+            data.angle = 0.0
+            data.energy = l["strength"]
+            # A sun shines along its local -Z.
+            z = [-c for c in gltf_to_blender(l["direction"])]
+            helper = (1.0, 0.0, 0.0) if abs(z[0]) < 0.9 else (0.0, 1.0, 0.0)
+            from mathutils import Vector
+            zv = Vector(z).normalized()
+            xv = Vector(helper).cross(zv).normalized()
+            yv = zv.cross(xv)
+            matrix = matrix_from_columns(xv, yv, zv, (0.0, 0.0, 0.0))
+        else:
+            fail("unsupported light type " + l["type"])
+        data.color = l["color"]
+        data.use_nodes = False
+        data.cycles.cast_shadow = True
+        data.cycles.use_multiple_importance_sampling = False
+        data.cycles.max_bounces = 0
+        obj = bpy.data.objects.new("stereobench_light_%d" % i, data)
+        obj.matrix_world = matrix
+        collection.objects.link(obj)
+        objects.append(obj)
+    return objects
+
+
+def setup_camera():
+    cam = PARAMS["camera"]
+    data = bpy.data.cameras.new("stereobench_right_eye")
+    data.type = "PERSP"
+    data.sensor_fit = "VERTICAL"
+    data.sensor_height = cam["sensor_height_mm"]
+    data.sensor_width = cam["sensor_height_mm"]
+    data.lens_unit = "MILLIMETERS"
+    data.lens = cam["lens_mm"]
+    data.shift_x = cam["shift_x"]
+    data.shift_y = cam["shift_y"]
+    data.clip_start = cam["clip_start"]
+    data.clip_end = cam["clip_end"]
+    obj = bpy.data.objects.new("stereobench_right_eye", data)
+    obj.matrix_world = matrix_from_columns(gltf_to_blender(cam["right"]), gltf_to_blender(cam["up"]),
+                                           gltf_to_blender(cam["back"]), gltf_to_blender(cam["origin"]))
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.scene.camera = obj
+
+
+def setup_render():
+    scene = bpy.context.scene
+    r = scene.render
+    r.engine = "CYCLES"
+    r.resolution_x = PARAMS["width"]
+    r.resolution_y = PARAMS["height"]
+    r.resolution_percentage = 100
+    r.pixel_aspect_x = 1.0
+    r.pixel_aspect_y = 1.0
+    r.use_border = False
+    r.film_transparent = False
+    r.dither_intensity = 0.0
+    r.use_persistent_data = True
+    r.use_motion_blur = False
+    if PARAMS["threads"] > 0:
+        r.threads_mode = "FIXED"
+        r.threads = PARAMS["threads"]
+    else:
+        r.threads_mode = "AUTO"
+    r.image_settings.file_format = "OPEN_EXR"
+    r.image_settings.color_mode = "RGBA"
+    r.image_settings.color_depth = "32"
+    r.image_settings.exr_codec = "ZIP"
+    r.use_file_extension = False
+    c = scene.cycles
+    c.device = "CPU"
+    c.feature_set = "SUPPORTED"
+    c.shading_system = False
+    c.samples = 1
+    c.use_adaptive_sampling = False
+    c.use_denoising = False
+    c.seed = PARAMS["seed"]
+    c.use_animated_seed = False
+    c.sample_offset = 0
+    c.max_bounces = 0
+    c.diffuse_bounces = 0
+    c.glossy_bounces = 0
+    c.transmission_bounces = 0
+    c.volume_bounces = 0
+    c.transparent_max_bounces = 0
+    c.min_light_bounces = 0
+    c.min_transparent_bounces = 0
+    c.caustics_reflective = False
+    c.caustics_refractive = False
+    c.blur_glossy = 0.0
+    c.sample_clamp_direct = 0.0
+    c.sample_clamp_indirect = 0.0
+    c.light_sampling_threshold = 0.0
+    c.direct_light_sampling_type = "NEXT_EVENT_ESTIMATION"
+    c.use_guiding = False
+    c.pixel_filter_type = "BOX"
+    c.filter_width = PARAMS["filter_width"]
+    c.film_exposure = 1.0
+    c.use_camera_cull = False
+    c.use_distance_cull = False
+    c.use_fast_gi = False
+    c.texture_limit_render = "OFF"
+    scene.view_layers[0].use_pass_combined = True
+    v = scene.view_settings
+    v.view_transform = "Standard"
+    v.look = "None"
+    v.exposure = 0.0
+    v.gamma = 1.0
+    v.use_curve_mapping = False
+    scene.display_settings.display_device = "sRGB"
+
+
+def render_passes(lights, switches, background_strength):
+    scene = bpy.context.scene
+    for k, spec in enumerate(PARAMS["passes"]):
+        # A pass is either the ambient term alone (materials emit, reflect nothing) or one light
+        # alone (materials reflect, emit nothing): Cycles samples one light per shading point, so
+        # one light per render makes its single sample exact.
+        for tree, surface, bsdf, emission in switches:
+            tree.links.new(emission if spec["ambient"] else bsdf, surface)
+        background_strength.default_value = 1.0 if spec["background"] else 0.0
+        for i, obj in enumerate(lights):
+            obj.hide_render = i != spec["light"]
+        scene.render.filepath = spec["file"]
+        bpy.ops.render.render(write_still=True)
+        if not os.path.isfile(spec["file"]):
+            fail("Blender wrote no image to " + spec["file"])
+        print("stereobench: wrote pass %d to %s" % (k, spec["file"]), flush=True)
+
+
+import_scene()
+switches = setup_materials()
+background_strength = setup_world()
+lights = setup_lights()
+setup_camera()
+setup_render()
+render_passes(lights, switches, background_strength)
+)PY";
+  return kBody;
+}
+
+}  // namespace sb::validation

@@ -1,0 +1,414 @@
+// `povray`: the right eye rendered by POV-Ray 3.7 from an SDL export (DESIGN §6.1,
+// docs/truth_povray.md). The executable is `povray` on PATH, or the one the environment variable
+// STEREOBENCH_POVRAY names.
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <deque>
+#include <fstream>
+#include <mutex>
+#include <regex>
+#include <sstream>
+#include <thread>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
+#include "renderer/io/image_io.hpp"
+#include "validation/providers/povray_export.hpp"
+#include "validation/providers/providers.hpp"
+
+extern char** environ;
+
+namespace sb::validation {
+namespace {
+
+/// Bumped whenever the provider's command line or settings change (the SDL export has its own
+/// revision, povray::kExportRevision; both make up revision()).
+constexpr const char* kProviderRevision = "povray-provider-1";
+constexpr const char* kExecutableVariable = "STEREOBENCH_POVRAY";
+constexpr const char* kInstallHint = "install it with `ci/install-deps.sh povray`";
+
+/// Lines of POV-Ray's output quoted in an error.
+constexpr std::size_t kQuotedLines = 15;
+
+bool is_executable_file(const std::filesystem::path& p) {
+  struct stat st {};
+  return ::stat(p.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(p.c_str(), X_OK) == 0;
+}
+
+/// `name` looked up like a shell would: as given when it contains a slash, else along PATH.
+std::optional<std::filesystem::path> find_executable(const std::string& name) {
+  if (name.find('/') != std::string::npos) {
+    if (is_executable_file(name)) return std::filesystem::path(name);
+    return std::nullopt;
+  }
+  const char* path = std::getenv("PATH");
+  if (!path) return std::nullopt;
+  std::stringstream dirs(path);
+  std::string dir;
+  while (std::getline(dirs, dir, ':')) {
+    const std::filesystem::path candidate = std::filesystem::path(dir.empty() ? "." : dir) / name;
+    if (is_executable_file(candidate)) return candidate;
+  }
+  return std::nullopt;
+}
+
+/// A command to run: the executable, its arguments, a working folder and environment changes.
+struct Command {
+  std::filesystem::path executable;
+  std::vector<std::string> args;  ///< argv[1..]
+  std::filesystem::path cwd;      ///< empty = inherit
+  std::vector<std::pair<std::string, std::string>> set_env;
+  std::vector<std::string> unset_env;
+};
+
+/// Shell-quoted form of the command (for records and messages; not used to run it).
+std::string quoted(const Command& c) {
+  const auto q = [](const std::string& s) {
+    if (!s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789+-_=./,:") ==
+                          std::string::npos)
+      return s;
+    std::string out = "'";
+    for (char ch : s) out += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+    return out + "'";
+  };
+  std::string out;
+  if (!c.cwd.empty()) out += "cd " + q(c.cwd.string()) + " && ";
+  if (!c.unset_env.empty()) {
+    out += "env";
+    for (const std::string& u : c.unset_env) out += " -u " + u;
+    out += " ";
+  }
+  for (const auto& [k, v] : c.set_env) out += k + "=" + q(v) + " ";
+  out += q(c.executable.string());
+  for (const std::string& a : c.args) out += " " + q(a);
+  return out;
+}
+
+/// Runs `c` with stdout and stderr sent to `out_fd` and waits for it. Returns the exit status, or
+/// 128 + signal for a killed process; ToolError when it cannot be started.
+int run_command(const Command& c, int out_fd) {
+  // Everything the child needs is prepared before fork(): after it only async-signal-safe calls.
+  std::vector<std::string> env_strings;
+  for (char** e = environ; e && *e; ++e) {
+    const std::string entry(*e);
+    const std::string key = entry.substr(0, entry.find('='));
+    const bool replaced = std::any_of(c.set_env.begin(), c.set_env.end(), [&](const auto& kv) { return kv.first == key; });
+    const bool removed = std::find(c.unset_env.begin(), c.unset_env.end(), key) != c.unset_env.end();
+    if (!replaced && !removed) env_strings.push_back(entry);
+  }
+  for (const auto& [k, v] : c.set_env) env_strings.push_back(k + "=" + v);
+  std::vector<char*> envp;
+  for (std::string& s : env_strings) envp.push_back(s.data());
+  envp.push_back(nullptr);
+  std::string exe = c.executable.string();
+  std::vector<std::string> arg_strings = c.args;
+  std::vector<char*> argv{exe.data()};
+  for (std::string& a : arg_strings) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const std::string cwd = c.cwd.string();
+
+  const pid_t pid = ::fork();
+  if (pid < 0) throw ToolError(fmt::format("cannot start '{}': fork failed: {}", exe, std::strerror(errno)));
+  if (pid == 0) {
+    const int devnull = ::open("/dev/null", O_RDONLY);
+    if (devnull >= 0) ::dup2(devnull, 0);
+    ::dup2(out_fd, 1);
+    ::dup2(out_fd, 2);
+    if (!cwd.empty() && ::chdir(cwd.c_str()) != 0) ::_exit(126);
+    ::execve(exe.c_str(), argv.data(), envp.data());
+    ::_exit(127);
+  }
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) throw ToolError(fmt::format("waiting for '{}' failed: {}", exe, std::strerror(errno)));
+  }
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
+  return -1;
+}
+
+/// Runs `c` and returns its exit status and its output (stdout and stderr together).
+std::pair<int, std::string> run_capture(const Command& c) {
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) != 0) throw ToolError(fmt::format("cannot run '{}': pipe failed: {}", c.executable.string(), std::strerror(errno)));
+  // The child writes into the pipe; the parent reads after the child ends, which is safe for the
+  // short version banner (far below the pipe's buffer). Longer output goes to a file instead.
+  int status = -1;
+  try {
+    status = run_command(c, fds[1]);
+  } catch (...) {
+    ::close(fds[0]);
+    ::close(fds[1]);
+    throw;
+  }
+  ::close(fds[1]);
+  std::string out;
+  char buf[4096];
+  for (;;) {
+    const ssize_t n = ::read(fds[0], buf, sizeof buf);
+    if (n > 0) {
+      out.append(buf, static_cast<std::size_t>(n));
+    } else if (n < 0 && errno == EINTR) {
+      continue;
+    } else {
+      break;
+    }
+  }
+  ::close(fds[0]);
+  return {status, out};
+}
+
+/// The last `n` non-empty lines of a text, each indented, for quoting in a message.
+std::string last_lines(const std::string& text, std::size_t n) {
+  std::deque<std::string> lines;
+  std::stringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    lines.push_back(line);
+    if (lines.size() > n) lines.pop_front();
+  }
+  std::string out;
+  for (const std::string& l : lines) out += "\n    " + l;
+  return out;
+}
+
+/// The distinct warning lines of a POV-Ray log (at most `limit`).
+std::vector<std::string> warning_lines(const std::string& log, std::size_t limit) {
+  std::vector<std::string> out;
+  std::stringstream in(log);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.find("Warning") == std::string::npos) continue;
+    if (std::find(out.begin(), out.end(), line) != out.end()) continue;
+    out.push_back(line);
+    if (out.size() >= limit) break;
+  }
+  return out;
+}
+
+/// What `povray --version` said.
+struct ToolInfo {
+  std::filesystem::path executable;
+  std::string version;  ///< "POV-Ray 3.7.0.10"
+  std::string banner;   ///< the full version line, e.g. "POV-Ray 3.7.0.10.unofficial"
+};
+
+class PovrayProvider final : public TruthProvider {
+ public:
+  PovrayProvider() {
+    const char* named = std::getenv(kExecutableVariable);
+    if (named && *named) {
+      requested_ = named;
+      from_variable_ = true;
+    }
+  }
+
+  std::string name() const override { return "povray"; }
+  std::string description() const override {
+    return "POV-Ray 3.7 from an SDL export (mesh2, exact inverse-square lights, no anti-aliasing); executable "
+           "from $STEREOBENCH_POVRAY or PATH";
+  }
+
+  std::optional<std::string> unavailable_reason() const override {
+    probe();
+    return reason_;
+  }
+
+  std::string tool_version() const override {
+    probe();
+    if (reason_) throw ToolError(*reason_);
+    return info_.version;
+  }
+
+  std::string revision() const override { return fmt::format("{}+{}", kProviderRevision, povray::kExportRevision); }
+
+  TruthRender render(const TruthRequest& request) const override {
+    const auto start = std::chrono::steady_clock::now();
+    probe();
+    if (reason_) throw ToolError(*reason_);
+
+    const EyeCamera eye = request.rig.eye(Eye::right);
+    std::error_code ec;
+    const std::filesystem::path dir = std::filesystem::absolute(request.work_dir, ec);
+    if (ec) throw IoError(fmt::format("work folder '{}': {}", request.work_dir.string(), ec.message()));
+    std::filesystem::create_directories(dir, ec);
+    if (ec) throw IoError(fmt::format("cannot create the POV-Ray work folder '{}': {}", dir.string(), ec.message()));
+
+    // A stale image from an earlier run must never be read as this run's output.
+    const std::filesystem::path image_file = dir / "right.exr";
+    const std::filesystem::path log_file = dir / "povray.log";
+    std::filesystem::remove(image_file, ec);
+    if (ec) throw IoError(fmt::format("cannot remove the old render '{}': {}", image_file.string(), ec.message()));
+
+    // Export.
+    const povray::ExportResult exported = povray::export_scene(request.scene.scene(), eye, dir);
+    const double export_seconds = seconds_since(start);
+
+    // A private configuration: POV-Ray reads its INI from $POVINI (else ./povray.ini, then the
+    // user's and the system's) and its I/O permissions from $HOME/.povray/3.7/povray.conf after
+    // the system's; pointing both into the work folder keeps a user's own settings out.
+    io::write_text_atomically(dir / "povray.ini", "; stereobench povray provider: every option is on the command line\n");
+    io::write_text_atomically(dir / ".povray" / "3.7" / "povray.conf",
+                              "; stereobench povray provider: read and write only in the work folder\n"
+                              "[File I/O Security]\nrestricted\n[Shellout Security]\nforbidden\n"
+                              "[Permitted Paths]\nread+write = .\n");
+
+    const int threads = request.threads > 0 ? request.threads
+                                            : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    Command cmd;
+    cmd.executable = info_.executable;
+    cmd.cwd = dir;
+    cmd.unset_env = {"DISPLAY"};
+    cmd.set_env = {{"POVINI", (dir / "povray.ini").string()}, {"HOME", dir.string()}};
+    cmd.args = {"+I" + exported.sdl_file.filename().string(),
+                "+O" + image_file.filename().string(),
+                "+FE",  // OpenEXR, half float, linear
+                fmt::format("+W{}", eye.width),
+                fmt::format("+H{}", eye.height),
+                "-A",   // no anti-aliasing: one ray through each pixel centre
+                "-J",   // no jitter
+                "-UA",  // no alpha channel: the background colour is written
+                "-D",   // no display window
+                "-P",   // no pause
+                "-V",   // not verbose
+                "-GS",  // no statistics
+                "-GR",  // no render progress
+                "-C",   // no continued trace
+                "+Q9",
+                fmt::format("+WT{}", threads)};
+
+    const int fd = ::open(log_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) throw IoError(fmt::format("cannot create the POV-Ray log '{}': {}", log_file.string(), std::strerror(errno)));
+    int status = -1;
+    try {
+      status = run_command(cmd, fd);
+    } catch (...) {
+      ::close(fd);
+      throw;
+    }
+    ::close(fd);
+    const double render_seconds = seconds_since(start) - export_seconds;
+    std::string log;
+    try {
+      log = io::read_file(log_file);
+    } catch (const Error&) {
+      log = "(no output)";
+    }
+    const bool have_image = std::filesystem::is_regular_file(image_file, ec);
+    if (status != 0 || !have_image)
+      throw ToolError(fmt::format(
+          "POV-Ray failed ({}) rendering '{}'; the scene file is kept there, rerun it with: {}\nlast lines of its "
+          "output ({}):{}",
+          status != 0 ? fmt::format("exit status {}", status) : std::string("no image written"),
+          exported.sdl_file.string(), quoted(cmd), log_file.string(), last_lines(log, kQuotedLines)));
+
+    Image raw;
+    try {
+      raw = io::read_exr(image_file);
+    } catch (const Error& e) {
+      throw ToolError(fmt::format("POV-Ray wrote '{}' but it cannot be read: {}", image_file.string(), e.what()));
+    }
+    if (raw.width() != eye.width || raw.height() != eye.height || !raw.has_plane(planes::rgb))
+      throw ToolError(fmt::format("POV-Ray wrote '{}' as {}x{} with planes [{}]; expected {}x{} with rgb",
+                                  image_file.string(), raw.width(), raw.height(), raw.plane_list(), eye.width,
+                                  eye.height));
+    TruthRender out;
+    out.provider = name();
+    out.tool_version = info_.version;
+    out.right = Image(eye.width, eye.height);
+    const std::span<const float> src = raw.plane(planes::rgb).f32();
+    std::copy(src.begin(), src.end(), out.right.add_plane(planes::rgb).f32().begin());
+    out.command = quoted(cmd);
+    out.settings = exported.settings;
+    out.settings["provider_revision"] = kProviderRevision;
+    out.settings["executable"] = info_.executable.string();
+    out.settings["executable_from"] = from_variable_ ? kExecutableVariable : "PATH";
+    out.settings["tool_banner"] = info_.banner;
+    out.settings["options"] = cmd.args;
+    out.settings["antialias"] = false;
+    out.settings["radiosity"] = false;
+    out.settings["output"] = "OpenEXR half float (11-bit significand: relative rounding error <= 2^-11 = 4.9e-4)";
+    out.settings["threads"] = threads;
+    out.settings["work_dir"] = dir.string();
+    out.settings["export_seconds"] = export_seconds;
+    out.settings["render_seconds"] = render_seconds;
+    out.settings["export_warnings"] = exported.warnings;
+    out.settings["povray_warnings"] = warning_lines(log, 20);
+    out.seconds = seconds_since(start);
+    return out;
+  }
+
+ private:
+  static double seconds_since(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  }
+
+  /// Finds the executable and asks it for its version, once.
+  void probe() const {
+    std::call_once(probed_, [this] {
+      const std::optional<std::filesystem::path> exe = find_executable(requested_);
+      if (!exe) {
+        reason_ = from_variable_
+                      ? fmt::format("{}='{}' is not an executable file (nor a command on PATH); point it at POV-Ray "
+                                    "3.7's `povray`, or unset it to use povray from PATH ({})",
+                                    kExecutableVariable, requested_, kInstallHint)
+                      : fmt::format("povray not found on PATH; {} (or set {} to its path)", kInstallHint,
+                                    kExecutableVariable);
+        return;
+      }
+      info_.executable = *exe;
+      Command cmd;
+      cmd.executable = *exe;
+      cmd.args = {"--version"};
+      cmd.unset_env = {"DISPLAY"};
+      std::pair<int, std::string> result;
+      try {
+        result = run_capture(cmd);
+      } catch (const Error& e) {
+        reason_ = fmt::format("'{}' cannot be run: {}", exe->string(), e.what());
+        return;
+      }
+      static const std::regex version_line(R"(POV-Ray (\d+)\.(\d+)(\.\d+)*\S*)");
+      std::smatch m;
+      if (!std::regex_search(result.second, m, version_line)) {
+        reason_ = fmt::format("'{} --version' did not report a POV-Ray version (exit status {});{} {}",
+                              exe->string(), result.first, last_lines(result.second, 5), kInstallHint);
+        return;
+      }
+      info_.banner = m.str(0);
+      std::string numeric = m.str(0).substr(8);
+      const std::size_t end = numeric.find_first_not_of("0123456789.");
+      if (end != std::string::npos) numeric.resize(end);
+      while (!numeric.empty() && numeric.back() == '.') numeric.pop_back();
+      info_.version = "POV-Ray " + numeric;
+      const int major = std::stoi(m.str(1)), minor = std::stoi(m.str(2));
+      if (major < 3 || (major == 3 && minor < 7))
+        reason_ = fmt::format("'{}' is {}, the povray provider needs POV-Ray 3.7 or newer; {}", exe->string(),
+                              info_.banner, kInstallHint);
+    });
+  }
+
+  std::string requested_ = "povray";
+  bool from_variable_ = false;
+  mutable std::once_flag probed_;
+  mutable std::optional<std::string> reason_;
+  mutable ToolInfo info_;
+};
+
+}  // namespace
+
+std::unique_ptr<TruthProvider> make_povray_provider() { return std::make_unique<PovrayProvider>(); }
+
+}  // namespace sb::validation

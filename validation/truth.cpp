@@ -1,0 +1,31 @@
+// The registry of ground-truth providers.
+#include "validation/truth.hpp"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "renderer/error.hpp"
+#include "validation/providers/providers.hpp"
+
+namespace sb::validation {
+
+Image rgb_plane_only(const Image& image) {
+  Image out(image.width(), image.height());
+  const Plane& src = image.plane(planes::rgb);
+  std::copy_n(src.data_f32(), src.value_count(), out.add_plane(planes::rgb).data_f32());
+  return out;
+}
+
+std::vector<std::string> truth_provider_names() { return {"full", "blender", "povray"}; }
+
+std::unique_ptr<TruthProvider> make_truth_provider(std::string_view name) {
+  if (name == "full") return make_full_provider();
+  if (name == "blender") return make_blender_provider();
+  if (name == "povray") return make_povray_provider();
+  throw InputError(fmt::format("unknown ground-truth provider '{}'; choose one of: {}", name,
+                               fmt::join(truth_provider_names(), ", ")));
+}
+
+}  // namespace sb::validation

@@ -1,0 +1,49 @@
+// The truth cache: external providers' renders kept on disk under a content hash of everything
+// that determines them (scene content, rig, resolution, provider, its revision and tool version),
+// so that a sweep renders each ground truth once.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "validation/truth.hpp"
+
+namespace sb::validation {
+
+/// The cache key of a request for a provider: SHA-256 of hash_scene, every rig parameter and the
+/// centre pose, the provider's name, revision() and tool_version().
+[[nodiscard]] std::string truth_key(const TruthProvider& provider, const TruthRequest& request);
+
+/// Renders under <dir>/<provider>/<key>.exr with <key>.json beside it (provider, tool version,
+/// settings, command, seconds, image hash). Both are written atomically, the EXR first, so an
+/// entry is complete exactly when its JSON exists.
+class TruthCache {
+ public:
+  explicit TruthCache(std::filesystem::path dir) : dir_(std::move(dir)) {}
+  [[nodiscard]] const std::filesystem::path& dir() const { return dir_; }
+  [[nodiscard]] std::filesystem::path image_path(const std::string& provider, const std::string& key) const;
+
+  /// The cached render, or nothing when absent. An entry whose image no longer matches its
+  /// recorded hash (edited, truncated) counts as absent and is overwritten by the next store().
+  [[nodiscard]] std::optional<TruthRender> load(const std::string& provider, const std::string& key) const;
+  void store(const std::string& key, const TruthRender& render) const;
+
+ private:
+  std::filesystem::path dir_;
+};
+
+/// A ground-truth render and where it came from.
+struct ResolvedTruth {
+  TruthRender render;
+  std::string key;
+  bool cached = false;  ///< loaded from the cache rather than rendered now
+};
+
+/// Renders the request with the provider, through the cache when one is given. The `full`
+/// provider is never cached: it is this suite's own renderer, as fast as a pipeline, and must
+/// follow every change to it. ToolError when the provider is unavailable.
+[[nodiscard]] ResolvedTruth resolve_truth(const TruthProvider& provider, const TruthRequest& request,
+                                          const TruthCache* cache);
+
+}  // namespace sb::validation

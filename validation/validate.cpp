@@ -1,0 +1,112 @@
+// Measuring a pipeline's right eye against ground truth.
+#include "validation/validate.hpp"
+
+#include <chrono>
+
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
+#include "renderer/io/render_output.hpp"
+
+namespace sb::validation {
+
+using nlohmann::json;
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+RegionMask mask_of(int width, int height, std::vector<uint8_t> inside) {
+  RegionMask m;
+  m.width = width;
+  m.height = height;
+  m.inside = std::move(inside);
+  return m;
+}
+
+}  // namespace
+
+ValidationTarget prepare_target(const RenderScene& scene, const std::filesystem::path& scene_file,
+                                const StereoRig& rig, const TruthProvider& provider, const TruthCache* cache,
+                                const std::filesystem::path& work_dir, const Executor& executor) {
+  const TruthRequest request{scene, scene_file, rig, work_dir, executor.threads()};
+  ValidationTarget t{scene, rig, resolve_truth(provider, request, cache), {}, {}, 0.0};
+  const RigParams& p = rig.params();
+  if (t.truth.render.right.width() != p.width || t.truth.render.right.height() != p.height)
+    throw InputError(fmt::format("the '{}' ground truth is {}x{} but the rig is {}x{}", provider.name(),
+                                 t.truth.render.right.width(), t.truth.render.right.height(), p.width, p.height));
+  t.truth_srgb8 = encode_srgb8(t.truth.render.right, fmt::format("the '{}' ground truth", provider.name()));
+  const auto start = std::chrono::steady_clock::now();
+  const VisibleSurfaces right = trace_visible_surfaces(scene, rig.eye(Eye::right), executor);
+  t.disocclusions = true_disocclusions(scene, rig, right, executor);
+  t.disocclusion_seconds = seconds_since(start);
+  return t;
+}
+
+PipelineValidation validate_pipeline(const ValidationTarget& target, const Pipeline& pipeline,
+                                     const PipelineOptions& options, const Executor& executor,
+                                     const MetricOptions& metric_options) {
+  PipelineValidation v;
+  v.pipeline = pipeline.info().name;
+  v.options = options;
+  v.result = pipeline.render(target.scene, target.rig, options, RenderContext{executor});
+  const auto start = std::chrono::steady_clock::now();
+  const Image& right = v.result.right;
+  const int w = right.width(), h = right.height();
+  v.right_srgb8 = encode_srgb8(right, fmt::format("{}'s right eye", v.pipeline));
+  v.whole = compare_images(v.right_srgb8, target.truth_srgb8, nullptr, metric_options);
+
+  std::vector<uint8_t> reprojected(right.pixel_count());
+  const uint32_t* source = right.data_u32(planes::source);
+  for (size_t i = 0; i < reprojected.size(); ++i)
+    reprojected[i] = source[i] == static_cast<uint32_t>(Source::reprojected) ? 1 : 0;
+  v.hole_mask = hole_mask_from_sources(right);
+  std::vector<uint8_t> disoccluded(target.disocclusions.mask.size());
+  for (size_t i = 0; i < disoccluded.size(); ++i) disoccluded[i] = target.disocclusions.mask[i] != 0 ? 1 : 0;
+  const RegionMask regions[] = {mask_of(w, h, std::move(reprojected)), mask_of(w, h, v.hole_mask),
+                                mask_of(w, h, std::move(disoccluded))};
+  for (size_t r = 0; r < std::size(kRegionNames); ++r)
+    v.regions.emplace_back(kRegionNames[r], compare_images(v.right_srgb8, target.truth_srgb8, &regions[r], metric_options));
+  v.ssim = ssim_map(v.right_srgb8, target.truth_srgb8);
+  v.holes = hole_statistics(right, v.result.counters, target.disocclusions);
+  v.seconds_metrics = seconds_since(start);
+  return v;
+}
+
+json validation_record(const ValidationTarget& target, const PipelineValidation& v, int threads, const json& images) {
+  json regions = json::object();
+  for (const auto& [name, m] : v.regions) regions[name] = to_json(m);
+  json timings = json::object();
+  for (const auto& [stage, s] : v.result.timings.stages()) timings[stage] = s;
+  json counters = json::object();
+  for (const auto& [name, value] : v.result.counters.snapshot()) counters[name] = value;
+  const Scene& scene = target.scene.scene();
+  const TruthRender& truth = target.truth.render;
+  return {{"kind", "stereobench.validation"},
+          {"schema_version", kValidationSchemaVersion},
+          {"metrics_version", kMetricsVersion},
+          {"pipeline", v.pipeline},
+          {"options", v.options.values()},
+          {"scene",
+           {{"name", scene.name}, {"path", scene.path}, {"triangles", scene.triangle_count()},
+            {"lights", scene.lights.size()}}},
+          {"rig", io::rig_to_json(target.rig)},
+          {"truth",
+           {{"provider", truth.provider}, {"tool_version", truth.tool_version}, {"settings", truth.settings},
+            {"command", truth.command}, {"seconds", truth.seconds}, {"cached", target.truth.cached},
+            {"cache_key", target.truth.key}}},
+          {"metrics", to_json(v.whole)},
+          {"regions", regions},
+          {"holes", to_json(v.holes)},
+          {"timings_s", timings},
+          {"total_s", v.result.timings.total()},
+          {"counters", counters},
+          {"threads", threads},
+          {"analysis_s", {{"metrics", v.seconds_metrics}, {"true_disocclusions", target.disocclusion_seconds}}},
+          {"versions", io::versions_json()},
+          {"images", images}};
+}
+
+}  // namespace sb::validation

@@ -1,0 +1,57 @@
+// Images written by a validation.
+#include "validation/validation_images.hpp"
+
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
+#include "renderer/io/image_io.hpp"
+#include "validation/metric_images.hpp"
+
+namespace sb::validation {
+
+using nlohmann::json;
+
+Srgb8Image disocclusion_image(const Srgb8Image& truth, const TrueDisocclusions& disocclusions) {
+  if (disocclusions.mask.size() != truth.pixel_count())
+    throw InputError(fmt::format("a true disocclusion mask of {} pixels does not fit a {}x{} image",
+                                 disocclusions.mask.size(), truth.width, truth.height));
+  Srgb8Image out = truth;
+  for (size_t i = 0; i < out.pixel_count(); ++i) {
+    uint8_t* px = &out.rgb[3 * i];
+    const auto kind = static_cast<Disocclusion>(disocclusions.mask[i]);
+    const uint8_t tint[2][3] = {{255, 140, 0}, {230, 20, 20}};  // outside the frustum, hidden
+    for (int c = 0; c < 3; ++c) {
+      const int dimmed = px[c] / 3;
+      px[c] = kind == Disocclusion::visible
+                  ? static_cast<uint8_t>(dimmed)
+                  : static_cast<uint8_t>((dimmed + 3 * tint[kind == Disocclusion::hidden ? 1 : 0][c]) / 4);
+    }
+  }
+  return out;
+}
+
+json write_target_images(const std::filesystem::path& dir, const std::string& stem, const ValidationTarget& target) {
+  const std::string provider = target.truth.render.provider;
+  const std::filesystem::path exr = dir / fmt::format("{}_truth-{}.exr", stem, provider);
+  const std::filesystem::path png = dir / fmt::format("{}_truth-{}.png", stem, provider);
+  const std::filesystem::path dis = dir / fmt::format("{}_disocclusions.png", stem);
+  io::write_exr(exr, target.truth.render.right);
+  write_png(png, target.truth_srgb8);
+  write_png(dis, disocclusion_image(target.truth_srgb8, target.disocclusions));
+  return {{"truth_exr", exr.string()}, {"truth_png", png.string()}, {"true_disocclusions_png", dis.string()}};
+}
+
+json write_pipeline_images(const std::filesystem::path& dir, const std::string& stem, const ValidationTarget& target,
+                           const PipelineValidation& v) {
+  const auto path = [&](const char* suffix) { return dir / fmt::format("{}_{}", stem, suffix); };
+  io::write_exr(path("right.exr"), v.result.right);
+  write_png(path("right.png"), v.right_srgb8);
+  write_png(path("diff.png"), difference_image(v.right_srgb8, target.truth_srgb8));
+  write_png(path("ssim.png"), ssim_image(v.ssim));
+  io::write_png_preview(path("holes.png"), hole_overlay(v.result.right, v.hole_mask, target.disocclusions.mask));
+  return {{"right_exr", path("right.exr").string()}, {"right_png", path("right.png").string()},
+          {"diff_png", path("diff.png").string()},   {"ssim_png", path("ssim.png").string()},
+          {"holes_png", path("holes.png").string()}};
+}
+
+}  // namespace sb::validation

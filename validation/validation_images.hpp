@@ -1,0 +1,31 @@
+// The images a validation writes (DESIGN §6, `stereobench validate`): the right eye, the ground
+// truth, the difference and SSIM maps, the hole mask against the true disocclusions, and the
+// true disocclusions themselves.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "validation/validate.hpp"
+
+namespace sb::validation {
+
+/// The true disocclusions over the ground truth: every pixel the ground truth's sRGB colour at a
+/// third of its brightness, disoccluded pixels outside the left frustum orange and hidden ones
+/// red (75 % tint over the dimmed colour). InputError if the sizes differ.
+[[nodiscard]] Srgb8Image disocclusion_image(const Srgb8Image& truth, const TrueDisocclusions& disocclusions);
+
+/// Writes the images shared by every pipeline of a target under `dir`: <stem>_truth-<provider>.exr
+/// and .png, and <stem>_disocclusions.png. Returns {name: path}.
+nlohmann::json write_target_images(const std::filesystem::path& dir, const std::string& stem,
+                                   const ValidationTarget& target);
+
+/// Writes a pipeline's images under `dir`: <stem>_right.exr (every AOV) and _right.png, _diff.png
+/// (difference heat map), _ssim.png (SSIM map) and _holes.png (hole mask against the true
+/// disocclusions: green found, red missed, blue flagged needlessly). Returns {name: path}.
+nlohmann::json write_pipeline_images(const std::filesystem::path& dir, const std::string& stem,
+                                     const ValidationTarget& target, const PipelineValidation& v);
+
+}  // namespace sb::validation
