@@ -192,16 +192,19 @@ double psnr_from_mse(double mse) {
   return 10.0 * std::log10(255.0 * 255.0 / mse);
 }
 
-SsimMap ssim_map(const Srgb8Image& a, const Srgb8Image& b) {
-  check_pair(a, b, nullptr);
-  SsimMap map{a.width, a.height, std::vector<float>(a.pixel_count(), std::numeric_limits<float>::quiet_NaN()), kNaN, 0};
-  if (!ssim_defined(a.width, a.height)) return map;
-  const cv::Mat s = ssim_channel_mean(a, b);
+namespace {
+
+/// The SSIM map of a pair as an SsimMap (values NaN outside the valid region), from the channel
+/// mean of ssim_channel_mean.
+SsimMap to_ssim_map(const cv::Mat& s, int width, int height) {
+  SsimMap map{width, height, std::vector<float>(static_cast<std::size_t>(width) * static_cast<std::size_t>(height),
+                                                std::numeric_limits<float>::quiet_NaN()),
+              kNaN, 0};
   double sum = 0.0;
-  for (int y = kSsimRadius; y < a.height - kSsimRadius; ++y) {
+  for (int y = kSsimRadius; y < height - kSsimRadius; ++y) {
     const double* row = s.ptr<double>(y);
-    for (int x = kSsimRadius; x < a.width - kSsimRadius; ++x) {
-      map.values[static_cast<std::size_t>(y) * static_cast<std::size_t>(a.width) + static_cast<std::size_t>(x)] =
+    for (int x = kSsimRadius; x < width - kSsimRadius; ++x) {
+      map.values[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)] =
           static_cast<float>(row[x]);
       sum += row[x];
       ++map.valid_pixels;
@@ -211,12 +214,9 @@ SsimMap ssim_map(const Srgb8Image& a, const Srgb8Image& b) {
   return map;
 }
 
-ImageMetrics compare_images(const Srgb8Image& a, const Srgb8Image& b, const RegionMask* region,
-                            const MetricOptions& options) {
-  check_pair(a, b, region);
-  if (options.error_threshold < 0 || options.error_threshold > 255)
-    throw InputError(
-        fmt::format("error threshold {} is out of range; give 0..255 (8-bit codes)", options.error_threshold));
+/// Every metric but SSIM over the region (SSIM left NaN).
+ImageMetrics pixel_metrics(const Srgb8Image& a, const Srgb8Image& b, const RegionMask* region,
+                           const MetricOptions& options) {
   ImageMetrics m;
   m.error_threshold = options.error_threshold;
   uint64_t squared = 0;
@@ -236,32 +236,68 @@ ImageMetrics compare_images(const Srgb8Image& a, const Srgb8Image& b, const Regi
       m.max_y = static_cast<int>(i / static_cast<std::size_t>(a.width));
     }
   }
+  m.ssim = kNaN;
   if (m.pixels == 0) {
-    m.mse = m.psnr = m.ssim = m.error_fraction = kNaN;
+    m.mse = m.psnr = m.error_fraction = kNaN;
     return m;
   }
   m.mse = static_cast<double>(squared) / static_cast<double>(3 * m.pixels);
   m.psnr = psnr_from_mse(m.mse);
   m.error_fraction = static_cast<double>(m.error_pixels) / static_cast<double>(m.pixels);
-
-  // SSIM: the mean over the region's pixels inside the valid region.
-  m.ssim = kNaN;
-  if (ssim_defined(a.width, a.height)) {
-    const cv::Mat s = ssim_channel_mean(a, b);
-    double sum = 0.0;
-    for (int y = kSsimRadius; y < a.height - kSsimRadius; ++y) {
-      const double* row = s.ptr<double>(y);
-      for (int x = kSsimRadius; x < a.width - kSsimRadius; ++x) {
-        if (!in_region(region,
-                       static_cast<std::size_t>(y) * static_cast<std::size_t>(a.width) + static_cast<std::size_t>(x)))
-          continue;
-        sum += row[x];
-        ++m.ssim_pixels;
-      }
-    }
-    if (m.ssim_pixels > 0) m.ssim = sum / static_cast<double>(m.ssim_pixels);
-  }
   return m;
+}
+
+/// SSIM of `m`: the mean of the channel-mean map `s` over the region's pixels inside the valid region.
+void add_ssim(const cv::Mat& s, int width, int height, const RegionMask* region, ImageMetrics& m) {
+  if (m.pixels == 0) return;
+  double sum = 0.0;
+  for (int y = kSsimRadius; y < height - kSsimRadius; ++y) {
+    const double* row = s.ptr<double>(y);
+    for (int x = kSsimRadius; x < width - kSsimRadius; ++x) {
+      if (!in_region(region, static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)))
+        continue;
+      sum += row[x];
+      ++m.ssim_pixels;
+    }
+  }
+  if (m.ssim_pixels > 0) m.ssim = sum / static_cast<double>(m.ssim_pixels);
+}
+
+}  // namespace
+
+SsimMap ssim_map(const Srgb8Image& a, const Srgb8Image& b) {
+  check_pair(a, b, nullptr);
+  if (!ssim_defined(a.width, a.height))
+    return SsimMap{a.width, a.height, std::vector<float>(a.pixel_count(), std::numeric_limits<float>::quiet_NaN()),
+                   kNaN, 0};
+  return to_ssim_map(ssim_channel_mean(a, b), a.width, a.height);
+}
+
+std::vector<ImageMetrics> compare_regions(const Srgb8Image& a, const Srgb8Image& b,
+                                          std::span<const RegionMask* const> regions, const MetricOptions& options,
+                                          SsimMap* map) {
+  for (const RegionMask* region : regions) check_pair(a, b, region);
+  if (regions.empty()) check_pair(a, b, nullptr);
+  if (options.error_threshold < 0 || options.error_threshold > 255)
+    throw InputError(
+        fmt::format("error threshold {} is out of range; give 0..255 (8-bit codes)", options.error_threshold));
+  std::vector<ImageMetrics> out;
+  out.reserve(regions.size());
+  for (const RegionMask* region : regions) out.push_back(pixel_metrics(a, b, region, options));
+  if (!ssim_defined(a.width, a.height)) {
+    if (map != nullptr) *map = ssim_map(a, b);
+    return out;
+  }
+  const cv::Mat s = ssim_channel_mean(a, b);
+  for (size_t r = 0; r < regions.size(); ++r) add_ssim(s, a.width, a.height, regions[r], out[r]);
+  if (map != nullptr) *map = to_ssim_map(s, a.width, a.height);
+  return out;
+}
+
+ImageMetrics compare_images(const Srgb8Image& a, const Srgb8Image& b, const RegionMask* region,
+                            const MetricOptions& options) {
+  const RegionMask* const regions[] = {region};
+  return compare_regions(a, b, regions, options).front();
 }
 
 nlohmann::json to_json(const ImageMetrics& m) {

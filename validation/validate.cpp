@@ -56,8 +56,6 @@ PipelineValidation validate_pipeline(const ValidationTarget& target, const Pipel
   const Image& right = v.result.right;
   const int w = right.width(), h = right.height();
   v.right_srgb8 = encode_srgb8(right, fmt::format("{}'s right eye", v.pipeline));
-  v.whole = compare_images(v.right_srgb8, target.truth_srgb8, nullptr, metric_options);
-
   std::vector<uint8_t> reprojected(right.pixel_count());
   const uint32_t* source = right.data_u32(planes::source);
   for (size_t i = 0; i < reprojected.size(); ++i)
@@ -65,11 +63,13 @@ PipelineValidation validate_pipeline(const ValidationTarget& target, const Pipel
   v.hole_mask = hole_mask_from_sources(right);
   std::vector<uint8_t> disoccluded(target.disocclusions.mask.size());
   for (size_t i = 0; i < disoccluded.size(); ++i) disoccluded[i] = target.disocclusions.mask[i] != 0 ? 1 : 0;
-  const RegionMask regions[] = {mask_of(w, h, std::move(reprojected)), mask_of(w, h, v.hole_mask),
-                                mask_of(w, h, std::move(disoccluded))};
-  for (size_t r = 0; r < std::size(kRegionNames); ++r)
-    v.regions.emplace_back(kRegionNames[r], compare_images(v.right_srgb8, target.truth_srgb8, &regions[r], metric_options));
-  v.ssim = ssim_map(v.right_srgb8, target.truth_srgb8);
+  const RegionMask masks[] = {mask_of(w, h, std::move(reprojected)), mask_of(w, h, v.hole_mask),
+                              mask_of(w, h, std::move(disoccluded))};
+  const RegionMask* const regions[] = {nullptr, &masks[0], &masks[1], &masks[2]};
+  const std::vector<ImageMetrics> metrics =
+      compare_regions(v.right_srgb8, target.truth_srgb8, regions, metric_options, &v.ssim);
+  v.whole = metrics[0];
+  for (size_t r = 0; r < std::size(kRegionNames); ++r) v.regions.emplace_back(kRegionNames[r], metrics[r + 1]);
   v.holes = hole_statistics(right, v.result.counters, target.disocclusions);
   v.seconds_metrics = seconds_since(start);
   return v;

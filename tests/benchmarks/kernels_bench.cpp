@@ -10,6 +10,7 @@
 #include "renderer/stages/lighting.hpp"
 #include "renderer/stages/trace.hpp"
 #include "support/render_support.hpp"
+#include "validation/metrics.hpp"
 
 namespace sb {
 namespace {
@@ -60,6 +61,33 @@ void BM_TraceEye(benchmark::State& state) {
   }
 }
 
+/// Two 8-bit images of a size: uniform noise and the same noise with every code shifted.
+std::pair<validation::Srgb8Image, validation::Srgb8Image> noise_pair(int width, int height) {
+  validation::Srgb8Image a{width, height, std::vector<uint8_t>(size_t(width) * size_t(height) * 3)};
+  uint32_t state = 12345u;
+  for (uint8_t& v : a.rgb) {
+    state = state * 1664525u + 1013904223u;
+    v = static_cast<uint8_t>(state >> 24);
+  }
+  validation::Srgb8Image b = a;
+  for (uint8_t& v : b.rgb) v = static_cast<uint8_t>(v / 2 + 40);
+  return {std::move(a), std::move(b)};
+}
+
+/// SSIM map of a 3840 x 2160 pair (DESIGN §6.2), the largest comparison a sweep makes.
+void BM_Ssim4k(benchmark::State& state) {
+  const auto [a, b] = noise_pair(3840, 2160);
+  for (auto _ : state) benchmark::DoNotOptimize(validation::ssim_map(a, b).mean);
+}
+
+/// Every metric of a 3840 x 2160 pair (MSE, PSNR, SSIM, error pixels, max error).
+void BM_CompareImages4k(benchmark::State& state) {
+  const auto [a, b] = noise_pair(3840, 2160);
+  for (auto _ : state) benchmark::DoNotOptimize(validation::compare_images(a, b).ssim);
+}
+
+BENCHMARK(BM_Ssim4k)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_CompareImages4k)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Rasterize)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ShadeGBuffer)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_TraceEye)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -33,6 +33,19 @@ void damage(const fs::path& file) {
   f.write("damaged!", 8);
 }
 
+TEST(ReferenceStore, CommittedReferencesStillHold) {
+  // The small references committed under reference/store (box-wall at 160x90 by every provider),
+  // verified in a copy so that the source tree is never written. Renders here are bit-identical
+  // to them; 50 dB leaves room for another CPU whose Embree kernels round differently.
+  test::ScratchDir dir;
+  fs::copy(fs::path(SB_SOURCE_DIR) / "reference" / "store", dir / "store", fs::copy_options::recursive);
+  const ReferenceStore store(dir / "store");
+  ASSERT_EQ(store.ids().size(), 3u) << "reference/store should hold the box-wall references of full, blender, povray";
+  const test::CliRun r = test::run_cli(ref(dir, "verify") + " --min-psnr 50");
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("3 of 3 reference(s) verified"), std::string::npos) << r.out;
+}
+
 TEST(ReferenceStore, GenerateWritesImageAndProvenance) {
   test::ScratchDir dir;
   const test::CliRun gen = test::run_cli(ref(dir, "generate") + " --scene box-wall --resolution 64x36 --threads 1");

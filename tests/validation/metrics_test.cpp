@@ -287,6 +287,27 @@ TEST(Ssim, NoiseLowersItAndItIsSymmetric) {
 
 // ---- JSON and the linear difference -------------------------------------------------------------
 
+TEST(Metrics, SeveralRegionsEqualOneAtATime) {
+  const Srgb8Image a = codes(40, 31, pattern);
+  const Srgb8Image b = codes(40, 31, [](int x, int y, int c) { return hashed(x, y, c, 7u); });
+  RegionMask left = RegionMask::filled(40, 31, false), empty = RegionMask::filled(40, 31, false);
+  for (int y = 0; y < 31; ++y)
+    for (int x = 0; x < 17; ++x) left.inside[static_cast<size_t>(y) * 40 + x] = 1;
+  const RegionMask* const regions[] = {nullptr, &left, &empty};
+  validation::SsimMap map;
+  const std::vector<ImageMetrics> all = compare_regions(a, b, regions, {}, &map);
+  ASSERT_EQ(all.size(), 3u);
+  for (size_t r = 0; r < 3; ++r) {
+    const ImageMetrics one = compare_images(a, b, regions[r]);
+    EXPECT_EQ(to_json(all[r]), to_json(one)) << "region " << r;
+  }
+  const validation::SsimMap direct = validation::ssim_map(a, b);
+  EXPECT_EQ(map.mean, direct.mean);
+  EXPECT_EQ(map.valid_pixels, direct.valid_pixels);
+  for (size_t i = 0; i < map.values.size(); ++i)
+    EXPECT_TRUE(map.values[i] == direct.values[i] || (std::isnan(map.values[i]) && std::isnan(direct.values[i])));
+}
+
 TEST(Metrics, JsonRecord) {
   const Srgb8Image a = codes(16, 12, pattern);
   Srgb8Image b = a;

@@ -149,6 +149,7 @@ def setup_materials():
     default = make_material("stereobench_default", PARAMS["default_material"], textures, switches)
     plain = {}
     unmatched = set()
+    done = set()
     for obj in bpy.data.objects:
         if obj.type != "MESH":
             continue
@@ -156,6 +157,9 @@ def setup_materials():
         obj.cycles.shadow_terminator_offset = 0.0
         obj.cycles.shadow_terminator_geometry_offset = 0.0
         mesh = obj.data
+        if mesh.as_pointer() in done:  # a mesh instanced by several nodes: its slots are set
+            continue
+        done.add(mesh.as_pointer())
         if len(mesh.materials) == 0:
             mesh.materials.append(default)
             continue
