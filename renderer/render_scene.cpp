@@ -7,7 +7,8 @@
 
 namespace sb {
 
-RenderScene::RenderScene(const Scene& scene) : scene_(&scene), geometry_(scene), rays_(geometry_) {
+RenderScene::RenderScene(const Scene& scene, bool refittable)
+    : scene_(&scene), geometry_(scene), rays_(geometry_, refittable) {
   const auto t0 = std::chrono::steady_clock::now();
   textures_.reserve(scene.textures.size());
   for (const Texture& t : scene.textures) textures_.emplace_back(t);

@@ -13,7 +13,9 @@ namespace sb {
 
 class RenderScene {
  public:
-  explicit RenderScene(const Scene& scene);
+  /// Prepares `scene`, which must outlive this object. With `refittable`, the BVH is built for
+  /// update_geometry() to refit it (animated scenes).
+  explicit RenderScene(const Scene& scene, bool refittable = false);
   RenderScene(const RenderScene&) = delete;
   RenderScene& operator=(const RenderScene&) = delete;
 
@@ -27,6 +29,11 @@ class RenderScene {
   /// A length below the float resolution of the scene's coordinates times a safety factor: the
   /// offset of shadow-ray origins.
   [[nodiscard]] float ray_epsilon() const { return ray_epsilon_; }
+
+  /// After the scene's vertex positions and normals changed in place (rigid animation: same
+  /// meshes and topology, see renderer/animation.hpp): updates the BVH (refit or rebuild). Returns
+  /// the seconds taken. Materials, textures and lights are read from the scene as they are.
+  double update_geometry() { return rays_.update(); }
 
  private:
   const Scene* scene_;

@@ -57,7 +57,8 @@ void cull_back_faces(const RTCFilterFunctionNArguments* args) {
 
 }  // namespace
 
-RayScene::RayScene(const SceneGeometry& geometry) : impl_(std::make_unique<Impl>()) {
+RayScene::RayScene(const SceneGeometry& geometry, bool refittable)
+    : impl_(std::make_unique<Impl>()), refittable_(refittable) {
   const auto t0 = std::chrono::steady_clock::now();
   impl_->geometry = &geometry;
   impl_->device = rtcNewDevice("verbose=0");
@@ -65,8 +66,8 @@ RayScene::RayScene(const SceneGeometry& geometry) : impl_(std::make_unique<Impl>
   rtcSetDeviceErrorFunction(impl_->device, on_error, impl_.get());
   rtcSetDeviceMemoryMonitorFunction(impl_->device, on_memory, impl_.get());
   impl_->scene = rtcNewScene(impl_->device);
-  rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
-  rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_MEDIUM);
+  rtcSetSceneFlags(impl_->scene, refittable ? RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_DYNAMIC : RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(impl_->scene, refittable ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_MEDIUM);
   const Scene& s = *geometry.scene;
   for (size_t m = 0; m < s.meshes.size(); ++m) {
     const Mesh& mesh = s.meshes[m];
@@ -82,6 +83,7 @@ RayScene::RayScene(const SceneGeometry& geometry) : impl_(std::make_unique<Impl>
     }
     std::memcpy(v, mesh.positions.data(), mesh.positions.size() * sizeof(vec3));
     std::memcpy(idx, mesh.indices.data(), mesh.indices.size() * sizeof(uint32_t));
+    if (refittable) rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_REFIT);
     if (geometry.single_sided[m]) {
       rtcSetGeometryUserData(g, const_cast<Mesh*>(&mesh));
       rtcSetGeometryIntersectFilterFunction(g, cull_back_faces);
@@ -95,6 +97,23 @@ RayScene::RayScene(const SceneGeometry& geometry) : impl_(std::make_unique<Impl>
   if (!impl_->error.empty()) throw IoError(fmt::format("building the BVH failed: {}", impl_->error));
   build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   memory_bytes_ = static_cast<size_t>(impl_->peak.load());
+}
+
+double RayScene::update() {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Scene& s = *impl_->geometry->scene;
+  for (size_t m = 0; m < s.meshes.size(); ++m) {
+    const Mesh& mesh = s.meshes[m];
+    RTCGeometry g = rtcGetGeometry(impl_->scene, static_cast<unsigned>(m));
+    auto* v = static_cast<float*>(rtcGetGeometryBufferData(g, RTC_BUFFER_TYPE_VERTEX, 0));
+    if (!v) throw IoError(fmt::format("Embree has no vertex buffer for mesh '{}' to update", mesh.name));
+    std::memcpy(v, mesh.positions.data(), mesh.positions.size() * sizeof(vec3));
+    rtcUpdateGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0);
+    rtcCommitGeometry(g);
+  }
+  rtcCommitScene(impl_->scene);
+  if (!impl_->error.empty()) throw IoError(fmt::format("updating the BVH failed: {}", impl_->error));
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 RayScene::~RayScene() {

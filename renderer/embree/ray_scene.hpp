@@ -35,7 +35,9 @@ constexpr int kRayPacket = 16;
 /// The scene's BVH. Thread-safe for queries once constructed.
 class RayScene {
  public:
-  explicit RayScene(const SceneGeometry& geometry);
+  /// Builds the BVH. With `refittable`, the BVH is built so that update() refits it (Embree's
+  /// dynamic scene and refit build quality) instead of rebuilding it.
+  explicit RayScene(const SceneGeometry& geometry, bool refittable = false);
   ~RayScene();
   RayScene(const RayScene&) = delete;
   RayScene& operator=(const RayScene&) = delete;
@@ -44,6 +46,11 @@ class RayScene {
   void intersect(std::span<const RayQuery> rays, std::span<RayHit> hits) const;
   /// Occlusion of up to 16 ray segments: blocked[i] = 1 when anything lies within [tnear, tfar].
   void occluded(std::span<const RayQuery> rays, std::span<uint8_t> blocked) const;
+
+  /// After the scene's vertex positions changed in place (same meshes, same topology): copies
+  /// them into the BVH's buffers and refits (refittable) or rebuilds it. Returns the seconds taken.
+  double update();
+  [[nodiscard]] bool refittable() const { return refittable_; }
 
   [[nodiscard]] double build_seconds() const { return build_seconds_; }
   /// Peak bytes Embree allocated for the scene (BVH and geometry buffers).
@@ -56,6 +63,7 @@ class RayScene {
   std::unique_ptr<Impl> impl_;
   double build_seconds_ = 0.0;
   size_t memory_bytes_ = 0;
+  bool refittable_ = false;
 };
 
 }  // namespace sb

@@ -1,0 +1,116 @@
+// Camera paths and rigid node animation.
+#include "renderer/animation.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
+
+namespace sb {
+
+namespace {
+
+bool finite(const dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+/// Rotation by `radians` about the unit `axis` (Rodrigues).
+dmat3 rotation(const dvec3& axis, double radians) {
+  const double c = std::cos(radians), s = std::sin(radians), t = 1.0 - c;
+  const double x = axis.x, y = axis.y, z = axis.z;
+  // Column-major: m[col][row].
+  return dmat3(t * x * x + c, t * x * y + s * z, t * x * z - s * y,   //
+               t * x * y - s * z, t * y * y + c, t * y * z + s * x,   //
+               t * x * z + s * y, t * y * z - s * x, t * z * z + c);
+}
+
+}  // namespace
+
+void PathSpec::validate() const {
+  if (frames < 1 || frames > 100000)
+    throw InputError(fmt::format("path frames {} is out of range; give 1..100000", frames));
+  for (size_t i = 0; i < camera_keys.size(); ++i) {
+    const CameraKey& k = camera_keys[i];
+    if (!finite(k.position) || !finite(k.target))
+      throw InputError(fmt::format("camera key {} has a non-finite coordinate", i + 1));
+    if (glm::length(k.target - k.position) < 1e-9)
+      throw InputError(fmt::format("camera key {} looks at its own position; give a target elsewhere", i + 1));
+  }
+  if (spin) {
+    if (!finite(spin->axis) || glm::length(spin->axis) < 1e-12)
+      throw InputError("the spin axis is zero or not finite; give a direction such as 0,1,0");
+    if (!std::isfinite(spin->degrees_per_frame))
+      throw InputError("the spin angle per frame is not finite");
+    if (spin->pivot && !finite(*spin->pivot)) throw InputError("the spin pivot is not finite");
+  }
+}
+
+SceneAnimator::SceneAnimator(Scene& scene, const PathSpec& path) : scene_(scene), path_(path) {
+  path_.validate();
+  if (!path_.spin) return;
+  Bounds3 bounds;
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    if (mesh.name.rfind(path_.spin->mesh_prefix, 0) != 0) continue;
+    turning_.push_back(m);
+    base_positions_.push_back(mesh.positions);
+    base_normals_.push_back(mesh.normals);
+    for (const vec3& p : mesh.positions) bounds.extend(p);
+  }
+  if (turning_.empty())
+    throw InputError(fmt::format("the spin's mesh prefix '{}' matches no mesh of scene '{}'", path_.spin->mesh_prefix,
+                                 scene.name));
+  pivot_ = path_.spin->pivot ? *path_.spin->pivot : dvec3(0.5f * (bounds.lo + bounds.hi));
+}
+
+void SceneAnimator::apply(int frame) {
+  if (frame < 0 || frame >= path_.frames)
+    throw InputError(fmt::format("frame {} is outside the path's 0..{}", frame, path_.frames - 1));
+  if (turning_.empty()) return;
+  const double radians = degrees_to_radians(path_.spin->degrees_per_frame * frame);
+  const dmat3 r = rotation(glm::normalize(path_.spin->axis), radians);
+  for (size_t k = 0; k < turning_.size(); ++k) {
+    Mesh& mesh = scene_.meshes[turning_[k]];
+    const std::vector<vec3>& p0 = base_positions_[k];
+    for (size_t i = 0; i < p0.size(); ++i) mesh.positions[i] = vec3(pivot_ + r * (dvec3(p0[i]) - pivot_));
+    const std::vector<vec3>& n0 = base_normals_[k];
+    for (size_t i = 0; i < n0.size(); ++i) mesh.normals[i] = vec3(r * dvec3(n0[i]));
+  }
+}
+
+CameraPose SceneAnimator::camera_at(int frame, const CameraPose& base) const {
+  const std::vector<CameraKey>& keys = path_.camera_keys;
+  if (keys.empty()) return base;
+  if (keys.size() == 1 || path_.frames == 1) return CameraPose::look_at(keys.front().position, keys.front().target);
+  const double u = static_cast<double>(frame) / static_cast<double>(path_.frames - 1) * static_cast<double>(keys.size() - 1);
+  const size_t i = std::min(static_cast<size_t>(u), keys.size() - 2);
+  const double t = u - static_cast<double>(i);
+  const dvec3 position = glm::mix(keys[i].position, keys[i + 1].position, t);
+  const dvec3 target = glm::mix(keys[i].target, keys[i + 1].target, t);
+  return CameraPose::look_at(position, target);
+}
+
+std::vector<CameraKey> parse_camera_keys(const std::string& text) {
+  std::vector<CameraKey> keys;
+  std::stringstream list(text);
+  std::string item;
+  const auto vec = [&](const std::string& part, size_t key) {
+    dvec3 v;
+    char c1 = 0, c2 = 0;
+    std::stringstream in(part);
+    if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !(in >> std::ws).eof())
+      throw InputError(fmt::format("camera key {} '{}': '{}' is not x,y,z (meters)", key, item, part));
+    return v;
+  };
+  while (std::getline(list, item, ';')) {
+    if (item.empty()) continue;
+    const size_t arrow = item.find('>');
+    if (arrow == std::string::npos)
+      throw InputError(fmt::format("camera key {} '{}' is not POSITION>TARGET, e.g. 0,1.6,3>0,1.2,0", keys.size() + 1, item));
+    keys.push_back({vec(item.substr(0, arrow), keys.size() + 1), vec(item.substr(arrow + 1), keys.size() + 1)});
+  }
+  if (keys.empty()) throw InputError("no camera key given; give POSITION>TARGET;POSITION>TARGET...");
+  return keys;
+}
+
+}  // namespace sb

@@ -1,0 +1,73 @@
+// Animation along a path of frames (DESIGN §7): a camera moving through key poses and rigid node
+// animation (meshes turning about an axis, e.g. Al-Hagri's "Animated Spheres" turning about Y).
+// Frames are applied to a Scene in place; RenderScene::update_geometry() then refits the BVH.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "renderer/math.hpp"
+#include "renderer/rig.hpp"
+#include "renderer/scene.hpp"
+
+namespace sb {
+
+/// A camera key pose: where the centre camera stands and the point it looks at (+Y up).
+struct CameraKey {
+  dvec3 position{0.0};
+  dvec3 target{0.0, 0.0, -1.0};
+};
+
+/// Rigid rotation of meshes about an axis through a pivot, by a fixed angle per frame.
+struct Spin {
+  dvec3 axis{0.0, 1.0, 0.0};
+  /// The pivot; unset = the centre of the turning meshes' bounds at frame 0.
+  std::optional<dvec3> pivot;
+  double degrees_per_frame = 1.0;
+  /// Meshes whose name starts with this prefix turn ("" = every mesh).
+  std::string mesh_prefix;
+};
+
+/// A path of `frames` frames: the camera along `camera_keys` (none: the rig's own pose; one: that
+/// pose; more: piecewise linear in position and target, the keys spread evenly over the frames,
+/// the first at frame 0 and the last at frame frames-1) and an optional spin.
+struct PathSpec {
+  int frames = 1;
+  std::vector<CameraKey> camera_keys;
+  std::optional<Spin> spin;
+
+  /// InputError naming the field: frames outside 1..100000, a key whose target equals its
+  /// position, a zero spin axis, a non-finite angle.
+  void validate() const;
+};
+
+/// Applies the frames of a path to a scene. Keeps the scene's frame-0 positions and normals of
+/// the turning meshes, so frame k is always R(k * angle) applied to frame 0 (no drift).
+class SceneAnimator {
+ public:
+  /// InputError when the spin's prefix matches no mesh.
+  SceneAnimator(Scene& scene, const PathSpec& path);
+
+  [[nodiscard]] int frames() const { return path_.frames; }
+  [[nodiscard]] bool moves_geometry() const { return !turning_.empty(); }
+  [[nodiscard]] size_t turning_meshes() const { return turning_.size(); }
+
+  /// Sets the turning meshes' positions and normals to those of `frame` (0 <= frame < frames()).
+  void apply(int frame);
+  /// The centre camera pose at `frame`; `base` when the path has no camera keys.
+  [[nodiscard]] CameraPose camera_at(int frame, const CameraPose& base) const;
+
+ private:
+  Scene& scene_;
+  PathSpec path_;
+  dvec3 pivot_{0.0};
+  std::vector<size_t> turning_;  ///< indices of the turning meshes
+  std::vector<std::vector<vec3>> base_positions_, base_normals_;
+};
+
+/// Parses camera keys "px,py,pz>tx,ty,tz;px,py,pz>tx,ty,tz;..." (meters). InputError naming the
+/// key and what is wrong.
+[[nodiscard]] std::vector<CameraKey> parse_camera_keys(const std::string& text);
+
+}  // namespace sb

@@ -1,0 +1,53 @@
+// `stereobench path`: one JSON line per frame with the BVH update timed per frame, and bad input.
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "support/run_cli.hpp"
+#include "support/scratch_dir.hpp"
+
+namespace sb {
+namespace {
+
+using nlohmann::json;
+
+std::string args(const test::ScratchDir& dir) {
+  return "path --scene box-wall --resolution 96x54 --threads 2 --scenes-dir '" +
+         (std::filesystem::path(SB_BINARY_DIR) / "Testing" / "scenes-cache").string() + "' --out '" +
+         (dir / "out").string() + "'";
+}
+
+TEST(PathCommand, FramesWithSpinAndCameraKeys) {
+  test::ScratchDir dir;
+  const test::CliRun r = test::run_cli(args(dir) + " --frames 3 --spin-deg 10 --pipelines plain-rt,repro-rt"
+                                                   " --camera-keys '0,1,6>0,0.5,0;1,1,6>0,0.5,0'");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("BVH refit per frame"), std::string::npos) << r.out;
+  std::stringstream lines(test::read_text(dir / "out" / "box-wall_path.jsonl"));
+  std::vector<json> frames;
+  for (std::string line; std::getline(lines, line);) frames.push_back(json::parse(line));
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_EQ(frames[0]["bvh"], "build");
+  EXPECT_EQ(frames[1]["bvh"], "refit");
+  EXPECT_GT(frames[2]["bvh_update_s"].get<double>(), 0.0);
+  EXPECT_EQ(frames[2]["frame"], 2);
+  EXPECT_NE(frames[0]["camera"]["position"], frames[2]["camera"]["position"]);
+  for (const json& f : frames) {
+    EXPECT_EQ(f["pipelines"]["plain-rt"]["metrics"]["psnr"], "inf") << "plain-rt is the built-in ground truth";
+    EXPECT_GT(f["pipelines"]["repro-rt"]["total_s"].get<double>(), 0.0);
+    EXPECT_GT(f["pipelines"]["repro-rt"]["metrics"]["psnr"].get<double>(), 30.0);
+  }
+}
+
+TEST(PathCommand, BadInput) {
+  test::ScratchDir dir;
+  EXPECT_EQ(test::run_cli(args(dir) + " --bvh sometimes").code, 3);
+  EXPECT_EQ(test::run_cli(args(dir) + " --frames 0").code, 3);
+  EXPECT_EQ(test::run_cli(args(dir) + " --camera-keys '1,2,3'").code, 3);
+  EXPECT_EQ(test::run_cli(args(dir) + " --spin-deg 5 --spin-prefix nothing-like-this").code, 3);
+}
+
+}  // namespace
+}  // namespace sb

@@ -1,0 +1,38 @@
+// Validation along a path of frames (DESIGN §7, issue "sweeps": camera paths and animation): per
+// frame the scene is animated, its BVH refit or rebuilt (timed as its own stage), the ground truth
+// and true disocclusions computed, and every pipeline rendered and measured.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "renderer/animation.hpp"
+#include "renderer/parallel.hpp"
+#include "renderer/pipeline.hpp"
+#include "validation/truth_cache.hpp"
+
+namespace sb::validation {
+
+struct PathRun {
+  std::filesystem::path scene_file;  ///< for providers that import it
+  RigParams rig;                     ///< resolution, interaxial, convergence, field of view
+  CameraPose pose;                   ///< the centre camera when the path has no camera keys
+  PathSpec path;
+  std::vector<const Pipeline*> pipelines;
+  const TruthProvider* truth = nullptr;
+  const TruthCache* cache = nullptr;
+  std::filesystem::path work_dir;
+  bool refit = true;  ///< refit the BVH per frame (else rebuild it)
+};
+
+/// Runs every frame of the path on `scene` (animated in place; left at the last frame) and calls
+/// `on_frame` with each frame's record: frame, animate_s, bvh_update_s, bvh ("refit"/"rebuild"),
+/// camera pose, truth seconds, true disocclusion fraction, and per pipeline total_s, timings_s,
+/// counters and the whole-image metrics (metrics JSON of validation/metrics.hpp).
+void run_path(Scene& scene, const PathRun& run, const Executor& executor,
+              const std::function<void(const nlohmann::json& frame)>& on_frame);
+
+}  // namespace sb::validation
