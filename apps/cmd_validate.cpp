@@ -3,6 +3,7 @@
 // images and a result record per pipeline, and a table on the terminal.
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -28,6 +29,7 @@ using nlohmann::json;
 struct ValidateArgs {
   std::string scene = "spheres";
   std::vector<std::string> pipelines{"all"};
+  std::vector<std::string> options;
   std::string truth = "full";
   std::string scenes_dir;
   std::string out = "out/validate";
@@ -69,6 +71,10 @@ std::string number(double v, const char* format) {
 void run_validate(const ValidateArgs& a) {
   const RigOverrides overrides = a.rig.overrides();
   const std::vector<const Pipeline*> chosen = chosen_pipelines(a.pipelines);
+  const std::map<std::string, std::string> given = parse_key_values(a.options, "--option");
+  // Checked before anything renders: an option applies to every chosen pipeline.
+  std::vector<PipelineOptions> options;
+  for (const Pipeline* p : chosen) options.emplace_back(p->info(), given);
   if (a.error_threshold < 0 || a.error_threshold > 255)
     throw InputError(fmt::format("--error-threshold {} is outside 0..255 (8-bit codes)", a.error_threshold));
   const std::unique_ptr<validation::TruthProvider> provider = validation::make_truth_provider(a.truth);
@@ -100,9 +106,9 @@ void run_validate(const ValidateArgs& a) {
   json records = json::array();
   fmt::print("\n{:<16} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10}\n", "pipeline", "PSNR dB", "SSIM", "MSE",
              "err %", "holes %", "recall", "prec.", "time ms");
-  for (const Pipeline* pipeline : chosen) {
-    const PipelineOptions options(pipeline->info(), {});
-    const validation::PipelineValidation v = validation::validate_pipeline(target, *pipeline, options, executor, metric_options);
+  for (size_t i = 0; i < chosen.size(); ++i) {
+    const validation::PipelineValidation v =
+        validation::validate_pipeline(target, *chosen[i], options[i], executor, metric_options);
     const std::string stem = fmt::format("{}_{}", scene_stem, v.pipeline);
     json images = validation::write_pipeline_images(out, stem, target, v);
     images.update(shared_images);
@@ -134,6 +140,9 @@ void register_validate_command(CLI::App& root) {
   v->add_option("--pipelines,-p", a->pipelines,
                 "Pipelines to validate: names, comma-separated or repeated, or 'all' (see `stereobench pipelines`)")
       ->capture_default_str();
+  v->add_option("--option,-o", a->options,
+                "Pipeline option NAME=VALUE, applied to every chosen pipeline (each must declare it; see\n"
+                "`stereobench pipelines`)");
   v->add_option("--truth", a->truth,
                 "Ground truth: full (this suite's ray tracer), blender (Cycles) or povray; an unavailable\n"
                 "tool is an error (exit 4)")

@@ -24,6 +24,16 @@ void register_compare_command(CLI::App& root);
 
 /// `stereobench validate`.
 void register_validate_command(CLI::App& root);
+/// `stereobench sweep run|cells|csv|collect`.
+void register_sweep_command(CLI::App& root);
+/// `stereobench gate`.
+void register_gate_command(CLI::App& root);
+
+/// `stereobench path`.
+void register_path_command(CLI::App& root);
+
+/// `stereobench report RESULTS --out DIR`.
+void register_report_command(CLI::App& root);
 
 /// `stereobench reference generate|verify|update|list`; `command_line` is recorded in provenance.
 void register_reference_command(CLI::App& root, const std::string& command_line);

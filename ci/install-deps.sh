@@ -7,7 +7,9 @@
 #   blender   Blender, for the Cycles ground-truth provider
 #   povray    POV-Ray, for the POV-Ray ground-truth provider
 #   skimage   python3-skimage, the SSIM oracle in the metric tests
-#   chromium  headless Chromium, for the report test
+#   report    Node.js and the npm package the HTML report bundles (Chart.js; ci/package.json)
+#   chromium  headless Chromium, plus the npm packages of the HTML report and its test (Chart.js,
+#             playwright-core; pinned in ci/package.json)
 #   slurm     slurm-wlm and munge, for the Slurm executor test
 #   all       every group above
 set -euo pipefail
@@ -21,10 +23,11 @@ core=(cmake make g++ pkg-config git ca-certificates
       libopencv-dev libssl-dev
       libtinygltf-dev nlohmann-json3-dev libstb-dev
       libcli11-dev libfmt-dev libtomlplusplus-dev libglm-dev
-      libgtest-dev libgmock-dev libbenchmark-dev)
+      libgtest-dev libgmock-dev libbenchmark-dev libxml2-utils)
 
 declare -A group_pkgs=(
   [validator]=""
+  [report]=""
   [blender]="blender"
   [povray]="povray"
   [skimage]="python3-skimage python3-numpy"
@@ -34,7 +37,7 @@ declare -A group_pkgs=(
 
 groups=("$@")
 if [[ " ${groups[*]-} " == *" all "* ]]; then
-  groups=(validator blender povray skimage chromium slurm)
+  groups=(validator report blender povray skimage chromium slurm)
 fi
 
 pkgs=("${core[@]}")
@@ -50,7 +53,7 @@ done
 
 # Node.js may come with its own npm (from another Debian-compatible repository);
 # only ask Debian for node and npm when either command is absent.
-if [[ " ${groups[*]-} " == *" validator "* ]]; then
+if [[ " ${groups[*]-} " =~ " "(validator|report|chromium)" " ]]; then
   command -v node >/dev/null 2>&1 || pkgs+=(nodejs)
   command -v npm >/dev/null 2>&1 || pkgs+=(npm)
 fi
@@ -65,17 +68,26 @@ sudo=""
 [[ $(id -u) -ne 0 ]] && sudo="sudo"
 if [[ ${#missing[@]} -gt 0 ]]; then
   echo "install-deps: installing ${missing[*]}"
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  $sudo apt-get -o DPkg::Lock::Timeout=300 update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get -o DPkg::Lock::Timeout=300 install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-# The glTF validator comes from npm, pinned in ci/package.json, installed into ci/node_modules.
+# npm packages, pinned in ci/package.json, installed into ci/node_modules: the glTF validator
+# (group validator), Chart.js and playwright-core (group chromium; playwright-core drives Debian's
+# chromium and never downloads a browser).
+npm_needed=()
 for g in "${groups[@]}"; do
-  if [[ "$g" == validator ]]; then
-    if [[ ! -x "$here/node_modules/.bin/gltf-validator" && ! -f "$here/node_modules/gltf-validator/package.json" ]]; then
-      echo "install-deps: installing gltf-validator from npm"
-      (cd "$here" && npm ci --no-audit --no-fund --loglevel=error)
-    fi
+  case "$g" in
+    validator) npm_needed+=(gltf-validator) ;;
+    report) npm_needed+=(chart.js) ;;
+    chromium) npm_needed+=(chart.js playwright-core) ;;
+  esac
+done
+for m in "${npm_needed[@]}"; do
+  if [[ ! -f "$here/node_modules/$m/package.json" ]]; then
+    echo "install-deps: installing the npm packages of ci/package.json (${npm_needed[*]})"
+    (cd "$here" && PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1 npm ci --no-audit --no-fund --loglevel=error)
+    break
   fi
 done
 echo "install-deps: ok"

@@ -1,24 +1,27 @@
 #!/usr/bin/env bash
-# The main job: installs what is needed, builds stereobench, generates the built-in scenes,
-# validates every registered pipeline on the default scene against the built-in ground truth
-# (records and images under out/validate, a table on the terminal) and prints a side-by-side
-# timing table.
+# The main job: installs what is needed, builds stereobench, runs the smoke sweep (every registered
+# pipeline on a built-in scene against the built-in ground truth), writes its HTML report, runs the
+# quality gate and prints the report's path.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
 jobs=$(nproc)
 
-bash ci/install-deps.sh
+bash ci/install-deps.sh report
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$jobs"
 
 sb=./build/apps/stereobench
-$sb scenes generate --all --out out/scenes
-scene=bistro
-resolution=960x540
-# Every registered pipeline's right eye against the built-in ground truth (full ray tracing):
-# metrics, hole statistics, images and one JSON record per pipeline under out/validate.
-$sb validate --scene "$scene" --resolution "$resolution" --pipelines all --truth full --out out/validate
-# Their timings side by side, medians over repetitions, speed-ups against plain-raster.
-$sb bench --scene "$scene" --resolution "$resolution" --baseline plain-raster --repetitions 3 --warmup 1 \
-  --json out/validate/bench.json
+out=out/main
+# The smoke sweep (ci/smoke.toml): every registered pipeline on a built-in scene, validated against
+# the built-in ground truth (full ray tracing) and timed side by side. A second run resumes it.
+$sb sweep run ci/smoke.toml --out "$out"
+# The HTML report of the sweep (tables, charts, an image viewer per cell), readable offline.
+$sb report "$out/results.jsonl" --out "$out/report"
+# The quality gate against ci/gate.toml, with a JUnit file for CI systems. A warning (exit 1) is
+# reported but does not stop the job; a failure (exit 2) does.
+gate=0
+$sb gate --config ci/gate.toml --results "$out/results.jsonl" --junit "$out/junit.xml" || gate=$?
+echo
+echo "report: $root/$out/report/index.html"
+[[ $gate -le 1 ]] || exit "$gate"

@@ -7,8 +7,9 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
 jobs=$(nproc)
 
-# The ground-truth provider tests run Blender and POV-Ray, the metric tests scikit-image.
-bash ci/install-deps.sh validator blender povray skimage
+# The ground-truth provider tests run Blender and POV-Ray, the metric tests scikit-image, the report
+# test Chromium.
+bash ci/install-deps.sh validator blender povray skimage chromium slurm
 
 echo "== build (Release, warnings as errors)"
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DSB_WERROR=ON >/dev/null

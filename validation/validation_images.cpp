@@ -30,28 +30,48 @@ Srgb8Image disocclusion_image(const Srgb8Image& truth, const TrueDisocclusions& 
   return out;
 }
 
-json write_target_images(const std::filesystem::path& dir, const std::string& stem, const ValidationTarget& target) {
+json write_target_images(const std::filesystem::path& dir, const std::string& stem, const ValidationTarget& target,
+                         const ImageFileOptions& options) {
   const std::string provider = target.truth.render.provider;
   const std::filesystem::path exr = dir / fmt::format("{}_truth-{}.exr", stem, provider);
   const std::filesystem::path png = dir / fmt::format("{}_truth-{}.png", stem, provider);
   const std::filesystem::path dis = dir / fmt::format("{}_disocclusions.png", stem);
-  io::write_exr(exr, target.truth.render.right);
+  json files = json::object();
+  if (options.exr) {
+    io::write_exr(exr, target.truth.render.right);
+    files["truth_exr"] = exr.string();
+  }
   write_png(png, target.truth_srgb8);
   write_png(dis, disocclusion_image(target.truth_srgb8, target.disocclusions));
-  return {{"truth_exr", exr.string()}, {"truth_png", png.string()}, {"true_disocclusions_png", dis.string()}};
+  files["truth_png"] = png.string();
+  files["true_disocclusions_png"] = dis.string();
+  return files;
 }
 
 json write_pipeline_images(const std::filesystem::path& dir, const std::string& stem, const ValidationTarget& target,
-                           const PipelineValidation& v) {
+                           const PipelineValidation& v, const ImageFileOptions& options) {
   const auto path = [&](const char* suffix) { return dir / fmt::format("{}_{}", stem, suffix); };
-  io::write_exr(path("right.exr"), v.result.right);
+  json files = json::object();
+  if (options.exr) {
+    io::write_exr(path("right.exr"), v.result.right);
+    files["right_exr"] = path("right.exr").string();
+  }
   write_png(path("right.png"), v.right_srgb8);
   write_png(path("diff.png"), difference_image(v.right_srgb8, target.truth_srgb8));
   write_png(path("ssim.png"), ssim_image(v.ssim));
   io::write_png_preview(path("holes.png"), hole_overlay(v.result.right, v.hole_mask, target.disocclusions.mask));
-  return {{"right_exr", path("right.exr").string()}, {"right_png", path("right.png").string()},
-          {"diff_png", path("diff.png").string()},   {"ssim_png", path("ssim.png").string()},
-          {"holes_png", path("holes.png").string()}};
+  files["right_png"] = path("right.png").string();
+  files["diff_png"] = path("diff.png").string();
+  files["ssim_png"] = path("ssim.png").string();
+  files["holes_png"] = path("holes.png").string();
+  return files;
+}
+
+std::filesystem::path write_left_image(const std::filesystem::path& dir, const std::string& stem,
+                                       const PipelineValidation& v) {
+  const std::filesystem::path png = dir / fmt::format("{}_left.png", stem);
+  write_png(png, encode_srgb8(v.result.left, fmt::format("{}'s left eye", v.pipeline)));
+  return png;
 }
 
 }  // namespace sb::validation

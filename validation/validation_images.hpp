@@ -17,15 +17,27 @@ namespace sb::validation {
 /// red (75 % tint over the dimmed colour). InputError if the sizes differ.
 [[nodiscard]] Srgb8Image disocclusion_image(const Srgb8Image& truth, const TrueDisocclusions& disocclusions);
 
-/// Writes the images shared by every pipeline of a target under `dir`: <stem>_truth-<provider>.exr
-/// and .png, and <stem>_disocclusions.png. Returns {name: path}.
-nlohmann::json write_target_images(const std::filesystem::path& dir, const std::string& stem,
-                                   const ValidationTarget& target);
+/// Which image files a validation writes besides its PNGs.
+struct ImageFileOptions {
+  bool exr = true;  ///< the EXR of the ground truth and of every right eye (large: every AOV)
+};
 
-/// Writes a pipeline's images under `dir`: <stem>_right.exr (every AOV) and _right.png, _diff.png
-/// (difference heat map), _ssim.png (SSIM map) and _holes.png (hole mask against the true
-/// disocclusions: green found, red missed, blue flagged needlessly). Returns {name: path}.
+/// Writes the images shared by every pipeline of a target under `dir`: <stem>_truth-<provider>.exr
+/// (unless options.exr is false) and .png, and <stem>_disocclusions.png. Returns {name: path}.
+nlohmann::json write_target_images(const std::filesystem::path& dir, const std::string& stem,
+                                   const ValidationTarget& target, const ImageFileOptions& options = {});
+
+/// Writes a pipeline's images under `dir`: <stem>_right.exr (every AOV; unless options.exr is
+/// false) and _right.png, _diff.png (difference heat map), _ssim.png (SSIM map) and _holes.png
+/// (hole mask against the true disocclusions: green found, red missed, blue flagged needlessly).
+/// Returns {name: path}.
 nlohmann::json write_pipeline_images(const std::filesystem::path& dir, const std::string& stem,
-                                     const ValidationTarget& target, const PipelineValidation& v);
+                                     const ValidationTarget& target, const PipelineValidation& v,
+                                     const ImageFileOptions& options = {});
+
+/// Writes the pipeline's left eye as <stem>_left.png (sRGB), e.g. for anaglyph and side-by-side
+/// views of a right eye. Returns its path.
+std::filesystem::path write_left_image(const std::filesystem::path& dir, const std::string& stem,
+                                       const PipelineValidation& v);
 
 }  // namespace sb::validation

@@ -67,6 +67,19 @@ TEST(Validate, ExternalTruthIsRenderedOnceThenCached) {
   EXPECT_GE(record["metrics"]["psnr"].get<double>(), 45.0);
 }
 
+TEST(Validate, PipelineOptionsApplyAndAreChecked) {
+  test::ScratchDir dir;
+  const test::CliRun worse = test::run_cli(base_args(dir) + " --pipelines repro-rt --option discontinuity_px=1000000");
+  ASSERT_EQ(worse.code, 0) << worse.out;
+  const json record = json::parse(test::read_text(dir / "out" / "box-wall_full_repro-rt.json"));
+  EXPECT_EQ(record["options"]["discontinuity_px"], "1000000");
+  // Without disocclusion detection the hole mask misses most true disocclusions.
+  EXPECT_LT(record["holes"]["not_reprojected"]["recall"].get<double>(), 0.9);
+  const test::CliRun undeclared = test::run_cli(base_args(dir) + " --pipelines plain-rt --option discontinuity_px=1");
+  EXPECT_EQ(undeclared.code, 3) << undeclared.out;
+  EXPECT_NE(undeclared.out.find("discontinuity_px"), std::string::npos) << undeclared.out;
+}
+
 TEST(Validate, BadInputAndMissingTools) {
   test::ScratchDir dir;
   const test::CliRun unknown = test::run_cli(base_args(dir) + " --pipelines plain-rt,no-such-pipeline");

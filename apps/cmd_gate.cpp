@@ -1,0 +1,133 @@
+// `stereobench gate`: the CI quality gate. Applies ci/gate.toml's thresholds and the time-regression
+// test against a stored baseline to a sweep's results file, prints the checks that did not pass,
+// writes JUnit XML and JSON, and exits 0 (pass), 1 (warnings only) or 2 (any failure); bad input is 3.
+// `--update-baseline` instead stores the timing samples of the named pipelines and cells.
+#include <filesystem>
+#include <memory>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "apps/commands.hpp"
+#include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
+#include "renderer/pipeline.hpp"
+#include "validation/gate.hpp"
+#include "validation/junit.hpp"
+
+namespace sb::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kDefaultBaseline = "ci/baseline.json";
+
+struct GateArgs {
+  std::string config = "ci/gate.toml";
+  std::string results;
+  std::string baseline;
+  std::string junit;
+  std::string json_out;
+  bool update_baseline = false;
+  std::vector<std::string> only;
+  std::string cells;
+};
+
+std::vector<std::string> split_names(const std::vector<std::string>& items) {
+  std::vector<std::string> out;
+  for (const std::string& item : items) {
+    std::stringstream list(item);
+    std::string name;
+    while (std::getline(list, name, ','))
+      if (!name.empty() && std::find(out.begin(), out.end(), name) == out.end()) out.push_back(name);
+  }
+  return out;
+}
+
+void run_update(const GateArgs& a) {
+  const validation::BaselineSelection selection{split_names(a.only), a.cells};
+  const validation::GateResults results = validation::load_gate_results(a.results);
+  for (const std::string& w : results.warnings) fmt::print(stderr, "warning: {}\n", w);
+  const fs::path file = a.baseline.empty() ? fs::path(kDefaultBaseline) : fs::path(a.baseline);
+  validation::Baseline baseline = fs::exists(file) ? validation::load_baseline(file) : validation::Baseline{};
+  const std::vector<validation::BaselineChange> changes = validation::update_baseline(baseline, results, selection);
+  validation::save_baseline(file, baseline);
+  for (const validation::BaselineChange& c : changes) {
+    if (c.replaced)
+      fmt::print("updated {} {}: median {:.4g} s -> {:.4g} s\n", c.cell_id, c.pipeline, c.old_median_s, c.new_median_s);
+    else
+      fmt::print("added   {} {}: median {:.4g} s\n", c.cell_id, c.pipeline, c.new_median_s);
+  }
+  fmt::print("wrote {} ({} entr{} from {}; every other entry unchanged)\n", file.string(), changes.size(),
+             changes.size() == 1 ? "y" : "ies", a.results);
+}
+
+void run_gate(const GateArgs& a) {
+  if (a.update_baseline) {
+    run_update(a);
+    return;
+  }
+  if (!a.only.empty() || !a.cells.empty())
+    throw InputError("--only and --cells select what --update-baseline rewrites; add --update-baseline or drop them");
+  const validation::GateConfig config = validation::load_gate_config(a.config);
+  const validation::GateResults results = validation::load_gate_results(a.results);
+
+  // The baseline: an explicit --baseline must exist; the default one may be absent.
+  validation::Baseline baseline;
+  std::string baseline_note;
+  const fs::path baseline_file = a.baseline.empty() ? fs::path(kDefaultBaseline) : fs::path(a.baseline);
+  if (!a.baseline.empty() || fs::exists(baseline_file))
+    baseline = validation::load_baseline(baseline_file);
+  else
+    baseline_note = fmt::format(
+        "no baseline file {}: time regressions not checked (store one with "
+        "--update-baseline)",
+        baseline_file.string());
+
+  validation::ReproduceSettings reproduce;
+  for (const Pipeline* p : pipelines())
+    reproduce.pipeline_defaults[p->info().name] = PipelineOptions(p->info(), {}).values();
+
+  validation::GateReport report = validation::evaluate_gate(config, results, baseline, reproduce);
+  if (!baseline_note.empty()) report.notes.push_back(baseline_note);
+  fmt::print("{}", validation::format_gate_table(report));
+
+  if (!a.junit.empty()) {
+    io::write_text_atomically(a.junit, validation::junit_xml(report, "stereobench gate " + a.results));
+    fmt::print("wrote {}\n", a.junit);
+  }
+  if (!a.json_out.empty()) {
+    const nlohmann::json doc =
+        validation::gate_report_json(report, a.config, a.results, baseline_note.empty() ? baseline_file.string() : "");
+    io::write_text_atomically(a.json_out, doc.dump(2) + "\n");
+    fmt::print("wrote {}\n", a.json_out);
+  }
+  if (const int code = validation::exit_code(report.worst); code != 0) throw VerdictExit{code};
+}
+
+}  // namespace
+
+void register_gate_command(CLI::App& root) {
+  auto a = std::make_shared<GateArgs>();
+  CLI::App* g = root.add_subcommand(
+      "gate",
+      "The CI quality gate: apply the thresholds of a gate config (min PSNR, SSIM, disocclusion recall,\n"
+      "speed-up; max hole and error-pixel fractions; time regression against a stored baseline by\n"
+      "median, tolerance and a Mann-Whitney rank test) to every pipeline of every cell of a sweep's\n"
+      "results file. Exit 0 all pass, 1 warnings only, 2 any failure, 3 bad input. Each failure\n"
+      "comes with the `stereobench validate` command that re-measures it. See docs/gate.md.");
+  g->add_option("--config", a->config, "Gate thresholds (TOML)")->capture_default_str();
+  g->add_option("--results", a->results, "A sweep's results.jsonl")->required();
+  g->add_option("--baseline", a->baseline,
+                fmt::format("Timing baseline (JSON); default {} (if absent, no regression check)", kDefaultBaseline));
+  g->add_option("--junit", a->junit, "Write JUnit XML here (one testsuite per cell, one testcase per check)");
+  g->add_option("--json", a->json_out, "Write every check as JSON here");
+  g->add_flag("--update-baseline", a->update_baseline,
+              "Store the results' timing samples as the baseline for what --only/--cells name, and exit");
+  g->add_option("--only", a->only, "With --update-baseline: pipelines to store (comma-separated or repeated)");
+  g->add_option("--cells", a->cells, "With --update-baseline: cells to store, a glob over cell ids ('*' for all)");
+  g->callback([a] { run_gate(*a); });
+}
+
+}  // namespace sb::cli

@@ -1,0 +1,16 @@
+# Copies the report's page assets and Chart.js into DEST (cmake -P; see reports/CMakeLists.txt).
+# A missing Chart.js removes a stale copy, so that `stereobench report` names the fix.
+file(MAKE_DIRECTORY ${DEST})
+file(GLOB assets ${ASSETS}/*)
+foreach(f ${assets})
+  get_filename_component(name ${f} NAME)
+  configure_file(${f} ${DEST}/${name} COPYONLY)
+endforeach()
+set(chart ${CHARTJS}/dist/chart.umd.min.js)
+if(EXISTS ${chart})
+  configure_file(${chart} ${DEST}/chart.umd.min.js COPYONLY)
+  configure_file(${CHARTJS}/LICENSE.md ${DEST}/chart.js.LICENSE.md COPYONLY)
+else()
+  file(REMOVE ${DEST}/chart.umd.min.js ${DEST}/chart.js.LICENSE.md)
+  message(WARNING "Chart.js not found at ${chart}: run `ci/install-deps.sh chromium`")
+endif()

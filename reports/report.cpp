@@ -1,0 +1,406 @@
+// The static HTML report of a sweep: the page data, the image copies and the page itself.
+#include "reports/report.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <map>
+#include <set>
+#include <span>
+
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
+#include "sb_version.hpp"
+
+namespace sb::reports {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+/// Marks an index.html as ours, so that a later report may replace the folder's assets and images.
+constexpr const char* kGenerator = "stereobench report";
+/// The schema of the data embedded in the page (docs/report.md).
+constexpr const char* kDataSchema = "stereobench.report 1";
+
+/// Files the page needs from the assets folder; copied into OUT/assets/ except the template and
+/// the paper numbers, which are read here.
+constexpr const char* kTemplate = "report.html";
+constexpr const char* kPapers = "papers.json";
+constexpr const char* kCopiedAssets[] = {"report.js", "report.css", "chart.umd.min.js", "chart.js.LICENSE.md"};
+
+/// The value at `key` or null.
+json get_or_null(const json& j, const char* key) {
+  if (!j.is_object()) return nullptr;
+  const auto it = j.find(key);
+  return it == j.end() ? json(nullptr) : *it;
+}
+
+/// The value at a path of keys or null.
+json dig(const json& j, std::initializer_list<const char*> keys) {
+  const json* at = &j;
+  for (const char* k : keys) {
+    if (!at->is_object()) return nullptr;
+    const auto it = at->find(k);
+    if (it == at->end()) return nullptr;
+    at = &*it;
+  }
+  return *at;
+}
+
+/// A name safe as one path segment of a copied image.
+std::string path_segment(const std::string& name) {
+  std::string s = name;
+  for (char& c : s)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.')) c = '_';
+  if (s.empty() || s == "." || s == "..") s = "_";
+  return s;
+}
+
+/// The metric subset of a region record.
+json region_summary(const json& region) {
+  if (!region.is_object()) return nullptr;
+  return json{{"pixels", get_or_null(region, "pixels")},
+              {"psnr", get_or_null(region, "psnr")},
+              {"ssim", get_or_null(region, "ssim")},
+              {"mse", get_or_null(region, "mse")}};
+}
+
+/// One pipeline of a cell: quality, holes, time, images.
+json pipeline_summary(const json& p, const json& baseline_total) {
+  const json& v = p["validation"];
+  const json& m = v["metrics"];
+  json out{{"psnr", m["psnr"]},
+           {"ssim", m["ssim"]},
+           {"mse", m["mse"]},
+           {"error_fraction", m["error_fraction"]},
+           {"hole_fraction", dig(v, {"holes", "hole_fraction"})},
+           {"recall", dig(v, {"holes", "not_reprojected", "recall"})},
+           {"precision", dig(v, {"holes", "not_reprojected", "precision"})},
+           {"true_disocclusion_fraction", dig(v, {"holes", "true_disocclusions", "fraction"})}};
+  json regions = json::object();
+  if (v.contains("regions") && v["regions"].is_object())
+    for (const auto& [name, r] : v["regions"].items()) regions[name] = region_summary(r);
+  out["regions"] = regions;
+
+  // Time: the sweep's repeated measurement when present, else the validation's single run.
+  const json timing = get_or_null(p, "timing");
+  if (timing.is_object()) {
+    out["time_s"] = get_or_null(timing, "median_s");
+    out["min_s"] = get_or_null(timing, "min_s");
+    out["max_s"] = get_or_null(timing, "max_s");
+    out["repetitions"] = get_or_null(timing, "repetitions");
+    out["speedup"] = get_or_null(timing, "speedup_median");
+    out["stages_s"] = timing.contains("stages_median_s") ? timing["stages_median_s"] : get_or_null(v, "timings_s");
+    out["timing_source"] = "median";
+  } else {
+    const json total = get_or_null(v, "total_s");
+    out["time_s"] = total;
+    out["min_s"] = total;
+    out["max_s"] = total;
+    out["repetitions"] = 1;
+    const bool ratio = total.is_number() && baseline_total.is_number() && total.get<double>() > 0.0;
+    out["speedup"] = ratio ? json(baseline_total.get<double>() / total.get<double>()) : json(nullptr);
+    out["stages_s"] = get_or_null(v, "timings_s");
+    out["timing_source"] = "single run";
+  }
+  if (out["stages_s"].is_null()) out["stages_s"] = json::object();
+  return out;
+}
+
+/// The distinct string values of `key` over all cells, in order of appearance.
+std::vector<std::string> distinct(const ResultsFile& results, const char* key) {
+  std::vector<std::string> out;
+  for (const CellLine& c : results.cells) {
+    const json v = get_or_null(c.json, key);
+    if (!v.is_string()) continue;
+    const std::string s = v.get<std::string>();
+    if (std::find(out.begin(), out.end(), s) == out.end()) out.push_back(s);
+  }
+  return out;
+}
+
+/// `text` with &, <, >, " escaped for HTML text and attribute values.
+std::string html_escape(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+/// JSON safe inside <script type="application/json">: '<' only occurs inside strings there, so
+/// writing it as \u003c keeps "</script>" and "<!--" out of the element without changing the value.
+std::string script_json(const json& data) {
+  const std::string dumped = data.dump(-1, ' ', false, json::error_handler_t::replace);
+  std::string out;
+  out.reserve(dumped.size());
+  for (char c : dumped) {
+    if (c == '<') out += "\\u003c";
+    else out += c;
+  }
+  return out;
+}
+
+/// The template with each @@NAME@@ replaced by values[NAME] in one pass (a value is never scanned
+/// again); ToolError naming the template for an unknown marker or a value never used.
+std::string fill_template(const std::string& text, const std::map<std::string, std::string>& values,
+                          const fs::path& template_path) {
+  std::string out;
+  std::set<std::string> used;
+  size_t pos = 0;
+  for (size_t at = text.find("@@"); at != std::string::npos; at = text.find("@@", pos)) {
+    const size_t end = text.find("@@", at + 2);
+    const std::string name = end == std::string::npos ? "" : text.substr(at + 2, end - at - 2);
+    const auto it = values.find(name);
+    if (it == values.end())
+      throw ToolError(fmt::format("report template {} holds an unknown marker at byte {}; rebuild stereobench to "
+                                  "restore the report assets",
+                                  template_path.string(), at));
+    out.append(text, pos, at - pos);
+    out += it->second;
+    used.insert(name);
+    pos = end + 2;
+  }
+  out.append(text, pos, std::string::npos);
+  for (const auto& [name, value] : values)
+    if (!used.count(name))
+      throw ToolError(fmt::format("report template {} lacks @@{}@@; rebuild stereobench to restore the report assets",
+                                  template_path.string(), name));
+  return out;
+}
+
+/// Prepares the output folder: new, empty, or an earlier report whose index, assets and images go.
+void prepare_out_dir(const fs::path& out) {
+  std::error_code ec;
+  if (fs::exists(out, ec) && !fs::is_directory(out, ec))
+    throw InputError(fmt::format("--out {} is a file; give a folder for the report", out.string()));
+  if (fs::exists(out, ec) && !fs::is_empty(out, ec)) {
+    const fs::path index = out / "index.html";
+    const bool ours = fs::exists(index, ec) && io::read_file(index).find(fmt::format("content=\"{}", kGenerator)) !=
+                                                    std::string::npos;
+    if (!ours)
+      throw InputError(fmt::format("--out {} is not empty and holds no stereobench report; give a new or empty folder",
+                                   out.string()));
+    // The index first: a folder never holds an index.html whose assets or images are gone.
+    for (const char* sub : {"index.html", "assets", "images"}) {
+      fs::remove_all(out / sub, ec);
+      if (ec) throw IoError(fmt::format("cannot remove the earlier report's {}: {}", (out / sub).string(), ec.message()));
+    }
+  }
+  fs::create_directories(out, ec);
+  if (ec) throw IoError(fmt::format("cannot create the report folder {}: {}", out.string(), ec.message()));
+}
+
+/// Copies a file atomically (the destination's folders are created).
+void copy_atomically(const fs::path& from, const fs::path& to) {
+  const std::string bytes = io::read_file(from);
+  io::write_file_atomically(
+      to, std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size()));
+}
+
+}  // namespace
+
+fs::path report_assets_dir() {
+  if (const char* env = std::getenv("STEREOBENCH_REPORT_ASSETS"); env != nullptr && *env != '\0') return env;
+  return SB_REPORT_ASSETS_DIR;
+}
+
+std::string paper_experiment(const std::string& sweep_name) {
+  for (const char* name : {"wissmann-table2", "kim-table2", "kim-table3"})
+    if (sweep_name == name) return name;
+  if (sweep_name.rfind("al-hagri-", 0) == 0) return "al-hagri";
+  return "";
+}
+
+json report_data(const ResultsFile& results, const std::string& title, const json& papers,
+                 const std::function<std::string(const std::string&, const std::string&)>& image_path) {
+  const json& first = results.cells.front().json;
+  const std::string baseline = first["baseline"].get<std::string>();
+
+  // Pipelines: the baseline first, then every other one in name order.
+  std::set<std::string> names;
+  for (const CellLine& c : results.cells)
+    for (const auto& [name, p] : c.json["pipelines"].items()) names.insert(name);
+  json pipelines = json::array({baseline});
+  for (const std::string& n : names)
+    if (n != baseline) pipelines.push_back(n);
+
+  const auto image = [&image_path](const json& rel, const std::string& name) -> json {
+    if (!rel.is_string() || rel.get<std::string>().empty()) return nullptr;
+    const std::string p = image_path(rel.get<std::string>(), name);
+    return p.empty() ? json(nullptr) : json(p);
+  };
+
+  json cells = json::array();
+  double wall_total = 0.0;
+  std::set<std::string> hosts;
+  std::string started, finished;
+  for (size_t i = 0; i < results.cells.size(); ++i) {
+    const json& line = results.cells[i].json;
+    const json& cell = line["cell"];
+    const json& rig = line["rig"];
+    const std::string folder = fmt::format("{:04d}", i);
+    const json imgs = get_or_null(line, "images");
+    const std::string cell_baseline = line["baseline"].get<std::string>();
+    const json baseline_total = dig(line["pipelines"][cell_baseline], {"validation", "total_s"});
+
+    json entry{{"id", line["cell_id"]},
+               {"index", line["cell_index"]},
+               {"line", results.cells[i].line},
+               {"sweep", line["sweep"]},
+               {"scene", cell["scene"]},
+               {"scene_params", cell.contains("scene_params") ? cell["scene_params"] : json::object()},
+               {"resolution", cell["resolution"]},
+               {"width", rig["width"]},
+               {"height", rig["height"]},
+               {"interaxial_m", rig["interaxial_m"]},
+               {"convergence_m", rig["convergence_m"]},
+               {"max_disparity_px", rig["max_disparity_px"]},
+               {"vfov_deg", get_or_null(rig, "vfov_deg")},
+               {"lights", get_or_null(cell, "lights")},
+               {"truth", cell["truth"]},
+               {"path", get_or_null(cell, "path")},
+               {"frame", get_or_null(cell, "frame")},
+               {"baseline", cell_baseline},
+               {"triangles", nullptr},
+               {"wall_s", get_or_null(line, "wall_s")},
+               {"threads", get_or_null(line, "threads")},
+               {"host", get_or_null(line, "host")}};
+    entry["images"] = json{{"left", image(get_or_null(imgs, "left_png"), folder + "/left.png")},
+                           {"truth", image(get_or_null(imgs, "truth_png"), folder + "/truth.png")},
+                           {"disocclusions", image(get_or_null(imgs, "disocclusions_png"), folder + "/disocclusions.png")}};
+    if (const json tri = dig(line, {"scene", "triangles"}); tri.is_number_integer()) entry["triangles"] = tri;
+    json per = json::object();
+    for (const auto& [name, p] : line["pipelines"].items()) {
+      json s = pipeline_summary(p, baseline_total);
+      const json tri = dig(p, {"validation", "scene", "triangles"});
+      if (entry["triangles"].is_null() && tri.is_number_integer()) entry["triangles"] = tri;
+      const json pimgs = dig(imgs, {"pipelines", name.c_str()});
+      const std::string base = folder + "/" + path_segment(name) + "/";
+      s["images"] = json{{"right", image(get_or_null(pimgs, "right_png"), base + "right.png")},
+                         {"diff", image(get_or_null(pimgs, "diff_png"), base + "diff.png")},
+                         {"ssim", image(get_or_null(pimgs, "ssim_png"), base + "ssim.png")},
+                         {"holes", image(get_or_null(pimgs, "holes_png"), base + "holes.png")}};
+      per[name] = std::move(s);
+    }
+    entry["pipelines"] = std::move(per);
+    cells.push_back(std::move(entry));
+
+    if (const json w = get_or_null(line, "wall_s"); w.is_number()) wall_total += w.get<double>();
+    if (const json h = get_or_null(line, "host"); h.is_string()) hosts.insert(h.get<std::string>());
+    if (const json s = get_or_null(line, "started"); s.is_string() && (started.empty() || s.get<std::string>() < started))
+      started = s.get<std::string>();
+    if (const json f = get_or_null(line, "finished"); f.is_string() && f.get<std::string>() > finished)
+      finished = f.get<std::string>();
+  }
+
+  const std::vector<std::string> sweeps = distinct(results, "sweep");
+  const std::string experiment = sweeps.size() == 1 ? paper_experiment(sweeps.front()) : "";
+  json paper = nullptr;
+  if (!experiment.empty() && papers.contains(experiment)) {
+    paper = papers[experiment];
+    paper["experiment"] = experiment;
+  }
+  return json{{"schema", kDataSchema},
+              {"title", title},
+              {"results_file", results.path.filename().string()},
+              {"sweeps", sweeps},
+              {"description", get_or_null(first, "description")},
+              {"definition", get_or_null(first, "definition")},
+              {"definition_sha256", get_or_null(first, "definition_sha256")},
+              {"versions", get_or_null(first, "versions")},
+              {"jobs", get_or_null(first, "jobs")},
+              {"threads", get_or_null(first, "threads")},
+              {"hosts", hosts},
+              {"started", started.empty() ? json(nullptr) : json(started)},
+              {"finished", finished.empty() ? json(nullptr) : json(finished)},
+              {"cells_wall_s", wall_total},
+              {"baseline", baseline},
+              {"pipelines", pipelines},
+              {"cells", cells},
+              {"paper", paper},
+              {"warnings", results.warnings}};
+}
+
+ReportSummary write_report(const ResultsFile& results, const ReportOptions& options) {
+  const fs::path assets = options.assets_dir.empty() ? report_assets_dir() : options.assets_dir;
+  for (const char* f : {kTemplate, kPapers})
+    if (!fs::exists(assets / f))
+      throw ToolError(fmt::format("report asset {} is missing; rebuild stereobench (the build copies reports/assets "
+                                  "into {}) or set STEREOBENCH_REPORT_ASSETS",
+                                  (assets / f).string(), assets.string()));
+  for (const char* f : kCopiedAssets)
+    if (!fs::exists(assets / f))
+      throw ToolError(fmt::format("report asset {} is missing: Chart.js comes from npm (ci/package.json); run "
+                                  "`ci/install-deps.sh chromium` and rebuild stereobench",
+                                  (assets / f).string()));
+  json papers;
+  try {
+    papers = json::parse(io::read_file(assets / kPapers));
+  } catch (const json::parse_error& e) {
+    throw ToolError(fmt::format("report asset {} is not valid JSON: {}", (assets / kPapers).string(), e.what()));
+  }
+
+  const fs::path out = options.out_dir;
+  prepare_out_dir(out);
+  ReportSummary summary;
+  summary.warnings = results.warnings;
+
+  // Images: copied under images/ (or linked), each checked to exist.
+  const fs::path results_dir = results.path.has_parent_path() ? results.path.parent_path() : fs::path(".");
+  const auto image_path = [&](const std::string& rel, const std::string& name) -> std::string {
+    const fs::path source = results_dir / rel;
+    std::error_code ec;
+    if (!fs::is_regular_file(source, ec)) {
+      summary.warnings.push_back(fmt::format("{}: image {} is missing (looked for {}); the viewer shows it as "
+                                             "unavailable",
+                                             results.path.string(), rel, source.string()));
+      return "";
+    }
+    ++summary.images;
+    if (options.images == ImageMode::link) {
+      const fs::path relative = fs::relative(fs::absolute(source), fs::absolute(out), ec);
+      if (ec || relative.empty())
+        throw IoError(fmt::format("cannot express {} relative to {}: {}", source.string(), out.string(), ec.message()));
+      return relative.generic_string();
+    }
+    copy_atomically(source, out / "images" / name);
+    return "images/" + name;
+  };
+
+  std::string title = options.title;
+  if (title.empty()) {
+    const std::vector<std::string> sweeps = distinct(results, "sweep");
+    std::string joined;
+    for (const std::string& s : sweeps) joined += (joined.empty() ? "" : ", ") + s;
+    title = "stereobench report: " + joined;
+  }
+  const json data = report_data(results, title, papers, image_path);
+  summary.cells = data["cells"].size();
+  summary.pipelines = data["pipelines"].size();
+  summary.paper_experiment = data["paper"].is_object() ? data["paper"]["experiment"].get<std::string>() : "";
+
+  for (const char* f : kCopiedAssets) copy_atomically(assets / f, out / "assets" / f);
+
+  const std::string page = fill_template(io::read_file(assets / kTemplate),
+                                         {{"GENERATOR", html_escape(fmt::format("{} {}", kGenerator, SB_VERSION_STRING))},
+                                          {"TITLE", html_escape(title)},
+                                          {"DATA", script_json(data)}},
+                                         assets / kTemplate);
+  summary.index_html = out / "index.html";
+  io::write_text_atomically(summary.index_html, page);
+  return summary;
+}
+
+}  // namespace sb::reports

@@ -1,0 +1,106 @@
+// gate.toml: strict keys (an unknown key names itself and its line), warn/fail consistency, rule
+// cascading, turning checks off, and the shipped ci/gate.toml.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "renderer/error.hpp"
+#include "validation/gate.hpp"
+
+namespace sb::validation {
+namespace {
+
+/// The message of the InputError that parsing `text` throws ("" when it parses).
+std::string config_error(const std::string& text) {
+  try {
+    (void)parse_gate_config(text, "test.toml");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(GateConfig, UnknownKeyIsRejectedWithNameAndLine) {
+  const std::string in_defaults = config_error("[defaults]\nmin_psnr = 30\nmin_psnr_db = 31\n");
+  EXPECT_NE(in_defaults.find("test.toml:3"), std::string::npos) << in_defaults;
+  EXPECT_NE(in_defaults.find("'min_psnr_db'"), std::string::npos) << in_defaults;
+
+  const std::string in_rule =
+      config_error("[[rule]]\npipeline = \"repro-rt\"\n\n[[rule]]\nscene = \"spheres\"\nmax_holes = 0.1\n");
+  EXPECT_NE(in_rule.find("test.toml:6"), std::string::npos) << in_rule;
+  EXPECT_NE(in_rule.find("'max_holes'"), std::string::npos) << in_rule;
+
+  const std::string in_regression = config_error("[regression]\ntolerance = 0.1\nrepetitions = 3\n");
+  EXPECT_NE(in_regression.find("test.toml:3"), std::string::npos) << in_regression;
+  EXPECT_NE(in_regression.find("'repetitions'"), std::string::npos) << in_regression;
+
+  const std::string top = config_error("[default]\nmin_psnr = 30\n");
+  EXPECT_NE(top.find("test.toml:1"), std::string::npos) << top;
+  EXPECT_NE(top.find("'default'"), std::string::npos) << top;
+}
+
+TEST(GateConfig, BadValuesAreRejected) {
+  EXPECT_NE(config_error("[defaults]\nmin_psnr = \"high\"\n").find("test.toml:2"), std::string::npos);
+  EXPECT_NE(config_error("[defaults]\nmin_psnr = -1\n").find("min_psnr"), std::string::npos);
+  EXPECT_NE(config_error("[defaults]\nmin_psnr = true\n").find("false to turn the check off"), std::string::npos);
+  EXPECT_NE(config_error("[regression]\nalpha = 1.5\n").find("alpha"), std::string::npos);
+  EXPECT_NE(config_error("[regression]\nmin_repetitions = 2.5\n").find("min_repetitions"), std::string::npos);
+  EXPECT_NE(config_error("[[rule]]\npipeline = 3\n").find("pipeline"), std::string::npos);
+  EXPECT_NE(config_error("rule = 1\n").find("[[rule]]"), std::string::npos);
+  // A syntax error names the line and column.
+  EXPECT_NE(config_error("[defaults]\nmin_psnr = = 3\n").find("test.toml:2:"), std::string::npos);
+  // A warning level looser than the failure level of the same table.
+  const std::string looser = config_error("[defaults]\nmin_psnr = 38\nwarn_psnr = 37\n");
+  EXPECT_NE(looser.find("test.toml:3"), std::string::npos) << looser;
+  EXPECT_NE(looser.find("warn_psnr"), std::string::npos) << looser;
+  EXPECT_NE(config_error("[defaults]\nmax_hole_fraction = 0.1\nwarn_hole_fraction = 0.2\n").find("warn_hole_fraction"),
+            std::string::npos);
+}
+
+TEST(GateConfig, RulesOverrideDefaultsInFileOrder) {
+  const GateConfig c = parse_gate_config(
+      "[defaults]\nmin_psnr = 30\nmin_ssim = 0.9\n"
+      "[regression]\ntolerance = 0.2\n"
+      "[[rule]]\npipeline = \"repro-*\"\nmin_psnr = 35\n"
+      "[[rule]]\npipeline = \"repro-rt\"\nscene = \"spheres\"\nmin_psnr = 38.2\nwarn_psnr = 39\nmin_ssim = false\n"
+      "regression_tolerance = 0.3\n"
+      "[[rule]]\ncell = \"*|640x360|*\"\nregression_tolerance = false\n",
+      "test.toml");
+  ASSERT_EQ(c.rules.size(), 3u);
+  EXPECT_EQ(c.rules[1].line, 9);
+
+  ThresholdValues t = thresholds_for(c, "repro-rt", "spheres", "spheres|e=0.064m|c=default|320x180|lights=all|full");
+  EXPECT_EQ(t["min_psnr"], 38.2);
+  EXPECT_EQ(t["warn_psnr"], 39.0);
+  EXPECT_FALSE(t["min_ssim"].has_value());  // turned off
+  EXPECT_EQ(t["regression_tolerance"], 0.3);
+
+  t = thresholds_for(c, "repro-warp", "spheres", "x");
+  EXPECT_EQ(t["min_psnr"], 35.0);
+  EXPECT_EQ(t["min_ssim"], 0.9);
+  EXPECT_EQ(t["regression_tolerance"], 0.2);
+
+  t = thresholds_for(c, "plain-rt", "box-wall", "box-wall|e=0.064m|c=default|640x360|lights=all|full");
+  EXPECT_EQ(t["min_psnr"], 30.0);
+  EXPECT_FALSE(t["regression_tolerance"].has_value());
+}
+
+TEST(GateConfig, ShippedConfigParses) {
+  const GateConfig c = load_gate_config(std::filesystem::path(SB_SOURCE_DIR) / "ci" / "gate.toml");
+  EXPECT_FALSE(c.rules.empty());
+  EXPECT_DOUBLE_EQ(c.regression.tolerance, 0.10);
+  EXPECT_DOUBLE_EQ(c.regression.alpha, 0.05);
+  EXPECT_EQ(c.regression.min_repetitions, 3);
+  // The smoke scene's repro-rt thresholds (measured 48.34 dB at 320x180, e = 0.064 m).
+  ThresholdValues t = thresholds_for(c, "repro-rt", "box-wall", "box-wall|e=0.064m|c=default|320x180|lights=all|full");
+  EXPECT_EQ(t["min_psnr"], 46.0);
+  EXPECT_EQ(t["min_recall"], 0.99);
+  EXPECT_EQ(t["max_hole_fraction"], 0.03);
+  // The smoke sweep's scene: spheres rules (repro-rt measured 32.65 / 33.87 dB in the two cells).
+  t = thresholds_for(c, "repro-rt", "spheres", "spheres|e=0.12m|c=default|320x180|lights=all|full");
+  EXPECT_EQ(t["min_psnr"], 30.6);
+  EXPECT_EQ(t["max_hole_fraction"], 0.32);
+}
+
+}  // namespace
+}  // namespace sb::validation

@@ -1,0 +1,326 @@
+// The gate on hand-written results lines: verdicts and exit codes (pass 0, warn 1, fail 2, bad
+// input 3), the time regression against a baseline, baseline updates that touch only what is
+// named, and JUnit XML that validates against ci/junit.xsd.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <string>
+
+#include "gate/gate_fixture.hpp"
+#include "renderer/error.hpp"
+#include "support/run_cli.hpp"
+#include "support/scratch_dir.hpp"
+#include "validation/gate.hpp"
+#include "validation/junit.hpp"
+
+namespace sb::test {
+namespace {
+
+using nlohmann::json;
+using validation::Verdict;
+
+const std::string kConfig =
+    "[defaults]\n"
+    "min_psnr = 30\nwarn_psnr = 35\n"
+    "min_ssim = 0.99\n"
+    "max_hole_fraction = 0.05\n"
+    "[regression]\ntolerance = 0.10\nalpha = 0.05\nmin_repetitions = 3\n"
+    "[[rule]]\npipeline = \"repro-rt\"\nmin_psnr = 40\nmin_recall = 0.99\nmin_speedup = 1.2\n";
+
+/// Two cells of two pipelines that pass kConfig: PSNR 45 and 44 dB against limits 40 and 30.
+std::vector<json> passing_cells() {
+  return {fake_cell(0, 0.064, {{"plain-rt", 90, 1.0, 0, 0, 1, 1.0}, {"repro-rt", 45}}),
+          fake_cell(1, 0.12, {{"plain-rt", 90, 1.0, 0, 0, 1, 1.0}, {"repro-rt", 44}})};
+}
+
+validation::GateReport evaluate(const std::vector<json>& cells, const validation::Baseline& baseline = {},
+                                const std::string& config = kConfig) {
+  return validation::evaluate_gate(validation::parse_gate_config(config, "test.toml"),
+                                   validation::gate_results(cells, {}, "results.jsonl"), baseline);
+}
+
+const validation::GateCheck* find_check(const validation::GateReport& r, const std::string& pipeline,
+                                        const std::string& check, int cell = 0) {
+  int seen = -1;
+  std::string last_cell;
+  for (const validation::GateCheck& c : r.checks) {
+    if (c.cell_id != last_cell) {
+      last_cell = c.cell_id;
+      ++seen;
+    }
+    if (seen == cell && c.pipeline == pipeline && c.check == check) return &c;
+  }
+  return nullptr;
+}
+
+TEST(GateEval, PassingCellsPass) {
+  const validation::GateReport r = evaluate(passing_cells());
+  EXPECT_EQ(r.worst, Verdict::skip);  // only the time regression is skipped (no baseline)
+  EXPECT_EQ(validation::exit_code(r.worst), 0);
+  const validation::GateCheck* psnr = find_check(r, "repro-rt", "psnr");
+  ASSERT_NE(psnr, nullptr);
+  EXPECT_EQ(psnr->verdict, Verdict::pass);
+  EXPECT_EQ(psnr->fail_limit, 40.0);  // the rule overrides the default 30
+  const validation::GateCheck* reg = find_check(r, "repro-rt", "time_regression");
+  ASSERT_NE(reg, nullptr);
+  EXPECT_EQ(reg->verdict, Verdict::skip);
+  EXPECT_EQ(reg->message, "no baseline");
+  // plain-rt has no recall or speed-up threshold: no such check.
+  EXPECT_EQ(find_check(r, "plain-rt", "speedup"), nullptr);
+}
+
+TEST(GateEval, ThresholdAboveTheMeasuredValueFails) {
+  // repro-rt measured 45 dB; a minimum of 45.5 dB must fail.
+  const std::string config = kConfig + "[[rule]]\npipeline = \"repro-rt\"\nscene = \"box-wall\"\nmin_psnr = 45.5\n";
+  const validation::GateReport r = evaluate(passing_cells(), {}, config);
+  EXPECT_EQ(r.worst, Verdict::fail);
+  const validation::GateCheck* psnr = find_check(r, "repro-rt", "psnr");
+  ASSERT_NE(psnr, nullptr);
+  EXPECT_EQ(psnr->verdict, Verdict::fail);
+  EXPECT_DOUBLE_EQ(psnr->measured, 45.0);
+  EXPECT_EQ(psnr->fail_limit, 45.5);
+  EXPECT_NE(psnr->message.find("45.00 dB"), std::string::npos) << psnr->message;
+  EXPECT_NE(psnr->message.find("45.50 dB"), std::string::npos) << psnr->message;
+  EXPECT_EQ(psnr->reproduce,
+            "stereobench validate --scene box-wall --pipelines repro-rt --truth full --resolution 320x180 "
+            "--interaxial 0.064 --convergence 2");
+}
+
+TEST(GateEval, WarnLevelsAndEveryMetric) {
+  std::vector<json> cells = passing_cells();
+  // PSNR 33 dB: above the 30 dB failure level, below the 35 dB warning level.
+  cells[0]["pipelines"]["plain-rt"]["validation"]["metrics"]["psnr"] = 33.0;
+  validation::GateReport r = evaluate(cells);
+  EXPECT_EQ(find_check(r, "plain-rt", "psnr")->verdict, Verdict::warn);
+  EXPECT_EQ(r.worst, Verdict::warn);
+  EXPECT_EQ(validation::exit_code(r.worst), 1);
+
+  // Each remaining metric beyond its failure level fails on its own.
+  cells = passing_cells();
+  auto& e = cells[1]["pipelines"]["repro-rt"];
+  e["validation"]["metrics"]["ssim"] = 0.98;                     // min 0.99
+  e["validation"]["holes"]["hole_fraction"] = 0.06;              // max 0.05
+  e["validation"]["holes"]["not_reprojected"]["recall"] = 0.95;  // min 0.99
+  e["timing"]["speedup_median"] = 1.1;                           // min 1.2
+  r = evaluate(cells);
+  for (const char* check : {"ssim", "hole_fraction", "disocclusion_recall", "speedup"})
+    EXPECT_EQ(find_check(r, "repro-rt", check, 1)->verdict, Verdict::fail) << check;
+  EXPECT_EQ(find_check(r, "repro-rt", "psnr", 1)->verdict, Verdict::pass);
+
+  // PSNR "inf" (identical images) passes any minimum; a null value is reported as a skip.
+  cells = passing_cells();
+  cells[0]["pipelines"]["plain-rt"]["validation"]["metrics"]["psnr"] = "inf";
+  cells[0]["pipelines"]["repro-rt"]["validation"]["holes"]["not_reprojected"]["recall"] = nullptr;
+  r = evaluate(cells);
+  EXPECT_EQ(find_check(r, "plain-rt", "psnr")->verdict, Verdict::pass);
+  EXPECT_EQ(find_check(r, "repro-rt", "disocclusion_recall")->verdict, Verdict::skip);
+  // A value of the wrong type is bad input.
+  cells[0]["pipelines"]["repro-rt"]["validation"]["metrics"]["ssim"] = "high";
+  EXPECT_THROW((void)evaluate(cells), InputError);
+}
+
+TEST(GateEval, TimeRegressionAgainstTheBaseline) {
+  std::vector<json> cells = passing_cells();
+  const std::string id = cells[0]["cell_id"];
+  validation::Baseline baseline;
+  baseline.cells[id]["repro-rt"].samples_s = {0.010, 0.0102, 0.0098, 0.0101, 0.0099};
+  baseline.cells[id]["repro-rt"].median_s = 0.010;
+
+  // 20 % slower in every one of five repetitions: beyond the 10 % tolerance; exact one-sided p =
+  // 1/C(10,5) = 0.004 < 0.05: failure.
+  cells[0]["pipelines"]["repro-rt"]["timing"]["samples_s"] = {0.012, 0.0121, 0.0119, 0.0122, 0.0118};
+  validation::GateReport r = evaluate(cells, baseline);
+  const validation::GateCheck* reg = find_check(r, "repro-rt", "time_regression");
+  ASSERT_NE(reg, nullptr);
+  EXPECT_EQ(reg->verdict, Verdict::fail) << reg->message;
+  EXPECT_NEAR(reg->measured, 0.2, 1e-9);
+  EXPECT_NE(reg->message.find("p = 0.00397"), std::string::npos) << reg->message;
+
+  // Median 20 % slower but samples interleaved with the baseline's (U = 15 of 25, exact p = 0.345):
+  // beyond the tolerance, not significant: warning.
+  cells[0]["pipelines"]["repro-rt"]["timing"]["samples_s"] = {0.012, 0.0095, 0.0125, 0.0097, 0.013};
+  r = evaluate(cells, baseline);
+  EXPECT_EQ(find_check(r, "repro-rt", "time_regression")->verdict, Verdict::warn);
+
+  // 5 % slower, significant: within the tolerance, a pass.
+  cells[0]["pipelines"]["repro-rt"]["timing"]["samples_s"] = {0.0105, 0.0106, 0.0104, 0.0107, 0.0103};
+  r = evaluate(cells, baseline);
+  EXPECT_EQ(find_check(r, "repro-rt", "time_regression")->verdict, Verdict::pass);
+
+  // Two repetitions where three are needed: "not enough repetitions", a warning.
+  cells[0]["pipelines"]["repro-rt"]["timing"]["samples_s"] = {0.010, 0.010};
+  r = evaluate(cells, baseline);
+  reg = find_check(r, "repro-rt", "time_regression");
+  EXPECT_EQ(reg->verdict, Verdict::warn);
+  EXPECT_NE(reg->message.find("not enough repetitions"), std::string::npos) << reg->message;
+
+  // The other cell and pipeline have no baseline entry.
+  EXPECT_EQ(find_check(r, "repro-rt", "time_regression", 1)->message, "no baseline");
+  EXPECT_EQ(find_check(r, "plain-rt", "time_regression")->message, "no baseline");
+}
+
+TEST(GateEval, BaselineUpdateTouchesOnlyWhatIsNamed) {
+  ScratchDir dir;
+  std::vector<json> cells = passing_cells();
+  const std::string id0 = cells[0]["cell_id"], id1 = cells[1]["cell_id"];
+  // An existing baseline with an entry of each pipeline in cell 0.
+  validation::Baseline old;
+  old.cells[id0]["plain-rt"] = {{0.5, 0.5, 0.5}, 0.5, "earlier", "oldhost"};
+  old.cells[id0]["repro-rt"] = {{0.4, 0.4, 0.4}, 0.4, "earlier", "oldhost"};
+  validation::save_baseline(dir / "baseline.json", old);
+  write_results(dir / "results.jsonl", cells);
+
+  // No selection: an error that says how to name what to update; the file is unchanged.
+  const std::string before = read_text(dir / "baseline.json");
+  CliRun run = run_cli("gate --update-baseline --results " + (dir / "results.jsonl").string() + " --baseline " +
+                       (dir / "baseline.json").string());
+  EXPECT_EQ(run.code, 3) << run.out;
+  EXPECT_NE(run.out.find("--only"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("--cells"), std::string::npos) << run.out;
+  EXPECT_EQ(read_text(dir / "baseline.json"), before);
+
+  // --only repro-rt: both cells' repro-rt entries rewritten, plain-rt's entry kept as it was.
+  run = run_cli("gate --update-baseline --only repro-rt --results " + (dir / "results.jsonl").string() +
+                " --baseline " + (dir / "baseline.json").string());
+  ASSERT_EQ(run.code, 0) << run.out;
+  validation::Baseline now = validation::load_baseline(dir / "baseline.json");
+  EXPECT_EQ(now.find(id0, "plain-rt")->samples_s, std::vector<double>({0.5, 0.5, 0.5}));
+  EXPECT_EQ(now.find(id0, "plain-rt")->host, "oldhost");
+  EXPECT_EQ(now.find(id0, "repro-rt")->samples_s, std::vector<double>({0.010, 0.011, 0.012}));
+  EXPECT_DOUBLE_EQ(now.find(id0, "repro-rt")->median_s, 0.011);
+  EXPECT_EQ(now.find(id0, "repro-rt")->host, "testhost");
+  EXPECT_EQ(now.find(id0, "repro-rt")->recorded, "2026-11-21T19:20:00Z");
+  ASSERT_NE(now.find(id1, "repro-rt"), nullptr);
+  EXPECT_EQ(now.find(id1, "plain-rt"), nullptr);
+
+  // --cells: only the matching cell, every pipeline in it.
+  run = run_cli("gate --update-baseline --cells '*|e=0.12m|*' --results " + (dir / "results.jsonl").string() +
+                " --baseline " + (dir / "baseline.json").string());
+  ASSERT_EQ(run.code, 0) << run.out;
+  now = validation::load_baseline(dir / "baseline.json");
+  EXPECT_NE(now.find(id1, "plain-rt"), nullptr);
+  EXPECT_EQ(now.find(id0, "plain-rt")->host, "oldhost");
+
+  // A pipeline no cell has, and a pattern that matches nothing: errors.
+  run = run_cli("gate --update-baseline --only repro-rtx --results " + (dir / "results.jsonl").string() +
+                " --baseline " + (dir / "baseline.json").string());
+  EXPECT_EQ(run.code, 3) << run.out;
+  EXPECT_NE(run.out.find("repro-rtx"), std::string::npos) << run.out;
+  run = run_cli("gate --update-baseline --cells 'spheres|*' --results " + (dir / "results.jsonl").string() +
+                " --baseline " + (dir / "baseline.json").string());
+  EXPECT_EQ(run.code, 3) << run.out;
+}
+
+TEST(GateCli, ExitCodesAndOutputs) {
+  ScratchDir dir;
+  write_file(dir / "gate.toml", kConfig);
+  const std::string config = " --config " + (dir / "gate.toml").string();
+  // An empty baseline file: no entries, so no default ci/baseline.json is picked up by accident.
+  write_file(dir / "baseline.json", "{}\n");
+  const std::string baseline = " --baseline " + (dir / "baseline.json").string();
+
+  // All pass: 0.
+  write_results(dir / "pass.jsonl", passing_cells());
+  CliRun run = run_cli("gate" + config + baseline + " --results " + (dir / "pass.jsonl").string());
+  EXPECT_EQ(run.code, 0) << run.out;
+  EXPECT_NE(run.out.find("0 fail"), std::string::npos) << run.out;
+
+  // A warning only: 1.
+  std::vector<json> cells = passing_cells();
+  cells[1]["pipelines"]["plain-rt"]["validation"]["metrics"]["psnr"] = 33.0;
+  write_results(dir / "warn.jsonl", cells);
+  run = run_cli("gate" + config + baseline + " --results " + (dir / "warn.jsonl").string());
+  EXPECT_EQ(run.code, 1) << run.out;
+  EXPECT_NE(run.out.find("WARN"), std::string::npos) << run.out;
+
+  // A failure: 2, with the reproduce command in the table, the JSON and the JUnit XML.
+  cells[0]["pipelines"]["repro-rt"]["validation"]["metrics"]["psnr"] = 39.0;  // min 40
+  write_results(dir / "fail.jsonl", cells);
+  run = run_cli("gate" + config + baseline + " --results " + (dir / "fail.jsonl").string() + " --junit " +
+                (dir / "junit.xml").string() + " --json " + (dir / "gate.json").string());
+  EXPECT_EQ(run.code, 2) << run.out;
+  const std::string repro =
+      "stereobench validate --scene box-wall --pipelines repro-rt --truth full --resolution 320x180 --interaxial "
+      "0.064 --convergence 2";
+  EXPECT_NE(run.out.find("reproduce: " + repro), std::string::npos) << run.out;
+  const json gate = json::parse(read_text(dir / "gate.json"));
+  EXPECT_EQ(gate["exit_code"], 2);
+  EXPECT_EQ(gate["counts"]["fail"], 1);
+  EXPECT_EQ(gate["counts"]["warn"], 1);
+  bool found = false;
+  for (const json& c : gate["checks"])
+    if (c["verdict"] == "fail") {
+      found = true;
+      EXPECT_EQ(c["reproduce"], repro);
+      EXPECT_EQ(c["measured"], 39.0);
+      EXPECT_EQ(c["fail_limit"], 40.0);
+    }
+  EXPECT_TRUE(found);
+  const std::string xml = read_text(dir / "junit.xml");
+  EXPECT_NE(xml.find("<failure message=\"PSNR 39.00 dB is below the minimum 40.00 dB\""), std::string::npos) << xml;
+  EXPECT_NE(xml.find(repro), std::string::npos);
+
+  // The JUnit XML validates against the schema CI systems read (xmllint from libxml2-utils; its
+  // absence is a failure, install it with ci/install-deps.sh).
+  ASSERT_EQ(std::system("command -v xmllint >/dev/null 2>&1"), 0)
+      << "xmllint is missing: run ci/install-deps.sh (package libxml2-utils)";
+  const std::string xsd = std::string(SB_SOURCE_DIR) + "/ci/junit.xsd";
+  const int lint = std::system(("xmllint --noout --schema " + xsd + " " + (dir / "junit.xml").string() + " > " +
+                                (dir / "xmllint.log").string() + " 2>&1")
+                                   .c_str());
+  EXPECT_EQ(lint, 0) << read_text(dir / "xmllint.log");
+  // ... and the schema is not a pushover: a testcase without a name is rejected.
+  std::string broken = xml;
+  broken.replace(broken.find("<testcase name="), 15, "<testcase nam=");
+  write_file(dir / "broken.xml", broken);
+  EXPECT_NE(std::system(
+                ("xmllint --noout --schema " + xsd + " " + (dir / "broken.xml").string() + " >/dev/null 2>&1").c_str()),
+            0);
+}
+
+TEST(GateCli, BadInputIsExitThree) {
+  ScratchDir dir;
+  write_file(dir / "gate.toml", kConfig);
+  const std::string config = " --config " + (dir / "gate.toml").string();
+
+  // Malformed JSON in the middle of the file.
+  write_file(dir / "bad.jsonl", passing_cells()[0].dump() + "\n{\"kind\": \"stereobench.sweep_cell\", \n" +
+                                    passing_cells()[1].dump() + "\n");
+  CliRun run = run_cli("gate" + config + " --results " + (dir / "bad.jsonl").string());
+  EXPECT_EQ(run.code, 3) << run.out;
+  EXPECT_NE(run.out.find("bad.jsonl:2"), std::string::npos) << run.out;
+
+  // An empty results file is bad input, not a pass.
+  write_file(dir / "empty.jsonl", "");
+  run = run_cli("gate" + config + " --results " + (dir / "empty.jsonl").string());
+  EXPECT_EQ(run.code, 3) << run.out;
+  EXPECT_NE(run.out.find("no finished cell"), std::string::npos) << run.out;
+
+  // A missing results file, a missing config, a config with an unknown key, a duplicated cell.
+  run = run_cli("gate" + config + " --results " + (dir / "missing.jsonl").string());
+  EXPECT_EQ(run.code, 3) << run.out;
+  write_results(dir / "pass.jsonl", passing_cells());
+  run = run_cli("gate --config " + (dir / "nope.toml").string() + " --results " + (dir / "pass.jsonl").string());
+  EXPECT_EQ(run.code, 3) << run.out;
+  write_file(dir / "typo.toml", "[defaults]\nmin_pnsr = 30\n");
+  run = run_cli("gate --config " + (dir / "typo.toml").string() + " --results " + (dir / "pass.jsonl").string());
+  EXPECT_EQ(run.code, 3) << run.out;
+  EXPECT_NE(run.out.find("typo.toml:2"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("min_pnsr"), std::string::npos) << run.out;
+  write_results(dir / "dup.jsonl", {passing_cells()[0], passing_cells()[0]});
+  run = run_cli("gate" + config + " --results " + (dir / "dup.jsonl").string());
+  EXPECT_EQ(run.code, 3) << run.out;
+  EXPECT_NE(run.out.find("appears twice"), std::string::npos) << run.out;
+
+  // A torn last line (killed writer) is skipped with a warning; the rest is gated.
+  const std::string torn = passing_cells()[0].dump() + "\n" + passing_cells()[1].dump().substr(0, 200);
+  write_file(dir / "torn.jsonl", torn);
+  write_file(dir / "baseline.json", "{}\n");
+  run = run_cli("gate" + config + " --baseline " + (dir / "baseline.json").string() + " --results " +
+                (dir / "torn.jsonl").string());
+  EXPECT_EQ(run.code, 0) << run.out;
+  EXPECT_NE(run.out.find("torn.jsonl:2"), std::string::npos) << run.out;
+}
+
+}  // namespace
+}  // namespace sb::test

@@ -1,0 +1,275 @@
+// Checks a `stereobench report` page in headless Debian Chromium, opened from disk (file://):
+// no console error, page error, failed request or network request; one summary row per pipeline
+// and one cell-table row per (cell, pipeline); every chart canvas has data drawn inside its plot
+// area; in every cell and for every pipeline each viewer image loads, each mode button shows its
+// own view (all pipelines of the first cell, the first pipeline of the others), the slider follows
+// a drag, flicker alternates, the anaglyph is composed exactly; a full-page screenshot is written. Exit 0 when all holds, 1 with the list of problems otherwise.
+//
+// Usage: node tests/report/check_report.mjs REPORT/index.html SCREENSHOT.png [--quick]
+// --quick leaves out the viewer's interaction (mode buttons, slider drag, flicker, the anaglyph's
+// pixels) and keeps the rest: errors, tables, charts, every image of every cell and pipeline.
+// Chromium: /usr/bin/chromium or $STEREOBENCH_CHROMIUM; playwright-core from ci/node_modules
+// (ci/install-deps.sh chromium installs both).
+import { createRequire } from 'node:module';
+import { existsSync } from 'node:fs';
+import { resolve } from 'node:path';
+import { pathToFileURL } from 'node:url';
+
+const args = process.argv.slice(2);
+const quick = args.includes('--quick');
+const [indexArg, screenshotArg] = args.filter((a) => a !== '--quick');
+if (!indexArg || !screenshotArg) {
+  console.error('usage: node tests/report/check_report.mjs REPORT/index.html SCREENSHOT.png [--quick]');
+  process.exit(3);
+}
+const hint = 'install it with `ci/install-deps.sh chromium`';
+const chromiumPath = process.env.STEREOBENCH_CHROMIUM || '/usr/bin/chromium';
+if (!existsSync(chromiumPath)) {
+  console.error(`check_report: ${chromiumPath} is missing; ${hint}`);
+  process.exit(4);
+}
+const requireCi = createRequire(new URL('../../ci/package.json', import.meta.url));
+let chromium;
+try {
+  ({ chromium } = requireCi('playwright-core'));
+} catch (e) {
+  console.error(`check_report: playwright-core is missing from ci/node_modules (${e.message}); ${hint}`);
+  process.exit(4);
+}
+
+// A chart counts as drawn when its plot area holds at least this many saturated pixels (data
+// lines, markers or bars; axes, grid and text are grey). Measured on the smoke sweep's report:
+// 5,100-6,800 for the lines against interaxial, 660 for speed-up vs resolution (one marker per
+// pipeline), 127,000 for the stacked bars; a chart of three single markers measured 127; an
+// empty plot area has 0.
+const MIN_CHART_DATA_PIXELS = 100;
+// Share of an anaglyph canvas's screenshot that is not black: the smoke sweep's anaglyphs measured
+// 0.988-1.0 (box-wall's 0.987, black being its shadow); an undrawn canvas has nothing, i.e. 0.
+const MIN_ANAGLYPH_LIT_SHARE = 0.3;
+// The anaglyph against its definition, red from the left eye, green and blue from the right eye,
+// in 8-bit codes; the blend-mode composition is exact (measured 0).
+const MAX_ANAGLYPH_CODE_ERROR = 1;
+
+const problems = [];
+const report = {};
+const t0 = Date.now();
+const index = resolve(indexArg);
+const browser = await chromium.launch({ executablePath: chromiumPath, headless: true,
+  args: ['--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage'] });
+try {
+  const page = await browser.newPage({ viewport: { width: 1280, height: 1000 } });
+  page.on('console', (m) => { if (m.type() === 'error') problems.push(`console error: ${m.text()}`); });
+  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
+  page.on('requestfailed', (r) => problems.push(`request failed: ${r.url()} (${r.failure()?.errorText})`));
+  page.on('request', (r) => {
+    const u = r.url();
+    if (!u.startsWith('file:') && !u.startsWith('data:')) problems.push(`network request from an offline report: ${u}`);
+  });
+  page.setDefaultTimeout(15000);
+
+  await page.goto(pathToFileURL(index).href, { waitUntil: 'load' });
+  await page.waitForFunction(() => document.documentElement.dataset.reportReady === 'true');
+  const data = await page.evaluate(() => JSON.parse(document.getElementById('report-data').textContent));
+
+  // Tables.
+  const summaryRows = await page.locator('#summary tbody tr').count();
+  if (summaryRows !== data.pipelines.length) problems.push(`summary table: ${summaryRows} rows for ${data.pipelines.length} pipelines`);
+  const expectedCellRows = data.cells.reduce((n, c) => n + Object.keys(c.pipelines).length, 0);
+  const cellRows = await page.locator('#cells tbody tr').count();
+  if (cellRows !== expectedCellRows) problems.push(`cells table: ${cellRows} rows for ${expectedCellRows} (cell, pipeline) pairs`);
+  const infinite = data.cells.reduce((n, c) => n + Object.values(c.pipelines).filter((p) => p.psnr === 'inf').length, 0);
+  const shownInfinite = await page.evaluate(() => [...document.querySelectorAll('#cells tbody td')].filter((td) => td.textContent === '∞').length);
+  if (shownInfinite < infinite) problems.push(`cells table shows ∞ ${shownInfinite} times for ${infinite} infinite PSNR values`);
+  const bodyText = await page.evaluate(() => document.body.innerText);
+  for (const bad of ['NaN', 'undefined', 'Infinity', '[object Object]'])
+    if (bodyText.includes(bad)) problems.push(`the page text contains "${bad}"`);
+  if (data.paper) {
+    const paperRows = await page.locator('#paper tbody tr').count();
+    if (paperRows === 0) problems.push(`paper section ${data.paper.experiment}: no table rows`);
+    report.paper_rows = paperRows;
+  }
+
+  // Charts: data drawn inside each plot area.
+  const charts = await page.evaluate(() => [...document.querySelectorAll('figure.chart canvas')].map((canvas) => {
+    const chart = window.Chart && Chart.getChart(canvas);
+    if (!chart) return { title: canvas.getAttribute('aria-label'), pixels: 0, missing: true };
+    const r = chart.currentDevicePixelRatio;
+    const a = chart.chartArea;
+    const x = Math.floor(a.left * r), y = Math.floor(a.top * r);
+    const w = Math.max(1, Math.floor((a.right - a.left) * r)), h = Math.max(1, Math.floor((a.bottom - a.top) * r));
+    const px = canvas.getContext('2d').getImageData(x, y, w, h).data;
+    let saturated = 0;
+    for (let i = 0; i < px.length; i += 4) {
+      const hi = Math.max(px[i], px[i + 1], px[i + 2]), lo = Math.min(px[i], px[i + 1], px[i + 2]);
+      if (px[i + 3] > 128 && hi - lo > 80) saturated++;
+    }
+    return { title: canvas.getAttribute('aria-label').split('.')[0], pixels: saturated };
+  }));
+  // The charts of every report: speed-up vs resolution, PSNR, SSIM, MSE and holes vs interaxial,
+  // per-stage time (a chart without a finite value is left out and named in the caption).
+  const minCharts = 6;
+  if (charts.length < minCharts) problems.push(`${charts.length} charts, expected at least ${minCharts}`);
+  for (const c of charts)
+    if (c.pixels < MIN_CHART_DATA_PIXELS) problems.push(`chart "${c.title}": ${c.pixels} data pixels (< ${MIN_CHART_DATA_PIXELS})${c.missing ? ', no chart object' : ''}`);
+  report.charts = charts.map((c) => `${c.title}: ${c.pixels}`);
+
+  // Viewers: every cell, every pipeline, every mode.
+  const modes = ['sbs', 'slider', 'flicker', 'anaglyph', 'holes', 'diff'];
+  let imagesChecked = 0;
+  report.anaglyph_lit = [];
+  for (let ci = 0; ci < data.cells.length; ci++) {
+    const cell = page.locator('details.cell').nth(ci);
+    const cellId = await cell.getAttribute('id');
+    await cell.evaluate((d) => { d.open = true; });
+    await cell.scrollIntoViewIfNeeded();
+    const select = cell.locator('select');
+    const options = await select.locator('option').evaluateAll((os) => os.map((o) => o.value));
+    for (const pipeline of options) {
+      await select.selectOption(pipeline);
+      // Every mode for every pipeline of the first cell and the first pipeline of the others: each
+      // viewer's buttons are exercised, and the views are built the same for every pipeline.
+      const cycle = !quick && (ci === 0 || pipeline === options[0]);
+      for (const mode of cycle ? modes : []) {
+        await cell.locator(`button[data-mode="${mode}"]`).click();
+        const state = await cell.evaluate((d, m) => {
+          const views = [...d.querySelectorAll('.view')];
+          const visible = views.filter((v) => v.getClientRects().length > 0 && v.offsetHeight > 0).map((v) => v.dataset.view);
+          const pressed = [...d.querySelectorAll('button[aria-pressed="true"]')].map((b) => b.dataset.mode);
+          return { visible, pressed, missing: d.querySelectorAll(`.view[data-view="${m}"] .missing`).length };
+        }, mode);
+        const where = `cell ${ci + 1}, ${pipeline}, mode ${mode}`;
+        if (state.visible.length !== 1 || state.visible[0] !== mode) problems.push(`${where}: visible views ${JSON.stringify(state.visible)}`);
+        if (state.pressed.length !== 1 || state.pressed[0] !== mode) problems.push(`${where}: pressed buttons ${JSON.stringify(state.pressed)}`);
+        if (state.missing) problems.push(`${where}: ${state.missing} image(s) not in the results`);
+
+        if (mode === 'slider') {
+          const box = await cell.locator('.compare').boundingBox();
+          if (!box) problems.push(`${where}: no slider`);
+          else {
+            await page.mouse.move(box.x + box.width * 0.5, box.y + box.height / 2);
+            await page.mouse.down();
+            await page.mouse.move(box.x + box.width * 0.25, box.y + box.height / 2, { steps: 4 });
+            await page.mouse.up();
+            const value = Number(await cell.locator('.range-row input[type="range"]').first().inputValue());
+            if (Math.abs(value - 25) > 2) problems.push(`${where}: dragging the divider to 25 % left it at ${value} %`);
+          }
+        }
+        if (mode === 'flicker' && pipeline === options[0]) {  // alternation once per cell: it takes 0.7 s
+          const sel = `#${cellId} [data-view="flicker"] figcaption`;
+          const before = await page.locator(sel).textContent();
+          await page.waitForFunction(([s, b]) => document.querySelector(s).textContent !== b, [sel, before], { timeout: 3000 })
+            .catch(() => problems.push(`${where}: flicker did not alternate within 3 s`));
+        }
+        if (mode === 'anaglyph') {
+          const canvas = cell.locator('[data-view="anaglyph"] canvas');
+          await page.waitForFunction((s) => document.querySelector(s)?.dataset.drawn === 'true',
+            `#${cellId} [data-view="anaglyph"] canvas`, { timeout: 5000 })
+            .catch(() => problems.push(`${where}: the anaglyph was not drawn`));
+          // The canvas holds file:// images and cannot be read back here (the exact check below
+          // reads it in a browser allowed to); its screenshot shows whether it was drawn at all.
+          const png = (await canvas.screenshot()).toString('base64');
+          const lit = await page.evaluate(async (b64) => {
+            const img = new Image();
+            img.src = `data:image/png;base64,${b64}`;
+            await img.decode();
+            const c = document.createElement('canvas');
+            c.width = img.naturalWidth;
+            c.height = img.naturalHeight;
+            const ctx = c.getContext('2d');
+            ctx.drawImage(img, 0, 0);
+            const px = ctx.getImageData(0, 0, c.width, c.height).data;
+            let n = 0;
+            for (let i = 0; i < px.length; i += 4) if (Math.max(px[i], px[i + 1], px[i + 2]) > 20) n++;
+            return n / (px.length / 4);
+          }, png);
+          report.anaglyph_lit.push(Number(lit.toFixed(3)));
+          if (lit < MIN_ANAGLYPH_LIT_SHARE) problems.push(`${where}: the anaglyph canvas is ${(100 * lit).toFixed(1)} % lit (< ${100 * MIN_ANAGLYPH_LIT_SHARE} %)`);
+        }
+      }
+      // Every image of the viewer, in every view, loaded.
+      await cell.evaluate((d) => Promise.all([...d.querySelectorAll('img')].map((i) => (i.complete ? null : new Promise((r) => { i.onload = r; i.onerror = r; })))));
+      const imgs = await cell.evaluate((d) => [...d.querySelectorAll('img')].map((i) => ({ src: i.getAttribute('src'), w: i.naturalWidth, alt: i.alt })));
+      // Side by side 2, slider 2, flicker 1, hole overlay 2, difference 2.
+      if (imgs.length < 9) problems.push(`cell ${ci + 1}, ${pipeline}: ${imgs.length} images in the viewer, expected 9`);
+      for (const i of imgs) {
+        if (!(i.w > 0)) problems.push(`cell ${ci + 1}, ${pipeline}: image ${i.src} did not load`);
+        if (!i.alt) problems.push(`cell ${ci + 1}, ${pipeline}: image ${i.src} has no alt text`);
+      }
+      imagesChecked += imgs.length;
+    }
+    await cell.locator('button[data-mode="slider"]').click();
+  }
+  report.images_checked = imagesChecked;
+  if (!quick) {
+    await page.locator('details.cell').first().locator('button[data-mode="anaglyph"]').click();
+    await page.locator('details.cell').first().locator('[data-view="anaglyph"] canvas[data-drawn="true"]').waitFor();
+  }
+  await page.evaluate(() => window.scrollTo(0, 0));
+  await page.screenshot({ path: resolve(screenshotArg), fullPage: true });
+} catch (e) {
+  problems.push(`check failed: ${e.message}`);
+} finally {
+  await browser.close();
+}
+
+report.main_s = (Date.now() - t0) / 1000;
+
+// The anaglyph composition, pixel by pixel: a browser allowed to read file:// images back.
+const exact = quick ? null : await chromium.launch({ executablePath: chromiumPath, headless: true,
+  args: ['--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage', '--allow-file-access-from-files'] });
+try {
+  if (!exact) throw new Error('skipped');
+  const page = await exact.newPage({ viewport: { width: 1280, height: 1000 } });
+  page.setDefaultTimeout(15000);
+  await page.goto(pathToFileURL(index).href, { waitUntil: 'load' });
+  await page.waitForFunction(() => document.documentElement.dataset.reportReady === 'true');
+  const count = await page.locator('details.cell').count();
+  report.anaglyph_max_error = 0;
+  for (let ci = 0; ci < count; ci++) {
+    const cell = page.locator('details.cell').nth(ci);
+    await cell.evaluate((d) => { d.open = true; });
+    await cell.locator('button[data-mode="anaglyph"]').click();
+    for (const pipeline of await cell.locator('select option').evaluateAll((os) => os.map((o) => o.value))) {
+      await cell.locator('select').selectOption(pipeline);
+      await cell.locator('[data-view="anaglyph"] canvas[data-drawn="true"]').waitFor();
+      const err = await cell.evaluate(async (d, [ci2, p]) => {
+        const data = JSON.parse(document.getElementById('report-data').textContent);
+        const c = data.cells[ci2];
+        const pixels = async (path) => {
+          const img = new Image();
+          img.src = path.split('/').map((s) => (s === '..' ? s : encodeURIComponent(s))).join('/');
+          await img.decode();
+          const cv = document.createElement('canvas');
+          cv.width = img.naturalWidth;
+          cv.height = img.naturalHeight;
+          const ctx = cv.getContext('2d');
+          ctx.drawImage(img, 0, 0);
+          return ctx.getImageData(0, 0, cv.width, cv.height).data;
+        };
+        const left = await pixels(c.images.left);
+        const right = await pixels(c.pipelines[p].images.right);
+        const canvas = d.querySelector('[data-view="anaglyph"] canvas');
+        const got = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height).data;
+        if (got.length !== left.length) return 1e9;
+        let max = 0;
+        for (let i = 0; i < got.length; i += 4)
+          max = Math.max(max, Math.abs(got[i] - left[i]), Math.abs(got[i + 1] - right[i + 1]), Math.abs(got[i + 2] - right[i + 2]));
+        return max;
+      }, [ci, pipeline]);
+      report.anaglyph_max_error = Math.max(report.anaglyph_max_error, err);
+      if (err > MAX_ANAGLYPH_CODE_ERROR) problems.push(`cell ${ci + 1}, ${pipeline}: anaglyph differs from (left R, right G, right B) by ${err} codes`);
+    }
+  }
+} catch (e) {
+  if (exact) problems.push(`anaglyph check failed: ${e.message}`);
+} finally {
+  if (exact) await exact.close();
+}
+
+report.total_s = (Date.now() - t0) / 1000;
+console.log(`check_report: ${index}: ${JSON.stringify(report)}`);
+if (problems.length) {
+  console.log(`check_report: ${problems.length} problem(s):\n  ${problems.join('\n  ')}`);
+  process.exit(1);
+}
+console.log('check_report: ok');

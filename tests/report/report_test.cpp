@@ -1,0 +1,267 @@
+// `stereobench report`: the report of the smoke sweep (`stereobench sweep run ci/smoke.toml`: two
+// cells, every pipeline), checked in headless Chromium by tests/report/check_report.mjs (loads
+// offline without errors, tables, drawn charts, every image, every viewer mode, a screenshot), for
+// copied and linked images and every paper preset; and malformed results files (exit 3 naming the
+// file and line), torn last lines, missing images, the single-run timing fallback and a foreign
+// output folder.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "support/run_cli.hpp"
+#include "support/scratch_dir.hpp"
+
+namespace sb {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const fs::path kSource = SB_SOURCE_DIR;
+constexpr const char* kInstallHint = "install them with `ci/install-deps.sh chromium` (Debian chromium, node, and the "
+                                     "npm packages of ci/package.json)";
+
+std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
+
+/// Runs a shell command, capturing stdout and stderr.
+test::CliRun run_shell(const std::string& cmd) {
+  FILE* pipe = ::popen((cmd + " 2>&1").c_str(), "r");
+  test::CliRun r;
+  std::array<char, 1024> buf{};
+  while (pipe && std::fgets(buf.data(), buf.size(), pipe)) r.out += buf.data();
+  const int status = pipe ? ::pclose(pipe) : -1;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+void write_text(const fs::path& p, const std::string& text) {
+  fs::create_directories(p.parent_path());
+  std::ofstream(p, std::ios::binary) << text;
+}
+
+/// The data a report embeds (script#report-data of index.html).
+json embedded_data(const fs::path& index) {
+  const std::string html = test::read_text(index);
+  const std::string open = "<script type=\"application/json\" id=\"report-data\">";
+  const size_t a = html.find(open);
+  const size_t b = html.find("</script>", a);
+  if (a == std::string::npos || b == std::string::npos) return nullptr;
+  return json::parse(html.substr(a + open.size(), b - a - open.size()));
+}
+
+/// Fails (never skips) when the browser side is missing, naming the install command.
+void require_browser_tools() {
+  const char* env = std::getenv("STEREOBENCH_CHROMIUM");
+  const fs::path chromium = env ? env : "/usr/bin/chromium";
+  ASSERT_TRUE(fs::exists(chromium)) << chromium << " is missing; " << kInstallHint;
+  ASSERT_EQ(run_shell("command -v node").code, 0) << "node is missing; " << kInstallHint;
+  ASSERT_TRUE(fs::exists(kSource / "ci" / "node_modules" / "playwright-core" / "package.json"))
+      << "playwright-core is missing from ci/node_modules; " << kInstallHint;
+}
+
+/// Runs check_report.mjs on a report; returns its output (the test fails on a non-zero exit).
+/// `quick`: without the viewer's interaction (see check_report.mjs), for reports whose viewer is
+/// the same as one checked in full.
+std::string check_in_browser(const fs::path& index, const fs::path& screenshot, bool quick = false) {
+  const test::CliRun r = run_shell("node " + quoted(kSource / "tests" / "report" / "check_report.mjs") + " " +
+                                   quoted(index) + " " + quoted(screenshot) + (quick ? " --quick" : ""));
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_TRUE(fs::exists(screenshot)) << r.out;
+  return r.out;
+}
+
+TEST(Report, SmokeSweepReportsPassTheBrowserCheck) {
+  require_browser_tools();
+  if (HasFatalFailure()) return;
+  test::ScratchDir dir;
+  const fs::path sweep = dir / "smoke";
+  const test::CliRun run = test::run_cli("sweep run " + quoted(kSource / "ci" / "smoke.toml") + " --out " + quoted(sweep) +
+                                         " --threads 2 --scenes-dir " +
+                                         quoted(fs::path(SB_BINARY_DIR) / "Testing" / "scenes-cache"));
+  ASSERT_EQ(run.code, 0) << run.out;
+  std::vector<json> lines;
+  {
+    std::ifstream in(sweep / "results.jsonl");
+    for (std::string line; std::getline(in, line);)
+      if (!line.empty()) lines.push_back(json::parse(line));
+  }
+  ASSERT_EQ(lines.size(), 2u) << "ci/smoke.toml has two cells";
+  const size_t pipeline_count = lines[0]["pipelines"].size();
+
+  // The lines in another order (parallel cells finish in any order), then a line a killed writer
+  // left half-written; beside results.jsonl, so that the image paths hold.
+  const auto results_text = [&lines](const std::string& name) {
+    std::string text;
+    for (auto it = lines.rbegin(); it != lines.rend(); ++it) {
+      json l = *it;
+      l["sweep"] = name;
+      text += l.dump() + "\n";
+    }
+    return text + lines[0].dump().substr(0, 300);
+  };
+  write_text(sweep / "shuffled.jsonl", results_text("smoke"));
+
+  const test::CliRun r = test::run_cli("report " + quoted(sweep / "shuffled.jsonl") + " --out " + quoted(dir / "report"));
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("shuffled.jsonl:3: skipped an incomplete last line"), std::string::npos) << r.out;
+  // Per cell: left eye, truth, disocclusions, and four images per pipeline.
+  const std::string counts = std::to_string(lines.size()) + " cell(s) x " + std::to_string(pipeline_count) +
+                             " pipeline(s), " + std::to_string(lines.size() * (3 + 4 * pipeline_count)) + " image(s) copied";
+  EXPECT_NE(r.out.find(counts), std::string::npos) << r.out;
+
+  // The embedded data: cells in cell order, infinite PSNR kept as "inf", the sweep's timing, images copied.
+  const json data = embedded_data(dir / "report" / "index.html");
+  ASSERT_TRUE(data.is_object());
+  EXPECT_EQ(data["schema"], "stereobench.report 1");
+  EXPECT_EQ(data["pipelines"][0], "plain-rt");
+  EXPECT_EQ(data["pipelines"].size(), pipeline_count);
+  ASSERT_EQ(data["cells"].size(), 2u);
+  for (int i = 0; i < 2; ++i) {
+    const json& cell = data["cells"][i];
+    EXPECT_EQ(cell["index"], i);
+    EXPECT_EQ(cell["id"], lines[i]["cell_id"]);
+    EXPECT_EQ(cell["line"], 2 - i) << "line numbers name the shuffled file's lines";
+    EXPECT_EQ(cell["pipelines"]["plain-rt"]["psnr"], "inf") << "plain-rt's right eye is the built-in truth";
+    EXPECT_EQ(cell["pipelines"]["repro-rt"]["timing_source"], "median");
+    EXPECT_EQ(cell["pipelines"]["repro-rt"]["speedup"], lines[i]["pipelines"]["repro-rt"]["timing"]["speedup_median"]);
+    EXPECT_EQ(cell["pipelines"]["repro-rt"]["psnr"], lines[i]["pipelines"]["repro-rt"]["validation"]["metrics"]["psnr"]);
+    for (const auto& [key, path] : cell["images"].items()) {
+      ASSERT_TRUE(path.is_string()) << key;
+      EXPECT_TRUE(fs::exists(dir / "report" / path.get<std::string>())) << path;
+    }
+    for (const auto& [name, p] : cell["pipelines"].items())
+      for (const auto& [key, path] : p["images"].items()) {
+        ASSERT_TRUE(path.is_string()) << name << " " << key;
+        EXPECT_TRUE(fs::exists(dir / "report" / path.get<std::string>())) << path;
+      }
+  }
+  EXPECT_TRUE(data["paper"].is_null());
+  std::printf("%s", check_in_browser(dir / "report" / "index.html", dir / "report.png").c_str());
+
+  // Again into the same folder: the earlier report is replaced. Linked images load from the sweep.
+  const test::CliRun again = test::run_cli("report " + quoted(sweep / "shuffled.jsonl") + " --out " + quoted(dir / "report") +
+                                           " --link-images --title 'Linked <images>'");
+  ASSERT_EQ(again.code, 0) << again.out;
+  EXPECT_FALSE(fs::exists(dir / "report" / "images")) << "the earlier report's copies are removed";
+  const std::string html = test::read_text(dir / "report" / "index.html");
+  EXPECT_NE(html.find("<title>Linked &lt;images&gt;</title>"), std::string::npos);
+  EXPECT_EQ(embedded_data(dir / "report" / "index.html")["cells"][0]["images"]["left"],
+            "../smoke/" + lines[0]["images"]["left_png"].get<std::string>());
+  std::printf("%s", check_in_browser(dir / "report" / "index.html", dir / "report-linked.png", true).c_str());
+
+  // Every paper preset: the paper's numbers beside ours.
+  for (const char* preset : {"wissmann-table2", "kim-table2", "kim-table3", "al-hagri-interaxial"}) {
+    write_text(sweep / (std::string(preset) + ".jsonl"), results_text(preset));
+    const fs::path out = dir / (std::string("report-") + preset);
+    const test::CliRun p = test::run_cli("report " + quoted(sweep / (std::string(preset) + ".jsonl")) + " --out " + quoted(out));
+    ASSERT_EQ(p.code, 0) << p.out;
+    const json pd = embedded_data(out / "index.html");
+    ASSERT_TRUE(pd["paper"].is_object()) << preset;
+    EXPECT_EQ(pd["paper"]["experiment"], std::string(preset).rfind("al-hagri", 0) == 0 ? "al-hagri" : preset);
+    std::printf("%s", check_in_browser(out / "index.html", dir / (std::string("report-") + preset + ".png"), true).c_str());
+  }
+}
+
+/// A minimal valid results line (no images: the report shows them as unavailable).
+json minimal_line(const std::string& id, int index) {
+  const json metrics{{"psnr", 40.5}, {"ssim", 0.99}, {"mse", 5.8}, {"error_fraction", 0.01}};
+  return json{{"kind", "stereobench.sweep_cell"},
+              {"schema_version", 1},
+              {"sweep", "tiny"},
+              {"cell_id", id},
+              {"cell_index", index},
+              {"cell", {{"scene", "box-wall"}, {"resolution", "16x9"}, {"truth", "full"}, {"lights", nullptr}}},
+              {"rig", {{"width", 16}, {"height", 9}, {"interaxial_m", 0.064}, {"convergence_m", 2.0}, {"max_disparity_px", 0.5}}},
+              {"baseline", "plain-rt"},
+              {"pipelines",
+               {{"plain-rt", {{"validation", {{"metrics", metrics}, {"total_s", 0.01}}}}},
+                {"repro-rt", {{"validation", {{"metrics", metrics}, {"total_s", 0.004}, {"timings_s", {{"hole_fill", 0.001}}}}}}}}}};
+}
+
+TEST(Report, MalformedResultsExit3NamingFileAndLine) {
+  test::ScratchDir dir;
+  const std::string good = minimal_line("a", 0).dump() + "\n";
+  struct Case {
+    std::string text;
+    std::string expected;  ///< part of the message
+  };
+  json wrong_type = minimal_line("b", 1);
+  wrong_type["rig"]["width"] = "16";
+  json no_pipelines = minimal_line("b", 1);
+  no_pipelines.erase("pipelines");
+  json other_kind = minimal_line("b", 1);
+  other_kind["kind"] = "stereobench.validation";
+  json newer = minimal_line("b", 1);
+  newer["schema_version"] = 2;
+  json bad_metric = minimal_line("b", 1);
+  bad_metric["pipelines"]["plain-rt"]["validation"]["metrics"]["psnr"] = "high";
+  const std::vector<Case> cases = {
+      {good + "{\"kind\": \"stereobench.sweep_cell\", oops}\n" + minimal_line("c", 2).dump() + "\n",
+       "results.jsonl:2: not a JSON line"},
+      {good + wrong_type.dump() + "\n", "results.jsonl:2: field 'rig.width' is \"16\" but must be an integer"},
+      {good + no_pipelines.dump() + "\n", "results.jsonl:2: field 'pipelines' is missing"},
+      {good + other_kind.dump() + "\n", "results.jsonl:2: kind is \"stereobench.validation\""},
+      {good + newer.dump() + "\n", "results.jsonl:2: schema_version 2 is newer"},
+      {good + bad_metric.dump() + "\n", "results.jsonl:2: field 'pipelines.plain-rt.validation.metrics.psnr' is \"high\""},
+      {good + "\n" + minimal_line("a", 5).dump() + "\n", "results.jsonl:3: cell_id 'a' appears again (first on line 1)"},
+      {"[1, 2]\n", "results.jsonl:1: a results line must be a JSON object"},
+      {"", "holds no finished cell"},
+      {"{\"kind\": \"stereobench.sweep_ce", "holds no finished cell"},
+  };
+  for (const Case& c : cases) {
+    write_text(dir / "results.jsonl", c.text);
+    const test::CliRun r = test::run_cli("report " + quoted(dir / "results.jsonl") + " --out " + quoted(dir / "out"));
+    EXPECT_EQ(r.code, 3) << c.expected << "\n" << r.out;
+    EXPECT_NE(r.out.find(c.expected), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find((dir / "results.jsonl").string()), std::string::npos) << "the message names the file: " << r.out;
+    EXPECT_FALSE(fs::exists(dir / "out" / "index.html")) << "no report from a bad results file";
+  }
+  const test::CliRun missing = test::run_cli("report " + quoted(dir / "nope.jsonl") + " --out " + quoted(dir / "out"));
+  EXPECT_EQ(missing.code, 3) << missing.out;
+  EXPECT_NE(missing.out.find("nope.jsonl does not exist"), std::string::npos) << missing.out;
+  const test::CliRun usage = test::run_cli("report " + quoted(dir / "results.jsonl"));
+  EXPECT_EQ(usage.code, 3) << usage.out;
+  EXPECT_NE(usage.out.find("--out"), std::string::npos) << usage.out;
+}
+
+TEST(Report, WarnsOnTornTailAndMissingImagesAndGuardsForeignFolders) {
+  test::ScratchDir dir;
+  json with_images = minimal_line("b", 1);
+  with_images["images"] = {{"left_png", "cells/0001/left.png"}, {"pipelines", {{"plain-rt", {{"right_png", "cells/0001/r.png"}}}}}};
+  write_text(dir / "results.jsonl", minimal_line("a", 0).dump() + "\n" + with_images.dump() + "\n{\"kind\": \"stereob");
+  const test::CliRun r = test::run_cli("report " + quoted(dir / "results.jsonl") + " --out " + quoted(dir / "out"));
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("results.jsonl:3: skipped an incomplete last line"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("image cells/0001/left.png is missing"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("2 cell(s) x 2 pipeline(s), 0 image(s)"), std::string::npos) << r.out;
+  const json data = embedded_data(dir / "out" / "index.html");
+  EXPECT_TRUE(data["cells"][1]["images"]["left"].is_null());
+  // Without a "timing" block the time is the validation's single run: 0.01 s / 0.004 s = 2.5.
+  const json& repro = data["cells"][0]["pipelines"]["repro-rt"];
+  EXPECT_EQ(repro["timing_source"], "single run");
+  EXPECT_DOUBLE_EQ(repro["speedup"].get<double>(), 2.5);
+  EXPECT_EQ(repro["stages_s"]["hole_fill"], 0.001);
+  EXPECT_TRUE(data["cells"][0]["pipelines"]["plain-rt"]["hole_fraction"].is_null()) << "absent in the line: null, shown as —";
+  EXPECT_EQ(data["warnings"].size(), 1u) << "the torn line is reported in the page";
+  for (const char* asset : {"report.js", "report.css", "chart.umd.min.js"})
+    EXPECT_TRUE(fs::exists(dir / "out" / "assets" / asset)) << asset;
+
+  // A folder that holds something else is not overwritten.
+  write_text(dir / "mine" / "notes.txt", "keep");
+  const test::CliRun foreign = test::run_cli("report " + quoted(dir / "results.jsonl") + " --out " + quoted(dir / "mine"));
+  EXPECT_EQ(foreign.code, 3) << foreign.out;
+  EXPECT_NE(foreign.out.find("is not empty and holds no stereobench report"), std::string::npos) << foreign.out;
+  EXPECT_EQ(test::read_text(dir / "mine" / "notes.txt"), "keep");
+}
+
+}  // namespace
+}  // namespace sb

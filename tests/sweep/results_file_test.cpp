@@ -1,0 +1,155 @@
+// The results file: atomic appends, a torn last line tolerated and cut before the next append,
+// duplicates rejected, shards merged, CSV export.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <string>
+
+#include "renderer/error.hpp"
+#include "support/scratch_dir.hpp"
+#include "validation/results_file.hpp"
+
+namespace sb {
+namespace {
+
+using nlohmann::json;
+using namespace validation;
+
+json cell(size_t index, const std::string& id, double psnr = 40.0) {
+  return {{"kind", kSweepCellKind},
+          {"schema_version", kSweepSchemaVersion},
+          {"sweep", "t"},
+          {"definition_sha256", "abc"},
+          {"cell_id", id},
+          {"cell_index", index},
+          {"cell", {{"scene", "box-wall"}, {"scene_params", {{"size", 0.5}}}, {"truth", "full"}}},
+          {"rig", {{"width", 96}, {"height", 54}, {"interaxial_m", 0.064}, {"max_disparity_px", 3.5},
+                   {"convergence_m", 2.0}}},
+          {"baseline", "plain-rt"},
+          {"pipelines",
+           {{"plain-rt",
+             {{"validation",
+               {{"scene", {{"lights", 1}}},
+                {"metrics", {{"psnr", psnr}, {"ssim", 0.99}, {"mse", 1.5}, {"error_fraction", 0.01}}},
+                {"holes", {{"hole_fraction", 0.0}, {"not_reprojected", {{"recall", 1.0}, {"precision", 0.02}}}}}}},
+              {"timing", {{"median_s", 0.01}, {"speedup_median", 1.0}}}}}}}};
+}
+
+void append_text(const std::filesystem::path& file, const std::string& text) {
+  std::ofstream(file, std::ios::app | std::ios::binary) << text;
+}
+
+TEST(ResultsFile, AppendAndReadBack) {
+  test::ScratchDir dir;
+  const auto file = dir / "sub" / "results.jsonl";
+  EXPECT_TRUE(read_results(file).cells.empty());  // a missing file reads as empty
+  append_result(file, cell(0, "a"));
+  append_result(file, cell(1, "b", std::numeric_limits<double>::infinity()));
+  const std::string text = test::read_text(file);
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 2);  // one line per cell
+  const ResultsFile r = read_results(file);
+  ASSERT_EQ(r.cells.size(), 2u);
+  EXPECT_TRUE(r.warnings.empty());
+  EXPECT_EQ(r.cells[0]["cell_id"], "a");
+  EXPECT_EQ(r.cells[1]["pipelines"]["plain-rt"]["validation"]["metrics"]["psnr"], "inf");
+}
+
+TEST(ResultsFile, NonFiniteNumbers) {
+  const json j = finite_json({{"a", std::numeric_limits<double>::infinity()},
+                              {"b", {-std::numeric_limits<double>::infinity(), std::nan("")}},
+                              {"c", 1.5}});
+  EXPECT_EQ(j["a"], "inf");
+  EXPECT_EQ(j["b"][0], "-inf");
+  EXPECT_TRUE(j["b"][1].is_null());
+  EXPECT_EQ(j["c"], 1.5);
+}
+
+TEST(ResultsFile, TornLastLineSkippedThenCut) {
+  test::ScratchDir dir;
+  const auto file = dir / "results.jsonl";
+  append_result(file, cell(0, "a"));
+  const std::string whole = cell(1, "b").dump();
+  append_text(file, whole.substr(0, whole.size() / 2));  // a writer killed mid-line
+  const ResultsFile r = read_results(file);
+  ASSERT_EQ(r.cells.size(), 1u);
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_NE(r.warnings[0].find("results.jsonl:2: unterminated last line"), std::string::npos) << r.warnings[0];
+
+  // The next append removes the torn tail first, so the lines do not run together.
+  append_result(file, cell(1, "b"));
+  const ResultsFile after = read_results(file);
+  ASSERT_EQ(after.cells.size(), 2u);
+  EXPECT_TRUE(after.warnings.empty());
+  EXPECT_EQ(after.cells[1], cell(1, "b"));
+}
+
+TEST(ResultsFile, BadLinesAndDuplicatesRejected) {
+  test::ScratchDir dir;
+  const auto dup = dir / "dup.jsonl";
+  append_result(dup, cell(0, "a"));
+  append_result(dup, cell(1, "b"));
+  append_result(dup, cell(0, "a"));
+  try {
+    (void)read_results(dup);
+    FAIL() << "a duplicate cell_id was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("dup.jsonl:3: cell_id 'a' appears twice (also on line 1)"),
+              std::string::npos)
+        << e.what();
+  }
+
+  const auto bad = dir / "bad.jsonl";
+  append_text(bad, "{not json}\n");
+  append_result(bad, cell(0, "a"));
+  EXPECT_THROW((void)read_results(bad), InputError);  // a broken line that is not the last
+
+  const auto other = dir / "other.jsonl";
+  append_text(other, R"({"kind": "something.else", "schema_version": 1})" "\n");
+  EXPECT_THROW((void)read_results(other), InputError);
+}
+
+TEST(ResultsFile, CollectMergesShards) {
+  test::ScratchDir dir;
+  append_result(dir / "s0.jsonl", cell(2, "c"));
+  append_result(dir / "s0.jsonl", cell(0, "a"));
+  append_result(dir / "s1.jsonl", cell(1, "b"));
+  append_result(dir / "s1.jsonl", cell(0, "a"));  // identical duplicate: collapses
+  const std::vector<json> merged = collect_results({dir / "s0.jsonl", dir / "s1.jsonl"}, dir / "merged.jsonl");
+  ASSERT_EQ(merged.size(), 3u);
+  EXPECT_EQ(merged[0]["cell_id"], "a");
+  EXPECT_EQ(merged[1]["cell_id"], "b");
+  EXPECT_EQ(merged[2]["cell_id"], "c");
+  // The merged text reads back as a results file.
+  std::ofstream(dir / "all.jsonl") << results_text(merged);
+  EXPECT_EQ(read_results(dir / "all.jsonl").cells, merged);
+
+  append_result(dir / "s2.jsonl", cell(1, "b", 12.0));  // the same cell, other numbers
+  try {
+    (void)collect_results({dir / "s0.jsonl", dir / "s1.jsonl", dir / "s2.jsonl"}, dir / "merged.jsonl");
+    FAIL() << "a conflicting duplicate was merged";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cell_id 'b' is recorded differently"), std::string::npos) << e.what();
+  }
+
+  json foreign = cell(5, "z");
+  foreign["definition_sha256"] = "def";
+  append_result(dir / "s3.jsonl", foreign);
+  EXPECT_THROW((void)collect_results({dir / "s0.jsonl", dir / "s3.jsonl"}, dir / "merged.jsonl"), InputError);
+}
+
+TEST(ResultsFile, CsvRowsAndQuoting) {
+  json c = cell(0, "box-wall|e=0.064m,\"x\"");
+  const std::string csv = results_csv({c});
+  const size_t eol = csv.find("\r\n");
+  ASSERT_NE(eol, std::string::npos);
+  EXPECT_EQ(csv.substr(0, 24), "cell_index,cell_id,sweep");
+  const std::string row = csv.substr(eol + 2);
+  EXPECT_EQ(row,
+            "0,\"box-wall|e=0.064m,\"\"x\"\"\",t,box-wall,size=0.5,96,54,0.064,3.5,2,1,full,plain-rt,plain-rt,40,0.99,"
+            "1.5,0.01,0,1,0.02,0.01,1\r\n");
+}
+
+}  // namespace
+}  // namespace sb

@@ -1,0 +1,242 @@
+// Sweep definitions: every key parsed, every mistake rejected with its key path and line, cells
+// expanded in a fixed order with stable ids, and every shipped definition loads.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "renderer/error.hpp"
+#include "renderer/pipeline.hpp"
+#include "support/scratch_dir.hpp"
+#include "validation/sweep.hpp"
+
+namespace sb {
+namespace {
+
+namespace fs = std::filesystem;
+using validation::parse_sweep;
+using validation::SweepDefinition;
+
+/// The message of the InputError `text` raises (empty when it loads).
+std::string error_of(const std::string& text, const fs::path& file = "def.toml") {
+  try {
+    (void)parse_sweep(text, file);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(SweepDefinition, ParsesEveryKey) {
+  const SweepDefinition d = parse_sweep(R"(
+[sweep]
+name = "all-keys"
+description = "every key"
+scenes = ["box-wall", "complexity:triangles=1e6", "spheres:segments=8,count=10"]
+pipelines = ["repro-rt", "bw-warp"]
+baseline = "plain-raster"
+interaxial_m = [0.05, 0.1]
+convergence_m = [1.5, 3]
+resolutions = ["96x54", "hd"]
+lights = [1, 2]
+truths = ["full", "povray"]
+
+[timing]
+repetitions = 4
+warmup = 2
+
+[options.repro-rt]
+threshold_arcmin = 2
+
+[options.bw-warp]
+iterations = 6
+start = "far"
+
+[output]
+images = true
+exr = true
+)",
+                                        "dir/def.toml");
+  EXPECT_EQ(d.name, "all-keys");
+  EXPECT_EQ(d.description, "every key");
+  ASSERT_EQ(d.scenes.size(), 3u);
+  EXPECT_EQ(d.scenes[0].label, "box-wall");
+  EXPECT_EQ(d.scenes[1].label, "complexity:triangles=1000000");  // normalised number
+  EXPECT_EQ(d.scenes[1].params.at("triangles"), 1e6);
+  EXPECT_EQ(d.scenes[2].label, "spheres:count=10,segments=8");  // keys sorted
+  // Sorted, the baseline added because it was not listed.
+  EXPECT_EQ(d.pipelines, (std::vector<std::string>{"bw-warp", "plain-raster", "repro-rt"}));
+  EXPECT_EQ(d.baseline, "plain-raster");
+  EXPECT_FALSE(d.baseline_listed);
+  EXPECT_EQ(d.interaxial_m.size(), 2u);
+  EXPECT_EQ(*d.interaxial_m[1], 0.1);
+  EXPECT_FALSE(d.max_disparity_px.front().has_value());
+  EXPECT_EQ(*d.convergence_m[1], 3.0);
+  ASSERT_EQ(d.resolutions.size(), 2u);
+  EXPECT_EQ(d.resolutions[1]->label, "1920x1080");
+  EXPECT_EQ(*d.lights[1], 2);
+  EXPECT_EQ(d.truths, (std::vector<std::string>{"full", "povray"}));
+  EXPECT_EQ(d.repetitions, 4);
+  EXPECT_EQ(d.warmup, 2);
+  EXPECT_EQ(d.options.at("repro-rt").at("threshold_arcmin"), "2");
+  EXPECT_EQ(d.options.at("bw-warp").at("start"), "far");
+  EXPECT_TRUE(d.exr);
+  EXPECT_EQ(d.sha256.size(), 64u);
+  EXPECT_EQ(validation::expand_cells(d).size(), 3u * 2 * 2 * 2 * 2 * 2);
+}
+
+TEST(SweepDefinition, DefaultsForOmittedAxes) {
+  const SweepDefinition d = parse_sweep("[sweep]\n", "ci/some-name.toml");
+  EXPECT_EQ(d.name, "some-name");  // the file's stem
+  ASSERT_EQ(d.scenes.size(), 1u);
+  EXPECT_EQ(d.scenes[0].label, "spheres");
+  EXPECT_EQ(d.pipelines.size(), pipelines().size());  // every registered pipeline
+  EXPECT_TRUE(d.baseline_listed);
+  EXPECT_EQ(d.baseline, "plain-rt");
+  EXPECT_EQ(d.truths, (std::vector<std::string>{"full"}));
+  const auto cells = validation::expand_cells(d);
+  ASSERT_EQ(cells.size(), 1u);
+  EXPECT_EQ(cells[0].id, "spheres|e=default|c=default|res=default|lights=all|full");
+}
+
+TEST(SweepDefinition, UnknownKeysNameTheKeyAndLine) {
+  const std::string top = error_of("[sweep]\nname = \"x\"\n\n[timings]\nrepetitions = 1\n");
+  EXPECT_NE(top.find("def.toml:4: timings: unknown key"), std::string::npos) << top;
+  EXPECT_NE(top.find("sweep, timing, options, output"), std::string::npos) << top;
+
+  const std::string in_sweep = error_of("[sweep]\nname = \"x\"\nscene = [\"spheres\"]\n");
+  EXPECT_NE(in_sweep.find("def.toml:3: sweep.scene: unknown key"), std::string::npos) << in_sweep;
+  EXPECT_NE(in_sweep.find("scenes"), std::string::npos) << in_sweep;  // the valid keys are listed
+
+  const std::string in_timing = error_of("[sweep]\n[timing]\nrepetition = 3\n");
+  EXPECT_NE(in_timing.find("def.toml:3: timing.repetition: unknown key"), std::string::npos) << in_timing;
+  const std::string in_output = error_of("[sweep]\n[output]\npng = true\n");
+  EXPECT_NE(in_output.find("def.toml:3: output.png: unknown key"), std::string::npos) << in_output;
+
+  const std::string option = error_of("[sweep]\npipelines = [\"repro-rt\"]\n[options.repro-rt]\nthreshold = 2\n");
+  EXPECT_NE(option.find("def.toml:4: options.repro-rt.threshold"), std::string::npos) << option;
+  EXPECT_NE(option.find("no option 'threshold'"), std::string::npos) << option;
+
+  const std::string other = error_of("[sweep]\npipelines = [\"repro-rt\"]\n[options.fw-warp]\ntile = 32\n");
+  EXPECT_NE(other.find("def.toml:3: options.fw-warp: options for a pipeline the sweep does not run"),
+            std::string::npos)
+      << other;
+}
+
+TEST(SweepDefinition, BothInteraxialKindsRejected) {
+  const std::string e = error_of("[sweep]\ninteraxial_m = [0.064]\nmax_disparity_px = [30]\n");
+  EXPECT_NE(e.find("def.toml:3: sweep.max_disparity_px"), std::string::npos) << e;
+  EXPECT_NE(e.find("line 2"), std::string::npos) << e;
+}
+
+TEST(SweepDefinition, BadValuesRejected) {
+  const struct {
+    const char* toml;
+    const char* expected;
+  } cases[] = {
+      {"[sweep]\ninteraxial_m = [\"0.064\"]\n", "sweep.interaxial_m: must be a number, not a string"},
+      {"[sweep]\ninteraxial_m = []\n", "sweep.interaxial_m: is empty"},
+      {"[sweep]\ninteraxial_m = [-1]\n", "not a positive number"},
+      {"[sweep]\nconvergence_m = [2, 2.0]\n", "lists 2 twice"},
+      {"[sweep]\nlights = [1.5]\n", "sweep.lights: must be an integer, not a float"},
+      {"[sweep]\nlights = [0]\n", "not a light count"},
+      {"[sweep]\nresolutions = [\"huge\"]\n", "sweep.resolutions"},
+      {"[sweep]\nresolutions = [\"hd\", \"1920x1080\"]\n", "lists 1920x1080 twice"},
+      {"[sweep]\nscenes = [\"nowhere\"]\n", "unknown"},
+      {"[sweep]\nscenes = [\"complexity:triangles=5\"]\n", "outside"},
+      {"[sweep]\nscenes = [\"complexity:size=5\"]\n", "has no parameter 'size'"},
+      {"[sweep]\nscenes = [\"missing/scene.gltf\"]\n", "does not exist"},
+      {"[sweep]\nscenes = [\"spheres\", \"spheres\"]\n", "lists 'spheres' twice"},
+      {"[sweep]\npipelines = [\"repro-rtx\"]\n", "sweep.pipelines"},
+      {"[sweep]\nbaseline = \"nope\"\n", "sweep.baseline"},
+      {"[sweep]\ntruths = [\"mitsuba\"]\n", "unknown ground-truth provider 'mitsuba'"},
+      {"[sweep]\nname = 3\n", "sweep.name: must be a string, not an integer"},
+      {"[sweep]\n[timing]\nrepetitions = 0\n", "timing.repetitions: 0 is outside"},
+      {"[sweep]\n[output]\nimages = \"yes\"\n", "output.images: must be true or false"},
+      {"[sweep]\n[output]\nimages = false\nexr = true\n", "EXR images need"},
+      {"sweep = 3\n", "sweep: must be a table"},
+      {"[timing]\nrepetitions = 1\n", "no [sweep] table"},
+      {"[sweep\n", "not valid TOML"},
+  };
+  for (const auto& c : cases) {
+    const std::string e = error_of(c.toml);
+    EXPECT_NE(e.find(c.expected), std::string::npos) << c.toml << "\n -> " << e;
+    EXPECT_EQ(e.rfind("def.toml", 0), 0u) << "the message starts with the file: " << e;
+  }
+}
+
+TEST(SweepDefinition, GltfScenesResolveAgainstTheDefinitionsFolder) {
+  test::ScratchDir dir;
+  fs::create_directories(dir / "defs" / "scenes");
+  { std::ofstream(dir / "defs" / "scenes" / "a.gltf") << "{}"; }
+  const SweepDefinition d = parse_sweep("[sweep]\nscenes = [\"scenes/a.gltf\"]\n", dir / "defs" / "x.toml");
+  ASSERT_EQ(d.scenes.size(), 1u);
+  EXPECT_FALSE(d.scenes[0].builtin);
+  EXPECT_EQ(d.scenes[0].file, dir / "defs" / "scenes" / "a.gltf");
+  EXPECT_EQ(d.scenes[0].label, "scenes/a.gltf");  // ids do not depend on where the checkout is
+}
+
+TEST(SweepDefinition, CellOrderAndIdsAreStable) {
+  const SweepDefinition d = parse_sweep(R"([sweep]
+scenes = ["box-wall", "thin-pole"]
+max_disparity_px = [10, 20.5]
+resolutions = ["96x54"]
+lights = [1]
+)",
+                                        "def.toml");
+  const auto cells = validation::expand_cells(d);
+  ASSERT_EQ(cells.size(), 4u);
+  EXPECT_EQ(cells[0].id, "box-wall|e=10px|c=default|96x54|lights=1|full");
+  EXPECT_EQ(cells[1].id, "box-wall|e=20.5px|c=default|96x54|lights=1|full");
+  EXPECT_EQ(cells[2].id, "thin-pole|e=10px|c=default|96x54|lights=1|full");
+  EXPECT_EQ(cells[3].id, "thin-pole|e=20.5px|c=default|96x54|lights=1|full");
+  for (size_t i = 0; i < cells.size(); ++i) EXPECT_EQ(cells[i].index, i);
+  EXPECT_EQ(*cells[1].max_disparity_px, 20.5);
+  EXPECT_FALSE(cells[1].interaxial_m.has_value());
+  const nlohmann::json j = validation::cell_to_json(cells[1]);
+  EXPECT_EQ(j["scene"], "box-wall");
+  EXPECT_EQ(j["max_disparity_px"], 20.5);
+  EXPECT_TRUE(j["interaxial_m"].is_null());
+  EXPECT_EQ(j["resolution"], "96x54");
+  // Expanding again (or from a re-parsed text) gives the same ids.
+  const auto again = validation::expand_cells(parse_sweep(
+      "[sweep]\nscenes = [\"box-wall\", \"thin-pole\"]\nmax_disparity_px = [10, 20.5]\nresolutions = "
+      "[\"96x54\"]\nlights = [1]\n",
+      "other.toml"));
+  for (size_t i = 0; i < cells.size(); ++i) EXPECT_EQ(again[i].id, cells[i].id);
+}
+
+TEST(SweepDefinition, ShippedDefinitionsLoad) {
+  const fs::path ci = fs::path(SB_SOURCE_DIR) / "ci";
+  const size_t n_pipelines = pipelines().size();
+  const struct {
+    const char* file;
+    size_t cells;
+    size_t pipelines;  // 0: every registered pipeline
+  } shipped[] = {
+      {"smoke.toml", 2, 0},                              // spheres × 2 interaxial
+      {"nightly.toml", 6 * 3 * 2, 0},                    // 6 scenes × 3 disparities × 2 resolutions
+      {"presets/wissmann-table2.toml", 3 * 2, 5},        // 3 scenes × HD, 4K
+      {"presets/kim-table2.toml", 3, 5},                 // 3 focal distances
+      {"presets/kim-table3.toml", 3, 2},                 // 3 triangle counts
+      {"presets/al-hagri-dimensions.toml", 6 * 27, 6},   // 6 scenes × 200..1500 step 50
+      {"presets/al-hagri-interaxial.toml", 10, 6},       // 10..100 px
+      {"presets/al-hagri-lights.toml", 10, 6},           // 1..10 lights
+  };
+  size_t checked = 0;
+  for (const auto& s : shipped) {
+    const SweepDefinition d = validation::load_sweep(ci / s.file);
+    EXPECT_EQ(validation::expand_cells(d).size(), s.cells) << s.file;
+    EXPECT_EQ(d.pipelines.size(), s.pipelines ? s.pipelines : n_pipelines) << s.file;
+    ++checked;
+  }
+  // Every TOML shipped under ci/ (besides the gate's) is in the list above.
+  size_t on_disk = 0;
+  for (const fs::path& dir : {ci, ci / "presets"})
+    for (const auto& entry : fs::directory_iterator(dir))
+      if (entry.path().extension() == ".toml" && entry.path().filename() != "gate.toml") ++on_disk;
+  EXPECT_EQ(on_disk, checked);
+}
+
+}  // namespace
+}  // namespace sb

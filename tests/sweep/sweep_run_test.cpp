@@ -1,0 +1,275 @@
+// `stereobench sweep run` end to end: resumption after SIGKILL, shards merged by collect equal an
+// unsharded run, CSV export, and the shipped smoke sweep.
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "support/run_cli.hpp"
+#include "support/scratch_dir.hpp"
+#include "validation/results_file.hpp"
+
+extern char** environ;
+
+namespace sb {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+/// Six cells at 96x54 on the box in front of a wall: 3 interaxial distances × 2 sizes.
+constexpr const char* kTinySweep = R"([sweep]
+name = "tiny"
+scenes = ["box-wall"]
+pipelines = ["plain-rt", "plain-raster", "repro-rt", "rt-atomic", "bidir-warp"]
+interaxial_m = [0.04, 0.064, 0.1]
+resolutions = ["96x54", "128x72"]
+
+[timing]
+repetitions = 2
+warmup = 0
+)";
+
+/// The complete (newline-terminated) lines of a file; a torn tail is left out.
+std::vector<std::string> lines_of(const fs::path& file) {
+  std::string text = test::read_text(file);
+  text.resize(text.rfind('\n') == std::string::npos ? 0 : text.rfind('\n') + 1);
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+
+std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
+
+/// What must agree between two runs of a cell: everything measured except time.
+json measured(const json& cell) {
+  json out = {{"cell", cell["cell"]}, {"rig", cell["rig"]}};
+  for (const auto& [name, p] : cell["pipelines"].items()) {
+    const json& v = p["validation"];
+    out[name] = {{"metrics", v["metrics"]}, {"regions", v["regions"]}, {"holes", v["holes"]},
+                 {"counters", v["counters"]}, {"options", v["options"]}};
+  }
+  return out;
+}
+
+std::map<std::string, json> measured_by_id(const fs::path& file) {
+  std::map<std::string, json> out;
+  for (const json& c : validation::read_results(file).cells) out[c["cell_id"]] = measured(c);
+  return out;
+}
+
+TEST(SweepRun, ResumesAfterKillWithoutLosingOrDuplicatingCells) {
+  test::ScratchDir dir;
+  std::ofstream(dir / "tiny.toml") << kTinySweep;
+  const fs::path results = dir / "out" / "results.jsonl";
+  const std::string cli = SB_CLI_PATH;
+  const std::string def = (dir / "tiny.toml").string(), out = (dir / "out").string(),
+                    scenes = (dir / "scenes").string(), log = (dir / "first.log").string();
+  // Generate the scene first, so that the run killed below spends its time in cells.
+  ASSERT_EQ(test::run_cli("scenes generate box-wall --out " + quoted(dir / "scenes")).code, 0);
+
+  std::vector<std::string> args = {cli, "sweep", "run", def, "--out", out, "--scenes-dir", scenes, "--threads", "1"};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, cli.c_str(), &actions, nullptr, argv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&actions);
+
+  // Kill it once the first cell is recorded, while later cells are running.
+  bool exited = false;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (lines_of(results).size() >= 1) break;
+    int status = 0;
+    if (waitpid(pid, &status, WNOHANG) == pid) {
+      exited = true;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  if (!exited) {
+    ASSERT_EQ(kill(pid, SIGKILL), 0);
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    EXPECT_TRUE(WIFSIGNALED(status)) << "the run ended before it was killed; it must still have been running";
+  }
+  ASSERT_FALSE(exited) << "the run finished (or failed) before the kill: " << test::read_text(log);
+  const std::vector<std::string> before = lines_of(results);
+  ASSERT_GE(before.size(), 1u);
+  ASSERT_LT(before.size(), 6u) << "every cell finished before the kill";
+
+  // Resume: only the missing cells run.
+  const test::CliRun resumed = test::run_cli("sweep run " + quoted(dir / "tiny.toml") + " --out " + quoted(dir / "out") +
+                                             " --scenes-dir " + quoted(dir / "scenes") + " --threads 1");
+  ASSERT_EQ(resumed.code, 0) << resumed.out;
+  EXPECT_NE(resumed.out.find(std::to_string(before.size()) + " finished already, " +
+                             std::to_string(6 - before.size()) + " to run"),
+            std::string::npos)
+      << resumed.out;
+  const std::vector<std::string> after = lines_of(results);
+  const validation::ResultsFile r = validation::read_results(results);  // throws on a duplicate cell_id
+  EXPECT_TRUE(r.warnings.empty());
+  ASSERT_EQ(r.cells.size(), 6u);
+  std::set<size_t> indices;
+  for (const json& c : r.cells) indices.insert(c["cell_index"].get<size_t>());
+  EXPECT_EQ(indices, (std::set<size_t>{0, 1, 2, 3, 4, 5}));
+  // The cells recorded before the kill are unchanged, in their places.
+  for (size_t i = 0; i < before.size(); ++i) EXPECT_EQ(after[i], before[i]) << "line " << i + 1;
+
+  // A third run has nothing to do.
+  const test::CliRun again = test::run_cli("sweep run " + quoted(dir / "tiny.toml") + " --out " + quoted(dir / "out") +
+                                           " --scenes-dir " + quoted(dir / "scenes"));
+  ASSERT_EQ(again.code, 0) << again.out;
+  EXPECT_NE(again.out.find("6 finished already, 0 to run"), std::string::npos) << again.out;
+  EXPECT_EQ(lines_of(results), after);
+
+  // Images of a finished cell exist where its line says.
+  const json& first = r.cells.front();
+  for (const char* key : {"left_png", "truth_png", "disocclusions_png"})
+    EXPECT_TRUE(fs::exists(results.parent_path() / first["images"][key].get<std::string>())) << key;
+  for (const auto& [name, files] : first["images"]["pipelines"].items())
+    for (const auto& [kind, path] : files.items())
+      EXPECT_TRUE(fs::exists(results.parent_path() / path.get<std::string>())) << name << " " << kind;
+
+  // A changed definition is not mixed into these results.
+  std::ofstream(dir / "tiny.toml", std::ios::app) << "\n# edited\n";
+  const test::CliRun changed = test::run_cli("sweep run " + quoted(dir / "tiny.toml") + " --out " +
+                                             quoted(dir / "out") + " --scenes-dir " + quoted(dir / "scenes"));
+  EXPECT_EQ(changed.code, 3) << changed.out;
+  EXPECT_NE(changed.out.find("the definition changed"), std::string::npos) << changed.out;
+}
+
+TEST(SweepRun, ShardsCollectedEqualAnUnshardedRun) {
+  test::ScratchDir dir;
+  std::ofstream(dir / "tiny.toml") << kTinySweep;
+  const std::string common = " --scenes-dir " + quoted(dir / "scenes") + " --threads 1";
+  const std::string def = quoted(dir / "tiny.toml");
+  const test::CliRun whole = test::run_cli("sweep run " + def + " --out " + quoted(dir / "whole") + common);
+  ASSERT_EQ(whole.code, 0) << whole.out;
+  for (const char* shard : {"0/2", "1/2"}) {
+    const std::string name = std::string("shard") + shard[0];
+    const test::CliRun r = test::run_cli("sweep run " + def + " --shard " + shard + " --out " + quoted(dir / name) + common);
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_EQ(validation::read_results(dir / name / "results.jsonl").cells.size(), 3u) << shard;
+  }
+  const test::CliRun collected =
+      test::run_cli("sweep collect " + quoted(dir / "merged.jsonl") + " " + quoted(dir / "shard1" / "results.jsonl") +
+                    " " + quoted(dir / "shard0" / "results.jsonl"));
+  ASSERT_EQ(collected.code, 0) << collected.out;
+
+  const std::vector<json> merged = validation::read_results(dir / "merged.jsonl").cells;
+  ASSERT_EQ(merged.size(), 6u);
+  for (size_t i = 0; i < merged.size(); ++i) EXPECT_EQ(merged[i]["cell_index"], i);  // ordered by cell_index
+  const auto a = measured_by_id(dir / "whole" / "results.jsonl");
+  const auto b = measured_by_id(dir / "merged.jsonl");
+  ASSERT_EQ(a.size(), 6u);
+  for (const auto& [id, m] : a) {
+    ASSERT_TRUE(b.count(id)) << id;
+    EXPECT_EQ(b.at(id), m) << id;
+  }
+
+  // Collecting a shard with a conflicting copy of a cell fails, naming the cell.
+  std::vector<std::string> lines = lines_of(dir / "shard0" / "results.jsonl");
+  json changed = json::parse(lines[0]);
+  changed["wall_s"] = -1.0;
+  std::ofstream(dir / "conflict.jsonl") << changed.dump() << "\n";
+  const test::CliRun conflict = test::run_cli("sweep collect " + quoted(dir / "bad.jsonl") + " " +
+                                              quoted(dir / "shard0" / "results.jsonl") + " " +
+                                              quoted(dir / "conflict.jsonl"));
+  EXPECT_EQ(conflict.code, 3) << conflict.out;
+  EXPECT_NE(conflict.out.find(changed["cell_id"].get<std::string>()), std::string::npos) << conflict.out;
+  EXPECT_FALSE(fs::exists(dir / "bad.jsonl"));
+
+  // CSV export: a header and one row per (cell, pipeline).
+  const test::CliRun csv = test::run_cli("sweep csv " + quoted(dir / "merged.jsonl") + " --out " + quoted(dir / "m.csv"));
+  ASSERT_EQ(csv.code, 0) << csv.out;
+  const std::string text = test::read_text(dir / "m.csv");
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1 + 6 * 5);
+  EXPECT_EQ(text.rfind("cell_index,cell_id,", 0), 0u);
+}
+
+TEST(SweepRun, SmokeSweepRunsAndEveryLineIsWellFormed) {
+  test::ScratchDir dir;
+  const fs::path smoke = fs::path(SB_SOURCE_DIR) / "ci" / "smoke.toml";
+  const auto start = std::chrono::steady_clock::now();
+  const test::CliRun r =
+      test::run_cli("sweep run " + quoted(smoke) + " --out " + quoted(dir / "smoke") + " --scenes-dir " + quoted(dir / "scenes"));
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::printf("smoke sweep: %.1f s wall\n", seconds);  // a measurement, not an assertion (DESIGN §8)
+
+  const test::CliRun listed = test::run_cli("sweep cells " + quoted(smoke));
+  ASSERT_EQ(listed.code, 0) << listed.out;
+  const std::vector<json> cells = validation::read_results(dir / "smoke" / "results.jsonl").cells;
+  const test::CliRun pipelines = test::run_cli("pipelines");
+  size_t registered = 0;
+  for (std::istringstream in(pipelines.out); !in.eof();) {
+    std::string line;
+    std::getline(in, line);
+    if (!line.empty() && line[0] != ' ') ++registered;
+  }
+  ASSERT_EQ(cells.size(), 2u);
+  for (const json& c : cells) {
+    SCOPED_TRACE(c["cell_id"].get<std::string>());
+    EXPECT_EQ(c["kind"], "stereobench.sweep_cell");
+    EXPECT_EQ(c["schema_version"], 1);
+    EXPECT_EQ(c["sweep"], "smoke");
+    EXPECT_EQ(c["definition_sha256"].get<std::string>().size(), 64u);
+    EXPECT_EQ(c["cell_count"], 2);
+    EXPECT_EQ(c["rig"]["width"], 320);
+    EXPECT_EQ(c["jobs"], 1);
+    EXPECT_GT(c["wall_s"].get<double>(), 0.0);
+    EXPECT_EQ(c["pipelines"].size(), registered);
+    for (const auto& [name, p] : c["pipelines"].items()) {
+      SCOPED_TRACE(name);
+      const json& v = p["validation"];
+      EXPECT_EQ(v["kind"], "stereobench.validation");
+      EXPECT_EQ(v["pipeline"], name);
+      EXPECT_TRUE(v["metrics"]["ssim"].is_number());
+      EXPECT_TRUE(v["metrics"]["psnr"].is_number() || v["metrics"]["psnr"] == "inf");
+      const json& t = p["timing"];
+      EXPECT_EQ(t["repetitions"], 1);
+      EXPECT_EQ(t["samples_s"].size(), 1u);
+      EXPECT_GT(t["median_s"].get<double>(), 0.0);
+      EXPECT_GT(t["speedup_median"].get<double>(), 0.0);
+      if (name == "plain-rt") {
+        EXPECT_EQ(t["speedup_median"], 1.0);
+        EXPECT_EQ(v["metrics"]["psnr"], "inf");  // plain-rt's right eye is the built-in truth
+      }
+      for (const char* kind : {"right_png", "diff_png", "ssim_png", "holes_png"})
+        EXPECT_TRUE(fs::exists(dir / "smoke" / c["images"]["pipelines"][name][kind].get<std::string>())) << kind;
+    }
+  }
+  EXPECT_NE(cells[0]["rig"]["interaxial_m"], cells[1]["rig"]["interaxial_m"]);
+}
+
+TEST(SweepRun, BadDefinitionAndShardAreUsageErrors) {
+  test::ScratchDir dir;
+  std::ofstream(dir / "bad.toml") << "[sweep]\nscenes = [\"box-wall\"]\nresolution = [\"96x54\"]\n";
+  const test::CliRun bad = test::run_cli("sweep run " + quoted(dir / "bad.toml") + " --out " + quoted(dir / "o"));
+  EXPECT_EQ(bad.code, 3) << bad.out;
+  EXPECT_NE(bad.out.find("bad.toml:3: sweep.resolution: unknown key"), std::string::npos) << bad.out;
+  EXPECT_FALSE(fs::exists(dir / "o" / "results.jsonl"));
+  std::ofstream(dir / "ok.toml") << kTinySweep;
+  const test::CliRun shard = test::run_cli("sweep run " + quoted(dir / "ok.toml") + " --shard 2/2 --out " + quoted(dir / "o"));
+  EXPECT_EQ(shard.code, 3) << shard.out;
+}
+
+}  // namespace
+}  // namespace sb

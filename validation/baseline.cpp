@@ -1,0 +1,92 @@
+// Stored timing baselines: reading, validating and atomically writing ci/baseline.json.
+#include "validation/baseline.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
+
+namespace sb::validation {
+
+namespace {
+
+using nlohmann::json;
+
+double median_of(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace
+
+const BaselineEntry* Baseline::find(const std::string& cell_id, const std::string& pipeline) const {
+  const auto c = cells.find(cell_id);
+  if (c == cells.end()) return nullptr;
+  const auto p = c->second.find(pipeline);
+  return p == c->second.end() ? nullptr : &p->second;
+}
+
+Baseline parse_baseline(const json& doc, const std::string& source) {
+  if (!doc.is_object())
+    throw InputError(
+        fmt::format("{}: a baseline is a JSON object {{cell_id: {{pipeline: {{samples_s, ...}}}}}}", source));
+  Baseline b;
+  for (const auto& [cell_id, pipes] : doc.items()) {
+    if (!pipes.is_object())
+      throw InputError(fmt::format("{}: entry '{}' is not an object of pipelines", source, cell_id));
+    for (const auto& [pipeline, e] : pipes.items()) {
+      const std::string where = fmt::format("{}: '{}' / {}", source, cell_id, pipeline);
+      if (!e.is_object() || !e.contains("samples_s") || !e["samples_s"].is_array() || e["samples_s"].empty())
+        throw InputError(
+            fmt::format("{}: samples_s must be a non-empty array of seconds; rewrite the entry with "
+                        "`stereobench gate --update-baseline`",
+                        where));
+      BaselineEntry entry;
+      for (const json& s : e["samples_s"]) {
+        if (!s.is_number() || !std::isfinite(s.get<double>()) || !(s.get<double>() > 0.0))
+          throw InputError(fmt::format("{}: samples_s holds {}, not a positive time in seconds", where, s.dump()));
+        entry.samples_s.push_back(s.get<double>());
+      }
+      entry.median_s = median_of(entry.samples_s);
+      if (e.contains("recorded") && e["recorded"].is_string()) entry.recorded = e["recorded"].get<std::string>();
+      if (e.contains("host") && e["host"].is_string()) entry.host = e["host"].get<std::string>();
+      b.cells[cell_id][pipeline] = std::move(entry);
+    }
+  }
+  return b;
+}
+
+Baseline load_baseline(const std::filesystem::path& file) {
+  if (!std::filesystem::exists(file))
+    throw InputError(
+        fmt::format("baseline {} does not exist; create it with `stereobench gate --update-baseline "
+                    "--results FILE --baseline {} --cells '*'`",
+                    file.string(), file.string()));
+  const std::string text = io::read_file(file);
+  json doc;
+  try {
+    doc = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw InputError(fmt::format("baseline {} is not valid JSON ({})", file.string(), e.what()));
+  }
+  return parse_baseline(doc, file.string());
+}
+
+json baseline_json(const Baseline& baseline) {
+  json doc = json::object();
+  for (const auto& [cell_id, pipes] : baseline.cells)
+    for (const auto& [pipeline, e] : pipes)
+      doc[cell_id][pipeline] = {
+          {"samples_s", e.samples_s}, {"median_s", e.median_s}, {"recorded", e.recorded}, {"host", e.host}};
+  return doc;
+}
+
+void save_baseline(const std::filesystem::path& file, const Baseline& baseline) {
+  io::write_text_atomically(file, baseline_json(baseline).dump(2) + "\n");
+}
+
+}  // namespace sb::validation

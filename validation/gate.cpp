@@ -1,0 +1,710 @@
+// The CI quality gate: gate.toml parsing, results reading, threshold and time-regression checks.
+#include "validation/gate.hpp"
+
+#include <fnmatch.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
+#include "validation/results_file.hpp"
+
+namespace sb::validation {
+
+namespace {
+
+using nlohmann::json;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr const char* kToleranceKey = "regression_tolerance";
+
+// ---------------------------------------------------------------------------------------------
+// gate.toml
+
+/// Every threshold key of [defaults] and [[rule]], in kMetricChecks order.
+std::vector<std::string> threshold_keys() {
+  std::vector<std::string> keys;
+  for (const MetricCheck& c : kMetricChecks) {
+    keys.emplace_back(c.fail_key);
+    keys.emplace_back(c.warn_key);
+  }
+  return keys;
+}
+
+std::string joined(const std::vector<std::string>& items) {
+  std::string out;
+  for (const std::string& s : items) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+[[noreturn]] void config_error(const std::string& source, const toml::source_region& where, const std::string& what) {
+  throw InputError(fmt::format("{}:{}: {}", source, where.begin.line, what));
+}
+
+/// A threshold value: a non-negative finite number, or `false` to turn the check off.
+std::optional<double> threshold_value(const toml::node& node, const std::string& key, const std::string& source) {
+  if (node.is_boolean()) {
+    if (*node.value<bool>())
+      config_error(source, node.source(),
+                   fmt::format("{} = true is not a limit; give a number, or false to turn the check off", key));
+    return std::nullopt;
+  }
+  if (!node.is_number())
+    config_error(source, node.source(), fmt::format("{} must be a number (or false to turn the check off)", key));
+  const double v = *node.value<double>();
+  if (!std::isfinite(v) || v < 0.0)
+    config_error(source, node.source(), fmt::format("{} = {} is not a non-negative finite number", key, v));
+  return v;
+}
+
+/// Reads the threshold keys of one table; `extra` are further keys the caller handles itself.
+ThresholdValues read_thresholds(const toml::table& table, const std::string& table_name, const std::string& source,
+                                const std::set<std::string>& extra) {
+  const std::vector<std::string> keys = threshold_keys();
+  ThresholdValues values;
+  for (auto&& [key, node] : table) {
+    const std::string k(key.str());
+    if (extra.count(k)) continue;
+    if (std::find(keys.begin(), keys.end(), k) == keys.end()) {
+      std::vector<std::string> known = keys;
+      known.insert(known.end(), extra.begin(), extra.end());
+      config_error(source, key.source(),
+                   fmt::format("unknown key '{}' in {}; known keys: {}", k, table_name, joined(known)));
+    }
+    values[k] = threshold_value(node, k, source);
+  }
+  // A warning level must be reached before the failure level.
+  for (const MetricCheck& c : kMetricChecks) {
+    const auto f = values.find(c.fail_key);
+    const auto w = values.find(c.warn_key);
+    if (f == values.end() || w == values.end() || !f->second || !w->second) continue;
+    const bool looser = c.direction == Direction::at_least ? *w->second < *f->second : *w->second > *f->second;
+    if (looser)
+      config_error(source, table[c.warn_key].node()->source(),
+                   fmt::format("{} = {} is looser than {} = {} in {}; the warning level must lie between the "
+                               "failure level and the expected value",
+                               c.warn_key, *w->second, c.fail_key, *f->second, table_name));
+  }
+  return values;
+}
+
+RegressionSettings read_regression(const toml::table& table, const std::string& source) {
+  RegressionSettings r;
+  for (auto&& [key, node] : table) {
+    const std::string k(key.str());
+    if (k == "tolerance" || k == "alpha") {
+      const std::optional<double> v = node.value<double>();
+      if (!v || !std::isfinite(*v) || *v < 0.0)
+        config_error(source, node.source(), fmt::format("[regression] {} must be a non-negative number", k));
+      if (k == "alpha" && !(*v > 0.0 && *v < 1.0))
+        config_error(source, node.source(), fmt::format("[regression] alpha = {} must lie in (0, 1)", *v));
+      (k == "tolerance" ? r.tolerance : r.alpha) = *v;
+    } else if (k == "min_repetitions") {
+      const std::optional<int64_t> v = node.is_integer() ? node.value<int64_t>() : std::nullopt;
+      if (!v || *v < 1 || *v > 1000000)
+        config_error(source, node.source(), "[regression] min_repetitions must be an integer of at least 1");
+      r.min_repetitions = static_cast<int>(*v);
+    } else {
+      config_error(source, key.source(),
+                   fmt::format("unknown key '{}' in [regression]; known keys: tolerance, alpha, min_repetitions", k));
+    }
+  }
+  return r;
+}
+
+std::string glob_value(const toml::node& node, const std::string& key, const std::string& source) {
+  const std::optional<std::string> v = node.value<std::string>();
+  if (!v || v->empty())
+    config_error(source, node.source(),
+                 fmt::format("[[rule]] {} must be a non-empty string (a name or a glob such as 'repro-*')", key));
+  return *v;
+}
+
+bool glob_matches(const std::string& pattern, const std::string& text) {
+  return ::fnmatch(pattern.c_str(), text.c_str(), 0) == 0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Record values
+
+/// Formats a number for a command line: the shortest text that reads back to the same double.
+std::string number_arg(double v) {
+  return fmt::format("{}", v);
+}
+
+/// Quotes a command-line argument for a POSIX shell when it needs it.
+std::string shell_quote(const std::string& arg) {
+  const bool plain = !arg.empty() && std::all_of(arg.begin(), arg.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) ||
+           std::string_view("_-./=:,+@%").find(c) != std::string_view::npos;
+  });
+  if (plain) return arg;
+  std::string out = "'";
+  for (char c : arg) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+/// A number of a record: std::nullopt when absent, NaN for null, +-inf for "inf"/"-inf";
+/// InputError for any other type.
+std::optional<double> record_number(const json& entry, const char* pointer, const std::string& where) {
+  const json::json_pointer ptr(pointer);
+  if (!entry.contains(ptr)) return std::nullopt;
+  const json& v = entry.at(ptr);
+  if (v.is_null()) return kNaN;
+  if (v.is_number()) return v.get<double>();
+  if (v.is_string()) {
+    const std::string s = v.get<std::string>();
+    if (s == "inf") return std::numeric_limits<double>::infinity();
+    if (s == "-inf") return -std::numeric_limits<double>::infinity();
+  }
+  throw InputError(fmt::format("{}: {} is {}, not a number; the results file is damaged or from another tool", where,
+                               pointer, v.dump()));
+}
+
+/// The timing samples of a pipeline entry, or empty when absent.
+std::vector<double> record_samples(const json& entry, const std::string& where) {
+  const json::json_pointer ptr("/timing/samples_s");
+  if (!entry.contains(ptr)) return {};
+  const json& a = entry.at(ptr);
+  if (!a.is_array()) throw InputError(fmt::format("{}: timing.samples_s is not an array", where));
+  std::vector<double> out;
+  for (const json& v : a) {
+    if (!v.is_number() || !std::isfinite(v.get<double>()) || v.get<double>() < 0.0)
+      throw InputError(fmt::format("{}: timing.samples_s holds {}, not a time in seconds", where, v.dump()));
+    out.push_back(v.get<double>());
+  }
+  return out;
+}
+
+std::string value_text(const std::string& check, double v) {
+  if (std::isnan(v)) return "-";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  if (check == "psnr") return fmt::format("{:.2f} dB", v);
+  if (check == "speedup") return fmt::format("{:.2f}x", v);
+  if (check == kRegressionCheck) return fmt::format("{:+.1f} %", 100.0 * v);
+  return fmt::format("{:.4g}", v);
+}
+
+json json_number(double v) {
+  if (std::isnan(v)) return nullptr;
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  return v;
+}
+
+json json_limit(const std::optional<double>& v) {
+  return v ? json(*v) : json(nullptr);
+}
+
+}  // namespace
+
+const char* to_string(Verdict v) noexcept {
+  switch (v) {
+    case Verdict::pass:
+      return "pass";
+    case Verdict::skip:
+      return "skip";
+    case Verdict::warn:
+      return "warn";
+    case Verdict::fail:
+      return "fail";
+  }
+  return "?";
+}
+
+int exit_code(Verdict worst) noexcept {
+  if (worst == Verdict::fail) return static_cast<int>(ExitCode::gate_failure);
+  if (worst == Verdict::warn) return static_cast<int>(ExitCode::gate_warning);
+  return 0;
+}
+
+GateConfig parse_gate_config(const std::string& text, const std::string& source) {
+  toml::table root;
+  try {
+    root = toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    throw InputError(
+        fmt::format("{}:{}:{}: {}", source, e.source().begin.line, e.source().begin.column, e.description()));
+  }
+  GateConfig config;
+  config.source = source;
+  for (auto&& [key, node] : root) {
+    const std::string k(key.str());
+    if (k == "defaults") {
+      if (!node.is_table()) config_error(source, node.source(), "[defaults] must be a table");
+      config.defaults = read_thresholds(*node.as_table(), "[defaults]", source, {});
+    } else if (k == "regression") {
+      if (!node.is_table()) config_error(source, node.source(), "[regression] must be a table");
+      config.regression = read_regression(*node.as_table(), source);
+    } else if (k == "rule") {
+      if (!node.is_array_of_tables())
+        config_error(source, node.source(), "rule must be an array of tables: write each as [[rule]]");
+      for (const toml::node& item : *node.as_array()) {
+        const toml::table& t = *item.as_table();
+        GateRule rule;
+        rule.line = static_cast<int>(t.source().begin.line);
+        if (const toml::node* n = t.get("pipeline")) rule.pipeline = glob_value(*n, "pipeline", source);
+        if (const toml::node* n = t.get("scene")) rule.scene = glob_value(*n, "scene", source);
+        if (const toml::node* n = t.get("cell")) rule.cell = glob_value(*n, "cell", source);
+        rule.values = read_thresholds(t, fmt::format("[[rule]] (pipeline '{}', scene '{}')", rule.pipeline, rule.scene),
+                                      source, {"pipeline", "scene", "cell", kToleranceKey});
+        if (const toml::node* n = t.get(kToleranceKey))
+          rule.values[kToleranceKey] = threshold_value(*n, kToleranceKey, source);
+        config.rules.push_back(std::move(rule));
+      }
+    } else {
+      config_error(source, key.source(),
+                   fmt::format("unknown key '{}'; a gate config has [defaults], [regression] and [[rule]] tables", k));
+    }
+  }
+  return config;
+}
+
+GateConfig load_gate_config(const std::filesystem::path& file) {
+  if (!std::filesystem::exists(file))
+    throw InputError(fmt::format("gate config {} does not exist; give --config FILE (the shipped one is ci/gate.toml)",
+                                 file.string()));
+  return parse_gate_config(io::read_file(file), file.string());
+}
+
+ThresholdValues thresholds_for(const GateConfig& config, const std::string& pipeline, const std::string& scene,
+                               const std::string& cell_id) {
+  ThresholdValues values = config.defaults;
+  values[kToleranceKey] = config.regression.tolerance;
+  for (const GateRule& rule : config.rules) {
+    if (!glob_matches(rule.pipeline, pipeline) || !glob_matches(rule.scene, scene) || !glob_matches(rule.cell, cell_id))
+      continue;
+    for (const auto& [key, value] : rule.values) values[key] = value;
+  }
+  return values;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Results file
+
+GateResults gate_results(const std::vector<json>& cells, std::vector<std::string> warnings,
+                         const std::filesystem::path& file) {
+  GateResults results;
+  results.file = file;
+  results.warnings = std::move(warnings);
+  const std::string name = file.string();
+  for (const json& record : cells) {
+    GateCell cell;
+    cell.cell_id = record.value("cell_id", "");
+    const std::string where = fmt::format("{}: cell '{}'", name, cell.cell_id);
+    const json::json_pointer scene_ptr("/cell/scene");
+    if (!record.contains(scene_ptr) || !record.at(scene_ptr).is_string())
+      throw InputError(fmt::format("{}: cell.scene is missing or not a string", where));
+    cell.scene = record.at(scene_ptr).get<std::string>();
+    const json& pipes = record.contains("pipelines") ? record["pipelines"] : json();
+    if (!pipes.is_object() || pipes.empty())
+      throw InputError(fmt::format("{}: no pipelines object; the line is not a finished cell", where));
+    for (const auto& [pipeline, entry] : pipes.items())
+      if (!entry.is_object() || !entry.contains("validation") || !entry["validation"].is_object())
+        throw InputError(fmt::format("{}: pipelines.{} has no validation record", where, pipeline));
+    cell.record = record;
+    results.cells.push_back(std::move(cell));
+  }
+  if (results.cells.empty())
+    throw InputError(
+        fmt::format("{} holds no finished cell; run the sweep first (an empty results file is not "
+                    "a pass)",
+                    name));
+  return results;
+}
+
+GateResults load_gate_results(const std::filesystem::path& file) {
+  if (!std::filesystem::exists(file))
+    throw InputError(
+        fmt::format("results file {} does not exist; give --results with the results.jsonl a "
+                    "`stereobench sweep` wrote",
+                    file.string()));
+  ResultsFile read = read_results(file);
+  return gate_results(read.cells, std::move(read.warnings), file);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Statistics
+
+double median(std::vector<double> values) {
+  if (values.empty()) return kNaN;
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+RankTest mann_whitney_greater(std::span<const double> x, std::span<const double> y) {
+  RankTest r;
+  const size_t m = x.size(), n = y.size();
+  if (m == 0 || n == 0) return r;
+  // U: pairs with x above y, ties counted one half.
+  bool ties = false;
+  for (double a : x)
+    for (double b : y) {
+      if (a > b)
+        r.u += 1.0;
+      else if (a == b) {
+        r.u += 0.5;
+        ties = true;
+      }
+    }
+  std::vector<double> all(x.begin(), x.end());
+  all.insert(all.end(), y.begin(), y.end());
+  std::sort(all.begin(), all.end());
+  double tie_sum = 0.0;  // sum of t^3 - t over groups of equal values
+  for (size_t i = 0; i < all.size();) {
+    size_t j = i;
+    while (j < all.size() && all[j] == all[i]) ++j;
+    const double t = static_cast<double>(j - i);
+    if (t > 1) ties = true;
+    tie_sum += t * t * t - t;
+    i = j;
+  }
+  const double mn = static_cast<double>(m * n);
+  if (!ties && m + n <= 40) {
+    // Exact: count[i][j][k] = orderings of i x's and j y's with U = k. The largest value is either
+    // an x (above all j y's: U grows by j) or a y (U unchanged).
+    const size_t kmax = m * n;
+    std::vector<std::vector<std::vector<double>>> count(
+        m + 1, std::vector<std::vector<double>>(n + 1, std::vector<double>(kmax + 1, 0.0)));
+    for (size_t i = 0; i <= m; ++i)
+      for (size_t j = 0; j <= n; ++j) {
+        if (i == 0 || j == 0) {
+          count[i][j][0] = 1.0;
+          continue;
+        }
+        for (size_t k = 0; k <= i * j; ++k)
+          count[i][j][k] = (k >= j ? count[i - 1][j][k - j] : 0.0) + count[i][j - 1][k];
+      }
+    double total = 0.0, tail = 0.0;
+    const size_t u = static_cast<size_t>(r.u);
+    for (size_t k = 0; k <= kmax; ++k) {
+      total += count[m][n][k];
+      if (k >= u) tail += count[m][n][k];
+    }
+    r.p = tail / total;
+    r.exact = true;
+    return r;
+  }
+  const double N = static_cast<double>(m + n);
+  const double variance = mn / 12.0 * ((N + 1.0) - tie_sum / (N * (N - 1.0)));
+  if (!(variance > 0.0)) {
+    r.p = 1.0;  // every value equal: no evidence either way
+    return r;
+  }
+  const double z = (r.u - mn / 2.0 - 0.5) / std::sqrt(variance);
+  r.p = 0.5 * std::erfc(z / std::sqrt(2.0));
+  return r;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Baseline update
+
+std::vector<BaselineChange> update_baseline(Baseline& baseline, const GateResults& results,
+                                            const BaselineSelection& selection) {
+  const std::string name = results.file.string();
+  if (selection.empty())
+    throw InputError(
+        "--update-baseline rewrites only what you name: give --only PIPELINE[,PIPELINE...] and/or --cells PATTERN "
+        "(a glob over cell ids, e.g. 'spheres|*'); --cells '*' names every cell");
+  std::set<std::string> present;
+  for (const GateCell& cell : results.cells)
+    for (const auto& [pipeline, entry] : cell.record["pipelines"].items()) present.insert(pipeline);
+  for (const std::string& p : selection.pipelines)
+    if (!present.count(p))
+      throw InputError(fmt::format("--only {}: no cell of {} has that pipeline (it has: {})", p, name,
+                                   joined({present.begin(), present.end()})));
+  std::vector<BaselineChange> changes;
+  for (const GateCell& cell : results.cells) {
+    if (!selection.cells.empty() && !glob_matches(selection.cells, cell.cell_id)) continue;
+    for (const auto& [pipeline, entry] : cell.record["pipelines"].items()) {
+      if (!selection.pipelines.empty() &&
+          std::find(selection.pipelines.begin(), selection.pipelines.end(), pipeline) == selection.pipelines.end())
+        continue;
+      const std::string where = fmt::format("{}: cell '{}'", name, cell.cell_id);
+      BaselineEntry e;
+      e.samples_s = record_samples(entry, where);
+      if (e.samples_s.empty())
+        throw InputError(fmt::format("{}: cell '{}' pipeline {} has no timing.samples_s to store as its baseline",
+                                     where, cell.cell_id, pipeline));
+      e.median_s = median(e.samples_s);
+      e.recorded = cell.record.value("finished", json("")).is_string() ? cell.record.value("finished", "") : "";
+      e.host = cell.record.value("host", json("")).is_string() ? cell.record.value("host", "") : "";
+      BaselineChange change{cell.cell_id, pipeline, false, 0.0, e.median_s};
+      if (const BaselineEntry* old = baseline.find(cell.cell_id, pipeline)) {
+        change.replaced = true;
+        change.old_median_s = old->median_s;
+      }
+      baseline.cells[cell.cell_id][pipeline] = std::move(e);
+      changes.push_back(change);
+    }
+  }
+  if (changes.empty())
+    throw InputError(
+        fmt::format("the selection matches nothing in {}: --cells '{}' matches none of its {} cell "
+                    "ids (e.g. '{}')",
+                    name, selection.cells, results.cells.size(), results.cells.front().cell_id));
+  return changes;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Evaluation
+
+std::string reproduce_command(const GateCell& cell, const std::string& pipeline, const ReproduceSettings& settings) {
+  const json& rec = cell.record;
+  const json& c = rec.value("cell", json::object());
+  const json& rig = rec.value("rig", json::object());
+  const json& entry = rec["pipelines"].value(pipeline, json::object());
+  const json& validation = entry.value("validation", json::object());
+  auto num = [](const json& obj, const char* key) -> std::optional<double> {
+    if (!obj.is_object() || !obj.contains(key) || !obj[key].is_number()) return std::nullopt;
+    return obj[key].get<double>();
+  };
+
+  std::vector<std::string> args{"stereobench", "validate"};
+  auto add = [&](const std::string& flag, const std::string& value) {
+    args.push_back(flag);
+    args.push_back(shell_quote(value));
+  };
+  // A parameterised scene is generated into a file of its own: name that file.
+  std::string scene = cell.scene;
+  const json& params = c.value("scene_params", json::object());
+  if (params.is_object() && !params.empty() && validation.contains("scene") && validation["scene"].is_object() &&
+      validation["scene"].value("path", json()).is_string())
+    scene = validation["scene"]["path"].get<std::string>();
+  add("--scene", scene);
+  add("--pipelines", pipeline);
+  std::string truth = "full";
+  if (c.value("truth", json()).is_string()) truth = c["truth"].get<std::string>();
+  add("--truth", truth);
+  if (c.value("resolution", json()).is_string())
+    add("--resolution", c["resolution"].get<std::string>());
+  else if (num(rig, "width") && num(rig, "height"))
+    add("--resolution",
+        fmt::format("{}x{}", static_cast<int>(*num(rig, "width")), static_cast<int>(*num(rig, "height"))));
+  if (const auto d = num(c, "max_disparity_px"))
+    add("--max-disparity", number_arg(*d));
+  else if (const auto e = num(c, "interaxial_m") ? num(c, "interaxial_m") : num(rig, "interaxial_m"))
+    add("--interaxial", number_arg(*e));
+  if (const auto conv = num(c, "convergence_m") ? num(c, "convergence_m") : num(rig, "convergence_m"))
+    add("--convergence", number_arg(*conv));
+  if (const auto lights = num(c, "lights")) add("--lights", fmt::format("{}", static_cast<int>(*lights)));
+  if (const auto t = num(validation.value("metrics", json::object()), "error_threshold"); t && *t != 2.0)
+    add("--error-threshold", fmt::format("{}", static_cast<int>(*t)));
+  const json& options = validation.value("options", json::object());
+  if (options.is_object()) {
+    const auto defaults = settings.pipeline_defaults.find(pipeline);
+    for (const auto& [key, value] : options.items()) {
+      const std::string v = value.is_string() ? value.get<std::string>() : value.dump();
+      if (defaults != settings.pipeline_defaults.end()) {
+        const auto d = defaults->second.find(key);
+        if (d != defaults->second.end() && d->second == v) continue;
+      }
+      add("--option", key + "=" + v);
+    }
+  }
+  std::string out;
+  for (const std::string& a : args) out += (out.empty() ? "" : " ") + a;
+  return out;
+}
+
+GateReport evaluate_gate(const GateConfig& config, const GateResults& results, const Baseline& baseline,
+                         const ReproduceSettings& reproduce) {
+  GateReport report;
+  report.notes = results.warnings;
+  const RegressionSettings& reg = config.regression;
+  for (const GateCell& cell : results.cells) {
+    const std::string where = fmt::format("{}: cell '{}'", results.file.string(), cell.cell_id);
+    for (const auto& [pipeline, entry] : cell.record["pipelines"].items()) {
+      const ThresholdValues limits = thresholds_for(config, pipeline, cell.scene, cell.cell_id);
+      const std::string command = reproduce_command(cell, pipeline, reproduce);
+      auto limit = [&](const char* key) -> std::optional<double> {
+        const auto it = limits.find(key);
+        return it == limits.end() ? std::nullopt : it->second;
+      };
+      auto add = [&](GateCheck check) {
+        check.cell_id = cell.cell_id;
+        check.scene = cell.scene;
+        check.pipeline = pipeline;
+        check.reproduce = command;
+        report.checks.push_back(std::move(check));
+      };
+
+      // Thresholds.
+      for (const MetricCheck& mc : kMetricChecks) {
+        GateCheck check;
+        check.check = mc.name;
+        check.fail_limit = limit(mc.fail_key);
+        check.warn_limit = limit(mc.warn_key);
+        if (!check.fail_limit && !check.warn_limit) continue;
+        const std::optional<double> value = record_number(entry, mc.pointer, where + ": pipelines." + pipeline);
+        check.measured = value ? *value : kNaN;
+        if (!value || std::isnan(*value)) {
+          check.verdict = Verdict::skip;
+          check.message =
+              fmt::format("no {} in the record ({} is {})", mc.label, mc.pointer, value ? "null" : "absent");
+          add(std::move(check));
+          continue;
+        }
+        const double v = *value;
+        const bool at_least = mc.direction == Direction::at_least;
+        auto beyond = [&](double lim) { return at_least ? v < lim : v > lim; };
+        const char* side = at_least ? "below the minimum" : "above the maximum";
+        const std::string shown = value_text(mc.name, v);
+        if (check.fail_limit && beyond(*check.fail_limit)) {
+          check.verdict = Verdict::fail;
+          check.message = fmt::format("{} {} is {} {}", mc.label, shown, side, value_text(mc.name, *check.fail_limit));
+        } else if (check.warn_limit && beyond(*check.warn_limit)) {
+          check.verdict = Verdict::warn;
+          check.message = fmt::format("{} {} is {} warning level {}", mc.label, shown,
+                                      at_least ? "below the" : "above the", value_text(mc.name, *check.warn_limit));
+        } else {
+          check.verdict = Verdict::pass;
+          check.message = fmt::format("{} {} within {} {}", mc.label, shown, at_least ? ">=" : "<=",
+                                      value_text(mc.name, check.fail_limit ? *check.fail_limit : *check.warn_limit));
+        }
+        add(std::move(check));
+      }
+
+      // Time regression against the baseline.
+      const std::optional<double> tolerance = limit(kToleranceKey);
+      if (!tolerance) continue;
+      GateCheck check;
+      check.check = kRegressionCheck;
+      check.fail_limit = tolerance;
+      check.measured = kNaN;
+      const std::vector<double> samples = record_samples(entry, where + ": pipelines." + pipeline);
+      const BaselineEntry* base = baseline.find(cell.cell_id, pipeline);
+      if (samples.empty()) {
+        check.verdict = Verdict::skip;
+        check.message = "no timing samples in the record";
+      } else if (!base) {
+        check.verdict = Verdict::skip;
+        check.message = "no baseline";
+      } else {
+        const double now = median(samples), before = median(base->samples_s);
+        check.measured = now / before - 1.0;
+        const std::string change = fmt::format("median {:.4g} s vs baseline {:.4g} s ({:+.1f} %, tolerance {:.0f} %)",
+                                               now, before, 100.0 * check.measured, 100.0 * *tolerance);
+        const int n_now = static_cast<int>(samples.size()), n_base = static_cast<int>(base->samples_s.size());
+        if (n_now < reg.min_repetitions || n_base < reg.min_repetitions) {
+          check.verdict = Verdict::warn;
+          check.message = fmt::format(
+              "not enough repetitions for the rank test: {} now and {} in the baseline, "
+              "{} needed; {}",
+              n_now, n_base, reg.min_repetitions, change);
+        } else {
+          const RankTest test = mann_whitney_greater(samples, base->samples_s);
+          const std::string rank =
+              fmt::format("Mann-Whitney U = {:g}, one-sided p = {:.3g} ({}, alpha {:g}, {} vs {} samples)", test.u,
+                          test.p, test.exact ? "exact" : "normal approximation", reg.alpha, n_now, n_base);
+          if (check.measured > *tolerance) {
+            check.verdict = test.p <= reg.alpha ? Verdict::fail : Verdict::warn;
+            check.message = fmt::format("{}: slower beyond the tolerance, {}; {}", change,
+                                        test.p <= reg.alpha ? "significant" : "not significant", rank);
+          } else {
+            check.verdict = Verdict::pass;
+            check.message = fmt::format("{}; {}", change, rank);
+          }
+        }
+      }
+      add(std::move(check));
+    }
+  }
+  for (const GateCheck& c : report.checks) {
+    ++report.counts[c.verdict];
+    report.worst = std::max(report.worst, c.verdict);
+  }
+  return report;
+}
+
+std::string format_gate_table(const GateReport& report) {
+  std::ostringstream out;
+  size_t cell_w = 4, pipe_w = 8, check_w = 5;
+  for (const GateCheck& c : report.checks) {
+    if (c.verdict != Verdict::warn && c.verdict != Verdict::fail) continue;
+    cell_w = std::max(cell_w, c.cell_id.size());
+    pipe_w = std::max(pipe_w, c.pipeline.size());
+    check_w = std::max(check_w, c.check.size());
+  }
+  bool header = false;
+  for (const Verdict level : {Verdict::fail, Verdict::warn})
+    for (const GateCheck& c : report.checks) {
+      if (c.verdict != level) continue;
+      if (!header) {
+        out << fmt::format("{:<7} {:<{}} {:<{}} {:<{}} {:>12}  {}\n", "verdict", "cell", cell_w, "pipeline", pipe_w,
+                           "check", check_w, "measured", "limit");
+        header = true;
+      }
+      const std::optional<double> lim = c.verdict == Verdict::fail || !c.warn_limit ? c.fail_limit : c.warn_limit;
+      const bool at_least = c.check != kRegressionCheck &&
+                            std::any_of(std::begin(kMetricChecks), std::end(kMetricChecks), [&](const MetricCheck& m) {
+                              return c.check == m.name && m.direction == Direction::at_least;
+                            });
+      out << fmt::format("{:<7} {:<{}} {:<{}} {:<{}} {:>12}  {}\n", c.verdict == Verdict::fail ? "FAIL" : "WARN",
+                         c.cell_id, cell_w, c.pipeline, pipe_w, c.check, check_w, value_text(c.check, c.measured),
+                         lim ? fmt::format("{} {}", at_least ? ">=" : "<=", value_text(c.check, *lim)) : "-");
+      out << "        " << c.message << "\n";
+      if (c.verdict == Verdict::fail) out << "        reproduce: " << c.reproduce << "\n";
+    }
+  // Skipped checks, grouped by check and reason (e.g. every cell without a baseline entry).
+  std::map<std::pair<std::string, std::string>, int> skipped;
+  for (const GateCheck& c : report.checks)
+    if (c.verdict == Verdict::skip) ++skipped[{c.check, c.message}];
+  for (const auto& [key, n] : skipped) out << fmt::format("SKIP    {} x{}: {}\n", key.first, n, key.second);
+  for (const std::string& note : report.notes) out << "note: " << note << "\n";
+  auto count = [&](Verdict v) {
+    const auto it = report.counts.find(v);
+    return it == report.counts.end() ? 0 : it->second;
+  };
+  std::set<std::string> cells;
+  for (const GateCheck& c : report.checks) cells.insert(c.cell_id);
+  out << fmt::format("gate: {} checks over {} cells: {} pass, {} warn, {} fail, {} skipped -> {} (exit {})\n",
+                     report.checks.size(), cells.size(), count(Verdict::pass), count(Verdict::warn),
+                     count(Verdict::fail), count(Verdict::skip),
+                     report.worst == Verdict::fail   ? "FAIL"
+                     : report.worst == Verdict::warn ? "WARN"
+                                                     : "PASS",
+                     exit_code(report.worst));
+  return out.str();
+}
+
+json gate_report_json(const GateReport& report, const std::string& config_file, const std::string& results_file,
+                      const std::string& baseline_file) {
+  json checks = json::array();
+  for (const GateCheck& c : report.checks) {
+    json j = {{"cell_id", c.cell_id},
+              {"scene", c.scene},
+              {"pipeline", c.pipeline},
+              {"check", c.check},
+              {"verdict", to_string(c.verdict)},
+              {"measured", json_number(c.measured)},
+              {"fail_limit", json_limit(c.fail_limit)},
+              {"warn_limit", json_limit(c.warn_limit)},
+              {"message", c.message}};
+    if (c.verdict == Verdict::fail || c.verdict == Verdict::warn) j["reproduce"] = c.reproduce;
+    checks.push_back(std::move(j));
+  }
+  json counts = json::object();
+  for (const Verdict v : {Verdict::pass, Verdict::skip, Verdict::warn, Verdict::fail}) {
+    const auto it = report.counts.find(v);
+    counts[to_string(v)] = it == report.counts.end() ? 0 : it->second;
+  }
+  return {{"kind", "stereobench.gate"},
+          {"schema_version", 1},
+          {"config", config_file},
+          {"results", results_file},
+          {"baseline", baseline_file},
+          {"verdict", to_string(report.worst == Verdict::skip ? Verdict::pass : report.worst)},
+          {"exit_code", exit_code(report.worst)},
+          {"counts", counts},
+          {"notes", report.notes},
+          {"checks", checks}};
+}
+
+}  // namespace sb::validation

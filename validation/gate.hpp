@@ -1,0 +1,193 @@
+// The CI quality gate (DESIGN §7): thresholds per (pipeline, scene) from ci/gate.toml applied to the
+// cells of a sweep's results file, and a time-regression test against stored baseline samples.
+// Numbers in, verdicts out: no rendering, no output files (junit.hpp and the CLI write those).
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "validation/baseline.hpp"
+
+namespace sb::validation {
+
+/// A check's outcome. `skip` is a check that could not be made (no value, no baseline entry); it
+/// does not change the exit code but is listed.
+enum class Verdict { pass, skip, warn, fail };
+
+[[nodiscard]] const char* to_string(Verdict v) noexcept;
+
+/// Exit code of a whole gate run (DESIGN §2): 0 all pass (or skipped), 1 warnings only, 2 any failure.
+[[nodiscard]] int exit_code(Verdict worst) noexcept;
+
+/// Whether a metric must stay above (`at_least`) or below (`at_most`) its limit.
+enum class Direction { at_least, at_most };
+
+/// One threshold check on a number of a sweep cell's pipeline entry.
+struct MetricCheck {
+  const char* name;      ///< check name in reports and JUnit ("psnr")
+  const char* fail_key;  ///< gate.toml key of the fail level ("min_psnr")
+  const char* warn_key;  ///< gate.toml key of the warn level ("warn_psnr")
+  Direction direction;
+  const char* pointer;  ///< JSON pointer into the pipeline entry of a results line
+  const char* label;    ///< what the number is, for messages ("PSNR")
+};
+
+/// Every threshold check, in report order. The time regression is separate (RegressionSettings).
+inline constexpr MetricCheck kMetricChecks[] = {
+    {"psnr", "min_psnr", "warn_psnr", Direction::at_least, "/validation/metrics/psnr", "PSNR"},
+    {"ssim", "min_ssim", "warn_ssim", Direction::at_least, "/validation/metrics/ssim", "SSIM"},
+    {"error_fraction", "max_error_fraction", "warn_error_fraction", Direction::at_most,
+     "/validation/metrics/error_fraction", "error-pixel fraction"},
+    {"hole_fraction", "max_hole_fraction", "warn_hole_fraction", Direction::at_most, "/validation/holes/hole_fraction",
+     "hole fraction"},
+    {"disocclusion_recall", "min_recall", "warn_recall", Direction::at_least,
+     "/validation/holes/not_reprojected/recall", "disocclusion recall"},
+    {"speedup", "min_speedup", "warn_speedup", Direction::at_least, "/timing/speedup_median", "median speed-up"},
+};
+
+/// Name of the time-regression check.
+inline constexpr const char* kRegressionCheck = "time_regression";
+
+/// Threshold values by gate.toml key; std::nullopt where a table turns a threshold off (`= false`).
+using ThresholdValues = std::map<std::string, std::optional<double>>;
+
+/// A `[[rule]]`: thresholds for the cells whose pipeline, scene and cell id match the glob patterns
+/// (fnmatch; "*" when absent). Later rules override earlier ones key by key.
+struct GateRule {
+  std::string pipeline = "*";
+  std::string scene = "*";
+  std::string cell = "*";
+  ThresholdValues values;
+  int line = 0;  ///< where the rule starts in the config file
+};
+
+/// `[regression]`: the time regression against the baseline. The current samples regress when their
+/// median exceeds the baseline median by more than `tolerance` (a fraction) AND a one-sided
+/// Mann–Whitney U test finds them larger at level `alpha`; beyond the tolerance without
+/// significance is a warning, as is a cell with fewer than `min_repetitions` samples on either side.
+struct RegressionSettings {
+  double tolerance = 0.10;
+  double alpha = 0.05;
+  int min_repetitions = 3;
+};
+
+/// A parsed ci/gate.toml.
+struct GateConfig {
+  std::string source;        ///< file name for messages
+  ThresholdValues defaults;  ///< `[defaults]`
+  std::vector<GateRule> rules;
+  RegressionSettings regression;
+};
+
+/// Parses gate.toml text. InputError naming `source`, the line and the key for a syntax error, an
+/// unknown table or key, a value of the wrong type, a non-finite or negative limit, a warn level
+/// looser than the fail level of the same table, or a malformed glob.
+[[nodiscard]] GateConfig parse_gate_config(const std::string& text, const std::string& source);
+/// Reads and parses a gate.toml; IoError if it cannot be read.
+[[nodiscard]] GateConfig load_gate_config(const std::filesystem::path& file);
+
+/// The thresholds in force for one (pipeline, scene, cell): the defaults with every matching rule
+/// applied in file order; the regression tolerance under the key "regression_tolerance".
+[[nodiscard]] ThresholdValues thresholds_for(const GateConfig& config, const std::string& pipeline,
+                                             const std::string& scene, const std::string& cell_id);
+
+/// One finished cell of a sweep's results file, as the gate reads it.
+struct GateCell {
+  std::string cell_id;
+  std::string scene;
+  nlohmann::json record;  ///< the whole results line (docs/sweeps.md)
+};
+
+/// The cells of a sweep's results file (`results.jsonl`, read with read_results).
+struct GateResults {
+  std::filesystem::path file;
+  std::vector<GateCell> cells;
+  std::vector<std::string> warnings;  ///< e.g. a torn last line that was skipped
+};
+
+/// Checks the cells read from `file` for what the gate needs: a scene and at least one pipeline
+/// with a validation record; InputError naming the file and cell otherwise, and for no cell at all
+/// (an empty results file is bad input, never a pass).
+[[nodiscard]] GateResults gate_results(const std::vector<nlohmann::json>& cells, std::vector<std::string> warnings,
+                                       const std::filesystem::path& file);
+/// Reads a results file (read_results: a torn last line is skipped with a warning, a cell id that
+/// appears twice is an error) and checks it with gate_results; InputError when the file does not
+/// exist.
+[[nodiscard]] GateResults load_gate_results(const std::filesystem::path& file);
+
+/// The one-sided Mann–Whitney U (Wilcoxon rank-sum) test of H1: values of `x` tend to be larger than
+/// values of `y`. `u` counts the pairs with x > y (ties count 1/2). The p-value P(U >= u | H0) is
+/// exact (the permutation distribution) when there are no ties and n_x + n_y <= 40, and otherwise
+/// the normal approximation with tie-corrected variance and continuity correction.
+struct RankTest {
+  double u = 0.0;
+  double p = 1.0;
+  bool exact = false;
+};
+[[nodiscard]] RankTest mann_whitney_greater(std::span<const double> x, std::span<const double> y);
+
+/// The median (mean of the two middle values for an even count); NaN for no values.
+[[nodiscard]] double median(std::vector<double> values);
+
+/// Rewrites the baseline entries of the selected (cell, pipeline) pairs with the results' timing
+/// samples (`timing.samples_s`), leaving every other entry as it was. InputError when the selection
+/// is empty (say what to update: --only and/or --cells), names a pipeline that no cell has, matches
+/// no (cell, pipeline) at all, or selects an entry without timing samples.
+[[nodiscard]] std::vector<BaselineChange> update_baseline(Baseline& baseline, const GateResults& results,
+                                                          const BaselineSelection& selection);
+
+/// One check's outcome for one (cell, pipeline).
+struct GateCheck {
+  std::string cell_id;
+  std::string scene;
+  std::string pipeline;
+  std::string check;  ///< a kMetricChecks name or kRegressionCheck
+  Verdict verdict = Verdict::pass;
+  double measured = 0.0;             ///< NaN when there is no value
+  std::optional<double> fail_limit;  ///< the limit in force (regression: the tolerance)
+  std::optional<double> warn_limit;
+  std::string message;    ///< one line: what was measured against what
+  std::string reproduce;  ///< `stereobench validate ...` re-measuring the cell
+};
+
+/// Everything one gate run decided.
+struct GateReport {
+  std::vector<GateCheck> checks;  ///< per cell in file order, per pipeline by name, per check in order
+  std::map<Verdict, int> counts;
+  Verdict worst = Verdict::pass;
+  std::vector<std::string> notes;  ///< e.g. reading warnings and a missing baseline
+};
+
+/// How the reproduce command is written: the default options of each pipeline by name (options in
+/// a record that differ from them become `--option NAME=VALUE`; for a pipeline not listed, every
+/// option of the record is written).
+struct ReproduceSettings {
+  std::map<std::string, std::map<std::string, std::string>> pipeline_defaults;
+};
+
+/// Applies the configuration to every pipeline of every cell. `baseline` may be empty (then every
+/// time-regression check is a skip, "no baseline"). InputError naming the file and line for a
+/// record value of the wrong type.
+[[nodiscard]] GateReport evaluate_gate(const GateConfig& config, const GateResults& results, const Baseline& baseline,
+                                       const ReproduceSettings& reproduce = {});
+
+/// The `stereobench validate` command line that re-measures one pipeline of a cell: scene, pipeline,
+/// truth, resolution, interaxial (or max disparity), convergence, light count, error threshold, and
+/// the pipeline options that differ from the defaults.
+[[nodiscard]] std::string reproduce_command(const GateCell& cell, const std::string& pipeline,
+                                            const ReproduceSettings& settings);
+
+/// The readable table: one row per check that did not pass, then the counts.
+[[nodiscard]] std::string format_gate_table(const GateReport& report);
+
+/// The report as JSON (`stereobench.gate`, schema 1): verdict, counts, notes and every check.
+[[nodiscard]] nlohmann::json gate_report_json(const GateReport& report, const std::string& config_file,
+                                              const std::string& results_file, const std::string& baseline_file);
+
+}  // namespace sb::validation

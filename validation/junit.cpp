@@ -1,0 +1,113 @@
+// JUnit XML from a gate report.
+#include "validation/junit.hpp"
+
+#include <map>
+#include <vector>
+
+#include <fmt/format.h>
+
+namespace sb::validation {
+
+std::string xml_escape(std::string_view text, bool attribute) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char ch : text) {
+    const auto c = static_cast<unsigned char>(ch);
+    switch (ch) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += attribute ? "&quot;" : "\"";
+        break;
+      case '\'':
+        out += attribute ? "&apos;" : "'";
+        break;
+      case '\t':
+        out += attribute ? "&#9;" : "\t";
+        break;
+      case '\n':
+        out += attribute ? "&#10;" : "\n";
+        break;
+      case '\r':
+        out += "&#13;";
+        break;
+      default:
+        out += c < 0x20 || c == 0x7f ? '?' : ch;
+    }
+  }
+  return out;
+}
+
+namespace {
+
+std::string attr(std::string_view s) {
+  return xml_escape(s, true);
+}
+std::string text(std::string_view s) {
+  return xml_escape(s, false);
+}
+
+}  // namespace
+
+std::string junit_xml(const GateReport& report, const std::string& name) {
+  // Cells in the order of the report; checks of a cell stay in report order.
+  std::vector<std::string> order;
+  std::map<std::string, std::vector<const GateCheck*>> by_cell;
+  for (const GateCheck& c : report.checks) {
+    if (!by_cell.count(c.cell_id)) order.push_back(c.cell_id);
+    by_cell[c.cell_id].push_back(&c);
+  }
+  auto count = [](const std::vector<const GateCheck*>& checks, Verdict v) {
+    int n = 0;
+    for (const GateCheck* c : checks) n += c->verdict == v;
+    return n;
+  };
+  std::vector<const GateCheck*> all;
+  for (const GateCheck& c : report.checks) all.push_back(&c);
+
+  std::string out = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+  out += fmt::format("<testsuites name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"0\" skipped=\"{}\">\n", attr(name),
+                     all.size(), count(all, Verdict::fail), count(all, Verdict::skip));
+  int index = 0;
+  for (const std::string& cell_id : order) {
+    const std::vector<const GateCheck*>& checks = by_cell[cell_id];
+    out += fmt::format(
+        "  <testsuite name=\"{}\" id=\"{}\" package=\"stereobench.gate\" tests=\"{}\" failures=\"{}\" errors=\"0\" "
+        "skipped=\"{}\">\n",
+        attr(cell_id), index++, checks.size(), count(checks, Verdict::fail), count(checks, Verdict::skip));
+    out += fmt::format("    <properties>\n      <property name=\"scene\" value=\"{}\"/>\n    </properties>\n",
+                       attr(checks.front()->scene));
+    for (const GateCheck* c : checks) {
+      out += fmt::format("    <testcase name=\"{}\" classname=\"{}\"", attr(c->pipeline + " " + c->check),
+                         attr("gate." + c->scene + "." + c->pipeline));
+      if (c->verdict == Verdict::pass) {
+        out += "/>\n";
+        continue;
+      }
+      out += ">\n";
+      if (c->verdict == Verdict::fail) {
+        out += fmt::format("      <failure message=\"{}\" type=\"{}\">{}</failure>\n", attr(c->message), attr(c->check),
+                           text(fmt::format("{}\ncell: {}\npipeline: {}\nreproduce: {}", c->message, c->cell_id,
+                                            c->pipeline, c->reproduce)));
+      } else if (c->verdict == Verdict::skip) {
+        out += fmt::format("      <skipped message=\"{}\"/>\n", attr(c->message));
+      } else {
+        out += fmt::format("      <system-out>{}</system-out>\n",
+                           text(fmt::format("WARNING: {}\nreproduce: {}", c->message, c->reproduce)));
+      }
+      out += "    </testcase>\n";
+    }
+    out += "  </testsuite>\n";
+  }
+  out += "</testsuites>\n";
+  return out;
+}
+
+}  // namespace sb::validation

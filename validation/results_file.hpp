@@ -1,0 +1,62 @@
+// The results file of a sweep (docs/sweeps.md): JSON Lines, one line per finished cell, appended
+// atomically, read back tolerating a torn last line, merged across shards, exported as CSV.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace sb::validation {
+
+/// The `kind` and schema version of a results line.
+inline constexpr const char* kSweepCellKind = "stereobench.sweep_cell";
+inline constexpr int kSweepSchemaVersion = 1;
+
+/// A copy of `value` with every non-finite float made JSON-safe: +inf "inf", -inf "-inf", NaN null.
+[[nodiscard]] nlohmann::json finite_json(const nlohmann::json& value);
+
+/// Appends one cell's line: the whole line (finite_json, no line breaks inside, '\n' at the end)
+/// in one write under an exclusive flock on a file opened with O_APPEND, then fsync. A torn,
+/// unterminated tail left by a killed writer is cut off first (under the same lock), so lines
+/// never run together. Creates the file and its folder. IoError when it cannot be written.
+void append_result(const std::filesystem::path& file, const nlohmann::json& cell);
+
+/// What was read from a results file.
+struct ResultsFile {
+  std::vector<nlohmann::json> cells;  ///< in file order
+  std::vector<std::string> warnings;  ///< e.g. a torn last line skipped, naming file and line
+};
+
+/// Reads a results file. A missing file reads as empty. An unterminated last line (a writer
+/// killed mid-write) is skipped with a warning naming the file and line. InputError naming the
+/// file and line for any other line that is not a sweep-cell record of this schema version, and
+/// for a cell_id that appears twice. IoError when it cannot be read.
+[[nodiscard]] ResultsFile read_results(const std::filesystem::path& file);
+
+/// Image paths of a results line are relative to its file's folder: rewrites those of a cell moved
+/// from a file in folder `from` to a file in folder `to` so that they name the same files.
+void rebase_image_paths(nlohmann::json& cell, const std::filesystem::path& from, const std::filesystem::path& to);
+
+/// Merges the cells of several results files (shards) ordered by cell_index, for a merged file
+/// written at `out`: every cell's image paths are rebased from its file's folder to out's. Identical
+/// duplicates collapse; a cell_id recorded with different content is an InputError naming it and
+/// both files, as are files written by different definitions (sweep name or definition_sha256).
+[[nodiscard]] std::vector<nlohmann::json> collect_results(const std::vector<std::filesystem::path>& files,
+                                                          const std::filesystem::path& out,
+                                                          std::vector<std::string>* warnings = nullptr);
+
+/// The cells as JSON Lines text (one finite_json line each).
+[[nodiscard]] std::string results_text(const std::vector<nlohmann::json>& cells);
+
+/// The CSV header and one row per (cell, pipeline), RFC 4180 quoted, lines ending in CRLF.
+/// Columns: see kCsvColumns.
+[[nodiscard]] std::string results_csv(const std::vector<nlohmann::json>& cells);
+inline constexpr const char* kCsvColumns[] = {
+    "cell_index", "cell_id",    "sweep",          "scene",      "scene_params", "width",         "height",
+    "interaxial_m", "max_disparity_px", "convergence_m", "lights", "truth",   "pipeline",      "baseline",
+    "psnr",       "ssim",       "mse",            "error_fraction", "hole_fraction", "recall", "precision",
+    "median_s",   "speedup_median"};
+
+}  // namespace sb::validation

@@ -1,0 +1,506 @@
+// The Slurm executor of sweeps: job array script, submission with sbatch, waiting with squeue,
+// task outcomes from exit-code files (no accounting database needed), merging of the shards.
+#include "validation/slurm.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <thread>
+#include <utility>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
+#include "validation/results_file.hpp"
+
+extern char** environ;
+
+namespace sb::validation {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+/// What a finished child process left.
+struct ProcessResult {
+  int exit_code = -1;  ///< -1 when it was killed by a signal
+  std::string out;
+  std::string err;
+};
+
+/// Runs `program args...` (no shell) with stdin from /dev/null and captures stdout and stderr.
+/// ToolError when it cannot be started.
+ProcessResult run_process(const fs::path& program, const std::vector<std::string>& args) {
+  std::array<int, 2> out_pipe{-1, -1}, err_pipe{-1, -1};
+  if (::pipe2(out_pipe.data(), O_CLOEXEC) != 0 || ::pipe2(err_pipe.data(), O_CLOEXEC) != 0)
+    throw ToolError(fmt::format("cannot create a pipe to run {}: {}", program.string(), std::strerror(errno)));
+  std::vector<std::string> argv_text{program.string()};
+  argv_text.insert(argv_text.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : argv_text) argv.push_back(a.data());
+  argv.push_back(nullptr);
+
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_adddup2(&actions, out_pipe[1], 1);
+  posix_spawn_file_actions_adddup2(&actions, err_pipe[1], 2);
+  pid_t pid = 0;
+  const int spawn_error = ::posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  ::close(out_pipe[1]);
+  ::close(err_pipe[1]);
+  if (spawn_error != 0) {
+    ::close(out_pipe[0]);
+    ::close(err_pipe[0]);
+    throw ToolError(fmt::format("cannot run {}: {}", program.string(), std::strerror(spawn_error)));
+  }
+
+  // Both pipes are drained together so that neither can fill up and block the child.
+  ProcessResult r;
+  std::array<pollfd, 2> fds{pollfd{out_pipe[0], POLLIN, 0}, pollfd{err_pipe[0], POLLIN, 0}};
+  std::array<std::string*, 2> sinks{&r.out, &r.err};
+  size_t open_fds = 2;
+  std::array<char, 4096> buf{};
+  while (open_fds > 0) {
+    if (::poll(fds.data(), fds.size(), -1) < 0) {
+      if (errno == EINTR) continue;
+      break;
+    }
+    for (size_t i = 0; i < fds.size(); ++i) {
+      if (fds[i].fd < 0 || (fds[i].revents & (POLLIN | POLLHUP | POLLERR)) == 0) continue;
+      const ssize_t n = ::read(fds[i].fd, buf.data(), buf.size());
+      if (n > 0) {
+        sinks[i]->append(buf.data(), static_cast<size_t>(n));
+      } else if (n == 0 || errno != EINTR) {
+        ::close(fds[i].fd);
+        fds[i].fd = -1;
+        --open_fds;
+      }
+    }
+  }
+  for (const pollfd& p : fds)
+    if (p.fd >= 0) ::close(p.fd);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::string trimmed(std::string s) {
+  const auto not_space = [](unsigned char c) { return !std::isspace(c); };
+  s.erase(s.begin(), std::find_if(s.begin(), s.end(), not_space));
+  s.erase(std::find_if(s.rbegin(), s.rend(), not_space).base(), s.end());
+  return s;
+}
+
+/// Single-quoted for a POSIX shell.
+std::string shell_quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+/// A path written into an #SBATCH directive: sbatch splits directives at blanks and expands '%'
+/// patterns, so such characters cannot be carried.
+void check_directive_path(const fs::path& p, const std::string& what) {
+  const std::string s = p.string();
+  if (s.find_first_of(" \t\n\r'\"%\\") != std::string::npos)
+    throw InputError(fmt::format("{} '{}' holds a blank, quote, backslash or '%', which #SBATCH directives cannot "
+                                 "carry; choose a path without them",
+                                 what, s));
+}
+
+/// The last `n` lines of a text file ("(missing)" / "(empty)" when there are none).
+std::string tail_of(const fs::path& file, size_t n) {
+  std::ifstream in(file);
+  if (!in) return "(missing)";
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) {
+    lines.push_back(line);
+    if (lines.size() > n) lines.erase(lines.begin());
+  }
+  if (lines.empty()) return "(empty)";
+  std::string out;
+  for (const std::string& l : lines) out += "    " + l + "\n";
+  return out;
+}
+
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+/// Array task ids of the job still in the queue (pending, running, completing, ...), with their
+/// states; std::nullopt when squeue failed (its message in `error`).
+std::optional<std::map<size_t, std::string>> queued_tasks(const fs::path& squeue, const std::string& job_id,
+                                                          std::string& error) {
+  // -r: one line per array task, pending ones included; %K: the array task id; %T: the state.
+  const ProcessResult r = run_process(squeue, {"--noheader", "--array", "--jobs=" + job_id, "--format=%K %T"});
+  std::map<size_t, std::string> tasks;
+  if (r.exit_code != 0) {
+    // A job the controller has already forgotten (MinJobAge passed) is no longer queued.
+    if (r.err.find("Invalid job id") != std::string::npos) return tasks;
+    error = trimmed(r.err.empty() ? r.out : r.err);
+    if (error.empty()) error = fmt::format("exit code {}", r.exit_code);
+    return std::nullopt;
+  }
+  std::istringstream in(r.out);
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream words(line);
+    std::string id, state;
+    if (!(words >> id >> state)) continue;
+    if (id.find_first_not_of("0123456789") != std::string::npos) continue;
+    tasks[std::stoul(id)] = state;
+  }
+  return tasks;
+}
+
+/// `scontrol show job -o JOB_TASK` fields JobState and ExitCode, when the controller still knows it.
+struct ControllerView {
+  std::string state;
+  std::optional<int> exit_code;
+};
+std::optional<ControllerView> controller_view(const std::string& job_id, size_t task) {
+  fs::path scontrol;
+  try {
+    scontrol = slurm_tool("scontrol");
+  } catch (const ToolError&) {
+    return std::nullopt;
+  }
+  const ProcessResult r = run_process(scontrol, {"--oneliner", "show", "job", fmt::format("{}_{}", job_id, task)});
+  if (r.exit_code != 0) return std::nullopt;
+  ControllerView v;
+  std::smatch m;
+  if (std::regex_search(r.out, m, std::regex(R"(JobState=([A-Z_]+))"))) v.state = m[1];
+  if (std::regex_search(r.out, m, std::regex(R"(ExitCode=(\d+):(\d+))")))
+    v.exit_code = std::stoi(m[2]) != 0 ? 128 + std::stoi(m[2]) : std::stoi(m[1]);
+  if (v.state.empty()) return std::nullopt;
+  return v;
+}
+
+std::optional<int> read_status(const fs::path& file) {
+  std::ifstream in(file);
+  int code = 0;
+  if (in >> code) return code;
+  return std::nullopt;
+}
+
+}  // namespace
+
+fs::path SlurmLayout::results(size_t task) const { return dir / fmt::format("results-{}.jsonl", task); }
+fs::path SlurmLayout::out_log(size_t task) const { return dir / fmt::format("task-{}.out", task); }
+fs::path SlurmLayout::err_log(size_t task) const { return dir / fmt::format("task-{}.err", task); }
+fs::path SlurmLayout::status(size_t task) const { return dir / fmt::format("task-{}.status", task); }
+
+SlurmLayout slurm_layout(const fs::path& out_dir) {
+  SlurmLayout l;
+  l.dir = out_dir / "slurm";
+  l.script = l.dir / "sweep.sbatch";
+  l.submission = l.dir / "submission.json";
+  return l;
+}
+
+fs::path slurm_tool(const std::string& name) {
+  const char* path_env = std::getenv("PATH");
+  std::istringstream dirs(path_env ? path_env : "");
+  for (std::string dir; std::getline(dirs, dir, ':');) {
+    if (dir.empty()) continue;
+    const fs::path candidate = fs::path(dir) / name;
+    if (::access(candidate.c_str(), X_OK) == 0 && !fs::is_directory(candidate)) return candidate;
+  }
+  throw ToolError(fmt::format(
+      "'{}' not found on PATH: the slurm executor submits the sweep to a Slurm cluster, so it must run where the "
+      "Slurm client commands (sbatch, squeue, scontrol) reach a running slurmctld; install them with "
+      "`ci/install-deps.sh slurm` (a single-node cluster for trying it: tests/slurm/start_slurm.sh, "
+      "docs/slurm.md), or use --executor local",
+      name));
+}
+
+void check_slurm_time_limit(const std::string& value) {
+  static const std::regex kTime(R"((\d+)|(\d+):(\d{1,2})|(\d+):(\d{1,2}):(\d{1,2})|(\d+)-(\d+)(:\d{1,2}(:\d{1,2})?)?)");
+  if (value == "infinite" || value == "UNLIMITED" || std::regex_match(value, kTime)) return;
+  throw InputError(fmt::format("--time-limit '{}' is not a Slurm time; use HH:MM:SS (e.g. 01:30:00), MM, MM:SS, "
+                               "D-HH, D-HH:MM or D-HH:MM:SS",
+                               value));
+}
+
+std::string sbatch_script(const SweepDefinition& d, const SlurmSweepOptions& o) {
+  if (o.shards == 0) throw InputError("the number of Slurm array tasks (--shards) must be at least 1");
+  const SlurmLayout l = slurm_layout(o.out_dir);
+  check_directive_path(l.dir, "the Slurm log folder");
+  const fs::path workdir = o.workdir.empty() ? fs::current_path() : o.workdir;
+  check_directive_path(workdir, "the working directory");
+  if (!o.partition.empty() && !std::regex_match(o.partition, std::regex(R"([A-Za-z0-9_.,-]+)")))
+    throw InputError(fmt::format("--partition '{}' is not a Slurm partition name (letters, digits, '_', '.', '-')",
+                                 o.partition));
+  if (!o.time_limit.empty()) check_slurm_time_limit(o.time_limit);
+
+  std::string job_name = "sb-sweep-" + d.name;
+  for (char& c : job_name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') c = '_';
+
+  const std::string n = std::to_string(o.shards);
+  std::string s;
+  s += "#!/bin/bash\n";
+  s += fmt::format("# Sweep '{}' ({}) as a Slurm job array of {} task{}: task I runs the cells with\n", d.name,
+                   fs::absolute(d.file).string(), n, o.shards == 1 ? "" : "s");
+  s += fmt::format("# cell_index % {} == I into results-I.jsonl beside this script, its exit code into task-I.status.\n", n);
+  s += "# Written and submitted by `stereobench sweep run --executor slurm` (docs/slurm.md), which with\n";
+  s += "# --wait merges the shards into the sweep's results file once every task has ended.\n";
+  s += "#SBATCH --job-name=" + job_name + "\n";
+  s += fmt::format("#SBATCH --array=0-{}\n", o.shards - 1);
+  s += "#SBATCH --ntasks=1\n";
+  s += "#SBATCH --output=" + (l.dir / "task-%a.out").string() + "\n";
+  s += "#SBATCH --error=" + (l.dir / "task-%a.err").string() + "\n";
+  s += "#SBATCH --chdir=" + workdir.string() + "\n";
+  if (!o.partition.empty()) s += "#SBATCH --partition=" + o.partition + "\n";
+  if (!o.time_limit.empty()) s += "#SBATCH --time=" + o.time_limit + "\n";
+  s += "set -u\n";
+  s += "task=${SLURM_ARRAY_TASK_ID:?this script runs as a task of a Slurm job array: submit it with sbatch}\n";
+  if (o.threads > 0)
+    s += fmt::format("threads={}\n", o.threads);
+  else
+    s += "threads=${SLURM_CPUS_PER_TASK:-${SLURM_CPUS_ON_NODE:-1}}  # the CPUs Slurm allocated to this task\n";
+  s += "slurm_dir=" + shell_quote(l.dir.string()) + "\n";
+  std::string cmd = shell_quote(fs::absolute(o.stereobench).string()) + " sweep run " +
+                    shell_quote(fs::absolute(d.file).string()) + " --out " + shell_quote(o.out_dir.string()) +
+                    " \\\n    --shard \"$task/" + n + "\" --results \"$slurm_dir/results-$task.jsonl\" --threads \"$threads\"";
+  for (const std::string& a : o.run_args) cmd += " " + shell_quote(a);
+  s += cmd + "\n";
+  s += "code=$?\n";
+  s += "printf '%d\\n' \"$code\" > \"$slurm_dir/task-$task.status.tmp\" && "
+       "mv -f \"$slurm_dir/task-$task.status.tmp\" \"$slurm_dir/task-$task.status\"\n";
+  s += "exit \"$code\"\n";
+  return s;
+}
+
+SlurmSweepOptions resolve_slurm_options(const SweepDefinition& d, SlurmSweepOptions o) {
+  o.out_dir = fs::absolute(o.out_dir).lexically_normal();
+  o.stereobench = fs::absolute(o.stereobench);
+  if (o.workdir.empty()) o.workdir = fs::current_path();
+  const size_t cell_count = expand_cells(d).size();
+  if (o.shards == 0) o.shards = std::min(cell_count, kMaxSlurmShards);
+  if (o.shards > cell_count)
+    throw InputError(fmt::format("--shards {} is more than the {} cells of sweep '{}'; use at most {}", o.shards,
+                                 cell_count, d.name, cell_count));
+  if (o.shards > kMaxSlurmShards)
+    throw InputError(fmt::format("--shards {} exceeds Slurm's default MaxArraySize ({} tasks); use fewer shards",
+                                 o.shards, kMaxSlurmShards + 1));
+  for (const std::string& a : o.sbatch_args)
+    if (a.empty() || a[0] != '-')
+      throw InputError(fmt::format("--sbatch-arg '{}' is not an sbatch option (it must start with '-', e.g. "
+                                   "--sbatch-arg=--mem=4G)",
+                                   a));
+  (void)sbatch_script(d, o);
+  return o;
+}
+
+SlurmSubmission submit_sweep(const SweepDefinition& d, SlurmSweepOptions o) {
+  const fs::path sbatch = slurm_tool("sbatch");
+  const fs::path squeue = slurm_tool("squeue");
+  o = resolve_slurm_options(d, std::move(o));
+  const std::string script = sbatch_script(d, o);
+  const SlurmLayout l = slurm_layout(o.out_dir);
+
+  // An earlier submission into this folder: still running, or sharded another way.
+  if (fs::exists(l.submission)) {
+    json before;
+    try {
+      before = json::parse(std::ifstream(l.submission));
+    } catch (const json::exception& e) {
+      throw InputError(fmt::format("{}: unreadable ({}); remove it to submit again", l.submission.string(), e.what()));
+    }
+    const std::string job = before.value("job_id", "");
+    std::string error;
+    if (!job.empty()) {
+      const auto queued = queued_tasks(squeue, job, error);
+      if (!queued)
+        throw ToolError(fmt::format("squeue cannot tell whether job {} of {} still runs: {}", job,
+                                    l.submission.string(), error));
+      if (!queued->empty())
+        throw InputError(fmt::format("Slurm job {} of this sweep ({}) is still queued or running; wait for it "
+                                     "(squeue -j {}) or cancel it (scancel {}) before submitting again",
+                                     job, o.out_dir.string(), job, job));
+    }
+    bool has_results = false;
+    for (const auto& entry : fs::directory_iterator(l.dir))
+      if (entry.path().filename().string().rfind("results-", 0) == 0 && fs::file_size(entry.path()) > 0)
+        has_results = true;
+    const size_t shards_before = before.value("shards", size_t{0});
+    if (has_results && shards_before != o.shards)
+      throw InputError(fmt::format("{} holds results of {} shards; submit with --shards {} to continue them, or "
+                                   "use another --out",
+                                   l.dir.string(), shards_before, shards_before));
+    if (has_results && before.value("definition_sha256", "") != d.sha256)
+      throw InputError(fmt::format("{} holds results of another version of {} (definition_sha256 differs); use "
+                                   "another --out",
+                                   l.dir.string(), d.file.string()));
+  }
+
+  fs::create_directories(l.dir);
+  for (size_t t = 0; t < o.shards; ++t)
+    for (const fs::path& stale : {l.out_log(t), l.err_log(t), l.status(t)}) fs::remove(stale);
+  io::write_text_atomically(l.script, script);
+
+  SlurmSubmission sub;
+  sub.shards = o.shards;
+  sub.layout = l;
+  std::vector<std::string> args{"--parsable"};
+  args.insert(args.end(), o.sbatch_args.begin(), o.sbatch_args.end());
+  args.push_back(l.script.string());
+  sub.sbatch_command = {sbatch.string()};
+  sub.sbatch_command.insert(sub.sbatch_command.end(), args.begin(), args.end());
+  const ProcessResult r = run_process(sbatch, args);
+  // --parsable prints "JOBID" or "JOBID;CLUSTER".
+  const std::string first = trimmed(r.out.substr(0, r.out.find_first_of(";\n")));
+  if (r.exit_code != 0 || first.empty() || first.find_first_not_of("0123456789") != std::string::npos) {
+    std::string cmd;
+    for (const std::string& a : sub.sbatch_command) cmd += (cmd.empty() ? "" : " ") + a;
+    throw ToolError(fmt::format("sbatch could not submit {} (exit code {}): {}\n  command: {}\n  check that a Slurm "
+                                "controller answers (`sinfo`) and that the options are valid for this cluster",
+                                l.script.string(), r.exit_code, trimmed(r.err + r.out), cmd));
+  }
+  sub.job_id = first;
+  const json record = {{"job_id", sub.job_id},
+                       {"shards", sub.shards},
+                       {"sweep", d.name},
+                       {"definition", fs::absolute(d.file).string()},
+                       {"definition_sha256", d.sha256},
+                       {"script", l.script.string()},
+                       {"sbatch_command", sub.sbatch_command},
+                       {"submitted", utc_now()}};
+  io::write_text_atomically(l.submission, record.dump(2) + "\n");
+  return sub;
+}
+
+std::vector<SlurmTaskOutcome> wait_for_array(const SlurmSubmission& sub, std::chrono::milliseconds poll,
+                                             const std::function<void(const SlurmArrayProgress&)>& progress,
+                                             std::chrono::seconds give_up) {
+  const fs::path squeue = slurm_tool("squeue");
+  std::optional<SlurmArrayProgress> last;
+  auto failing_since = std::chrono::steady_clock::time_point::max();
+  while (true) {
+    std::string error;
+    const auto queued = queued_tasks(squeue, sub.job_id, error);
+    const auto now = std::chrono::steady_clock::now();
+    if (!queued) {
+      if (failing_since == std::chrono::steady_clock::time_point::max()) failing_since = now;
+      if (now - failing_since > give_up)
+        throw ToolError(fmt::format("squeue has failed for {} s while waiting for Slurm job {}: {}; the tasks may "
+                                    "still run: check `squeue -j {}` and collect later with `stereobench sweep "
+                                    "collect`",
+                                    give_up.count(), sub.job_id, error, sub.job_id));
+      std::this_thread::sleep_for(poll);
+      continue;
+    }
+    failing_since = std::chrono::steady_clock::time_point::max();
+    SlurmArrayProgress p;
+    p.total = sub.shards;
+    for (const auto& [task, state] : *queued) (state == "PENDING" ? p.pending : p.running) += 1;
+    p.ended = sub.shards - std::min(sub.shards, queued->size());
+    if (progress && (!last || last->pending != p.pending || last->running != p.running || last->ended != p.ended))
+      progress(p);
+    last = p;
+    if (queued->empty()) break;
+    std::this_thread::sleep_for(poll);
+  }
+
+  std::vector<SlurmTaskOutcome> outcomes;
+  for (size_t t = 0; t < sub.shards; ++t) {
+    SlurmTaskOutcome o;
+    o.task = t;
+    o.exit_code = read_status(sub.layout.status(t));
+    const std::optional<ControllerView> view = o.exit_code && *o.exit_code == 0 ? std::nullopt
+                                                                                : controller_view(sub.job_id, t);
+    if (o.exit_code) {
+      o.state = *o.exit_code == 0 ? "COMPLETED" : (view ? view->state : "FAILED");
+    } else if (view) {
+      // No exit code file: the script was killed (time limit, cancellation, node failure), or the
+      // file is not visible here yet on a shared file system; the controller still knows.
+      o.state = view->state;
+      if (view->state == "COMPLETED") o.exit_code = view->exit_code;
+    } else {
+      o.state = "UNKNOWN";
+    }
+    if (!o.exit_code)
+      o.detail = fmt::format("ended as {} without writing its exit code to {} (killed by Slurm: time limit, "
+                             "cancellation, memory or node failure)",
+                             o.state, sub.layout.status(t).string());
+    else if (*o.exit_code != 0)
+      o.detail = fmt::format("`stereobench sweep run` exited with code {}", *o.exit_code);
+    else if (!fs::exists(sub.layout.results(t)))
+      o.detail = fmt::format("exited with code 0 but wrote no results file {}", sub.layout.results(t).string());
+    outcomes.push_back(o);
+  }
+  return outcomes;
+}
+
+std::string describe_failed_tasks(const SlurmSubmission& sub, const std::vector<SlurmTaskOutcome>& outcomes,
+                                  size_t tail_lines) {
+  std::string out;
+  for (const SlurmTaskOutcome& o : outcomes) {
+    if (o.ok()) continue;
+    out += fmt::format("task {} of job {} ({}): {}\n", o.task, sub.job_id, o.state, o.detail);
+    out += fmt::format("  last lines of {}:\n{}", sub.layout.err_log(o.task).string(),
+                       tail_of(sub.layout.err_log(o.task), tail_lines));
+    if (out.back() != '\n') out += '\n';
+    out += fmt::format("  last lines of {}:\n{}", sub.layout.out_log(o.task).string(),
+                       tail_of(sub.layout.out_log(o.task), tail_lines));
+    if (out.back() != '\n') out += '\n';
+  }
+  return out;
+}
+
+size_t collect_slurm_results(const SweepDefinition& d, const SlurmSubmission& sub, const fs::path& results,
+                             std::vector<std::string>* warnings) {
+  std::vector<fs::path> files;
+  for (size_t t = 0; t < sub.shards; ++t) {
+    if (!fs::exists(sub.layout.results(t)))
+      throw InputError(fmt::format("{}: results of task {} missing; the task did not finish",
+                                   sub.layout.results(t).string(), t));
+    files.push_back(sub.layout.results(t));
+  }
+  std::vector<json> cells = collect_results(files, results, warnings);
+  std::set<std::string> have;
+  for (const json& c : cells) have.insert(c.value("cell_id", ""));
+  std::vector<std::string> missing;
+  const std::vector<SweepCell> all = expand_cells(d);
+  for (const SweepCell& c : all)
+    if (!have.count(c.id)) missing.push_back(c.id);
+  if (!missing.empty()) {
+    std::string list;
+    for (size_t i = 0; i < missing.size() && i < 10; ++i) list += "\n  " + missing[i];
+    if (missing.size() > 10) list += fmt::format("\n  ... and {} more", missing.size() - 10);
+    throw InputError(fmt::format("the results of the {} tasks in {} lack {} of the {} cells of sweep '{}':{}",
+                                 sub.shards, sub.layout.dir.string(), missing.size(), all.size(),
+                                 d.name, list));
+  }
+  io::write_text_atomically(results, results_text(cells));
+  return cells.size();
+}
+
+}  // namespace sb::validation

@@ -1,0 +1,490 @@
+// Loading and expanding sweep definitions.
+#include "validation/sweep.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <string_view>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
+#include "renderer/pipeline.hpp"
+#include "renderer/rig.hpp"
+#include "scenes/generators.hpp"
+#include "validation/content_hash.hpp"
+#include "validation/truth.hpp"
+
+namespace sb::validation {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::string number_text(double value) { return fmt::format("{}", value); }
+
+namespace {
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const std::string& s : items) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+/// Reports problems at a place in the definition: "<file>:<line>: <key path>: <what>".
+class Where {
+ public:
+  explicit Where(fs::path file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const toml::source_region& at, const std::string& key_path, const std::string& what) const {
+    throw InputError(fmt::format("{}:{}: {}: {}", file_.string(), at.begin.line, key_path, what));
+  }
+  [[noreturn]] void fail(const toml::node& at, const std::string& key_path, const std::string& what) const {
+    fail(at.source(), key_path, what);
+  }
+  [[nodiscard]] const fs::path& file() const { return file_; }
+
+ private:
+  fs::path file_;
+};
+
+/// InputError for every key of `table` not among `valid`, naming it, its line and the valid keys.
+void check_keys(const Where& where, const toml::table& table, const std::string& prefix,
+                const std::vector<std::string>& valid) {
+  for (auto&& [key, node] : table) {
+    const std::string name(key.str());
+    if (std::find(valid.begin(), valid.end(), name) != valid.end()) continue;
+    where.fail(key.source(), prefix.empty() ? name : prefix + "." + name,
+               fmt::format("unknown key; valid keys{}: {}", prefix.empty() ? " at the top level" : " in [" + prefix + "]",
+                           join(valid)));
+  }
+}
+
+const char* type_name(const toml::node& node) {
+  switch (node.type()) {
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a float";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::table: return "a table";
+    default: return "a date or time";
+  }
+}
+
+const toml::table& table_at(const Where& where, const toml::node& node, const std::string& path) {
+  if (!node.is_table()) where.fail(node, path, fmt::format("must be a table, not {}", type_name(node)));
+  return *node.as_table();
+}
+
+std::string string_at(const Where& where, const toml::node& node, const std::string& path) {
+  if (!node.is_string()) where.fail(node, path, fmt::format("must be a string, not {}", type_name(node)));
+  return node.as_string()->get();
+}
+
+double number_at(const Where& where, const toml::node& node, const std::string& path) {
+  if (node.is_integer()) return static_cast<double>(node.as_integer()->get());
+  if (node.is_floating_point()) return node.as_floating_point()->get();
+  where.fail(node, path, fmt::format("must be a number, not {}", type_name(node)));
+}
+
+int64_t integer_at(const Where& where, const toml::node& node, const std::string& path) {
+  if (!node.is_integer()) where.fail(node, path, fmt::format("must be an integer, not {}", type_name(node)));
+  return node.as_integer()->get();
+}
+
+bool bool_at(const Where& where, const toml::node& node, const std::string& path) {
+  if (!node.is_boolean()) where.fail(node, path, fmt::format("must be true or false, not {}", type_name(node)));
+  return node.as_boolean()->get();
+}
+
+/// The entries of an axis: an array (non-empty) or a single value standing for a one-entry axis.
+std::vector<const toml::node*> axis_entries(const Where& where, const toml::node& node, const std::string& path) {
+  std::vector<const toml::node*> out;
+  if (const toml::array* a = node.as_array()) {
+    if (a->empty()) where.fail(node, path, "is empty; give at least one value or leave the key out for the scene's default");
+    for (const toml::node& e : *a) out.push_back(&e);
+  } else {
+    out.push_back(&node);
+  }
+  return out;
+}
+
+/// A positive finite length or disparity.
+double positive_at(const Where& where, const toml::node& node, const std::string& path, const char* hint) {
+  const double v = number_at(where, node, path);
+  if (!std::isfinite(v) || v <= 0.0) where.fail(node, path, fmt::format("{} is not a positive number; {}", v, hint));
+  return v;
+}
+
+/// A numeric axis; repeated values are an error (they would give cells with one id).
+std::vector<std::optional<double>> positive_axis(const Where& where, const toml::node& node, const std::string& path,
+                                                 const char* hint) {
+  std::vector<std::optional<double>> out;
+  for (const toml::node* e : axis_entries(where, node, path)) {
+    const double v = positive_at(where, *e, path, hint);
+    for (const auto& seen : out)
+      if (*seen == v) where.fail(*e, path, fmt::format("lists {} twice", number_text(v)));
+    out.push_back(v);
+  }
+  return out;
+}
+
+bool is_file_spec(const std::string& text) {
+  const std::string ext = fs::path(text).extension().string();
+  return ext == ".gltf" || ext == ".glb" || text.find('/') != std::string::npos;
+}
+
+SweepScene parse_scene_entry(const Where& where, const toml::node& node, const std::string& path) {
+  const std::string text = string_at(where, node, path);
+  if (text.find('|') != std::string::npos)
+    where.fail(node, path, fmt::format("'{}' contains '|', which separates the parts of a cell id; rename the file", text));
+  if (!is_file_spec(text)) {
+    try {
+      return parse_builtin_scene(text);
+    } catch (const InputError& e) {
+      where.fail(node, path, e.what());
+    }
+  }
+  SweepScene s;
+  s.builtin = false;
+  s.label = text;
+  s.name = text;
+  s.file = fs::path(text).is_absolute() ? fs::path(text) : where.file().parent_path() / text;
+  std::error_code ec;
+  if (!fs::is_regular_file(s.file, ec))
+    where.fail(node, path,
+               fmt::format("scene file {} does not exist (paths are relative to the definition's folder); give an "
+                           "existing .gltf/.glb or a built-in scene name (see `stereobench scenes list`)",
+                           s.file.string()));
+  return s;
+}
+
+std::vector<std::string> all_pipeline_names() {
+  std::vector<std::string> names;
+  for (const Pipeline* p : pipelines()) names.push_back(p->info().name);
+  return names;
+}
+
+void parse_pipelines(const Where& where, const toml::node& node, SweepDefinition& d) {
+  const std::string path = "sweep.pipelines";
+  std::vector<std::string> names;
+  for (const toml::node* e : axis_entries(where, node, path)) {
+    const std::string name = string_at(where, *e, path);
+    if (name == "all") {
+      for (const std::string& n : all_pipeline_names())
+        if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
+      continue;
+    }
+    try {
+      (void)find_pipeline(name);
+    } catch (const InputError& err) {
+      where.fail(*e, path, err.what());
+    }
+    if (std::find(names.begin(), names.end(), name) != names.end())
+      where.fail(*e, path, fmt::format("lists '{}' twice", name));
+    names.push_back(name);
+  }
+  d.pipelines = names;
+}
+
+/// A pipeline option's value as the pipeline reads it (text).
+std::string option_text(const Where& where, const toml::node& node, const std::string& path) {
+  if (node.is_string()) return node.as_string()->get();
+  if (node.is_boolean()) return node.as_boolean()->get() ? "true" : "false";
+  if (node.is_integer()) return std::to_string(node.as_integer()->get());
+  if (node.is_floating_point()) return number_text(node.as_floating_point()->get());
+  where.fail(node, path, fmt::format("must be a string, number or boolean, not {}", type_name(node)));
+}
+
+const std::vector<std::string> kTopKeys = {"sweep", "timing", "options", "output"};
+const std::vector<std::string> kSweepKeys = {"name",          "description",      "scenes",        "pipelines",
+                                             "baseline",      "interaxial_m",     "max_disparity_px",
+                                             "convergence_m", "resolutions",      "lights",        "truths"};
+const std::vector<std::string> kTimingKeys = {"repetitions", "warmup"};
+const std::vector<std::string> kOutputKeys = {"images", "exr"};
+
+}  // namespace
+
+SweepScene parse_builtin_scene(const std::string& text) {
+  const size_t colon = text.find(':');
+  SweepScene s;
+  s.builtin = true;
+  s.name = text.substr(0, colon);
+  const scenes::GeneratorInfo& info = scenes::find_generator(s.name);
+  if (colon != std::string::npos) {
+    const std::string list = text.substr(colon + 1);
+    if (list.empty()) throw InputError(fmt::format("scene '{}': nothing after ':'; give name:key=value,key=value", text));
+    size_t start = 0;
+    while (start <= list.size()) {
+      const size_t comma = std::min(list.find(',', start), list.size());
+      const std::string item = list.substr(start, comma - start);
+      start = comma + 1;
+      const size_t eq = item.find('=');
+      if (eq == std::string::npos || eq == 0)
+        throw InputError(fmt::format("scene '{}': '{}' is not key=value", text, item));
+      const std::string key = item.substr(0, eq), value_text = item.substr(eq + 1);
+      const scenes::GeneratorParam* param = nullptr;
+      for (const scenes::GeneratorParam& p : info.params)
+        if (p.name == key) param = &p;
+      if (!param) {
+        std::vector<std::string> known;
+        for (const scenes::GeneratorParam& p : info.params) known.push_back(p.name);
+        throw InputError(fmt::format("scene '{}': '{}' has no parameter '{}' (its parameters: {})", text, s.name, key,
+                                     known.empty() ? std::string("none") : join(known)));
+      }
+      double value = 0.0;
+      size_t used = 0;
+      try {
+        value = std::stod(value_text, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != value_text.size() || !std::isfinite(value))
+        throw InputError(fmt::format("scene '{}': {}={} is not a number", text, key, value_text));
+      if (value < param->min_value || value > param->max_value)
+        throw InputError(fmt::format("scene '{}': {}={} is outside {}..{}", text, key, value_text,
+                                     number_text(param->min_value), number_text(param->max_value)));
+      if (param->integer && value != std::floor(value))
+        throw InputError(fmt::format("scene '{}': {} must be a whole number, not {}", text, key, value_text));
+      if (!s.params.emplace(key, value).second)
+        throw InputError(fmt::format("scene '{}': parameter '{}' given twice", text, key));
+      if (comma == list.size()) break;
+    }
+  }
+  s.label = s.name;
+  std::string sep = ":";
+  for (const auto& [key, value] : s.params) {
+    s.label += sep + key + "=" + number_text(value);
+    sep = ",";
+  }
+  return s;
+}
+
+SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
+  const Where where(file);
+  toml::table root;
+  try {
+    root = toml::parse(text, file.string());
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("{}:{}:{}: not valid TOML: {}", file.string(), e.source().begin.line,
+                                 e.source().begin.column, e.description()));
+  }
+  check_keys(where, root, "", kTopKeys);
+
+  SweepDefinition d;
+  d.file = file;
+  d.sha256 = Sha256().add(text).hex();
+  d.name = file.stem().string();
+
+  const toml::node* sweep_node = root.get("sweep");
+  if (!sweep_node)
+    throw InputError(fmt::format("{}: no [sweep] table; a definition needs at least [sweep] with a name (see "
+                                 "docs/sweeps.md)",
+                                 file.string()));
+  const toml::table& sweep = table_at(where, *sweep_node, "sweep");
+  check_keys(where, sweep, "sweep", kSweepKeys);
+
+  if (const toml::node* n = sweep.get("name")) {
+    d.name = string_at(where, *n, "sweep.name");
+    if (d.name.empty() || d.name.find_first_of("/\\\n") != std::string::npos)
+      where.fail(*n, "sweep.name", "must be a non-empty name without '/', '\\' or line breaks");
+  }
+  if (const toml::node* n = sweep.get("description")) d.description = string_at(where, *n, "sweep.description");
+
+  // Scenes.
+  d.scenes = {parse_builtin_scene("spheres")};
+  if (const toml::node* n = sweep.get("scenes")) {
+    d.scenes.clear();
+    for (const toml::node* e : axis_entries(where, *n, "sweep.scenes")) {
+      SweepScene s = parse_scene_entry(where, *e, "sweep.scenes");
+      for (const SweepScene& seen : d.scenes)
+        if (seen.label == s.label) where.fail(*e, "sweep.scenes", fmt::format("lists '{}' twice", s.label));
+      d.scenes.push_back(std::move(s));
+    }
+  }
+
+  // Pipelines and the baseline.
+  d.pipelines = all_pipeline_names();
+  if (const toml::node* n = sweep.get("pipelines")) parse_pipelines(where, *n, d);
+  if (const toml::node* n = sweep.get("baseline")) {
+    d.baseline = string_at(where, *n, "sweep.baseline");
+    try {
+      (void)find_pipeline(d.baseline);
+    } catch (const InputError& err) {
+      where.fail(*n, "sweep.baseline", err.what());
+    }
+  } else {
+    (void)find_pipeline(d.baseline);
+  }
+  d.baseline_listed = std::find(d.pipelines.begin(), d.pipelines.end(), d.baseline) != d.pipelines.end();
+  if (!d.baseline_listed) d.pipelines.push_back(d.baseline);
+  std::sort(d.pipelines.begin(), d.pipelines.end());
+
+  // Rig axes.
+  const toml::node* interaxial = sweep.get("interaxial_m");
+  const toml::node* disparity = sweep.get("max_disparity_px");
+  if (interaxial && disparity)
+    where.fail(*disparity, "sweep.max_disparity_px",
+               fmt::format("the interaxial is already given in meters (sweep.interaxial_m, line {}); give it one "
+                           "way only",
+                           interaxial->source().begin.line));
+  if (interaxial)
+    d.interaxial_m = positive_axis(where, *interaxial, "sweep.interaxial_m", "give eye separations in meters, e.g. 0.064");
+  if (disparity)
+    d.max_disparity_px =
+        positive_axis(where, *disparity, "sweep.max_disparity_px", "give disparities at infinity in pixels, e.g. 30");
+  if (const toml::node* n = sweep.get("convergence_m"))
+    d.convergence_m = positive_axis(where, *n, "sweep.convergence_m", "give zero-parallax distances in meters, e.g. 2.0");
+  if (const toml::node* n = sweep.get("resolutions")) {
+    d.resolutions.clear();
+    for (const toml::node* e : axis_entries(where, *n, "sweep.resolutions")) {
+      const std::string given = string_at(where, *e, "sweep.resolutions");
+      ivec2 size{0, 0};
+      try {
+        size = parse_resolution(given);
+      } catch (const InputError& err) {
+        where.fail(*e, "sweep.resolutions", err.what());
+      }
+      SweepResolution r{fmt::format("{}x{}", size.x, size.y), size.x, size.y};
+      for (const auto& seen : d.resolutions)
+        if (seen->label == r.label)
+          where.fail(*e, "sweep.resolutions", fmt::format("lists {} twice ('{}' is {})", r.label, given, r.label));
+      d.resolutions.emplace_back(r);
+    }
+  }
+  if (const toml::node* n = sweep.get("lights")) {
+    d.lights.clear();
+    for (const toml::node* e : axis_entries(where, *n, "sweep.lights")) {
+      const int64_t v = integer_at(where, *e, "sweep.lights");
+      if (v < 1 || v > 100000) where.fail(*e, "sweep.lights", fmt::format("{} is not a light count of 1 or more", v));
+      for (const auto& seen : d.lights)
+        if (*seen == v) where.fail(*e, "sweep.lights", fmt::format("lists {} twice", v));
+      d.lights.emplace_back(static_cast<int>(v));
+    }
+  }
+  if (const toml::node* n = sweep.get("truths")) {
+    d.truths.clear();
+    const std::vector<std::string> known = truth_provider_names();
+    for (const toml::node* e : axis_entries(where, *n, "sweep.truths")) {
+      const std::string name = string_at(where, *e, "sweep.truths");
+      if (std::find(known.begin(), known.end(), name) == known.end())
+        where.fail(*e, "sweep.truths", fmt::format("unknown ground-truth provider '{}' (providers: {})", name, join(known)));
+      if (std::find(d.truths.begin(), d.truths.end(), name) != d.truths.end())
+        where.fail(*e, "sweep.truths", fmt::format("lists '{}' twice", name));
+      d.truths.push_back(name);
+    }
+  }
+
+  // Timing.
+  if (const toml::node* n = root.get("timing")) {
+    const toml::table& timing = table_at(where, *n, "timing");
+    check_keys(where, timing, "timing", kTimingKeys);
+    if (const toml::node* r = timing.get("repetitions")) {
+      const int64_t v = integer_at(where, *r, "timing.repetitions");
+      if (v < 1 || v > 10000) where.fail(*r, "timing.repetitions", fmt::format("{} is outside 1..10000", v));
+      d.repetitions = static_cast<int>(v);
+    }
+    if (const toml::node* w = timing.get("warmup")) {
+      const int64_t v = integer_at(where, *w, "timing.warmup");
+      if (v < 0 || v > 10000) where.fail(*w, "timing.warmup", fmt::format("{} is outside 0..10000", v));
+      d.warmup = static_cast<int>(v);
+    }
+  }
+
+  // Pipeline options, checked against what each pipeline declares.
+  if (const toml::node* n = root.get("options")) {
+    const toml::table& options = table_at(where, *n, "options");
+    for (auto&& [key, node] : options) {
+      const std::string pipeline(key.str());
+      const std::string path = "options." + pipeline;
+      if (std::find(d.pipelines.begin(), d.pipelines.end(), pipeline) == d.pipelines.end())
+        where.fail(key.source(), path,
+                   fmt::format("options for a pipeline the sweep does not run; its pipelines: {}", join(d.pipelines)));
+      std::map<std::string, std::string> values;
+      for (auto&& [option, value] : table_at(where, node, path)) {
+        const std::string option_path = path + "." + std::string(option.str());
+        values[std::string(option.str())] = option_text(where, value, option_path);
+        try {
+          (void)PipelineOptions(find_pipeline(pipeline).info(), {{std::string(option.str()), values[std::string(option.str())]}});
+        } catch (const InputError& err) {
+          where.fail(option.source(), option_path, err.what());
+        }
+      }
+      d.options[pipeline] = values;
+    }
+  }
+
+  // Output.
+  if (const toml::node* n = root.get("output")) {
+    const toml::table& output = table_at(where, *n, "output");
+    check_keys(where, output, "output", kOutputKeys);
+    if (const toml::node* v = output.get("images")) d.images = bool_at(where, *v, "output.images");
+    if (const toml::node* v = output.get("exr")) d.exr = bool_at(where, *v, "output.exr");
+    if (d.exr && !d.images)
+      where.fail(*output.get("exr"), "output.exr", "EXR images need output.images = true");
+  }
+  return d;
+}
+
+SweepDefinition load_sweep(const fs::path& file) {
+  std::error_code ec;
+  if (!fs::exists(file, ec))
+    throw InputError(fmt::format("{}: sweep definition does not exist; give a TOML file such as ci/smoke.toml",
+                                 file.string()));
+  return parse_sweep(io::read_file(file), file);
+}
+
+std::vector<SweepCell> expand_cells(const SweepDefinition& d) {
+  // One interaxial axis: meters, max disparity, or the scene default.
+  struct Interaxial {
+    std::optional<double> meters, pixels;
+    std::string label;
+  };
+  std::vector<Interaxial> interaxials;
+  const bool by_pixels = d.max_disparity_px.front().has_value();
+  if (by_pixels) {
+    for (const auto& v : d.max_disparity_px) interaxials.push_back({std::nullopt, v, "e=" + number_text(*v) + "px"});
+  } else {
+    for (const auto& v : d.interaxial_m)
+      interaxials.push_back({v, std::nullopt, v ? "e=" + number_text(*v) + "m" : "e=default"});
+  }
+
+  std::vector<SweepCell> cells;
+  for (const SweepScene& scene : d.scenes)
+    for (const Interaxial& e : interaxials)
+      for (const auto& c : d.convergence_m)
+        for (const auto& r : d.resolutions)
+          for (const auto& l : d.lights)
+            for (const std::string& truth : d.truths) {
+              SweepCell cell;
+              cell.index = cells.size();
+              cell.scene = scene;
+              cell.interaxial_m = e.meters;
+              cell.max_disparity_px = e.pixels;
+              cell.convergence_m = c;
+              cell.resolution = r;
+              cell.lights = l;
+              cell.truth = truth;
+              cell.id = fmt::format("{}|{}|{}|{}|{}|{}", scene.label, e.label,
+                                    c ? "c=" + number_text(*c) + "m" : "c=default", r ? r->label : "res=default",
+                                    l ? fmt::format("lights={}", *l) : "lights=all", truth);
+              cells.push_back(std::move(cell));
+            }
+  return cells;
+}
+
+json cell_to_json(const SweepCell& cell) {
+  const auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
+  return {{"scene", cell.scene.name},
+          {"scene_params", cell.scene.params.empty() ? json::object() : json(cell.scene.params)},
+          {"interaxial_m", opt(cell.interaxial_m)},
+          {"max_disparity_px", opt(cell.max_disparity_px)},
+          {"convergence_m", opt(cell.convergence_m)},
+          {"resolution", cell.resolution ? json(cell.resolution->label) : json(nullptr)},
+          {"lights", cell.lights ? json(*cell.lights) : json(nullptr)},
+          {"truth", cell.truth}};
+}
+
+}  // namespace sb::validation

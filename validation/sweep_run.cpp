@@ -1,0 +1,344 @@
+// The local executor of sweeps: cells validated and timed by parallel workers, one results line
+// each.
+#include "validation/sweep_run.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <ctime>
+#include <exception>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
+#include "renderer/io/gltf_loader.hpp"
+#include "renderer/io/render_output.hpp"
+#include "renderer/parallel.hpp"
+#include "renderer/pipeline.hpp"
+#include "scenes/catalog.hpp"
+#include "validation/benchmark.hpp"
+#include "validation/results_file.hpp"
+#include "validation/truth.hpp"
+#include "validation/truth_cache.hpp"
+#include "validation/validate.hpp"
+#include "validation/validation_images.hpp"
+
+namespace sb::validation {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+Shard parse_shard(const std::string& text) {
+  const size_t slash = text.find('/');
+  Shard s;
+  bool ok = slash != std::string::npos && slash > 0 && slash + 1 < text.size() &&
+            text.find_first_not_of("0123456789/") == std::string::npos && text.find('/', slash + 1) == std::string::npos;
+  if (ok) {
+    try {
+      s.index = std::stoul(text.substr(0, slash));
+      s.count = std::stoul(text.substr(slash + 1));
+    } catch (const std::exception&) {
+      ok = false;
+    }
+  }
+  if (!ok || s.count == 0 || s.index >= s.count)
+    throw InputError(fmt::format("--shard '{}' is not I/N with 0 <= I < N (e.g. 0/4 for the first of four shards)", text));
+  return s;
+}
+
+std::string cell_dir_name(size_t index, size_t cell_count) {
+  const size_t digits = std::max<size_t>(4, fmt::format("{}", cell_count > 0 ? cell_count - 1 : 0).size());
+  return fmt::format("{:0{}}", index, digits);
+}
+
+int threads_per_cell(const SweepRunOptions& options) {
+  if (options.threads > 0) return options.threads;
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return std::max(1, cores / std::max(1, options.jobs));
+}
+
+SweepPlan plan_sweep(const SweepDefinition& definition, const fs::path& results, const Shard& shard) {
+  SweepPlan plan;
+  plan.cells = expand_cells(definition);
+  ResultsFile existing = read_results(results);
+  plan.warnings = std::move(existing.warnings);
+  std::set<std::string> known, done;
+  for (const SweepCell& c : plan.cells) known.insert(c.id);
+  for (const json& line : existing.cells) {
+    const std::string sweep = line.value("sweep", ""), sha = line.value("definition_sha256", "");
+    const std::string id = line["cell_id"];
+    if (sweep != definition.name || sha != definition.sha256)
+      throw InputError(fmt::format(
+          "{} holds cells of sweep '{}' (definition sha256 {}), not of this definition '{}' ({}, sha256 {}); "
+          "the definition changed since those cells ran: give another --out or --results, or delete the file to "
+          "start over",
+          results.string(), sweep, sha.substr(0, 12), definition.name, definition.file.string(),
+          definition.sha256.substr(0, 12)));
+    if (!known.count(id))
+      throw InputError(fmt::format("{}: cell '{}' is not a cell of {}", results.string(), id, definition.file.string()));
+    done.insert(id);
+  }
+  for (const SweepCell& c : plan.cells) {
+    if (c.index % shard.count != shard.index) continue;
+    ++plan.in_shard;
+    if (done.count(c.id))
+      ++plan.finished;
+    else
+      plan.todo.push_back(c.index);
+  }
+  return plan;
+}
+
+namespace {
+
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+std::string host_name() {
+  char buf[256] = {};
+  if (::gethostname(buf, sizeof buf - 1) != 0) return "unknown";
+  return buf;
+}
+
+fs::path scene_file(const SweepScene& scene, const fs::path& scenes_dir) {
+  return scene.builtin ? scenes::resolve_builtin(scene.name, scene.params, scenes_dir) : scene.file;
+}
+
+/// The prepared scene of the worker's current cell, kept while consecutive cells share the file
+/// and light count (cells are ordered scene first), so loading and the BVH build happen once.
+class SceneCache {
+ public:
+  struct Entry {
+    const RenderScene& prepared;
+    fs::path file;
+    size_t lights_in_file;
+  };
+
+  Entry get(const fs::path& file, std::optional<int> lights) {
+    if (!loaded_ || file != file_) {
+      prepared_.reset();
+      used_.reset();
+      loaded_ = std::make_unique<Scene>(io::load_gltf(file));
+      file_ = file;
+    }
+    // A light count above the scene's keeps all of its lights (the record says how many).
+    const size_t keep = lights ? std::min(static_cast<size_t>(*lights), loaded_->lights.size()) : loaded_->lights.size();
+    if (!prepared_ || used_->lights.size() != keep) {
+      prepared_.reset();
+      used_ = std::make_unique<Scene>(*loaded_);
+      used_->lights.resize(keep);
+      prepared_ = std::make_unique<RenderScene>(*used_);
+    }
+    return {*prepared_, file_, loaded_->lights.size()};
+  }
+
+ private:
+  fs::path file_;
+  std::unique_ptr<Scene> loaded_;
+  std::unique_ptr<Scene> used_;
+  std::unique_ptr<RenderScene> prepared_;
+};
+
+/// `path` (written under `dir`) as a path relative to the results file's folder.
+std::string relative_to(const fs::path& path, const fs::path& base) {
+  return fs::absolute(path).lexically_normal().lexically_relative(fs::absolute(base).lexically_normal()).generic_string();
+}
+
+json relative_images(const json& files, const fs::path& base) {
+  json out = json::object();
+  for (const auto& [name, path] : files.items()) out[name] = relative_to(path.get<std::string>(), base);
+  return out;
+}
+
+json timing_json(const PipelineBench& b, const BenchResult& r, int warmup) {
+  const Summary total = summarize(b.total_seconds);
+  json stages = json::object();
+  for (const std::string& stage : b.stage_order) stages[stage] = summarize(b.stage_seconds.at(stage)).median;
+  return {{"repetitions", r.repetitions},   {"warmup", warmup},
+          {"median_s", total.median},       {"min_s", total.min},
+          {"max_s", total.max},             {"samples_s", b.total_seconds},
+          {"stages_median_s", stages},      {"speedup_median", b.speedup.median},
+          {"speedup_min", b.speedup.min},   {"speedup_max", b.speedup.max}};
+}
+
+/// Validates and times every pipeline of the definition in one cell; returns its results line.
+json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count, const SweepRunOptions& options,
+              SceneCache& scenes_cache, const Executor& executor) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::string started = utc_now();
+  const fs::path file = scene_file(cell.scene, options.scenes_dir);
+  const SceneCache::Entry scene = scenes_cache.get(file, cell.lights);
+
+  RigOverrides overrides;
+  overrides.interaxial = cell.interaxial_m;
+  overrides.max_disparity_px = cell.max_disparity_px;
+  overrides.convergence = cell.convergence_m;
+  if (cell.resolution) {
+    overrides.width = cell.resolution->width;
+    overrides.height = cell.resolution->height;
+  }
+  const StereoRig rig = resolve_rig(scene.prepared.scene(), overrides);
+
+  const std::string dir_name = cell_dir_name(cell.index, cell_count);
+  const fs::path results_dir = options.results.has_parent_path() ? options.results.parent_path() : fs::path(".");
+  const fs::path cell_dir = options.out_dir / "cells" / dir_name;
+  const std::unique_ptr<TruthProvider> provider = make_truth_provider(cell.truth);
+  const std::optional<TruthCache> cache =
+      options.truth_cache ? std::optional<TruthCache>(TruthCache(*options.truth_cache)) : std::nullopt;
+  const ValidationTarget target = prepare_target(scene.prepared, file, rig, *provider, cache ? &*cache : nullptr,
+                                                 options.out_dir / "work" / dir_name / cell.truth, executor);
+
+  // Quality: each pipeline rendered once and measured.
+  const ImageFileOptions image_options{d.exr};
+  json images = nullptr, target_images = json::object();
+  if (d.images) {
+    target_images = relative_images(write_target_images(cell_dir, "scene", target, image_options), results_dir);
+    images = {{"dir", relative_to(cell_dir, results_dir)},
+              {"truth_png", target_images["truth_png"]},
+              {"disocclusions_png", target_images["true_disocclusions_png"]},
+              {"pipelines", json::object()}};
+    if (target_images.contains("truth_exr")) images["truth_exr"] = target_images["truth_exr"];
+  }
+  json pipelines = json::object();
+  for (const std::string& name : d.pipelines) {
+    const Pipeline& pipeline = find_pipeline(name);
+    const auto given = d.options.find(name);
+    const PipelineOptions pipeline_options(pipeline.info(), given == d.options.end()
+                                                                ? std::map<std::string, std::string>{}
+                                                                : given->second);
+    const PipelineValidation v = validate_pipeline(target, pipeline, pipeline_options, executor);
+    json record_images = json::object();
+    if (d.images) {
+      const json files = relative_images(write_pipeline_images(cell_dir, name, target, v, image_options), results_dir);
+      images["pipelines"][name] = files;
+      record_images = files;
+      record_images.update(target_images);
+      if (name == d.baseline) images["left_png"] = relative_to(write_left_image(cell_dir, name, v), results_dir);
+    }
+    pipelines[name]["validation"] = validation_record(target, v, executor.threads(), record_images);
+  }
+
+  // Time: every pipeline side by side, speed-ups against the baseline paired per repetition.
+  BenchConfig bench;
+  bench.pipelines = d.pipelines;
+  bench.baseline = d.baseline;
+  bench.warmup = d.warmup;
+  bench.repetitions = d.repetitions;
+  bench.options = d.options;
+  const BenchResult timed = run_bench(scene.prepared, rig, bench, executor);
+  for (const PipelineBench& b : timed.pipelines) pipelines[b.name]["timing"] = timing_json(b, timed, d.warmup);
+
+  const Scene& s = scene.prepared.scene();
+  return {{"kind", kSweepCellKind},
+          {"schema_version", kSweepSchemaVersion},
+          {"sweep", d.name},
+          {"description", d.description},
+          {"definition", options.definition_label},
+          {"definition_sha256", d.sha256},
+          {"cell_id", cell.id},
+          {"cell_index", cell.index},
+          {"cell_count", cell_count},
+          {"cell", cell_to_json(cell)},
+          {"scene",
+           {{"name", s.name},
+            {"file", file.string()},
+            {"triangles", s.triangle_count()},
+            {"lights", s.lights.size()},
+            {"lights_in_file", scene.lights_in_file},
+            {"bvh_build_s", scene.prepared.bvh_build_seconds()}}},
+          {"rig", io::rig_to_json(rig)},
+          {"baseline", d.baseline},
+          {"baseline_listed", d.baseline_listed},
+          {"pipelines", pipelines},
+          {"images", images},
+          {"jobs", options.jobs},
+          {"threads", executor.threads()},
+          {"host", host_name()},
+          {"started", started},
+          {"finished", utc_now()},
+          {"wall_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
+          {"versions", io::versions_json()}};
+}
+
+}  // namespace
+
+void prepare_sweep(const SweepDefinition& d, const std::vector<SweepCell>& cells, const std::vector<size_t>& todo,
+                   const SweepRunOptions& options) {
+  std::set<std::string> truths, scenes_done;
+  for (size_t i : todo) truths.insert(cells[i].truth);
+  for (const std::string& name : truths) {
+    const std::unique_ptr<TruthProvider> provider = make_truth_provider(name);
+    if (auto why = provider->unavailable_reason())
+      throw ToolError(fmt::format("{}: truth '{}' is unavailable: {}", d.file.string(), name, *why));
+  }
+  for (size_t i : todo)
+    if (scenes_done.insert(cells[i].scene.label).second) (void)scene_file(cells[i].scene, options.scenes_dir);
+}
+
+void run_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, const std::vector<size_t>& todo,
+               const SweepRunOptions& options, const std::function<void(const CellProgress&)>& progress) {
+  if (options.jobs < 1) throw InputError(fmt::format("--jobs {} must be at least 1", options.jobs));
+  const int threads = threads_per_cell(options);
+  std::atomic<size_t> next{0};
+  std::atomic<bool> stop{false};
+  std::mutex report_mutex;
+  size_t finished = 0;
+  std::exception_ptr first_error;
+
+  const auto worker = [&] {
+    SceneCache scenes_cache;
+    const Executor executor(threads);
+    while (!stop) {
+      const size_t k = next++;
+      if (k >= todo.size()) return;
+      const SweepCell& cell = cells[todo[k]];
+      try {
+        const auto start = std::chrono::steady_clock::now();
+        const json line = run_cell(d, cell, cells.size(), options, scenes_cache, executor);
+        append_result(options.results, line);
+        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const std::lock_guard<std::mutex> lock(report_mutex);
+        ++finished;
+        if (progress) progress(CellProgress{cell, finished, todo.size(), wall});
+      } catch (...) {
+        std::exception_ptr error = std::current_exception();
+        try {
+          std::rethrow_exception(error);
+        } catch (const Error& e) {
+          // Name the cell; keep the kind of error (and with it the exit code).
+          error = std::make_exception_ptr(Error(e.code(), fmt::format("cell {} '{}': {}", cell.index, cell.id, e.what())));
+        } catch (...) {
+        }
+        const std::lock_guard<std::mutex> lock(report_mutex);
+        if (!first_error) first_error = error;
+        stop = true;
+        return;
+      }
+    }
+  };
+
+  const size_t workers = std::min(todo.size(), static_cast<size_t>(options.jobs));
+  if (workers <= 1) {
+    worker();
+  } else {
+    std::vector<std::thread> pool;
+    for (size_t i = 0; i < workers; ++i) pool.emplace_back(worker);
+    for (std::thread& t : pool) t.join();
+  }
+  if (first_error) std::rethrow_exception(first_error);
+}
+
+}  // namespace sb::validation
