@@ -1,11 +1,14 @@
 // `stereobench report`: the static HTML report of a sweep's results file (reports/, docs/report.md).
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 
 #include <fmt/format.h>
 
 #include "apps/commands.hpp"
+#include "renderer/error.hpp"
 #include "reports/report.hpp"
+#include "validation/history.hpp"
 
 namespace sb::cli {
 
@@ -16,14 +19,22 @@ struct ReportArgs {
   std::string out;
   std::string title;
   bool link_images = false;
+  std::string history;
 };
 
 void run_report(const ReportArgs& a) {
-  const reports::ResultsFile results = reports::read_results_file(a.results);
   reports::ReportOptions options;
   options.out_dir = a.out;
   options.title = a.title;
   options.images = a.link_images ? reports::ImageMode::link : reports::ImageMode::copy;
+  if (!a.history.empty()) {
+    if (!std::filesystem::exists(a.history))
+      throw InputError(fmt::format("--history {}: file does not exist", a.history));
+    const validation::HistoryFile h = validation::read_history(a.history);
+    for (const std::string& w : h.warnings) std::fprintf(stderr, "stereobench: warning: %s\n", w.c_str());
+    options.history = nlohmann::json(h.runs);
+  }
+  const reports::ResultsFile results = reports::read_results_file(a.results);
   const reports::ReportSummary s = reports::write_report(results, options);
   for (const std::string& w : s.warnings) std::fprintf(stderr, "stereobench: warning: %s\n", w.c_str());
   fmt::print("report of {} cell(s) x {} pipeline(s), {} image(s) {}{}\nwrote {}\n", s.cells, s.pipelines, s.images,
@@ -48,6 +59,9 @@ void register_report_command(CLI::App& root) {
   r->add_flag("--link-images", a->link_images,
               "Refer to the cells' images by relative paths instead of copying them under OUT/images\n"
               "(smaller, but the report then needs the results folder where it was)");
+  r->add_option("--history", a->history,
+                "History file of nightly runs (docs/nightly.md): adds a Trends section, per pipeline PSNR\n"
+                "and median time and the gate verdict per run");
   r->callback([a] { run_report(*a); });
 }
 

@@ -28,6 +28,8 @@ void register_validate_command(CLI::App& root);
 void register_sweep_command(CLI::App& root);
 /// `stereobench gate`.
 void register_gate_command(CLI::App& root);
+/// `stereobench nightly`.
+void register_nightly_command(CLI::App& root);
 
 /// `stereobench path`.
 void register_path_command(CLI::App& root);

@@ -64,6 +64,7 @@ int main(int argc, char** argv) {
   sb::cli::register_validate_command(app);
   sb::cli::register_sweep_command(app);
   sb::cli::register_gate_command(app);
+  sb::cli::register_nightly_command(app);
   sb::cli::register_compare_command(app);
   sb::cli::register_reference_command(app, command_line(argc, argv));
   sb::cli::register_report_command(app);

@@ -386,7 +386,8 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
     for (const std::string& s : sweeps) joined += (joined.empty() ? "" : ", ") + s;
     title = "stereobench report: " + joined;
   }
-  const json data = report_data(results, title, papers, image_path);
+  json data = report_data(results, title, papers, image_path);
+  if (!options.history.is_null()) data["history"] = options.history;
   summary.cells = data["cells"].size();
   summary.pipelines = data["pipelines"].size();
   summary.paper_experiment = data["paper"].is_object() ? data["paper"]["experiment"].get<std::string>() : "";

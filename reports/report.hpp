@@ -29,6 +29,9 @@ struct ReportOptions {
   /// Folder holding report.js, report.css, report.html, papers.json and chart.umd.min.js; empty:
   /// $STEREOBENCH_REPORT_ASSETS, else the build tree's copy (report_assets_dir()).
   std::filesystem::path assets_dir;
+  /// The nightly runs of a history file (validation/history.hpp, one object per run in file order);
+  /// an array, even an empty one, adds data.history and the page's Trends section. Null: none.
+  nlohmann::json history;
 };
 
 /// What write_report produced.

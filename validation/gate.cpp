@@ -455,6 +455,17 @@ std::vector<BaselineChange> update_baseline(Baseline& baseline, const GateResult
 // ---------------------------------------------------------------------------------------------
 // Evaluation
 
+namespace {
+
+/// Quoted arguments joined into one command line.
+std::string join_args(const std::vector<std::string>& args) {
+  std::string out;
+  for (const std::string& a : args) out += (out.empty() ? "" : " ") + a;
+  return out;
+}
+
+}  // namespace
+
 std::string reproduce_command(const GateCell& cell, const std::string& pipeline, const ReproduceSettings& settings) {
   const json& rec = cell.record;
   const json& c = rec.value("cell", json::object());
@@ -471,6 +482,17 @@ std::string reproduce_command(const GateCell& cell, const std::string& pipeline,
     args.push_back(flag);
     args.push_back(shell_quote(value));
   };
+  // A frame of a path: only the sweep animates the scene to that frame, so run that one cell
+  // again (cell_index % cell_count == cell_index selects it alone).
+  if (c.contains("frame") && c["frame"].is_number() && rec.value("definition", json()).is_string() &&
+      num(rec, "cell_index") && num(rec, "cell_count")) {
+    args = {"stereobench", "sweep", "run"};
+    args.push_back(shell_quote(rec["definition"].get<std::string>()));
+    add("--out", "out/reproduce");
+    add("--shard", fmt::format("{}/{}", static_cast<uint64_t>(*num(rec, "cell_index")),
+                               static_cast<uint64_t>(*num(rec, "cell_count"))));
+    return join_args(args);
+  }
   // A parameterised scene is generated into a file of its own: name that file.
   std::string scene = cell.scene;
   const json& params = c.value("scene_params", json::object());
@@ -508,9 +530,7 @@ std::string reproduce_command(const GateCell& cell, const std::string& pipeline,
       add("--option", key + "=" + v);
     }
   }
-  std::string out;
-  for (const std::string& a : args) out += (out.empty() ? "" : " ") + a;
-  return out;
+  return join_args(args);
 }
 
 GateReport evaluate_gate(const GateConfig& config, const GateResults& results, const Baseline& baseline,

@@ -198,12 +198,99 @@ std::string option_text(const Where& where, const toml::node& node, const std::s
   where.fail(node, path, fmt::format("must be a string, number or boolean, not {}", type_name(node)));
 }
 
-const std::vector<std::string> kTopKeys = {"sweep", "timing", "options", "output"};
+const std::vector<std::string> kTopKeys = {"sweep", "timing", "options", "output", "path"};
+const std::vector<std::string> kPathKeys = {"frames", "camera_keys", "spin", "bvh"};
+const std::vector<std::string> kSpinKeys = {"axis", "degrees_per_frame", "pivot", "mesh_prefix"};
 const std::vector<std::string> kSweepKeys = {"name",          "description",      "scenes",        "pipelines",
                                              "baseline",      "interaxial_m",     "max_disparity_px",
                                              "convergence_m", "resolutions",      "lights",        "truths"};
 const std::vector<std::string> kTimingKeys = {"repetitions", "warmup"};
 const std::vector<std::string> kOutputKeys = {"images", "exr"};
+
+/// `count` finite numbers from an array, e.g. a point [x, y, z] in meters.
+std::vector<double> numbers_at(const Where& where, const toml::node& node, const std::string& path, size_t count,
+                               const char* example) {
+  const toml::array* a = node.as_array();
+  if (!a || a->size() != count)
+    where.fail(node, path,
+               fmt::format("must be an array of {} numbers, e.g. {}, not {}", count, example,
+                           a ? fmt::format("{} values", a->size()) : std::string(type_name(node))));
+  std::vector<double> out;
+  for (const toml::node& e : *a) {
+    const double v = number_at(where, e, path);
+    if (!std::isfinite(v)) where.fail(e, path, fmt::format("{} is not a finite number", v));
+    out.push_back(v);
+  }
+  return out;
+}
+
+dvec3 point_at(const Where& where, const toml::node& node, const std::string& path, const char* example) {
+  const std::vector<double> v = numbers_at(where, node, path, 3, example);
+  return {v[0], v[1], v[2]};
+}
+
+/// The [path] table: frames, camera key poses, a spin and the BVH update.
+void parse_path(const Where& where, const toml::node& node, SweepDefinition& d) {
+  const toml::table& table = table_at(where, node, "path");
+  check_keys(where, table, "path", kPathKeys);
+  PathSpec path;
+  const toml::node* frames = table.get("frames");
+  if (!frames) where.fail(node, "path.frames", "is missing; a [path] needs the number of frames, e.g. frames = 30");
+  const int64_t n = integer_at(where, *frames, "path.frames");
+  if (n < 1 || n > 100000) where.fail(*frames, "path.frames", fmt::format("{} is outside 1..100000", n));
+  path.frames = static_cast<int>(n);
+  if (const toml::node* keys = table.get("camera_keys")) {
+    const toml::array* a = keys->as_array();
+    if (!a || a->empty())
+      where.fail(*keys, "path.camera_keys",
+                 "must be a non-empty array of key poses [px, py, pz, tx, ty, tz] (position and target, meters)");
+    for (const toml::node& e : *a) {
+      const std::vector<double> v =
+          numbers_at(where, e, "path.camera_keys", 6, "[0, 1.6, 4, 0, 1, 0] (position, then target, meters)");
+      const CameraKey key{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+      if (key.position == key.target)
+        where.fail(e, "path.camera_keys", "a key pose whose target equals its position has no viewing direction");
+      path.camera_keys.push_back(key);
+    }
+  }
+  if (const toml::node* spin_node = table.get("spin")) {
+    const toml::table& spin = table_at(where, *spin_node, "path.spin");
+    check_keys(where, spin, "path.spin", kSpinKeys);
+    Spin s;
+    if (const toml::node* v = spin.get("axis")) {
+      s.axis = point_at(where, *v, "path.spin.axis", "[0, 1, 0]");
+      if (glm::length(s.axis) < 1e-12) where.fail(*v, "path.spin.axis", "is zero; give a direction such as [0, 1, 0]");
+    }
+    if (const toml::node* v = spin.get("degrees_per_frame")) {
+      s.degrees_per_frame = number_at(where, *v, "path.spin.degrees_per_frame");
+      if (!std::isfinite(s.degrees_per_frame))
+        where.fail(*v, "path.spin.degrees_per_frame", "is not a finite number of degrees");
+    }
+    if (const toml::node* v = spin.get("pivot")) s.pivot = point_at(where, *v, "path.spin.pivot", "[0, 0.5, 0]");
+    if (const toml::node* v = spin.get("mesh_prefix")) s.mesh_prefix = string_at(where, *v, "path.spin.mesh_prefix");
+    path.spin = s;
+  }
+  if (const toml::node* v = table.get("bvh")) {
+    const std::string bvh = string_at(where, *v, "path.bvh");
+    if (bvh != "refit" && bvh != "rebuild")
+      where.fail(*v, "path.bvh", fmt::format("'{}' is neither \"refit\" nor \"rebuild\"", bvh));
+    d.path_refit = bvh == "refit";
+  }
+  try {
+    path.validate();
+  } catch (const InputError& e) {
+    where.fail(node, "path", e.what());
+  }
+  // External renderers import the scene file, which does not move: a spin needs the built-in truth.
+  if (path.spin)
+    for (const std::string& truth : d.truths)
+      if (truth != "full")
+        where.fail(node, "path.spin",
+                   fmt::format("truth '{}' renders the scene file, which does not turn; a spinning path needs "
+                               "truths = [\"full\"]",
+                               truth));
+  d.path = path;
+}
 
 }  // namespace
 
@@ -416,6 +503,8 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
     }
   }
 
+  if (const toml::node* n = root.get("path")) parse_path(where, *n, d);
+
   // Output.
   if (const toml::node* n = root.get("output")) {
     const toml::table& output = table_at(where, *n, "output");
@@ -451,40 +540,51 @@ std::vector<SweepCell> expand_cells(const SweepDefinition& d) {
       interaxials.push_back({v, std::nullopt, v ? "e=" + number_text(*v) + "m" : "e=default"});
   }
 
+  std::vector<std::optional<int>> frames{std::nullopt};
+  if (d.path) {
+    frames.clear();
+    for (int k = 0; k < d.path->frames; ++k) frames.emplace_back(k);
+  }
+
   std::vector<SweepCell> cells;
   for (const SweepScene& scene : d.scenes)
     for (const Interaxial& e : interaxials)
       for (const auto& c : d.convergence_m)
         for (const auto& r : d.resolutions)
           for (const auto& l : d.lights)
-            for (const std::string& truth : d.truths) {
-              SweepCell cell;
-              cell.index = cells.size();
-              cell.scene = scene;
-              cell.interaxial_m = e.meters;
-              cell.max_disparity_px = e.pixels;
-              cell.convergence_m = c;
-              cell.resolution = r;
-              cell.lights = l;
-              cell.truth = truth;
-              cell.id = fmt::format("{}|{}|{}|{}|{}|{}", scene.label, e.label,
-                                    c ? "c=" + number_text(*c) + "m" : "c=default", r ? r->label : "res=default",
-                                    l ? fmt::format("lights={}", *l) : "lights=all", truth);
-              cells.push_back(std::move(cell));
-            }
+            for (const std::string& truth : d.truths)
+              for (const auto& frame : frames) {
+                SweepCell cell;
+                cell.index = cells.size();
+                cell.scene = scene;
+                cell.interaxial_m = e.meters;
+                cell.max_disparity_px = e.pixels;
+                cell.convergence_m = c;
+                cell.resolution = r;
+                cell.lights = l;
+                cell.truth = truth;
+                cell.frame = frame;
+                cell.id = fmt::format("{}|{}|{}|{}|{}|{}", scene.label, e.label,
+                                      c ? "c=" + number_text(*c) + "m" : "c=default", r ? r->label : "res=default",
+                                      l ? fmt::format("lights={}", *l) : "lights=all", truth);
+                if (frame) cell.id += fmt::format("|frame={}", *frame);
+                cells.push_back(std::move(cell));
+              }
   return cells;
 }
 
 json cell_to_json(const SweepCell& cell) {
   const auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
-  return {{"scene", cell.scene.name},
-          {"scene_params", cell.scene.params.empty() ? json::object() : json(cell.scene.params)},
-          {"interaxial_m", opt(cell.interaxial_m)},
-          {"max_disparity_px", opt(cell.max_disparity_px)},
-          {"convergence_m", opt(cell.convergence_m)},
-          {"resolution", cell.resolution ? json(cell.resolution->label) : json(nullptr)},
-          {"lights", cell.lights ? json(*cell.lights) : json(nullptr)},
-          {"truth", cell.truth}};
+  json out = {{"scene", cell.scene.name},
+              {"scene_params", cell.scene.params.empty() ? json::object() : json(cell.scene.params)},
+              {"interaxial_m", opt(cell.interaxial_m)},
+              {"max_disparity_px", opt(cell.max_disparity_px)},
+              {"convergence_m", opt(cell.convergence_m)},
+              {"resolution", cell.resolution ? json(cell.resolution->label) : json(nullptr)},
+              {"lights", cell.lights ? json(*cell.lights) : json(nullptr)},
+              {"truth", cell.truth}};
+  if (cell.frame) out["frame"] = *cell.frame;
+  return out;
 }
 
 }  // namespace sb::validation

@@ -14,6 +14,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "renderer/animation.hpp"
+
 namespace sb::validation {
 
 /// One entry of the `scenes` axis: a built-in scene with optional generator parameters
@@ -60,6 +62,11 @@ struct SweepDefinition {
   int warmup = 1;
   std::map<std::string, std::map<std::string, std::string>> options;  ///< per pipeline, checked
 
+  /// The `path` axis ([path]): every other combination runs once per frame, the scene animated
+  /// and the camera moved to that frame. Unset: no animation, one cell per combination.
+  std::optional<PathSpec> path;
+  bool path_refit = true;  ///< per-frame BVH update: refit (true) or rebuild
+
   bool images = true;  ///< PNG images per cell
   bool exr = false;    ///< also the EXR of every right eye and ground truth
 };
@@ -75,6 +82,7 @@ struct SweepCell {
   std::optional<SweepResolution> resolution;
   std::optional<int> lights;
   std::string truth;
+  std::optional<int> frame;  ///< the frame of the definition's path (set only with a [path])
 };
 
 /// Parses a definition. InputError naming the file, the key path and its line for unknown keys
@@ -86,7 +94,8 @@ struct SweepCell {
 [[nodiscard]] SweepDefinition parse_sweep(const std::string& text, const std::filesystem::path& file);
 
 /// The cells in their fixed order: scenes outermost, then interaxial (or max disparity),
-/// convergence, resolution, lights and truth innermost; `index` counts from 0 in that order.
+/// convergence, resolution, lights, truth and, with a [path], the frame innermost (frames of one
+/// combination in order, "|frame=k" ending the id); `index` counts from 0 in that order.
 [[nodiscard]] std::vector<SweepCell> expand_cells(const SweepDefinition& definition);
 
 /// The cell's axes as written into results ("cell" of docs/sweeps.md).

@@ -17,6 +17,7 @@
 
 #include <fmt/format.h>
 
+#include "renderer/animation.hpp"
 #include "renderer/error.hpp"
 #include "renderer/io/gltf_loader.hpp"
 #include "renderer/io/render_output.hpp"
@@ -117,38 +118,83 @@ fs::path scene_file(const SweepScene& scene, const fs::path& scenes_dir) {
   return scene.builtin ? scenes::resolve_builtin(scene.name, scene.params, scenes_dir) : scene.file;
 }
 
+/// How a frame cell's scene reached its frame: the animation and BVH update, timed.
+struct FrameUpdate {
+  double animate_s = 0.0;
+  double bvh_update_s = 0.0;
+  std::string bvh;  ///< "build" (prepared anew at this frame), "refit", "rebuild" or "static"
+};
+
 /// The prepared scene of the worker's current cell, kept while consecutive cells share the file
 /// and light count (cells are ordered scene first), so loading and the BVH build happen once.
+/// With a path, the kept scene is animated from whatever frame it shows to the cell's frame and
+/// its BVH refit or rebuilt; frame k is always frame 0 turned by k steps (SceneAnimator), so the
+/// geometry does not depend on the order frames run in.
 class SceneCache {
  public:
   struct Entry {
     const RenderScene& prepared;
     fs::path file;
     size_t lights_in_file;
+    const SceneAnimator* animator;  ///< set with a path
+    std::optional<FrameUpdate> update;  ///< set with a path
   };
 
-  Entry get(const fs::path& file, std::optional<int> lights) {
+  Entry get(const fs::path& file, std::optional<int> lights, const std::optional<PathSpec>& path, bool refit,
+            std::optional<int> frame) {
     if (!loaded_ || file != file_) {
-      prepared_.reset();
-      used_.reset();
+      reset();
       loaded_ = std::make_unique<Scene>(io::load_gltf(file));
       file_ = file;
     }
     // A light count above the scene's keeps all of its lights (the record says how many).
     const size_t keep = lights ? std::min(static_cast<size_t>(*lights), loaded_->lights.size()) : loaded_->lights.size();
-    if (!prepared_ || used_->lights.size() != keep) {
-      prepared_.reset();
+    const bool animated = path.has_value() && frame.has_value();
+    const bool reusable = prepared_ && used_->lights.size() == keep && animated == (animator_ != nullptr) &&
+                          (!animated || refit == refit_);
+    std::optional<FrameUpdate> update;
+    if (!reusable) {
+      reset();
       used_ = std::make_unique<Scene>(*loaded_);
       used_->lights.resize(keep);
-      prepared_ = std::make_unique<RenderScene>(*used_);
+      if (animated) {
+        refit_ = refit;
+        const auto t0 = std::chrono::steady_clock::now();
+        animator_ = std::make_unique<SceneAnimator>(*used_, *path);
+        animator_->apply(*frame);
+        const double animate_s = seconds_since(t0);
+        prepared_ = std::make_unique<RenderScene>(*used_, refit && animator_->moves_geometry());
+        update = FrameUpdate{animate_s, prepared_->bvh_build_seconds(), "build"};
+      } else {
+        prepared_ = std::make_unique<RenderScene>(*used_);
+      }
+    } else if (animated) {
+      const auto t0 = std::chrono::steady_clock::now();
+      animator_->apply(*frame);
+      const double animate_s = seconds_since(t0);
+      if (animator_->moves_geometry())
+        update = FrameUpdate{animate_s, prepared_->update_geometry(), refit ? "refit" : "rebuild"};
+      else
+        update = FrameUpdate{animate_s, 0.0, "static"};
     }
-    return {*prepared_, file_, loaded_->lights.size()};
+    return {*prepared_, file_, loaded_->lights.size(), animator_.get(), update};
   }
 
  private:
+  static double seconds_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  void reset() {
+    prepared_.reset();
+    animator_.reset();
+    used_.reset();
+  }
+
   fs::path file_;
+  bool refit_ = true;
   std::unique_ptr<Scene> loaded_;
   std::unique_ptr<Scene> used_;
+  std::unique_ptr<SceneAnimator> animator_;
   std::unique_ptr<RenderScene> prepared_;
 };
 
@@ -180,7 +226,7 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
   const auto start = std::chrono::steady_clock::now();
   const std::string started = utc_now();
   const fs::path file = scene_file(cell.scene, options.scenes_dir);
-  const SceneCache::Entry scene = scenes_cache.get(file, cell.lights);
+  const SceneCache::Entry scene = scenes_cache.get(file, cell.lights, d.path, d.path_refit, cell.frame);
 
   RigOverrides overrides;
   overrides.interaxial = cell.interaxial_m;
@@ -190,7 +236,10 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
     overrides.width = cell.resolution->width;
     overrides.height = cell.resolution->height;
   }
-  const StereoRig rig = resolve_rig(scene.prepared.scene(), overrides);
+  const StereoRig resolved = resolve_rig(scene.prepared.scene(), overrides);
+  // On a path the centre camera stands where the path puts it at this frame.
+  const StereoRig rig = scene.animator ? StereoRig(scene.animator->camera_at(*cell.frame, resolved.pose()), resolved.params())
+                                       : resolved;
 
   const std::string dir_name = cell_dir_name(cell.index, cell_count);
   const fs::path results_dir = options.results.has_parent_path() ? options.results.parent_path() : fs::path(".");
@@ -242,6 +291,17 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
   for (const PipelineBench& b : timed.pipelines) pipelines[b.name]["timing"] = timing_json(b, timed, d.warmup);
 
   const Scene& s = scene.prepared.scene();
+  json animation = nullptr;
+  if (scene.update)
+    animation = {{"frame", *cell.frame},
+                 {"frames", d.path->frames},
+                 {"bvh", scene.update->bvh},
+                 {"bvh_update_s", scene.update->bvh_update_s},
+                 {"animate_s", scene.update->animate_s},
+                 {"turning_meshes", scene.animator->turning_meshes()},
+                 {"camera",
+                  {{"position", {rig.pose().position.x, rig.pose().position.y, rig.pose().position.z}},
+                   {"back", {rig.pose().back.x, rig.pose().back.y, rig.pose().back.z}}}}};
   return {{"kind", kSweepCellKind},
           {"schema_version", kSweepSchemaVersion},
           {"sweep", d.name},
@@ -260,6 +320,7 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
             {"lights_in_file", scene.lights_in_file},
             {"bvh_build_s", scene.prepared.bvh_build_seconds()}}},
           {"rig", io::rig_to_json(rig)},
+          {"animation", animation},
           {"baseline", d.baseline},
           {"baseline_listed", d.baseline_listed},
           {"pipelines", pipelines},

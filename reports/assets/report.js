@@ -791,10 +791,81 @@
     return { id: 'viewer', title: 'Image viewer', node };
   }
 
+
+  /** Trends across the nightly runs of a history file (data.history, docs/nightly.md): per pipeline
+   * the median PSNR and median time of each run, and the gate's verdict counts per run. */
+  function trendsSection() {
+    const runs = data.history;
+    if (!Array.isArray(runs)) return null;
+    const node = el('section', { 'aria-labelledby': 'trends-h' }, el('h2', { id: 'trends-h' }, 'Trends'));
+    if (runs.length === 0) {
+      node.append(el('p', { class: 'note' }, 'The history file holds no run yet.'));
+      return { id: 'trends', title: 'Trends', node };
+    }
+    const labels = runs.map((r) => String(r.date).replace('T', ' ').replace('Z', ''));
+    // This report's pipelines first (their colours as elsewhere), then those only earlier runs had.
+    const names = distinct([...pipelines, ...runs.flatMap((r) => Object.keys(r.pipelines || {}))])
+      .filter((p) => runs.some((r) => (r.pipelines || {})[p]));
+    const extra = names.filter((p) => !pipelines.includes(p));
+    const colour = (p) => (pipelines.includes(p) ? colorOf(p) : palette[(pipelines.length + extra.indexOf(p)) % palette.length]);
+    const runText = `${runs.length} run${runs.length === 1 ? '' : 's'} from ${labels[0]} to ${labels[labels.length - 1]} UTC`;
+
+    const lineChart = (title, key, scale, yTitle, caption, omittedWhy) => {
+      const datasets = [];
+      const omitted = [];
+      names.forEach((p, k) => {
+        const points = runs.map((r) => {
+          const v = num(((r.pipelines || {})[p] || {})[key]);
+          return v === null || !Number.isFinite(v) ? null : v * scale;
+        });
+        if (points.every((v) => v === null)) {
+          omitted.push(p);
+          return;
+        }
+        datasets.unshift({ label: p, data: points, borderColor: colour(p), backgroundColor: colour(p),
+          pointStyle: markers[k % markers.length], pointRadius: 5, borderWidth: 2, borderDash: dashes[k % dashes.length],
+          spanGaps: true, clip: 8 });
+      });
+      if (datasets.length === 0) return null;
+      const why = omitted.length ? ` Not plotted (no finite value${omittedWhy ? ': ' + omittedWhy : ''}): ${omitted.join(', ')}.` : '';
+      const config = { type: 'line', data: { labels, datasets },
+        options: { scales: { x: axis('run (UTC)', { offset: true }), y: axis(yTitle) },
+          plugins: { legend: { position: 'bottom', reverse: true, labels: { usePointStyle: true } } } } };
+      return chartFigure(title, `${caption} ${runText}.${why}`, config, 230 + 24 * Math.ceil(names.length / 5));
+    };
+
+    const verdicts = [['fail', '#c92a2a'], ['warn', '#f08c00'], ['pass', '#2b8a3e'], ['skip', '#868e96']];
+    const gateChart = chartFigure('Gate verdict per run',
+      `Checks of the gate per verdict in each run; a run fails with any failed check, warns with warnings only, else passes (skipped checks do not count). ${runText}.`,
+      { type: 'bar', data: { labels, datasets: verdicts.map(([v, c]) => ({ label: v, backgroundColor: c,
+        data: runs.map((r) => num(((r.gate || {}).counts || {})[v]) || 0) })) },
+      options: { scales: { x: axis('run (UTC)', { stacked: true }), y: axis('checks', { stacked: true, beginAtZero: true }) },
+        plugins: { legend: { position: 'bottom' } } } }, 280);
+
+    const grid = el('div', { class: 'charts' });
+    grid.append(...[
+      lineChart('PSNR per run', 'psnr', 1, 'median PSNR (dB)', 'Median PSNR over each run\'s cells, per pipeline.',
+        'identical to the truth, PSNR ∞'),
+      lineChart('Median time per run', 'median_s', 1000, 'median time (ms)', 'Median over each run\'s cells of the pipeline\'s median time.'),
+      gateChart,
+    ].filter(Boolean));
+    node.append(grid);
+
+    const header = [{ text: 'Run (UTC)' }, { text: 'Host' }, { text: 'Revision' }, { text: 'Cells' }, { text: 'Verdict' },
+      ...verdicts.map(([v]) => ({ text: v }))];
+    const rows = runs.map((r, i) => ({ cls: `verdict-${r.gate.verdict}`, cells: [
+      { text: labels[i], th: true, title: r.run_id }, { text: r.host }, { text: r.git_revision },
+      { text: String(r.cells ?? '—'), num: true }, { text: r.gate.verdict },
+      ...verdicts.map(([v]) => ({ text: String(r.gate.counts[v] ?? 0), num: true }))] }));
+    node.append(table(`Nightly runs of the history file, oldest first (${runs.length}).`, header, rows));
+    return { id: 'trends', title: 'Trends', node };
+  }
+
   // ---------------------------------------------------------------- page
 
   // Sections in page order; each returns {id, title, node} or null when the data has nothing for it.
-  const sections = [overviewSection, summarySection, paperSection, chartsSection, cellTableSection, viewerSection];
+  const sections = [overviewSection, summarySection, paperSection, chartsSection, trendsSection, cellTableSection,
+    viewerSection];
   const main = document.getElementById('main');
   const toc = el('ul');
   for (const make of sections) {

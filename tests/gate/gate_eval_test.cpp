@@ -322,5 +322,18 @@ TEST(GateCli, BadInputIsExitThree) {
   EXPECT_NE(run.out.find("torn.jsonl:2"), std::string::npos) << run.out;
 }
 
+TEST(GateEval, AFrameOfAPathIsReproducedByRunningItsCellAgain) {
+  json cell = fake_cell(1, 0.064, {FakePipeline{}});
+  cell["cell"]["frame"] = 2;
+  cell["cell_count"] = 6;
+  cell["definition"] = "ci/presets/animated-spheres.toml";
+  const validation::GateCell gc{cell["cell_id"], "box-wall", cell};
+  const std::string command = validation::reproduce_command(gc, FakePipeline{}.name, {});
+  EXPECT_EQ(command, "stereobench sweep run ci/presets/animated-spheres.toml --out out/reproduce --shard 1/6") << command;
+  cell["cell"].erase("frame");
+  const validation::GateCell still{cell["cell_id"], "box-wall", cell};
+  EXPECT_EQ(validation::reproduce_command(still, FakePipeline{}.name, {}).rfind("stereobench validate", 0), 0u);
+}
+
 }  // namespace
 }  // namespace sb::test

@@ -16,11 +16,10 @@ namespace sb::reference {
 namespace {
 
 namespace fs = std::filesystem;
+using test::quoted;
 using nlohmann::json;
 
 const fs::path kScenes = fs::path(SB_BINARY_DIR) / "Testing" / "scenes-cache";
-
-std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
 
 /// `stereobench reference <sub> ...` on the test's own store.
 std::string ref(const test::ScratchDir& dir, const std::string& sub) {

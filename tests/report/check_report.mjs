@@ -3,7 +3,8 @@
 // and one cell-table row per (cell, pipeline); every chart canvas has data drawn inside its plot
 // area; in every cell and for every pipeline each viewer image loads, each mode button shows its
 // own view (all pipelines of the first cell, the first pipeline of the others), the slider follows
-// a drag, flicker alternates, the anaglyph is composed exactly; a full-page screenshot is written. Exit 0 when all holds, 1 with the list of problems otherwise.
+// a drag, flicker alternates, the anaglyph is composed exactly; with a history (nightly runs), the
+// Trends section has a row per run and its charts a point per run; a full-page screenshot is written. Exit 0 when all holds, 1 with the list of problems otherwise.
 //
 // Usage: node tests/report/check_report.mjs REPORT/index.html SCREENSHOT.png [--quick]
 // --quick leaves out the viewer's interaction (mode buttons, slider drag, flicker, the anaglyph's
@@ -112,6 +113,35 @@ try {
   for (const c of charts)
     if (c.pixels < MIN_CHART_DATA_PIXELS) problems.push(`chart "${c.title}": ${c.pixels} data pixels (< ${MIN_CHART_DATA_PIXELS})${c.missing ? ', no chart object' : ''}`);
   report.charts = charts.map((c) => `${c.title}: ${c.pixels}`);
+
+  // Trends (a report written with a history file): the median-time and gate-verdict charts always,
+  // the PSNR chart unless every PSNR is infinite; one table row per run; each line chart holds one
+  // point per run for every pipeline it plots.
+  if (Array.isArray(data.history)) {
+    const trends = await page.evaluate(() => {
+      const section = document.getElementById('trends');
+      if (!section) return null;
+      return {
+        rows: section.querySelectorAll('tbody tr').length,
+        charts: [...section.querySelectorAll('figure.chart canvas')].map((canvas) => {
+          const chart = window.Chart && Chart.getChart(canvas);
+          return { title: canvas.getAttribute('aria-label').split('.')[0], type: chart ? chart.config.type : null,
+            points: chart ? chart.data.datasets.map((d) => d.data.length) : [] };
+        }),
+      };
+    });
+    const runs = data.history.length;
+    if (!trends) problems.push('the data has a history but the page has no #trends section');
+    else if (runs > 0) {
+      if (trends.rows !== runs) problems.push(`trends table: ${trends.rows} rows for ${runs} runs`);
+      const finitePsnr = data.history.some((r) => Object.values(r.pipelines).some((p) => typeof p.psnr === 'number'));
+      const expected = finitePsnr ? 3 : 2;
+      if (trends.charts.length !== expected) problems.push(`trends: ${trends.charts.length} charts, expected ${expected}`);
+      for (const c of trends.charts)
+        if (c.points.some((n) => n !== runs)) problems.push(`trend chart "${c.title}": datasets of ${c.points.join(', ')} points for ${runs} runs`);
+      report.trends = trends.charts.map((c) => `${c.title}: ${c.points.length} datasets of ${runs} points`);
+    }
+  }
 
   // Viewers: every cell, every pipeline, every mode.
   const modes = ['sbs', 'slider', 'flicker', 'anaglyph', 'holes', 'diff'];

@@ -24,24 +24,13 @@ namespace sb {
 namespace {
 
 namespace fs = std::filesystem;
+using test::run_shell;
+using test::quoted;
 using nlohmann::json;
 
 const fs::path kSource = SB_SOURCE_DIR;
 constexpr const char* kInstallHint = "install them with `ci/install-deps.sh chromium` (Debian chromium, node, and the "
                                      "npm packages of ci/package.json)";
-
-std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
-
-/// Runs a shell command, capturing stdout and stderr.
-test::CliRun run_shell(const std::string& cmd) {
-  FILE* pipe = ::popen((cmd + " 2>&1").c_str(), "r");
-  test::CliRun r;
-  std::array<char, 1024> buf{};
-  while (pipe && std::fgets(buf.data(), buf.size(), pipe)) r.out += buf.data();
-  const int status = pipe ? ::pclose(pipe) : -1;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
 
 void write_text(const fs::path& p, const std::string& text) {
   fs::create_directories(p.parent_path());

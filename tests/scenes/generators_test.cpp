@@ -17,6 +17,7 @@
 
 #include "gltf_reader_support.hpp"
 #include "renderer/error.hpp"
+#include "support/run_cli.hpp"
 #include "support/scratch_dir.hpp"
 #include "scenes/generators.hpp"
 
@@ -24,6 +25,7 @@ namespace sb::scenes {
 namespace {
 
 namespace fs = std::filesystem;
+using test::quoted;
 using nlohmann::json;
 
 const std::vector<std::string> kExpectedNames = {"spheres",   "atrium",    "bistro",         "temple",
@@ -339,8 +341,6 @@ int run(const std::string& command, std::string& output) {
   const int status = pclose(pipe);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
-
-std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
 
 class KhronosValidator : public ::testing::Test {
  protected:

@@ -29,6 +29,8 @@ namespace sb {
 namespace {
 
 namespace fs = std::filesystem;
+using test::run_shell;
+using test::quoted;
 using nlohmann::json;
 
 /// Four cells (interaxial 40, 64, 100, 140 mm) of the box in front of a wall at 64x36, every
@@ -57,19 +59,6 @@ resolutions = ["64x36"]
 repetitions = 1
 warmup = 0
 )";
-
-std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
-
-/// Runs a shell command; exit code and stdout+stderr.
-test::CliRun run_shell(const std::string& command) {
-  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-  test::CliRun r;
-  std::array<char, 1024> buf{};
-  while (pipe && std::fgets(buf.data(), buf.size(), pipe)) r.out += buf.data();
-  const int status = pipe ? ::pclose(pipe) : -1;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
 
 /// What must agree between the local and the Slurm run of a cell: everything measured, not time.
 json measured(const json& cell) {

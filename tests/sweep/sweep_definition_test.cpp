@@ -206,6 +206,110 @@ lights = [1]
   for (size_t i = 0; i < cells.size(); ++i) EXPECT_EQ(again[i].id, cells[i].id);
 }
 
+TEST(SweepDefinition, ParsesThePath) {
+  const SweepDefinition d = parse_sweep(R"([sweep]
+scenes = ["box-wall"]
+
+[path]
+frames = 12
+camera_keys = [[0, 1.2, 1.5, 0, 0.4, -2.5], [1, 1.2, 1.5, 0, 0.4, -2.5]]
+bvh = "rebuild"
+
+[path.spin]
+axis = [0, 0, 2]
+degrees_per_frame = -2.5
+pivot = [0, 0.4, -2.5]
+mesh_prefix = "box"
+)",
+                                        "def.toml");
+  ASSERT_TRUE(d.path.has_value());
+  EXPECT_EQ(d.path->frames, 12);
+  ASSERT_EQ(d.path->camera_keys.size(), 2u);
+  EXPECT_EQ(d.path->camera_keys[1].position, dvec3(1.0, 1.2, 1.5));
+  EXPECT_EQ(d.path->camera_keys[1].target, dvec3(0.0, 0.4, -2.5));
+  ASSERT_TRUE(d.path->spin.has_value());
+  EXPECT_EQ(d.path->spin->axis, dvec3(0.0, 0.0, 2.0));
+  EXPECT_EQ(d.path->spin->degrees_per_frame, -2.5);
+  ASSERT_TRUE(d.path->spin->pivot.has_value());
+  EXPECT_EQ(*d.path->spin->pivot, dvec3(0.0, 0.4, -2.5));
+  EXPECT_EQ(d.path->spin->mesh_prefix, "box");
+  EXPECT_FALSE(d.path_refit);
+
+  // Defaults: no keys, no spin, refit; no [path] at all: no frames.
+  const SweepDefinition minimal = parse_sweep("[sweep]\n[path]\nframes = 3\n[path.spin]\n", "def.toml");
+  ASSERT_TRUE(minimal.path.has_value());
+  EXPECT_TRUE(minimal.path->camera_keys.empty());
+  ASSERT_TRUE(minimal.path->spin.has_value());
+  EXPECT_EQ(minimal.path->spin->axis, dvec3(0.0, 1.0, 0.0));
+  EXPECT_EQ(minimal.path->spin->degrees_per_frame, 1.0);
+  EXPECT_FALSE(minimal.path->spin->pivot.has_value());
+  EXPECT_TRUE(minimal.path_refit);
+  EXPECT_FALSE(parse_sweep("[sweep]\n", "def.toml").path.has_value());
+}
+
+TEST(SweepDefinition, RejectsBadPaths) {
+  const struct {
+    const char* toml;
+    const char* expected;
+  } cases[] = {
+      {"[sweep]\n[path]\nframes = 3\nframe = 2\n", "def.toml:4: path.frame: unknown key; valid keys in [path]: frames"},
+      {"[sweep]\n[path]\nframes = 3\n[path.spin]\nspeed = 2\n",
+       "def.toml:5: path.spin.speed: unknown key; valid keys in [path.spin]: axis"},
+      {"[sweep]\n[path]\nframes = 0\n", "def.toml:3: path.frames: 0 is outside 1..100000"},
+      {"[sweep]\n[path]\nframes = 2.5\n", "def.toml:3: path.frames: must be an integer"},
+      {"[sweep]\n[path]\ncamera_keys = [[0, 1, 2, 0, 0, 0]]\n", "def.toml:2: path.frames: is missing"},
+      {"[sweep]\n[path]\nframes = 3\ncamera_keys = [[0, 1, 2, 0, 0]]\n",
+       "def.toml:4: path.camera_keys: must be an array of 6 numbers, e.g. [0, 1.6, 4, 0, 1, 0] (position, then "
+       "target, meters), not 5 values"},
+      {"[sweep]\n[path]\nframes = 3\ncamera_keys = [[0, 1, 2, 0, 1, 2]]\n",
+       "def.toml:4: path.camera_keys: a key pose whose target equals its position"},
+      {"[sweep]\n[path]\nframes = 3\ncamera_keys = []\n", "def.toml:4: path.camera_keys: must be a non-empty array"},
+      {"[sweep]\n[path]\nframes = 3\nbvh = \"refresh\"\n", "def.toml:4: path.bvh: 'refresh' is neither"},
+      {"[sweep]\n[path]\nframes = 3\n[path.spin]\naxis = [0, 0, 0]\n", "def.toml:5: path.spin.axis: is zero"},
+      {"[sweep]\n[path]\nframes = 3\n[path.spin]\naxis = [0, 1]\n",
+       "def.toml:5: path.spin.axis: must be an array of 3 numbers"},
+      {"[sweep]\ntruths = [\"povray\"]\n[path]\nframes = 3\n[path.spin]\n",
+       "def.toml:3: path.spin: truth 'povray' renders the scene file, which does not turn"},
+      {"[sweep]\n[path]\nframes = 3\n[path.spin]\nmesh_prefix = 4\n", "def.toml:5: path.spin.mesh_prefix: must be a string"},
+  };
+  for (const auto& c : cases) {
+    const std::string e = error_of(c.toml);
+    EXPECT_NE(e.find(c.expected), std::string::npos) << c.toml << "\n -> " << e;
+  }
+}
+
+TEST(SweepDefinition, PathExpandsEveryCombinationIntoFrames) {
+  const SweepDefinition d = parse_sweep(R"([sweep]
+scenes = ["box-wall"]
+interaxial_m = [0.05, 0.1]
+resolutions = ["64x36"]
+
+[path]
+frames = 3
+[path.spin]
+mesh_prefix = "box"
+)",
+                                        "def.toml");
+  const std::vector<validation::SweepCell> cells = validation::expand_cells(d);
+  ASSERT_EQ(cells.size(), 2u * 3u);  // 2 interaxial distances × 3 frames
+  const std::vector<std::string> ids = {
+      "box-wall|e=0.05m|c=default|64x36|lights=all|full|frame=0", "box-wall|e=0.05m|c=default|64x36|lights=all|full|frame=1",
+      "box-wall|e=0.05m|c=default|64x36|lights=all|full|frame=2", "box-wall|e=0.1m|c=default|64x36|lights=all|full|frame=0",
+      "box-wall|e=0.1m|c=default|64x36|lights=all|full|frame=1",  "box-wall|e=0.1m|c=default|64x36|lights=all|full|frame=2"};
+  for (size_t i = 0; i < cells.size(); ++i) {
+    EXPECT_EQ(cells[i].index, i);
+    EXPECT_EQ(cells[i].id, ids[i]);
+    ASSERT_TRUE(cells[i].frame.has_value());
+    EXPECT_EQ(*cells[i].frame, static_cast<int>(i % 3));
+    EXPECT_EQ(validation::cell_to_json(cells[i])["frame"], i % 3);
+  }
+  // Without a path the cells carry no frame.
+  const std::vector<validation::SweepCell> still = validation::expand_cells(parse_sweep("[sweep]\n", "def.toml"));
+  ASSERT_EQ(still.size(), 1u);
+  EXPECT_FALSE(still[0].frame.has_value());
+  EXPECT_FALSE(validation::cell_to_json(still[0]).contains("frame"));
+}
+
 TEST(SweepDefinition, ShippedDefinitionsLoad) {
   const fs::path ci = fs::path(SB_SOURCE_DIR) / "ci";
   const size_t n_pipelines = pipelines().size();
@@ -222,6 +326,8 @@ TEST(SweepDefinition, ShippedDefinitionsLoad) {
       {"presets/al-hagri-dimensions.toml", 6 * 27, 6},   // 6 scenes × 200..1500 step 50
       {"presets/al-hagri-interaxial.toml", 10, 6},       // 10..100 px
       {"presets/al-hagri-lights.toml", 10, 6},           // 1..10 lights
+      {"presets/animated-spheres.toml", 30, 6},          // 30 frames of the turning spheres
+      {"presets/wissmann-path.toml", 60, 4},             // 60 frames along the bistro path
   };
   size_t checked = 0;
   for (const auto& s : shipped) {

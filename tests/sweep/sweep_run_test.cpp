@@ -25,6 +25,7 @@ namespace sb {
 namespace {
 
 namespace fs = std::filesystem;
+using test::quoted;
 using nlohmann::json;
 
 /// Six cells at 96x54 on the box in front of a wall: 3 interaxial distances × 2 sizes.
@@ -49,8 +50,6 @@ std::vector<std::string> lines_of(const fs::path& file) {
   for (std::string line; std::getline(in, line);) out.push_back(line);
   return out;
 }
-
-std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
 
 /// What must agree between two runs of a cell: everything measured except time.
 json measured(const json& cell) {
@@ -257,6 +256,116 @@ TEST(SweepRun, SmokeSweepRunsAndEveryLineIsWellFormed) {
     }
   }
   EXPECT_NE(cells[0]["rig"]["interaxial_m"], cells[1]["rig"]["interaxial_m"]);
+}
+
+/// Three frames of the box turning about the vertical through its centre, 64x36, two pipelines.
+constexpr const char* kSpinSweep = R"([sweep]
+name = "spin"
+scenes = ["box-wall"]
+pipelines = ["plain-rt", "repro-rt"]
+resolutions = ["64x36"]
+
+[path]
+frames = 3
+bvh = "refit"
+
+[path.spin]
+axis = [0, 1, 0]
+degrees_per_frame = 20
+mesh_prefix = "box"
+
+[timing]
+repetitions = 1
+warmup = 0
+)";
+
+TEST(SweepRun, PathFramesAnimateTheSceneAndResumeMidPath) {
+  test::ScratchDir dir;
+  std::ofstream(dir / "spin.toml") << kSpinSweep;
+  const std::string run = "sweep run " + quoted(dir / "spin.toml") + " --out " + quoted(dir / "out") +
+                          " --scenes-dir " + quoted(dir / "scenes") + " --threads 1";
+  const fs::path results = dir / "out" / "results.jsonl";
+  const test::CliRun first = test::run_cli(run);
+  ASSERT_EQ(first.code, 0) << first.out;
+  const std::vector<std::string> lines = lines_of(results);
+  ASSERT_EQ(lines.size(), 3u);
+  std::vector<json> cells;
+  for (const std::string& line : lines) cells.push_back(json::parse(line));
+  for (int k = 0; k < 3; ++k) {
+    SCOPED_TRACE(k);
+    const json& c = cells[static_cast<size_t>(k)];
+    EXPECT_EQ(c["cell"]["frame"], k);
+    EXPECT_EQ(c["cell_id"], "box-wall|e=default|c=default|64x36|lights=all|full|frame=" + std::to_string(k));
+    const json& a = c["animation"];
+    EXPECT_EQ(a["frame"], k);
+    EXPECT_EQ(a["frames"], 3);
+    EXPECT_EQ(a["turning_meshes"], 1);
+    EXPECT_GT(a["bvh_update_s"].get<double>(), 0.0);
+    EXPECT_GE(a["animate_s"].get<double>(), 0.0);
+    // One process runs the frames in order: frame 0 builds the BVH, later frames refit it.
+    EXPECT_EQ(a["bvh"], k == 0 ? "build" : "refit");
+  }
+  // The box moved: the right eye of each frame differs, and with it what repro-rt gets wrong.
+  for (int k = 1; k < 3; ++k) {
+    SCOPED_TRACE(k);
+    EXPECT_NE(measured(cells[static_cast<size_t>(k)])["repro-rt"]["metrics"],
+              measured(cells[static_cast<size_t>(k - 1)])["repro-rt"]["metrics"]);
+    EXPECT_NE(test::read_text(dir / "out" / cells[static_cast<size_t>(k)]["images"]["truth_png"].get<std::string>()),
+              test::read_text(dir / "out" / cells[static_cast<size_t>(k - 1)]["images"]["truth_png"].get<std::string>()));
+  }
+
+  // Resumed mid-path: frame 2 alone, on a scene prepared anew at frame 2, measures the same.
+  std::ofstream(results, std::ios::trunc) << lines[0] << "\n" << lines[1] << "\n";
+  const test::CliRun resumed = test::run_cli(run);
+  ASSERT_EQ(resumed.code, 0) << resumed.out;
+  EXPECT_NE(resumed.out.find("2 finished already, 1 to run"), std::string::npos) << resumed.out;
+  const std::vector<std::string> after = lines_of(results);
+  ASSERT_EQ(after.size(), 3u);
+  EXPECT_EQ(after[0], lines[0]);
+  EXPECT_EQ(after[1], lines[1]);
+  const json again = json::parse(after[2]);
+  EXPECT_EQ(again["cell_id"], cells[2]["cell_id"]);
+  EXPECT_EQ(again["animation"]["bvh"], "build");  // the timing says the BVH was built, not refit
+  EXPECT_EQ(measured(again), measured(cells[2]));
+  EXPECT_EQ(again["rig"], cells[2]["rig"]);
+}
+
+TEST(SweepRun, PathCameraKeysMoveTheCamera) {
+  test::ScratchDir dir;
+  std::ofstream(dir / "walk.toml") << R"([sweep]
+name = "walk"
+scenes = ["box-wall"]
+pipelines = ["repro-rt"]
+resolutions = ["64x36"]
+
+[path]
+frames = 3
+camera_keys = [[-1, 1.2, 1.5, 0, 0.4, -2.5], [1, 1.2, 1.5, 0, 0.4, -2.5]]
+
+[timing]
+repetitions = 1
+warmup = 0
+
+[output]
+images = false
+)";
+  const test::CliRun r = test::run_cli("sweep run " + quoted(dir / "walk.toml") + " --out " + quoted(dir / "out") +
+                                       " --scenes-dir " + quoted(dir / "scenes") + " --threads 1");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const std::vector<json> cells = validation::read_results(dir / "out" / "results.jsonl").cells;
+  ASSERT_EQ(cells.size(), 3u);
+  // Two keys over three frames: x = -1, 0, 1 (linear in position); nothing turns, the BVH stays.
+  const double expected_x[] = {-1.0, 0.0, 1.0};
+  for (size_t k = 0; k < 3; ++k) {
+    SCOPED_TRACE(k);
+    const json& a = cells[k]["animation"];
+    EXPECT_NEAR(a["camera"]["position"][0].get<double>(), expected_x[k], 1e-12);
+    EXPECT_NEAR(a["camera"]["position"][1].get<double>(), 1.2, 1e-12);
+    EXPECT_EQ(a["turning_meshes"], 0);
+    EXPECT_EQ(a["bvh"], k == 0 ? "build" : "static");
+  }
+  EXPECT_NE(cells[0]["pipelines"]["repro-rt"]["validation"]["metrics"],
+            cells[2]["pipelines"]["repro-rt"]["validation"]["metrics"]);
 }
 
 TEST(SweepRun, BadDefinitionAndShardAreUsageErrors) {

@@ -1,0 +1,265 @@
+// `stereobench nightly`: one nightly run of a sweep definition: the sweep (resumable) into a run
+// folder, the gate (JUnit and JSON beside the results), one line appended to the history file, and
+// the report with trend charts over every run of the history (docs/nightly.md). Exits with the
+// gate's code (0 pass, 1 warnings, 2 failures); 3 bad input, 4 missing tool.
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <memory>
+#include <regex>
+
+#include <fmt/format.h>
+
+#include "apps/cli_common.hpp"
+#include "apps/commands.hpp"
+#include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
+#include "renderer/pipeline.hpp"
+#include "reports/report.hpp"
+#include "validation/gate.hpp"
+#include "validation/history.hpp"
+#include "validation/junit.hpp"
+#include "validation/results_file.hpp"
+#include "validation/sweep.hpp"
+#include "validation/sweep_run.hpp"
+
+namespace sb::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using namespace sb::validation;
+
+constexpr const char* kDefaultBaseline = "ci/baseline.json";
+/// Written last into a run folder: the run is complete (history line appended, report written).
+constexpr const char* kRunDoneFile = "nightly.json";
+
+struct NightlyArgs {
+  std::string definition;
+  std::string out;
+  std::string history;
+  std::string gate_config = "ci/gate.toml";
+  std::string baseline;
+  std::string cache = "out/truth-cache";
+  std::string scenes_dir;
+  int jobs = 1;
+  int threads = 0;
+};
+
+/// Run folder names: the UTC start "YYYYMMDDTHHMMSSZ", with "-N" appended when a run of the same
+/// second exists.
+const std::regex kRunIdPattern(R"((\d{4})(\d{2})(\d{2})T(\d{2})(\d{2})(\d{2})Z(-\d+)?)");
+
+std::string utc_now_id() {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  ::gmtime_r(&now, &tm);
+  std::array<char, 32> buf{};
+  std::strftime(buf.data(), buf.size(), "%Y%m%dT%H%M%SZ", &tm);
+  return buf.data();
+}
+
+/// "2026-11-21T20:00:00Z" from a run id.
+std::string run_date(const std::string& run_id) {
+  std::smatch m;
+  if (!std::regex_match(run_id, m, kRunIdPattern)) return run_id;
+  return fmt::format("{}-{}-{}T{}:{}:{}Z", m[1].str(), m[2].str(), m[3].str(), m[4].str(), m[5].str(), m[6].str());
+}
+
+std::string host_name() {
+  std::array<char, 256> buf{};
+  if (::gethostname(buf.data(), buf.size() - 1) != 0) return "unknown";
+  return buf.data();
+}
+
+/// `git rev-parse --short HEAD` in `dir`, or "unknown" (no git, not a work tree).
+std::string git_revision(const fs::path& dir) {
+  const std::string cmd = fmt::format("git -C '{}' rev-parse --short HEAD 2>/dev/null", dir.string());
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  if (pipe == nullptr) return "unknown";
+  std::string out;
+  std::array<char, 128> buf{};
+  while (std::fgets(buf.data(), buf.size(), pipe)) out += buf.data();
+  const int status = ::pclose(pipe);
+  while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
+  if (status != 0 || out.empty() || out.find_first_not_of("0123456789abcdef") != std::string::npos) return "unknown";
+  return out;
+}
+
+/// The run folder: the newest unfinished run of this definition version (resumed), else a new one.
+fs::path choose_run_dir(const fs::path& out, const SweepDefinition& d, bool* resumed) {
+  std::vector<std::string> ids;
+  std::error_code ec;
+  if (fs::is_directory(out, ec))
+    for (const fs::directory_entry& e : fs::directory_iterator(out, ec)) {
+      const std::string name = e.path().filename().string();
+      if (e.is_directory(ec) && std::regex_match(name, kRunIdPattern)) ids.push_back(name);
+    }
+  std::sort(ids.begin(), ids.end(), [](const std::string& a, const std::string& b) {
+    // "-N" suffixes order after the plain id of the same second, and numerically among themselves.
+    const std::string sa = a.substr(0, 16), sb = b.substr(0, 16);
+    if (sa != sb) return sa < sb;
+    const int na = a.size() > 17 ? std::stoi(a.substr(17)) : 1, nb = b.size() > 17 ? std::stoi(b.substr(17)) : 1;
+    return na < nb;
+  });
+  *resumed = false;
+  if (!ids.empty()) {
+    const fs::path newest = out / ids.back();
+    if (!fs::exists(newest / kRunDoneFile, ec)) {
+      const ResultsFile r = read_results(newest / "results.jsonl");
+      const bool same = r.cells.empty() || r.cells.front().value("definition_sha256", "") == d.sha256;
+      if (same) {
+        *resumed = true;
+        return newest;
+      }
+      fmt::print(stderr, "note: the unfinished run {} holds results of another version of {}; starting a new run\n",
+                 newest.string(), d.file.string());
+    }
+  }
+  const std::string base = utc_now_id();
+  std::string id = base;
+  for (int n = 2; fs::exists(out / id, ec); ++n) id = fmt::format("{}-{}", base, n);
+  fs::create_directories(out / id, ec);
+  if (ec) throw IoError(fmt::format("cannot create the run folder {}: {}", (out / id).string(), ec.message()));
+  return out / id;
+}
+
+void run_nightly(const NightlyArgs& a) {
+  if (a.jobs < 1 || a.jobs > 256) throw InputError(fmt::format("--jobs {} is outside 1..256", a.jobs));
+  const SweepDefinition d = load_sweep(a.definition);
+  const GateConfig gate_config = load_gate_config(a.gate_config);
+  const fs::path out = a.out.empty() ? fs::path("out") / "nightly" / d.name : fs::path(a.out);
+  const fs::path history_file = a.history.empty() ? out / "history.jsonl" : fs::path(a.history);
+  // Read before any cell runs: a malformed history stops the run before it costs anything.
+  const HistoryFile history_before = read_history(history_file);
+  for (const std::string& w : history_before.warnings) fmt::print(stderr, "warning: {}\n", w);
+
+  Baseline baseline;
+  std::string baseline_note;
+  const fs::path baseline_file = a.baseline.empty() ? fs::path(kDefaultBaseline) : fs::path(a.baseline);
+  if (!a.baseline.empty() || fs::exists(baseline_file))
+    baseline = load_baseline(baseline_file);
+  else
+    baseline_note = fmt::format("no baseline file {}: time regressions not checked", baseline_file.string());
+
+  // 1. The sweep, into the run folder.
+  bool resumed = false;
+  const fs::path run_dir = choose_run_dir(out, d, &resumed);
+  const std::string run_id = run_dir.filename().string();
+  SweepRunOptions o;
+  o.out_dir = run_dir;
+  o.results = run_dir / "results.jsonl";
+  o.scenes_dir = a.scenes_dir;
+  if (!a.cache.empty()) o.truth_cache = fs::path(a.cache);
+  o.definition_label = a.definition;
+  o.jobs = a.jobs;
+  o.threads = checked_threads(a.threads);
+  const SweepPlan plan = plan_sweep(d, o.results);
+  for (const std::string& w : plan.warnings) fmt::print(stderr, "warning: {}\n", w);
+  fmt::print("nightly {} run {} ({}): {} cells × {} pipelines, {} finished already, {} to run\n", d.name, run_id,
+             resumed ? "resumed" : "new", plan.cells.size(), d.pipelines.size(), plan.finished, plan.todo.size());
+  std::fflush(stdout);
+  if (!plan.todo.empty()) {
+    prepare_sweep(d, plan.cells, plan.todo, o);
+    const auto start = std::chrono::steady_clock::now();
+    run_cells(d, plan.cells, plan.todo, o, [](const CellProgress& p) {
+      fmt::print(stderr, "[{}/{}] cell {} {} done in {:.1f} s\n", p.finished, p.total, p.cell.index, p.cell.id,
+                 p.wall_s);
+      std::fflush(stderr);
+    });
+    fmt::print("ran {} cells in {:.1f} s\n", plan.todo.size(),
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+
+  // 2. The gate.
+  const GateResults results = load_gate_results(o.results);
+  ReproduceSettings reproduce;
+  for (const Pipeline* p : pipelines()) reproduce.pipeline_defaults[p->info().name] = PipelineOptions(p->info(), {}).values();
+  GateReport gate = evaluate_gate(gate_config, results, baseline, reproduce);
+  for (const std::string& w : results.warnings) gate.notes.push_back(w);
+  if (!baseline_note.empty()) gate.notes.push_back(baseline_note);
+  fmt::print("{}", format_gate_table(gate));
+  io::write_text_atomically(run_dir / "gate-junit.xml", junit_xml(gate, "stereobench nightly " + o.results.string()));
+  io::write_text_atomically(run_dir / "gate.json",
+                            gate_report_json(gate, a.gate_config, o.results.string(),
+                                             baseline_note.empty() ? baseline_file.string() : "")
+                                    .dump(2) +
+                                "\n");
+
+  // 3. The history line (once per run, also when a run killed after appending it is resumed).
+  NightlyRun run;
+  run.run_id = run_id;
+  run.date = run_date(run_id);
+  run.host = host_name();
+  run.git_revision = git_revision(fs::absolute(d.file).parent_path());
+  run.sweep = d.name;
+  run.definition = a.definition;
+  run.definition_sha256 = d.sha256;
+  const fs::path history_dir = history_file.has_parent_path() ? history_file.parent_path() : fs::path(".");
+  run.results = fs::absolute(o.results).lexically_normal().lexically_relative(fs::absolute(history_dir).lexically_normal())
+                    .generic_string();
+  std::vector<json> cells;
+  for (const GateCell& c : results.cells) cells.push_back(c.record);
+  const bool recorded = std::any_of(history_before.runs.begin(), history_before.runs.end(),
+                                    [&run_id](const json& r) { return r["run_id"] == run_id; });
+  if (recorded)
+    fmt::print(stderr, "note: {} already holds run {}; not appended again\n", history_file.string(), run_id);
+  else
+    append_history(history_file, history_entry(run, cells, gate));
+  const HistoryFile history = read_history(history_file);
+
+  // 4. The report with the trends.
+  const reports::ResultsFile report_results = reports::read_results_file(o.results);
+  reports::ReportOptions options;
+  options.out_dir = run_dir / "report";
+  options.title = fmt::format("stereobench nightly: {} {}", d.name, run.date);
+  options.history = json(history.runs);
+  const reports::ReportSummary s = reports::write_report(report_results, options);
+  for (const std::string& w : s.warnings) fmt::print(stderr, "warning: {}\n", w);
+
+  const int code = exit_code(gate.worst);
+  io::write_text_atomically(run_dir / kRunDoneFile,
+                            json{{"run_id", run_id},
+                                 {"date", run.date},
+                                 {"gate_verdict", gate_verdict(gate)},
+                                 {"exit_code", code},
+                                 {"history", history_file.string()},
+                                 {"report", s.index_html.string()}}
+                                    .dump(2) +
+                                "\n");
+  fmt::print("history {} ({} runs)\nreport {}\ngate verdict: {} (exit {})\n", history_file.string(),
+             history.runs.size(), s.index_html.string(), gate_verdict(gate), code);
+  if (code != 0) throw VerdictExit{code};
+}
+
+}  // namespace
+
+void register_nightly_command(CLI::App& root) {
+  auto a = std::make_shared<NightlyArgs>();
+  CLI::App* n = root.add_subcommand(
+      "nightly",
+      "One nightly run: the sweep (resuming the newest unfinished run) into OUT/<UTC date-time>/, the\n"
+      "gate (gate-junit.xml, gate.json there), one line appended to the history file, and the report\n"
+      "(OUT/<run>/report/) with trend charts over the history. Exit: the gate's 0/1/2; 3 bad input,\n"
+      "4 missing tool. See docs/nightly.md.");
+  n->add_option("definition", a->definition, "Sweep definition (TOML), e.g. ci/nightly.toml")->required();
+  n->add_option("--out", a->out, "Folder of the runs (default out/nightly/<sweep name>)");
+  n->add_option("--history", a->history, "History file (JSON Lines; default <out>/history.jsonl)");
+  n->add_option("--gate-config", a->gate_config, "Gate thresholds (TOML)")->capture_default_str();
+  n->add_option("--baseline", a->baseline,
+                fmt::format("Timing baseline (JSON); default {} (if absent, no regression check)", kDefaultBaseline));
+  n->add_option("--jobs,-j", a->jobs, "Cells run at once (1 keeps timings undisturbed)")->capture_default_str();
+  n->add_option("--threads,-t", a->threads, "Threads per cell (0 = the machine's cores / jobs)")->capture_default_str();
+  n->add_option("--cache", a->cache, "Folder of cached external ground-truth renders ('' to disable)")
+      ->capture_default_str();
+  add_scenes_dir_option(*n, a->scenes_dir);
+  n->callback([a] { run_nightly(*a); });
+}
+
+}  // namespace sb::cli

@@ -1,0 +1,252 @@
+// `stereobench nightly`: two runs of a tiny sweep give two run folders with results, gate files and
+// a report, two history lines with the per-pipeline medians and gate counts, and a report whose
+// Trends section has a point per run (embedded data and Chromium); a malformed history is bad input.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "support/run_cli.hpp"
+#include "support/scratch_dir.hpp"
+#include "validation/history.hpp"
+
+namespace sb {
+namespace {
+
+namespace fs = std::filesystem;
+using test::run_shell;
+using test::quoted;
+using nlohmann::json;
+
+const fs::path kSource = SB_SOURCE_DIR;
+
+void write_text(const fs::path& p, const std::string& text) {
+  fs::create_directories(p.parent_path());
+  std::ofstream(p, std::ios::binary) << text;
+}
+
+json embedded_data(const fs::path& index) {
+  const std::string html = test::read_text(index);
+  const std::string open = "<script type=\"application/json\" id=\"report-data\">";
+  const size_t a = html.find(open);
+  const size_t b = html.find("</script>", a);
+  if (a == std::string::npos || b == std::string::npos) return nullptr;
+  return json::parse(html.substr(a + open.size(), b - a - open.size()));
+}
+
+std::vector<json> json_lines(const fs::path& file) {
+  std::vector<json> out;
+  std::ifstream in(file);
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) out.push_back(json::parse(line));
+  return out;
+}
+
+/// box-wall at 64x36: the baseline and two reprojection pipelines, one repetition.
+constexpr const char* kDefinition = R"([sweep]
+name = "nightly-tiny"
+scenes = ["box-wall"]
+pipelines = ["plain-rt", "repro-rt", "repro-warp"]
+baseline = "plain-rt"
+resolutions = ["64x36"]
+truths = ["full"]
+
+[timing]
+repetitions = 1
+warmup = 0
+
+[output]
+images = true
+exr = false
+)";
+
+/// A gate both runs pass with a wide margin: the limits are a third below what the tiny sweep
+/// measures (deterministic images; timing is not gated here), so the test checks the pass path of
+/// nightly, not the pipelines' quality (tests/gate does that).
+constexpr const char* kGateConfig = R"([defaults]
+min_psnr = 20           # measured: repro-rt 39.88 dB, repro-warp 32.67 dB, plain-rt inf
+min_ssim = 0.6          # measured: repro-rt 0.9932, repro-warp 0.9892, plain-rt 1
+max_hole_fraction = 0.1 # measured: repro-rt 0.0104, repro-warp 0.0017, plain-rt 0
+)";
+
+std::string nightly_args(const test::ScratchDir& dir) {
+  return "nightly " + quoted(dir / "tiny.toml") + " --out " + quoted(dir / "runs") + " --gate-config " +
+         quoted(dir / "gate.toml") + " --baseline " + quoted(dir / "empty-baseline.json") + " --scenes-dir " +
+         quoted(dir / "scenes") + " --cache '' --threads 1";
+}
+
+TEST(NightlyTest, TwoRunsGiveHistoryGateFilesAndTrends) {
+  test::ScratchDir dir;
+  write_text(dir / "tiny.toml", kDefinition);
+  write_text(dir / "gate.toml", kGateConfig);
+  // An empty baseline: every time_regression check is a skip (no entry for the cell).
+  write_text(dir / "empty-baseline.json", "{}\n");
+
+  const test::CliRun first = test::run_cli(nightly_args(dir));
+  ASSERT_EQ(first.code, 0) << first.out;
+  const test::CliRun second = test::run_cli(nightly_args(dir));
+  ASSERT_EQ(second.code, 0) << second.out;
+  EXPECT_NE(second.out.find("gate verdict: pass (exit 0)"), std::string::npos) << second.out;
+
+  // Two complete run folders named by their UTC start.
+  std::vector<fs::path> runs;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs"))
+    if (e.is_directory()) runs.push_back(e.path());
+  std::sort(runs.begin(), runs.end());
+  ASSERT_EQ(runs.size(), 2u);
+  const std::regex run_id(R"(\d{8}T\d{6}Z(-\d+)?)");
+  for (const fs::path& r : runs) {
+    EXPECT_TRUE(std::regex_match(r.filename().string(), run_id)) << r;
+    for (const char* f : {"results.jsonl", "gate-junit.xml", "gate.json", "nightly.json", "report/index.html"})
+      EXPECT_TRUE(fs::is_regular_file(r / f)) << r / f;
+    EXPECT_EQ(json_lines(r / "results.jsonl").size(), 1u) << r;
+    const json gate = json::parse(test::read_text(r / "gate.json"));
+    EXPECT_EQ(gate["verdict"], "pass") << gate.dump(2);
+    EXPECT_NE(test::read_text(r / "gate-junit.xml").find("<testsuites"), std::string::npos);
+  }
+
+  // Two history lines, one per run, in run order, with every field.
+  const std::vector<json> history = json_lines(dir / "runs" / "history.jsonl");
+  ASSERT_EQ(history.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    const json& h = history[i];
+    EXPECT_NO_THROW(validation::check_history_line(h, "line"));
+    EXPECT_EQ(h["run_id"], runs[i].filename().string());
+    EXPECT_TRUE(std::regex_match(h["date"].get<std::string>(), std::regex(R"(\d{4}-\d{2}-\d{2}T\d{2}:\d{2}:\d{2}Z)")));
+    EXPECT_FALSE(h["host"].get<std::string>().empty());
+    // The revision of the work tree holding the definition, as git itself reports it ("unknown"
+    // where the build tree lies outside any git work tree).
+    const test::CliRun git = run_shell("git -C " + quoted(dir.path()) + " rev-parse --short HEAD 2>/dev/null");
+    std::string expected = git.code == 0 ? git.out : "unknown";
+    while (!expected.empty() && expected.back() == '\n') expected.pop_back();
+    EXPECT_EQ(h["git_revision"], expected);
+    if (git.code == 0) {
+      EXPECT_TRUE(std::regex_match(expected, std::regex("[0-9a-f]{4,40}"))) << expected;
+    }
+    EXPECT_EQ(h["sweep"], "nightly-tiny");
+    EXPECT_EQ(h["definition_sha256"].get<std::string>().size(), 64u);
+    EXPECT_EQ(h["results"], runs[i].filename().string() + "/results.jsonl");
+    EXPECT_EQ(h["cells"], 1);
+    ASSERT_EQ(h["pipelines"].size(), 3u) << h.dump(2);
+    for (const char* p : {"plain-rt", "repro-rt", "repro-warp"}) {
+      const json& s = h["pipelines"][p];
+      EXPECT_EQ(s["cells"], 1) << p;
+      EXPECT_TRUE(s["median_s"].is_number() && s["median_s"].get<double>() > 0.0) << p << s.dump();
+      EXPECT_TRUE(s["ssim"].is_number()) << p << s.dump();
+      EXPECT_TRUE(s["hole_fraction"].is_number()) << p << s.dump();
+      EXPECT_TRUE(s["speedup"].is_number()) << p << s.dump();
+    }
+    // The baseline renders the truth itself: PSNR infinite; the reprojections are finite.
+    EXPECT_EQ(h["pipelines"]["plain-rt"]["psnr"], "inf");
+    EXPECT_TRUE(h["pipelines"]["repro-rt"]["psnr"].is_number());
+    EXPECT_EQ(h["gate"]["verdict"], "pass");
+    EXPECT_EQ(h["gate"]["exit_code"], 0);
+    EXPECT_GT(h["gate"]["counts"]["pass"].get<int>(), 0);
+    EXPECT_EQ(h["gate"]["counts"]["fail"], 0);
+    EXPECT_EQ(h["gate"]["counts"]["warn"], 0);
+  }
+  EXPECT_LT(history[0]["run_id"].get<std::string>(), history[1]["run_id"].get<std::string>());
+
+  // The second run's report embeds both runs.
+  const fs::path index = runs[1] / "report" / "index.html";
+  const json data = embedded_data(index);
+  ASSERT_TRUE(data.is_object());
+  ASSERT_TRUE(data["history"].is_array());
+  ASSERT_EQ(data["history"].size(), 2u);
+  for (const json& h : data["history"]) EXPECT_TRUE(h["pipelines"]["repro-rt"]["psnr"].is_number());
+
+  // The page in Chromium: the Trends section with one table row and one point per run in each
+  // chart, every chart drawn (check_report.mjs, without the viewer's interaction).
+  const test::CliRun browser = run_shell("node " + quoted(kSource / "tests" / "report" / "check_report.mjs") + " " +
+                                         quoted(index) + " " + quoted(dir / "report.png") + " --quick");
+  EXPECT_EQ(browser.code, 0) << browser.out;
+  EXPECT_NE(browser.out.find("PSNR per run: 2 datasets of 2 points"), std::string::npos) << browser.out;
+  EXPECT_NE(browser.out.find("Median time per run: 3 datasets of 2 points"), std::string::npos) << browser.out;
+  EXPECT_NE(browser.out.find("Gate verdict per run: 4 datasets of 2 points"), std::string::npos) << browser.out;
+
+  // `stereobench report --history` gives the same section from the history file.
+  const test::CliRun report = test::run_cli("report " + quoted(runs[0] / "results.jsonl") + " --out " +
+                                            quoted(dir / "report-again") + " --history " +
+                                            quoted(dir / "runs" / "history.jsonl"));
+  ASSERT_EQ(report.code, 0) << report.out;
+  EXPECT_EQ(embedded_data(dir / "report-again" / "index.html")["history"].size(), 2u);
+}
+
+TEST(NightlyTest, ResumesAnUnfinishedRunAndRecordsItOnce) {
+  test::ScratchDir dir;
+  write_text(dir / "tiny.toml", kDefinition);
+  write_text(dir / "gate.toml", kGateConfig);
+  write_text(dir / "empty-baseline.json", "{}\n");
+  const test::CliRun first = test::run_cli(nightly_args(dir));
+  ASSERT_EQ(first.code, 0) << first.out;
+  std::vector<fs::path> runs;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs"))
+    if (e.is_directory()) runs.push_back(e.path());
+  ASSERT_EQ(runs.size(), 1u);
+  // As if killed after appending its history line: the run has no nightly.json.
+  fs::remove(runs[0] / "nightly.json");
+  const test::CliRun again = test::run_cli(nightly_args(dir));
+  ASSERT_EQ(again.code, 0) << again.out;
+  EXPECT_NE(again.out.find("run " + runs[0].filename().string() + " (resumed): 1 cells × 3 pipelines, 1 finished already, 0 to run"),
+            std::string::npos)
+      << again.out;
+  EXPECT_NE(again.out.find("not appended again"), std::string::npos) << again.out;
+  EXPECT_TRUE(fs::is_regular_file(runs[0] / "nightly.json"));
+  EXPECT_EQ(json_lines(dir / "runs" / "history.jsonl").size(), 1u);
+  size_t folders = 0;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs")) folders += e.is_directory() ? 1 : 0;
+  EXPECT_EQ(folders, 1u);
+}
+
+TEST(NightlyTest, FailingGateExitsTwoAndIsRecorded) {
+  test::ScratchDir dir;
+  write_text(dir / "tiny.toml", kDefinition);
+  // 45 dB is above both reprojections' PSNR (39.88 and 32.67 dB measured); plain-rt is inf.
+  write_text(dir / "gate.toml", "[defaults]\nmin_psnr = 45\n");
+  write_text(dir / "empty-baseline.json", "{}\n");
+  const test::CliRun r = test::run_cli(nightly_args(dir));
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("gate verdict: fail (exit 2)"), std::string::npos) << r.out;
+  const std::vector<json> history = json_lines(dir / "runs" / "history.jsonl");
+  ASSERT_EQ(history.size(), 1u);
+  EXPECT_EQ(history[0]["gate"]["verdict"], "fail");
+  EXPECT_EQ(history[0]["gate"]["exit_code"], 2);
+  EXPECT_EQ(history[0]["gate"]["counts"]["fail"], 2);  // the PSNR of repro-rt and repro-warp
+  EXPECT_EQ(history[0]["gate"]["counts"]["pass"], 1);  // plain-rt's infinite PSNR
+}
+
+TEST(NightlyTest, MalformedHistoryIsBadInputNamingFileAndLine) {
+  test::ScratchDir dir;
+  write_text(dir / "tiny.toml", kDefinition);
+  write_text(dir / "gate.toml", kGateConfig);
+  write_text(dir / "empty-baseline.json", "{}\n");
+  const fs::path history = dir / "runs" / "history.jsonl";
+  write_text(history, "\n{\"kind\": \"stereobench.nightly_run\", \"schema_version\": 1}\n");
+  const test::CliRun r = test::run_cli(nightly_args(dir) + " --history " + quoted(history));
+  EXPECT_EQ(r.code, 3) << r.out;
+  EXPECT_NE(r.out.find(history.string() + ":2:"), std::string::npos) << r.out;
+  // Read before the sweep: nothing ran.
+  size_t run_folders = 0;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs")) run_folders += e.is_directory() ? 1 : 0;
+  EXPECT_EQ(run_folders, 0u);
+
+  // `report --history` reads the history before the results: the message names the history's line.
+  write_text(history, "not json\n");
+  const test::CliRun r2 = test::run_cli("report " + quoted(dir / "none.jsonl") + " --out " + quoted(dir / "rep") +
+                                        " --history " + quoted(history));
+  EXPECT_EQ(r2.code, 3) << r2.out;
+  EXPECT_NE(r2.out.find(history.string() + ":1:"), std::string::npos) << r2.out;
+}
+
+}  // namespace
+}  // namespace sb

@@ -1,0 +1,59 @@
+// The history file of nightly runs (docs/nightly.md): JSON Lines, one line per finished run with
+// per-pipeline medians over the run's cells and the gate's verdict counts, appended atomically and
+// read back for the report's trend charts.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "validation/gate.hpp"
+
+namespace sb::validation {
+
+/// The `kind` and schema version of a history line.
+inline constexpr const char* kHistoryKind = "stereobench.nightly_run";
+inline constexpr int kHistorySchemaVersion = 1;
+
+/// What identifies one nightly run.
+struct NightlyRun {
+  std::string run_id;             ///< the run folder's name, "20261121T200000Z"
+  std::string date;               ///< UTC start, ISO 8601 "2026-11-21T20:00:00Z"
+  std::string host;               ///< the machine that ran it
+  std::string git_revision;       ///< `git rev-parse --short HEAD`, or "unknown"
+  std::string sweep;              ///< the definition's name
+  std::string definition;         ///< its path as given
+  std::string definition_sha256;  ///< of its bytes
+  std::string results;            ///< the results file, relative to the history file's folder
+};
+
+/// The history line of a run: `run` plus, per pipeline (by name), the medians over the run's cells
+/// of PSNR ("inf" when infinite), SSIM, hole fraction, time (median_s) and speed-up over the
+/// baseline, with the number of cells; and the gate's verdict ("pass", "warn", "fail") and counts
+/// per verdict. A value no cell has is null.
+[[nodiscard]] nlohmann::json history_entry(const NightlyRun& run, const std::vector<nlohmann::json>& cells,
+                                           const GateReport& gate);
+
+/// The verdict of a whole gate run as a word: "pass" (exit 0, skipped checks included), "warn" (1)
+/// or "fail" (2).
+[[nodiscard]] const char* gate_verdict(const GateReport& gate) noexcept;
+
+/// Checks one parsed history line; InputError prefixed with `where` ("FILE:LINE") naming the field.
+void check_history_line(const nlohmann::json& line, const std::string& where);
+
+/// Reads a history file: a missing file reads as empty; an unterminated last line (a writer killed
+/// mid-write) is skipped with a warning; any other line that is not valid JSON or not a history
+/// line of this schema, or a run_id seen twice, is an InputError naming the file and line.
+struct HistoryFile {
+  std::vector<nlohmann::json> runs;   ///< in file order
+  std::vector<std::string> warnings;  ///< "FILE:LINE: ..." for a skipped torn last line
+};
+[[nodiscard]] HistoryFile read_history(const std::filesystem::path& file);
+
+/// Appends one run's line atomically (append_result: one write under a lock, fsync). The line is
+/// checked first (check_history_line).
+void append_history(const std::filesystem::path& file, const nlohmann::json& entry);
+
+}  // namespace sb::validation
