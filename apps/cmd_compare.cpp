@@ -113,7 +113,11 @@ int run_compare(const CompareArgs& a) {
 
   validation::MetricOptions options;
   options.error_threshold = a.error_threshold;
-  const ImageMetrics m = validation::compare_images(fa.image, fb.image, region, options);
+  // The SSIM map is computed once, for the metrics and the picture.
+  validation::SsimMap ssim;
+  const validation::RegionMask* const regions[] = {region};
+  const ImageMetrics m =
+      validation::compare_regions(fa.image, fb.image, regions, options, a.ssim_map.empty() ? nullptr : &ssim).front();
   const bool ssim_limited = a.fail_ssim || a.warn_ssim;
   if (ssim_limited && std::isnan(m.ssim))
     throw InputError(
@@ -136,7 +140,7 @@ int run_compare(const CompareArgs& a) {
   // Pictures first, so that a failing comparison still leaves them to look at.
   if (!a.diff.empty()) validation::write_png(a.diff, validation::difference_image(fa.image, fb.image, region));
   if (!a.ssim_map.empty())
-    validation::write_png(a.ssim_map, validation::ssim_image(validation::ssim_map(fa.image, fb.image), region));
+    validation::write_png(a.ssim_map, validation::ssim_image(ssim, region));
 
   if (!a.json.empty()) {
     nlohmann::json record;

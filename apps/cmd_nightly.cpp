@@ -181,8 +181,7 @@ void run_nightly(const NightlyArgs& a) {
   const GateResults results = load_gate_results(o.results);
   ReproduceSettings reproduce;
   for (const Pipeline* p : pipelines()) reproduce.pipeline_defaults[p->info().name] = PipelineOptions(p->info(), {}).values();
-  GateReport gate = evaluate_gate(gate_config, results, baseline, reproduce);
-  for (const std::string& w : results.warnings) gate.notes.push_back(w);
+  GateReport gate = evaluate_gate(gate_config, results, baseline, reproduce);  // notes the read warnings
   if (!baseline_note.empty()) gate.notes.push_back(baseline_note);
   fmt::print("{}", format_gate_table(gate));
   io::write_text_atomically(run_dir / "gate-junit.xml", junit_xml(gate, "stereobench nightly " + o.results.string()));

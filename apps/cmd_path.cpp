@@ -70,7 +70,13 @@ void run_path_command(const PathArgs& a) {
   validation::PathRun run;
   run.path.frames = a.frames;
   if (!a.camera_keys.empty()) run.path.camera_keys = parse_camera_keys(a.camera_keys);
-  if (a.spin_deg) run.path.spin = Spin{parse_axis(a.spin_axis), std::nullopt, *a.spin_deg, a.spin_prefix};
+  if (a.spin_deg) {
+    // Blender imports the scene file, which does not turn; full and povray render the moved scene.
+    if (a.truth == "blender")
+      throw InputError("--spin-deg with --truth blender: Blender renders the scene file, which does not turn; "
+                       "use --truth full or povray");
+    run.path.spin = Spin{parse_axis(a.spin_axis), std::nullopt, *a.spin_deg, a.spin_prefix};
+  }
   run.path.validate();
   const RigOverrides overrides = a.rig.overrides();
   for (const std::string& name : a.pipelines) run.pipelines.push_back(&find_pipeline(name));

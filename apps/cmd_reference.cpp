@@ -126,7 +126,10 @@ void run_list(const ReferenceArgs& a) {
   fmt::print("{} reference(s) in {}\n", ids.size(), store.root().string());
   for (const std::string& id : ids) {
     const json p = store.provenance(id);
-    fmt::print("  {:<48} {:<22} {}\n", id, p.at("provider").value("tool_version", "?"), p.value("date", "?"));
+    const nlohmann::json& provider = p.value("provider", nlohmann::json::object());
+    fmt::print("  {:<48} {:<22} {}\n", id,
+               provider.is_object() ? provider.value("tool_version", std::string("?")) : std::string("?"),
+               p.value("date", std::string("?")));
   }
 }
 

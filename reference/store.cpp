@@ -247,7 +247,9 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
   const ReferenceSpec spec = spec_of(id);
   const Prepared p = prepare(spec, scenes_dir);
   const std::string scene_hash = validation::hash_scene(p.loaded.scene);
-  const std::string recorded_scene = prov.at("scene").value("content_sha256", "");
+  const json& scene_record = prov.value("scene", json::object());
+  const std::string recorded_scene =
+      scene_record.is_object() ? scene_record.value("content_sha256", std::string()) : std::string();
   if (scene_hash != recorded_scene) {
     r.status = Status::scene_changed;
     r.detail = fmt::format("scene '{}' ({}) now hashes to {}, the reference was rendered from {}; regenerate it",

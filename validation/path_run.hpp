@@ -1,4 +1,4 @@
-// Validation along a path of frames (DESIGN §7, issue "sweeps": camera paths and animation): per
+// Validation along a path of frames (DESIGN §7, camera paths and animation): per
 // frame the scene is animated, its BVH refit or rebuilt (timed as its own stage), the ground truth
 // and true disocclusions computed, and every pipeline rendered and measured.
 #pragma once

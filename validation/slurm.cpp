@@ -480,7 +480,7 @@ size_t collect_slurm_results(const SweepDefinition& d, const SlurmSubmission& su
   std::vector<fs::path> files;
   for (size_t t = 0; t < sub.shards; ++t) {
     if (!fs::exists(sub.layout.results(t)))
-      throw InputError(fmt::format("{}: results of task {} missing; the task did not finish",
+      throw ToolError(fmt::format("{}: results of task {} missing; the task did not finish (see its logs)",
                                    sub.layout.results(t).string(), t));
     files.push_back(sub.layout.results(t));
   }

@@ -281,13 +281,14 @@ void parse_path(const Where& where, const toml::node& node, SweepDefinition& d) 
   } catch (const InputError& e) {
     where.fail(node, "path", e.what());
   }
-  // External renderers import the scene file, which does not move: a spin needs the built-in truth.
+  // Blender imports the scene file, which does not move (the full and povray truths render the
+  // scene as animated in memory): a spin cannot use it.
   if (path.spin)
     for (const std::string& truth : d.truths)
-      if (truth != "full")
+      if (truth == "blender")
         where.fail(node, "path.spin",
                    fmt::format("truth '{}' renders the scene file, which does not turn; a spinning path needs "
-                               "truths = [\"full\"]",
+                               "truths \"full\" or \"povray\"",
                                truth));
   d.path = path;
 }

@@ -58,7 +58,7 @@ void cull_back_faces(const RTCFilterFunctionNArguments* args) {
 }  // namespace
 
 RayScene::RayScene(const SceneGeometry& geometry, bool refittable)
-    : impl_(std::make_unique<Impl>()), refittable_(refittable) {
+    : impl_(std::make_unique<Impl>()) {
   const auto t0 = std::chrono::steady_clock::now();
   impl_->geometry = &geometry;
   impl_->device = rtcNewDevice("verbose=0");

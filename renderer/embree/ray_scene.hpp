@@ -50,7 +50,6 @@ class RayScene {
   /// After the scene's vertex positions changed in place (same meshes, same topology): copies
   /// them into the BVH's buffers and refits (refittable) or rebuilds it. Returns the seconds taken.
   double update();
-  [[nodiscard]] bool refittable() const { return refittable_; }
 
   [[nodiscard]] double build_seconds() const { return build_seconds_; }
   /// Peak bytes Embree allocated for the scene (BVH and geometry buffers).
@@ -63,7 +62,6 @@ class RayScene {
   std::unique_ptr<Impl> impl_;
   double build_seconds_ = 0.0;
   size_t memory_bytes_ = 0;
-  bool refittable_ = false;
 };
 
 }  // namespace sb

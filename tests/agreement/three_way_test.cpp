@@ -1,5 +1,4 @@
-// Three-way agreement of the ground-truth providers (DESIGN §6.1, issue "validation layer" item
-// 5): `full`, `blender` and `povray` render the right eye of every untextured built-in scene at
+// Three-way agreement of the ground-truth providers (DESIGN §6.1): `full`, `blender` and `povray` render the right eye of every untextured built-in scene at
 // 640x360, and each pair must agree to PSNR >= 45 dB (8-bit sRGB) with a mean absolute difference
 // of at most 0.5 % of the mean over lit pixels. The textured plane is reported, not gated: the
 // three filter textures differently (trilinear mip-mapping here, none in Cycles or POV-Ray).
@@ -33,7 +32,9 @@ namespace fs = std::filesystem;
 constexpr int kWidth = 640, kHeight = 360;
 /// Lit pixels: the largest channel of either image above 1e-3 (linear radiance).
 constexpr float kLitThreshold = 1e-3f;
-// The issue's thresholds, the same for every pair and scene.
+// The required agreement, the same for every pair and scene. Measured (worst pair): spheres
+// 47.22 dB / 0.069 %, dragon 50.09 dB / 0.048 %, the analytic scenes 68 dB and up / 0.018 %
+// (docs/ground_truth.md).
 constexpr double kMinPsnr = 45.0;          // dB, 8-bit sRGB
 constexpr double kMaxRelativeMad = 0.005;  // mean |a - b| / mean(b) over lit pixels
 

@@ -37,6 +37,7 @@ TEST(PathCommand, FramesWithSpinAndCameraKeys) {
   for (const json& f : frames) {
     EXPECT_EQ(f["pipelines"]["plain-rt"]["metrics"]["psnr"], "inf") << "plain-rt is the built-in ground truth";
     EXPECT_GT(f["pipelines"]["repro-rt"]["total_s"].get<double>(), 0.0);
+    // Measured 38.4-43.5 dB over the three frames; below 30 dB the frame's truth or rig is wrong.
     EXPECT_GT(f["pipelines"]["repro-rt"]["metrics"]["psnr"].get<double>(), 30.0);
   }
 }
@@ -47,6 +48,7 @@ TEST(PathCommand, BadInput) {
   EXPECT_EQ(test::run_cli(args(dir) + " --frames 0").code, 3);
   EXPECT_EQ(test::run_cli(args(dir) + " --camera-keys '1,2,3'").code, 3);
   EXPECT_EQ(test::run_cli(args(dir) + " --spin-deg 5 --spin-prefix nothing-like-this").code, 3);
+  EXPECT_EQ(test::run_cli(args(dir) + " --spin-deg 5 --truth blender").code, 3);
 }
 
 }  // namespace

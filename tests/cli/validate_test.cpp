@@ -37,9 +37,9 @@ TEST(Validate, WritesRecordsImagesAndTable) {
   EXPECT_TRUE(plain["regions"]["reprojected"]["psnr"].is_null());
 
   const json repro = json::parse(test::read_text(out / "box-wall_full_repro-rt.json"));
-  EXPECT_GT(repro["regions"]["reprojected"]["pixels"].get<int>(), 10000);
+  EXPECT_GT(repro["regions"]["reprojected"]["pixels"].get<int>(), 10000);  // 14254 of 14400 measured
   EXPECT_GT(repro["holes"]["true_disocclusions"]["pixels"].get<int>(), 0);
-  EXPECT_GT(repro["holes"]["not_reprojected"]["recall"].get<double>(), 0.9);
+  EXPECT_GT(repro["holes"]["not_reprojected"]["recall"].get<double>(), 0.9);  // measured 1.0
   EXPECT_EQ(repro["regions"]["true_disocclusions"]["pixels"], repro["holes"]["true_disocclusions"]["pixels"]);
   EXPECT_GT(repro["total_s"].get<double>(), 0.0);
   EXPECT_FALSE(repro["metrics_version"].get<std::string>().empty());
@@ -74,7 +74,7 @@ TEST(Validate, PipelineOptionsApplyAndAreChecked) {
   const json record = json::parse(test::read_text(dir / "out" / "box-wall_full_repro-rt.json"));
   EXPECT_EQ(record["options"]["discontinuity_px"], "1000000");
   // Without disocclusion detection the hole mask misses most true disocclusions.
-  EXPECT_LT(record["holes"]["not_reprojected"]["recall"].get<double>(), 0.9);
+  EXPECT_LT(record["holes"]["not_reprojected"]["recall"].get<double>(), 0.9);  // measured 0.773 (1.0 with defaults)
   const test::CliRun undeclared = test::run_cli(base_args(dir) + " --pipelines plain-rt --option discontinuity_px=1");
   EXPECT_EQ(undeclared.code, 3) << undeclared.out;
   EXPECT_NE(undeclared.out.find("discontinuity_px"), std::string::npos) << undeclared.out;

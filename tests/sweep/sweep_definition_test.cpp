@@ -268,8 +268,8 @@ TEST(SweepDefinition, RejectsBadPaths) {
       {"[sweep]\n[path]\nframes = 3\n[path.spin]\naxis = [0, 0, 0]\n", "def.toml:5: path.spin.axis: is zero"},
       {"[sweep]\n[path]\nframes = 3\n[path.spin]\naxis = [0, 1]\n",
        "def.toml:5: path.spin.axis: must be an array of 3 numbers"},
-      {"[sweep]\ntruths = [\"povray\"]\n[path]\nframes = 3\n[path.spin]\n",
-       "def.toml:3: path.spin: truth 'povray' renders the scene file, which does not turn"},
+      {"[sweep]\ntruths = [\"blender\"]\n[path]\nframes = 3\n[path.spin]\n",
+       "def.toml:3: path.spin: truth 'blender' renders the scene file, which does not turn"},
       {"[sweep]\n[path]\nframes = 3\n[path.spin]\nmesh_prefix = 4\n", "def.toml:5: path.spin.mesh_prefix: must be a string"},
   };
   for (const auto& c : cases) {

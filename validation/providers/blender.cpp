@@ -40,7 +40,7 @@ constexpr const char* kExecutableVariable = "STEREOBENCH_BLENDER";
 
 // Calibration (docs/truth_blender.md). A Cycles point light of power P watts and radius 0 has
 // radiant intensity P / (4 pi) W/sr; a sun of strength S gives irradiance S W/m^2 on a surface
-// facing it. Both verified to float precision by tests/blender/lit_plane_test.cpp.
+// facing it. Both verified to float precision by the BlenderCalibration tests (tests/blender).
 constexpr double kPointPowerPerIntensity = 4.0 * kPi;
 constexpr double kSunStrengthPerIrradiance = 1.0;
 /// Sensor height of the exported camera; any value works, the lens is scaled with it.
@@ -66,7 +66,7 @@ struct ProcessResult {
 /// cannot be started.
 ProcessResult run_process(const std::vector<std::string>& argv) {
   int pipe_fds[2];
-  if (::pipe(pipe_fds) != 0)
+  if (::pipe2(pipe_fds, O_CLOEXEC) != 0)  // not inherited by renderers other workers start
     throw ToolError(fmt::format("cannot create a pipe to run {}: {}", argv.at(0), std::strerror(errno)));
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
