@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "support/run_cli.hpp"
+#include "support/report_support.hpp"
 #include "support/scratch_dir.hpp"
 #include "validation/history.hpp"
 
@@ -26,23 +27,11 @@ namespace {
 namespace fs = std::filesystem;
 using test::run_shell;
 using test::quoted;
+using test::embedded_data;
+using test::write_text;
 using nlohmann::json;
 
 const fs::path kSource = SB_SOURCE_DIR;
-
-void write_text(const fs::path& p, const std::string& text) {
-  fs::create_directories(p.parent_path());
-  std::ofstream(p, std::ios::binary) << text;
-}
-
-json embedded_data(const fs::path& index) {
-  const std::string html = test::read_text(index);
-  const std::string open = "<script type=\"application/json\" id=\"report-data\">";
-  const size_t a = html.find(open);
-  const size_t b = html.find("</script>", a);
-  if (a == std::string::npos || b == std::string::npos) return nullptr;
-  return json::parse(html.substr(a + open.size(), b - a - open.size()));
-}
 
 std::vector<json> json_lines(const fs::path& file) {
   std::vector<json> out;

@@ -21,6 +21,7 @@
 #include "renderer/render_scene.hpp"
 #include "scenes/catalog.hpp"
 #include "support/render_support.hpp"
+#include "support/scoped_env.hpp"
 #include "support/scratch_dir.hpp"
 #include "validation/truth.hpp"
 
@@ -49,29 +50,7 @@ TruthRender render_truth(const TruthProvider& provider, const RenderScene& scene
   return provider.render(request);
 }
 
-/// Sets an environment variable (or removes it, for nullopt) until the end of the scope.
-class ScopedEnv {
- public:
-  ScopedEnv(std::string name, const std::optional<std::string>& value) : name_(std::move(name)) {
-    if (const char* old = std::getenv(name_.c_str())) old_ = old;
-    if (value)
-      ::setenv(name_.c_str(), value->c_str(), 1);
-    else
-      ::unsetenv(name_.c_str());
-  }
-  ScopedEnv(const ScopedEnv&) = delete;
-  ScopedEnv& operator=(const ScopedEnv&) = delete;
-  ~ScopedEnv() {
-    if (old_)
-      ::setenv(name_.c_str(), old_->c_str(), 1);
-    else
-      ::unsetenv(name_.c_str());
-  }
-
- private:
-  std::string name_;
-  std::optional<std::string> old_;
-};
+using test::ScopedEnv;
 
 // ---------------------------------------------------------------------------------------------
 // Calibration: the lit plane against the closed form of DESIGN §3.

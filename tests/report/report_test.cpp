@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "support/run_cli.hpp"
+#include "support/report_support.hpp"
 #include "support/scratch_dir.hpp"
 
 namespace sb {
@@ -26,26 +27,13 @@ namespace {
 namespace fs = std::filesystem;
 using test::run_shell;
 using test::quoted;
+using test::embedded_data;
+using test::write_text;
 using nlohmann::json;
 
 const fs::path kSource = SB_SOURCE_DIR;
 constexpr const char* kInstallHint = "install them with `ci/install-deps.sh chromium` (Debian chromium, node, and the "
                                      "npm packages of ci/package.json)";
-
-void write_text(const fs::path& p, const std::string& text) {
-  fs::create_directories(p.parent_path());
-  std::ofstream(p, std::ios::binary) << text;
-}
-
-/// The data a report embeds (script#report-data of index.html).
-json embedded_data(const fs::path& index) {
-  const std::string html = test::read_text(index);
-  const std::string open = "<script type=\"application/json\" id=\"report-data\">";
-  const size_t a = html.find(open);
-  const size_t b = html.find("</script>", a);
-  if (a == std::string::npos || b == std::string::npos) return nullptr;
-  return json::parse(html.substr(a + open.size(), b - a - open.size()));
-}
 
 /// Fails (never skips) when the browser side is missing, naming the install command.
 void require_browser_tools() {
