@@ -210,6 +210,20 @@ std::string presets_help() {
   return text;
 }
 
+nlohmann::json preset_json(const PresetRun& run, const Executor& executor) {
+  return {{"preset", run.preset->name},
+          {"summary", run.preset->summary},
+          {"pipelines", run.config.pipelines},
+          {"baseline", run.config.baseline},
+          {"warmup", run.config.warmup},
+          {"repetitions", run.config.repetitions},
+          {"threads", executor.threads()},
+          {"rows_per_series", run.rows_per_series},
+          {"complete", false},
+          {"rows", nlohmann::json::array()},
+          {"versions", io::versions_json()}};
+}
+
 void run_bench_preset(const PresetRun& run, const Executor& executor) {
   const BenchPreset& preset = *run.preset;
   run.config.validate();  // before any scene is generated or loaded
@@ -236,17 +250,7 @@ void run_bench_preset(const PresetRun& run, const Executor& executor) {
   fmt::print("speed-up = median over repetitions of {}'s total / the pipeline's total, paired per repetition\n",
              run.config.baseline);
 
-  nlohmann::json out = {{"preset", preset.name},
-                        {"summary", preset.summary},
-                        {"pipelines", run.config.pipelines},
-                        {"baseline", run.config.baseline},
-                        {"warmup", run.config.warmup},
-                        {"repetitions", run.config.repetitions},
-                        {"threads", executor.threads()},
-                        {"rows_per_series", run.rows_per_series},
-                        {"complete", false},
-                        {"rows", nlohmann::json::array()},
-                        {"versions", io::versions_json()}};
+  nlohmann::json out = preset_json(run, executor);
   const auto write_json = [&] {
     if (!run.json_out.empty()) io::write_text_atomically(run.json_out, out.dump(2) + "\n");
   };

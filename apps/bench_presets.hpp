@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "renderer/error.hpp"
+#include <nlohmann/json.hpp>
+
 #include "renderer/parallel.hpp"
 #include "renderer/rig.hpp"
 #include "validation/benchmark.hpp"
@@ -182,5 +184,9 @@ struct MeasuredPeak {
   }
   return first;
 }
+
+/// The head of a preset's JSON file (preset, pipelines, baseline, repetitions, threads, versions),
+/// with "complete": false and no rows yet.
+[[nodiscard]] nlohmann::json preset_json(const PresetRun& run, const Executor& executor);
 
 }  // namespace sb::cli

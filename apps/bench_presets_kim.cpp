@@ -104,21 +104,6 @@ StereoRig row_rig(const Scene& scene, const PresetRun& run, const PresetRow& row
   return resolve_rig(scene, o);
 }
 
-/// The JSON head both Kim presets share.
-nlohmann::json preset_json(const PresetRun& run, const Executor& executor) {
-  return {{"preset", run.preset->name},
-          {"summary", run.preset->summary},
-          {"pipelines", run.config.pipelines},
-          {"baseline", run.config.baseline},
-          {"warmup", run.config.warmup},
-          {"repetitions", run.config.repetitions},
-          {"threads", executor.threads()},
-          {"rows_per_series", run.rows_per_series},
-          {"complete", false},
-          {"rows", nlohmann::json::array()},
-          {"versions", io::versions_json()}};
-}
-
 nlohmann::json scene_json(const Scene& scene, const PresetRow& row) {
   return {{"name", scene.name},
           {"path", scene.path},
