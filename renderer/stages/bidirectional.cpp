@@ -48,6 +48,9 @@ Image partial_eye(const RenderScene& scene, const StereoRig& rig, Eye which, con
 std::vector<OptionSpec> bidir_option_specs() {
   return {tile_option_spec(),
           {"max_crack", "2", "widest run of hole pixels in a row filled by linear interpolation after the composition"},
+          {"crack_depth", "1.01",
+           "a run of at most max_crack pixels deeper than this factor times the depth on both sides is a crack "
+           "(a farther surface showing through the warped one) and is filled; 0 turns this off"},
           {"segment", "256", "target-row segment length of the row warp in pixels (the image does not depend on it)"},
           {"partials", "false", "also output each eye's partial image (<stem>_left_partial.png, <stem>_right_partial.png)"}};
 }
@@ -60,6 +63,10 @@ BidirSettings BidirSettings::from(const std::string& pipeline, const PipelineOpt
   s.keep_partials = options.get_bool("partials");
   if (s.warp.segment < 1)
     throw InputError(fmt::format("{}: option segment={} must be at least 1 pixel", pipeline, s.warp.segment));
+  s.crack_depth_ratio = options.get_double("crack_depth");
+  if (!(s.crack_depth_ratio == 0.0 || (s.crack_depth_ratio >= 1.0 && s.crack_depth_ratio <= 100.0)))
+    throw InputError(fmt::format("{}: option crack_depth={} must be 0 (off) or lie in [1, 100]", pipeline,
+                                 s.crack_depth_ratio));
   return s;
 }
 
@@ -100,6 +107,12 @@ void render_bidirectional(const RenderScene& scene, const StereoRig& rig, const 
   CrackFillStats cracks_right, cracks_left;
   {
     ScopedStage stage(r.timings, "crack_fill");
+    if (settings.crack_depth_ratio > 0.0) {
+      r.counters.set("depth_cracks_right",
+                     mark_depth_cracks(r.right, settings.max_crack, settings.crack_depth_ratio, executor));
+      r.counters.set("depth_cracks_left",
+                     mark_depth_cracks(r.left, settings.max_crack, settings.crack_depth_ratio, executor));
+    }
     cracks_right = fill_cracks(r.right, settings.max_crack, executor);
     cracks_left = fill_cracks(r.left, settings.max_crack, executor);
   }

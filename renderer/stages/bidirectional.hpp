@@ -16,6 +16,7 @@ namespace sb {
 struct BidirSettings {
   RasterOptions raster;
   int max_crack = 2;
+  double crack_depth_ratio = 1.01;  ///< mark_depth_cracks before the fill; 0 = off
   RowWarpOptions warp{256, false};  ///< partial images: only surfaces are warped
   bool keep_partials = false;       ///< add the partial images to the result's extras
 

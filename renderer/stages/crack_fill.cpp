@@ -4,20 +4,81 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
+#include "renderer/stages/eye_image.hpp"
 
 namespace sb {
 
-CrackFillStats fill_cracks(Image& image, int max_width, const Executor& executor) {
+namespace {
+
+void require_crack_planes(const Image& image, int max_width) {
   if (max_width < 0)
     throw InputError(fmt::format("crack fill: max width {} must be 0 or more pixels", max_width));
   for (std::string_view name :
        {planes::rgb, planes::depth, planes::normal, planes::albedo, planes::primid, planes::source})
     if (!image.has_plane(name))
       throw InputError(fmt::format("crack fill: the image has no '{}' plane (it has {})", name, image.plane_list()));
+}
+
+}  // namespace
+
+uint64_t mark_depth_cracks(Image& image, int max_width, double depth_ratio, const Executor& executor) {
+  require_crack_planes(image, max_width);
+  if (!(depth_ratio >= 1.0 && depth_ratio < 1e6))
+    throw InputError(fmt::format("crack fill: depth ratio {} must be 1 or more", depth_ratio));
+  const float* depth = image.data_f32(planes::depth);
+  const uint32_t* tag = image.data_u32(planes::source);
+  EyeWriter out(image);
+  const int w = image.width(), h = image.height();
+  const auto hole = static_cast<uint32_t>(Source::hole);
+  const auto bound = [&](size_t i) { return tag[i] != hole && std::isfinite(depth[i]); };
+  std::atomic<uint64_t> marked{0};
+  executor.for_range(static_cast<size_t>(h), 4, [&](size_t begin, size_t end) {
+    uint64_t n_marked = 0;
+    std::vector<size_t> deeper;
+    for (size_t y = begin; y < end; ++y) {
+      const size_t row = y * static_cast<size_t>(w);
+      int a = 1;
+      while (a < w) {
+        const size_t l = row + a - 1;
+        if (!bound(l)) {
+          ++a;
+          continue;
+        }
+        // The run [a, b) of pixels that are holes or deeper than L, at most max_width + 1 long.
+        const double left_limit = depth[l] * depth_ratio;
+        int b = a;
+        while (b < w && b - a <= max_width && (tag[row + b] == hole || depth[row + b] > left_limit)) ++b;
+        if (b == a || b - a > max_width || b == w || !bound(row + b)) {
+          a = std::max(a + 1, b);
+          continue;
+        }
+        const double right_limit = depth[row + b] * depth_ratio;
+        deeper.clear();
+        bool crack = true;
+        for (int k = a; k < b && crack; ++k) {
+          if (tag[row + k] == hole) continue;
+          crack = depth[row + k] > right_limit;
+          deeper.push_back(row + k);
+        }
+        if (crack && !deeper.empty()) {
+          for (const size_t i : deeper) out.hole(i);
+          n_marked += deeper.size();
+        }
+        a = b + 1;
+      }
+    }
+    marked += n_marked;
+  });
+  return marked;
+}
+
+CrackFillStats fill_cracks(Image& image, int max_width, const Executor& executor) {
+  require_crack_planes(image, max_width);
   float* rgb = image.data_f32(planes::rgb);
   float* depth = image.data_f32(planes::depth);
   float* normal = image.data_f32(planes::normal);

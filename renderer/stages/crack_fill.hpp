@@ -44,6 +44,18 @@ struct CrackFillStats {
 /// InputError for a negative max_width or a missing plane.
 CrackFillStats fill_cracks(Image& image, int max_width, const Executor& executor);
 
+/// Kim's crack detection by depth (§3.2: a crack shows a surface farther than the pixels around
+/// it). In a composed image a narrow sliver of a farther surface can show through where the
+/// nearer surface warped in from the other eye leaves a gap. Per row, a run of at most max_width
+/// pixels, each a hole or deeper than `depth_ratio` times the depth of both pixels bounding the
+/// run, with at least one such deeper non-hole pixel, between two non-hole pixels of finite depth,
+/// is turned into holes (radiance 0, depth +inf, tag `hole`) for fill_cracks to fill. Runs are
+/// found left to right; a run's right bound may be the next run's left bound. Every other
+/// pixel is left as it is. Rows run in parallel, each reading and writing only itself. Returns the
+/// pixels turned into holes. InputError for a negative max_width, a depth_ratio below 1 or a
+/// missing plane.
+uint64_t mark_depth_cracks(Image& image, int max_width, double depth_ratio, const Executor& executor);
+
 /// The "max_crack" option of the pipelines that fill cracks, checked (0..64; InputError naming
 /// the pipeline otherwise).
 [[nodiscard]] int max_crack_option(const std::string& pipeline, const PipelineOptions& options);

@@ -26,11 +26,15 @@ class FocalDistance : public ::testing::TestWithParam<double> {};
 
 /// SSIM floors of bidir-warp's right eye, just under the values measured here; the aim is 0.99
 /// (the thesis: 0.994, 0.998, 0.995). What remains: pixels moved to the nearest pixel centre on
-/// textured stone and cloth (no resampling), and disocclusions wider than the 2-px crack fill,
-/// which show the background colour.
+/// textured stone and cloth (no resampling), silhouettes of warped surfaces off by up to half a
+/// pixel, and disocclusions wider than the 2-px crack fill, which show the background colour.
+/// Linear resampling along the rows was tried: it lowers the reprojected pixels' MSE (28.4 to
+/// 22.5 at 6 m) but blurs them, and SSIM falls (0.9597 to 0.9553 there), so the warp moves whole
+/// pixels as Kim's does.
 double ssim_floor(double convergence) {
-  // Measured: 0.9651 at 6 m, 0.9597 at 2 m, 0.9494 at 0.3 m.
-  static const std::map<double, double> measured{{6.0, 0.964}, {2.0, 0.958}, {0.3, 0.948}};
+  // Measured with crack_depth 1.01 (far surfaces showing through cracks are filled): 0.9675 at
+  // 6 m, 0.9606 at 2 m, 0.9561 at 0.3 m (without: 0.9651, 0.9597, 0.9494).
+  static const std::map<double, double> measured{{6.0, 0.967}, {2.0, 0.960}, {0.3, 0.955}};
   return measured.at(convergence);
 }
 
@@ -51,8 +55,8 @@ TEST_P(FocalDistance, BidirWarpAgainstTwoPassAndBaselines) {
   EXPECT_GE(bidir.ssim, ssim_floor(GetParam()));
   EXPECT_GT(bidir.ssim, fw.ssim);
   // At 6 m the disparities are small and few holes open; bw-warp's interpolated lookup then beats
-  // the row warp's move to the nearest pixel centre (measured 0.9717 against 0.9651). From 2 m on,
-  // bidir-warp is ahead of both, far ahead at 0.3 m (0.9494 against 0.8184 and 0.8078).
+  // the row warp's move to the nearest pixel centre (measured 0.9707 against 0.9675). From 2 m on,
+  // bidir-warp is ahead of both, far ahead at 0.3 m (0.9561 against 0.8174 and 0.8068).
   if (GetParam() < 6.0) {
     EXPECT_GT(bidir.ssim, bw.ssim);
   }

@@ -269,6 +269,52 @@ TEST(CrackFill, FillsNarrowCracksAndCountsTheRest) {
   EXPECT_THROW((void)fill_cracks(none, -1, Executor(1)), InputError);
 }
 
+TEST(CrackFill, DepthCracksAreFarSurfacesBetweenNearerPixels) {
+  const int w = 24, h = 1;
+  Image image = make_eye_image(w, h);
+  for (int x = 0; x < w; ++x) set_pixel(image, x, 0, 2.0f);
+  // x = 3: one pixel of a surface at 5 m between pixels at 2 m — a crack.
+  set_pixel(image, 3, 0, 5.0f);
+  // x = 7, 8: a hole and a far pixel between pixels at 2 m — one 2-px crack.
+  set_pixel(image, 7, 0, kInf, Source::hole);
+  set_pixel(image, 8, 0, 5.0f);
+  // x = 12..14: three far pixels — wider than max_width 2, not a crack.
+  for (int x = 12; x < 15; ++x) set_pixel(image, x, 0, 5.0f);
+  // x = 17: only 0.5 % deeper than its neighbours — within the ratio 1.01, not a crack.
+  set_pixel(image, 17, 0, 2.01f);
+  // x = 20: deeper than its left neighbour but not than its right one (a step), not a crack.
+  set_pixel(image, 20, 0, 4.0f);
+  set_pixel(image, 21, 0, 6.0f);
+  set_pixel(image, 22, 0, 6.0f);
+  set_pixel(image, 23, 0, 6.0f);
+  // x = 10: a plain hole between nearer pixels is left to fill_cracks, not counted here.
+  set_pixel(image, 10, 0, kInf, Source::hole);
+  const Image before = image;
+
+  EXPECT_EQ(mark_depth_cracks(image, 2, 1.01, Executor(1)), 2u);
+  const uint32_t* tag = image.data_u32(planes::source);
+  for (int x = 0; x < w; ++x) {
+    const bool hole = x == 3 || x == 7 || x == 8 || x == 10;
+    EXPECT_EQ(tag[x] == static_cast<uint32_t>(Source::hole), hole) << x;
+    if (!hole) {
+      EXPECT_EQ(image.rgb_at(x, 0), before.rgb_at(x, 0)) << x;
+    }
+  }
+  EXPECT_TRUE(std::isinf(image.plane(planes::depth).at_f32(3, 0)));
+  // The fill then interpolates them from the nearer surface.
+  const CrackFillStats s = fill_cracks(image, 2, Executor(1));
+  EXPECT_EQ(s.pixels_filled, 4u);
+  EXPECT_FLOAT_EQ(image.plane(planes::depth).at_f32(3, 0), 2.0f);
+
+  // Larger widths and ratios behave as their definitions say; inputs are checked.
+  Image wide = before;
+  EXPECT_EQ(mark_depth_cracks(wide, 3, 1.01, Executor(2)), 2u + 3u);
+  Image strict = before;
+  EXPECT_EQ(mark_depth_cracks(strict, 2, 3.0, Executor(2)), 0u);
+  EXPECT_THROW((void)mark_depth_cracks(strict, -1, 1.01, Executor(1)), InputError);
+  EXPECT_THROW((void)mark_depth_cracks(strict, 2, 0.5, Executor(1)), InputError);
+}
+
 using KimPlane = test::LitPlane;
 
 /// The right eye is the left eye shifted by `shift` whole pixels; the `shift` columns at the left
