@@ -289,6 +289,8 @@ std::string results_csv(const std::vector<json>& cells) {
                           at(cell, {"rig", "max_disparity_px"}),
                           at(cell, {"rig", "convergence_m"}),
                           at(p, {"validation", "scene", "lights"}),
+                          at(cell, {"animation", "frame"}),
+                          at(cell, {"animation", "bvh_update_s"}),
                           at(cell, {"cell", "truth"}),
                           name,
                           at(cell, {"baseline"}),

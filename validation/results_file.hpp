@@ -55,7 +55,8 @@ void rebase_image_paths(nlohmann::json& cell, const std::filesystem::path& from,
 [[nodiscard]] std::string results_csv(const std::vector<nlohmann::json>& cells);
 inline constexpr const char* kCsvColumns[] = {
     "cell_index", "cell_id",    "sweep",          "scene",      "scene_params", "width",         "height",
-    "interaxial_m", "max_disparity_px", "convergence_m", "lights", "truth",   "pipeline",      "baseline",
+    "interaxial_m", "max_disparity_px", "convergence_m", "lights", "frame",  "bvh_update_s", "truth",
+    "pipeline",   "baseline",
     "psnr",       "ssim",       "mse",            "error_fraction", "hole_fraction", "recall", "precision",
     "median_s",   "speedup_median"};
 

@@ -147,8 +147,14 @@ TEST(ResultsFile, CsvRowsAndQuoting) {
   EXPECT_EQ(csv.substr(0, 24), "cell_index,cell_id,sweep");
   const std::string row = csv.substr(eol + 2);
   EXPECT_EQ(row,
-            "0,\"box-wall|e=0.064m,\"\"x\"\"\",t,box-wall,size=0.5,96,54,0.064,3.5,2,1,full,plain-rt,plain-rt,40,0.99,"
+            "0,\"box-wall|e=0.064m,\"\"x\"\"\",t,box-wall,size=0.5,96,54,0.064,3.5,2,1,,,full,plain-rt,plain-rt,40,0.99,"
             "1.5,0.01,0,1,0.02,0.01,1\r\n");
+  // A frame of a camera path: its frame number and BVH update time.
+  json f = cell(3, "spheres|frame=2");
+  f["animation"] = {{"frame", 2}, {"bvh_update_s", 0.038}};
+  const std::string path_csv = results_csv({f});
+  EXPECT_NE(path_csv.find(",frame,bvh_update_s,"), std::string::npos);
+  EXPECT_NE(path_csv.find(",1,2,0.038,full,"), std::string::npos) << path_csv;
 }
 
 }  // namespace
