@@ -20,16 +20,8 @@ enum class RightState : uint8_t { missed = 0, reprojected = 1, blocked = 2 };
 
 }  // namespace
 
-PixelReprojector::PixelReprojector(const StereoRig& rig) : left_(rig.eye(Eye::left)), right_(rig.eye(Eye::right)) {}
-
-int32_t PixelReprojector::target(int x, int y, float depth) const {
-  if (!(depth > 0.0f) || !std::isfinite(depth)) return kNoSource;
-  const dvec3 p = right_.project(left_.unproject(x + 0.5, y + 0.5, depth));
-  if (!(p.z > 0.0)) return kNoSource;
-  const double column = std::floor(p.x);
-  if (!(column >= 0.0 && column < right_.width)) return kNoSource;
-  return static_cast<int32_t>(column);
-}
+PixelReprojector::PixelReprojector(const StereoRig& rig)
+    : left_(rig.eye(Eye::left)), right_(rig.eye(Eye::right)), motion_(rig, Eye::left), width_(rig.params().width) {}
 
 Validation validate_and_copy(const RenderScene& scene, const PixelReprojector& reprojector, const RightSources& sources,
                              const Image& left, const ValidationSettings& settings, const Executor& executor,

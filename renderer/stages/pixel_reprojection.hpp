@@ -5,6 +5,7 @@
 // rt-es-isler, rt-buffer and rt-atomic.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -16,6 +17,7 @@
 #include "renderer/render_scene.hpp"
 #include "renderer/rig.hpp"
 #include "renderer/stages/eye_image.hpp"
+#include "renderer/stages/row_warp.hpp"
 #include "renderer/stages/trace.hpp"
 #include "renderer/stats.hpp"
 
@@ -32,7 +34,13 @@ class PixelReprojector {
   /// The right-eye column that the hit of left pixel (x, y) at linear depth `depth` reprojects to:
   /// the right pixel containing the hit's projection (x rounded to the pixel, y unchanged by the
   /// rig's horizontal baseline); kNoSource for a miss (infinite depth) or a column outside the image.
-  [[nodiscard]] int32_t target(int x, int y, float depth) const;
+  /// With the rig's parallel, equally shifted eyes the projection moves by the disparity
+  /// f·e·(1/c − 1/z) along the row, so the column is target_column(x, disparity) of the row warp.
+  [[nodiscard]] int32_t target(int x, int /*y*/, float depth) const {
+    if (!(depth > 0.0f) || !std::isfinite(depth)) return kNoSource;
+    const int column = target_column(x, motion_(depth));
+    return column >= 0 && column < width_ ? column : kNoSource;
+  }
 
   [[nodiscard]] const EyeCamera& left() const { return left_; }
   [[nodiscard]] const EyeCamera& right() const { return right_; }
@@ -40,6 +48,8 @@ class PixelReprojector {
  private:
   EyeCamera left_;
   EyeCamera right_;
+  DisparityMotion motion_;
+  int width_ = 0;
 };
 
 /// The right eye of a parallel reprojection: per right pixel, the source column in the same row
