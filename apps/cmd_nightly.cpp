@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <memory>
 #include <regex>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -24,6 +25,7 @@
 #include "validation/gate.hpp"
 #include "validation/history.hpp"
 #include "validation/junit.hpp"
+#include "validation/process.hpp"
 #include "validation/results_file.hpp"
 #include "validation/sweep.hpp"
 #include "validation/sweep_run.hpp"
@@ -78,17 +80,20 @@ std::string host_name() {
   return buf.data();
 }
 
-/// `git rev-parse --short HEAD` in `dir`, or "unknown" (no git, not a work tree).
+/// `git rev-parse --short HEAD` in `dir`, or "unknown" (no git, not a work tree, no answer).
 std::string git_revision(const fs::path& dir) {
-  const std::string cmd = fmt::format("git -C '{}' rev-parse --short HEAD 2>/dev/null", dir.string());
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  if (pipe == nullptr) return "unknown";
-  std::string out;
-  std::array<char, 128> buf{};
-  while (std::fgets(buf.data(), buf.size(), pipe)) out += buf.data();
-  const int status = ::pclose(pipe);
+  ProcessOptions options;
+  options.stderr_to = ChildOutput::discard;
+  options.timeout = kShortCommandTimeout;
+  ProcessResult r;
+  try {
+    r = run_process({"git", "-C", dir.string(), "rev-parse", "--short", "HEAD"}, options);
+  } catch (const ToolError&) {
+    return "unknown";  // no git to start
+  }
+  std::string out = std::move(r.out);
   while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
-  if (status != 0 || out.empty() || out.find_first_not_of("0123456789abcdef") != std::string::npos) return "unknown";
+  if (!r.ok() || out.empty() || out.find_first_not_of("0123456789abcdef") != std::string::npos) return "unknown";
   return out;
 }
 

@@ -2,18 +2,8 @@
 // task outcomes from exit-code files (no accounting database needed), merging of the shards.
 #include "validation/slurm.hpp"
 
-#include <fcntl.h>
-#include <poll.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <array>
 #include <cctype>
-#include <cerrno>
-#include <cstdlib>
-#include <cstring>
 #include <ctime>
 #include <fstream>
 #include <map>
@@ -28,9 +18,8 @@
 
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "validation/process.hpp"
 #include "validation/results_file.hpp"
-
-extern char** environ;
 
 namespace sb::validation {
 
@@ -39,71 +28,14 @@ using nlohmann::json;
 
 namespace {
 
-/// What a finished child process left.
-struct ProcessResult {
-  int exit_code = -1;  ///< -1 when it was killed by a signal
-  std::string out;
-  std::string err;
-};
-
-/// Runs `program args...` (no shell) with stdin from /dev/null and captures stdout and stderr.
-/// ToolError when it cannot be started.
-ProcessResult run_process(const fs::path& program, const std::vector<std::string>& args) {
-  std::array<int, 2> out_pipe{-1, -1}, err_pipe{-1, -1};
-  if (::pipe2(out_pipe.data(), O_CLOEXEC) != 0 || ::pipe2(err_pipe.data(), O_CLOEXEC) != 0)
-    throw ToolError(fmt::format("cannot create a pipe to run {}: {}", program.string(), std::strerror(errno)));
-  std::vector<std::string> argv_text{program.string()};
-  argv_text.insert(argv_text.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (std::string& a : argv_text) argv.push_back(a.data());
-  argv.push_back(nullptr);
-
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_adddup2(&actions, out_pipe[1], 1);
-  posix_spawn_file_actions_adddup2(&actions, err_pipe[1], 2);
-  pid_t pid = 0;
-  const int spawn_error = ::posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  ::close(out_pipe[1]);
-  ::close(err_pipe[1]);
-  if (spawn_error != 0) {
-    ::close(out_pipe[0]);
-    ::close(err_pipe[0]);
-    throw ToolError(fmt::format("cannot run {}: {}", program.string(), std::strerror(spawn_error)));
-  }
-
-  // Both pipes are drained together so that neither can fill up and block the child.
-  ProcessResult r;
-  std::array<pollfd, 2> fds{pollfd{out_pipe[0], POLLIN, 0}, pollfd{err_pipe[0], POLLIN, 0}};
-  std::array<std::string*, 2> sinks{&r.out, &r.err};
-  size_t open_fds = 2;
-  std::array<char, 4096> buf{};
-  while (open_fds > 0) {
-    if (::poll(fds.data(), fds.size(), -1) < 0) {
-      if (errno == EINTR) continue;
-      break;
-    }
-    for (size_t i = 0; i < fds.size(); ++i) {
-      if (fds[i].fd < 0 || (fds[i].revents & (POLLIN | POLLHUP | POLLERR)) == 0) continue;
-      const ssize_t n = ::read(fds[i].fd, buf.data(), buf.size());
-      if (n > 0) {
-        sinks[i]->append(buf.data(), static_cast<size_t>(n));
-      } else if (n == 0 || errno != EINTR) {
-        ::close(fds[i].fd);
-        fds[i].fd = -1;
-        --open_fds;
-      }
-    }
-  }
-  for (const pollfd& p : fds)
-    if (p.fd >= 0) ::close(p.fd);
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+/// Runs a Slurm client command with stdout and stderr captured. These commands only talk to the
+/// controller, so a short limit keeps an unreachable one from hanging the caller.
+ProcessResult run_slurm_command(const fs::path& program, const std::vector<std::string>& args) {
+  std::vector<std::string> argv{program.string()};
+  argv.insert(argv.end(), args.begin(), args.end());
+  ProcessOptions options;
+  options.timeout = kShortCommandTimeout;
+  return run_process(argv, options);
 }
 
 std::string trimmed(std::string s) {
@@ -159,13 +91,17 @@ std::string utc_now() {
 std::optional<std::map<size_t, std::string>> queued_tasks(const fs::path& squeue, const std::string& job_id,
                                                           std::string& error) {
   // -r: one line per array task, pending ones included; %K: the array task id; %T: the state.
-  const ProcessResult r = run_process(squeue, {"--noheader", "--array", "--jobs=" + job_id, "--format=%K %T"});
+  const ProcessResult r = run_slurm_command(squeue, {"--noheader", "--array", "--jobs=" + job_id, "--format=%K %T"});
   std::map<size_t, std::string> tasks;
+  if (r.timed_out) {
+    error = fmt::format("squeue did not answer within {} and was stopped", format_limit(kShortCommandTimeout));
+    return std::nullopt;
+  }
   if (r.exit_code != 0) {
     // A job the controller has already forgotten (MinJobAge passed) is no longer queued.
     if (r.err.find("Invalid job id") != std::string::npos) return tasks;
     error = trimmed(r.err.empty() ? r.out : r.err);
-    if (error.empty()) error = fmt::format("exit code {}", r.exit_code);
+    if (error.empty()) error = r.describe();
     return std::nullopt;
   }
   std::istringstream in(r.out);
@@ -191,7 +127,8 @@ std::optional<ControllerView> controller_view(const std::string& job_id, size_t 
   } catch (const ToolError&) {
     return std::nullopt;
   }
-  const ProcessResult r = run_process(scontrol, {"--oneliner", "show", "job", fmt::format("{}_{}", job_id, task)});
+  const ProcessResult r =
+      run_slurm_command(scontrol, {"--oneliner", "show", "job", fmt::format("{}_{}", job_id, task)});
   if (r.exit_code != 0) return std::nullopt;
   ControllerView v;
   std::smatch m;
@@ -225,13 +162,7 @@ SlurmLayout slurm_layout(const fs::path& out_dir) {
 }
 
 fs::path slurm_tool(const std::string& name) {
-  const char* path_env = std::getenv("PATH");
-  std::istringstream dirs(path_env ? path_env : "");
-  for (std::string dir; std::getline(dirs, dir, ':');) {
-    if (dir.empty()) continue;
-    const fs::path candidate = fs::path(dir) / name;
-    if (::access(candidate.c_str(), X_OK) == 0 && !fs::is_directory(candidate)) return candidate;
-  }
+  if (std::optional<fs::path> found = find_program(name)) return *found;
   throw ToolError(fmt::format(
       "'{}' not found on PATH: the slurm executor submits the sweep to a Slurm cluster, so it must run where the "
       "Slurm client commands (sbatch, squeue, scontrol) reach a running slurmctld; install them with "
@@ -374,12 +305,17 @@ SlurmSubmission submit_sweep(const SweepDefinition& d, SlurmSweepOptions o) {
   args.push_back(l.script.string());
   sub.sbatch_command = {sbatch.string()};
   sub.sbatch_command.insert(sub.sbatch_command.end(), args.begin(), args.end());
-  const ProcessResult r = run_process(sbatch, args);
+  const ProcessResult r = run_slurm_command(sbatch, args);
   // --parsable prints "JOBID" or "JOBID;CLUSTER".
   const std::string first = trimmed(r.out.substr(0, r.out.find_first_of(";\n")));
-  if (r.exit_code != 0 || first.empty() || first.find_first_not_of("0123456789") != std::string::npos) {
+  if (!r.ok() || first.empty() || first.find_first_not_of("0123456789") != std::string::npos) {
     std::string cmd;
     for (const std::string& a : sub.sbatch_command) cmd += (cmd.empty() ? "" : " ") + a;
+    if (r.timed_out)
+      throw ToolError(fmt::format("sbatch did not answer within {} and was stopped while submitting {}; the job may "
+                                  "or may not have been queued: check `squeue --me` (cancel a stray job with scancel) "
+                                  "and that the Slurm controller answers (`sinfo`)\n  command: {}",
+                                  format_limit(kShortCommandTimeout), l.script.string(), cmd));
     throw ToolError(fmt::format("sbatch could not submit {} (exit code {}): {}\n  command: {}\n  check that a Slurm "
                                 "controller answers (`sinfo`) and that the options are valid for this cluster",
                                 l.script.string(), r.exit_code, trimmed(r.err + r.out), cmd));

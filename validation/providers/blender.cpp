@@ -2,19 +2,13 @@
 // glTF importer brings in the meshes; a generated script (validation/providers/blender_script.cpp
 // plus the numbers of the in-memory scene) replaces lights, materials, world and camera and renders
 // one EXR per light; the passes are summed here. docs/truth_blender.md derives every constant.
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <chrono>
 #include <cstdlib>
-#include <cstring>
 #include <deque>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <system_error>
 
@@ -23,10 +17,9 @@
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/image_io.hpp"
+#include "validation/process.hpp"
 #include "validation/providers/blender_script.hpp"
 #include "validation/providers/providers.hpp"
-
-extern char** environ;
 
 namespace sb::validation {
 namespace {
@@ -55,61 +48,6 @@ constexpr double kClipEnd = 1e9;
 /// Lines of Blender's output quoted in an error message.
 constexpr size_t kQuotedLines = 25;
 
-/// The output of a finished process.
-struct ProcessResult {
-  int exit_code = -1;     ///< exit status, or -1 when killed by a signal
-  int signal = 0;         ///< the signal that ended it, or 0
-  std::string output;     ///< stdout and stderr, interleaved
-};
-
-/// Runs argv[0] (a path) with stdin from /dev/null and stdout + stderr captured. ToolError when it
-/// cannot be started.
-ProcessResult run_process(const std::vector<std::string>& argv) {
-  int pipe_fds[2];
-  if (::pipe2(pipe_fds, O_CLOEXEC) != 0)  // not inherited by renderers other workers start
-    throw ToolError(fmt::format("cannot create a pipe to run {}: {}", argv.at(0), std::strerror(errno)));
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], 1);
-  posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], 2);
-  posix_spawn_file_actions_addclose(&actions, pipe_fds[0]);
-  posix_spawn_file_actions_addclose(&actions, pipe_fds[1]);
-  std::vector<char*> args;
-  args.reserve(argv.size() + 1);
-  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
-  pid_t pid = 0;
-  const int spawn_error = ::posix_spawn(&pid, argv[0].c_str(), &actions, nullptr, args.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  ::close(pipe_fds[1]);
-  if (spawn_error != 0) {
-    ::close(pipe_fds[0]);
-    throw ToolError(fmt::format("cannot start {}: {}", argv[0], std::strerror(spawn_error)));
-  }
-  ProcessResult result;
-  char buffer[65536];
-  for (;;) {
-    const ssize_t n = ::read(pipe_fds[0], buffer, sizeof buffer);
-    if (n > 0) {
-      result.output.append(buffer, static_cast<size_t>(n));
-    } else if (n == 0 || errno != EINTR) {
-      break;
-    }
-  }
-  ::close(pipe_fds[0]);
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) throw ToolError(fmt::format("lost track of {}: {}", argv[0], std::strerror(errno)));
-  }
-  if (WIFEXITED(status)) {
-    result.exit_code = WEXITSTATUS(status);
-  } else if (WIFSIGNALED(status)) {
-    result.signal = WTERMSIG(status);
-  }
-  return result;
-}
-
 /// The last `count` lines of a text, indented for an error message.
 std::string last_lines(const std::string& text, size_t count) {
   std::deque<std::string> lines;
@@ -124,11 +62,6 @@ std::string last_lines(const std::string& text, size_t count) {
   return out.empty() ? "\n  | (no output)" : out;
 }
 
-bool is_executable_file(const fs::path& p) {
-  std::error_code ec;
-  return fs::is_regular_file(p, ec) && ::access(p.c_str(), X_OK) == 0;
-}
-
 /// Where the Blender executable is, or why it cannot be found.
 struct Located {
   fs::path executable;
@@ -140,24 +73,14 @@ Located locate_blender() {
   const std::string name = configured != nullptr && *configured != '\0' ? configured : "blender";
   const std::string origin =
       configured != nullptr && *configured != '\0' ? fmt::format(" (from ${})", kExecutableVariable) : "";
+  const std::optional<fs::path> found = find_program(name);
   if (name.find('/') != std::string::npos) {
-    if (is_executable_file(name)) return {fs::absolute(name), ""};
+    if (found) return {fs::absolute(*found), ""};
     return {{}, fmt::format("the Blender executable '{}'{} does not exist or is not executable; point ${} at "
                             "Blender 3.4 or unset it and install Blender with `ci/install-deps.sh blender`",
                             name, origin, kExecutableVariable)};
   }
-  const char* path_env = std::getenv("PATH");
-  std::string_view path = path_env != nullptr ? path_env : "";
-  while (!path.empty()) {
-    const size_t colon = path.find(':');
-    const std::string_view dir = path.substr(0, colon);
-    if (!dir.empty()) {
-      const fs::path candidate = fs::path(std::string(dir)) / name;
-      if (is_executable_file(candidate)) return {candidate, ""};
-    }
-    if (colon == std::string_view::npos) break;
-    path.remove_prefix(colon + 1);
-  }
+  if (found) return {*found, ""};
   return {{}, fmt::format("'{}'{} not found on PATH; install Blender with `ci/install-deps.sh blender` or set "
                           "${} to the Blender executable",
                           name, origin, kExecutableVariable)};
@@ -169,8 +92,11 @@ std::string query_version(const fs::path& executable) {
   static std::map<std::string, std::string> cache;
   const std::lock_guard lock(mutex);
   if (auto it = cache.find(executable.string()); it != cache.end()) return it->second;
-  const ProcessResult r = run_process({executable.string(), "--factory-startup", "--version"});
-  std::istringstream in(r.output);
+  ProcessOptions options;
+  options.stderr_to = ChildOutput::to_stdout;
+  options.timeout = kShortCommandTimeout;
+  const ProcessResult r = run_process({executable.string(), "--factory-startup", "--version"}, options);
+  std::istringstream in(r.out);
   std::string version;
   for (std::string line; std::getline(in, line);) {
     if (line.rfind("Blender ", 0) == 0) {
@@ -179,10 +105,10 @@ std::string query_version(const fs::path& executable) {
     }
   }
   while (!version.empty() && std::isspace(static_cast<unsigned char>(version.back()))) version.pop_back();
-  if (r.exit_code != 0 || version.empty())
-    throw ToolError(fmt::format("'{} --version' failed (exit code {}){}; check the Blender installation "
+  if (!r.ok() || version.empty())
+    throw ToolError(fmt::format("'{} --version' failed (it {}){}; check the Blender installation "
                                 "(`ci/install-deps.sh blender`)",
-                                executable.string(), r.exit_code, last_lines(r.output, kQuotedLines)));
+                                executable.string(), r.describe(), last_lines(r.out, kQuotedLines)));
   cache.emplace(executable.string(), version);
   return version;
 }
@@ -313,6 +239,7 @@ class BlenderProvider final : public TruthProvider {
 
   TruthRender render(const TruthRequest& request) const override {
     const auto start = std::chrono::steady_clock::now();
+    const std::chrono::milliseconds limit = tool_timeout();  // InputError for a malformed value
     const Scene& scene = request.scene.scene();
     nlohmann::json params;
     params["lights"] = export_lights(scene);  // InputError for what Cycles cannot reproduce
@@ -393,17 +320,22 @@ class BlenderProvider final : public TruthProvider {
     text += blender_script_body();
     io::write_text_atomically(script, text);
 
-    const ProcessResult run = run_process(argv);
+    ProcessOptions options;
+    options.stderr_to = ChildOutput::to_stdout;
+    options.timeout = limit;
+    const ProcessResult run = run_process(argv, options);
     const fs::path log = work_dir / "blender_output.txt";
-    io::write_text_atomically(log, run.output);
-    if (run.exit_code != 0) {
-      const std::string how = run.signal != 0 ? fmt::format("was killed by signal {}", run.signal)
-                                              : fmt::format("exited with code {}", run.exit_code);
+    io::write_text_atomically(log, run.out);
+    if (run.timed_out)
+      throw ToolError(fmt::format("{} did not finish rendering {} within {} and was stopped; {}; the script is kept "
+                                  "in {} and the output so far in {}; last lines of the output:{}",
+                                  version, request.scene_file.string(), format_limit(limit), tool_timeout_hint(),
+                                  script.string(), log.string(), last_lines(run.out, kQuotedLines)));
+    if (!run.ok())
       throw ToolError(fmt::format("{} {} rendering {}; the script is kept in {} and the full output in {}; "
                                   "last lines of the output:{}",
-                                  version, how, request.scene_file.string(), script.string(), log.string(),
-                                  last_lines(run.output, kQuotedLines)));
-    }
+                                  version, run.describe(), request.scene_file.string(), script.string(), log.string(),
+                                  last_lines(run.out, kQuotedLines)));
 
     // Sum the passes in light order (the order in which our shading adds the lights).
     TruthRender out;
@@ -417,7 +349,7 @@ class BlenderProvider final : public TruthProvider {
         throw ToolError(fmt::format("{} exited normally but wrote no image {}; the script is kept in {}, its "
                                     "output in {}{}",
                                     version, passes[k].string(), script.string(), log.string(),
-                                    last_lines(run.output, kQuotedLines)));
+                                    last_lines(run.out, kQuotedLines)));
       const Image pass = io::read_exr(passes[k]);
       if (pass.width() != eye.width || pass.height() != eye.height || !pass.has_plane(planes::rgb))
         throw ToolError(fmt::format("{} wrote {} as {}x{} with planes [{}]; expected {}x{} with rgb", version,

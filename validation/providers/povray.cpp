@@ -1,16 +1,9 @@
 // `povray`: the right eye rendered by POV-Ray 3.7 from an SDL export (DESIGN §6.1,
 // docs/truth_povray.md). The executable is `povray` on PATH, or the one the environment variable
 // STEREOBENCH_POVRAY names.
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <chrono>
 #include <cstdlib>
-#include <cstring>
 #include <deque>
 #include <fstream>
 #include <mutex>
@@ -24,10 +17,9 @@
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/image_io.hpp"
+#include "validation/process.hpp"
 #include "validation/providers/povray_export.hpp"
 #include "validation/providers/providers.hpp"
-
-extern char** environ;
 
 namespace sb::validation {
 namespace {
@@ -41,35 +33,19 @@ constexpr const char* kInstallHint = "install it with `ci/install-deps.sh povray
 /// Lines of POV-Ray's output quoted in an error.
 constexpr std::size_t kQuotedLines = 15;
 
-bool is_executable_file(const std::filesystem::path& p) {
-  struct stat st {};
-  return ::stat(p.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(p.c_str(), X_OK) == 0;
-}
-
-/// `name` looked up like a shell would: as given when it contains a slash, else along PATH.
-std::optional<std::filesystem::path> find_executable(const std::string& name) {
-  if (name.find('/') != std::string::npos) {
-    if (is_executable_file(name)) return std::filesystem::path(name);
-    return std::nullopt;
-  }
-  const char* path = std::getenv("PATH");
-  if (!path) return std::nullopt;
-  std::stringstream dirs(path);
-  std::string dir;
-  while (std::getline(dirs, dir, ':')) {
-    const std::filesystem::path candidate = std::filesystem::path(dir.empty() ? "." : dir) / name;
-    if (is_executable_file(candidate)) return candidate;
-  }
-  return std::nullopt;
-}
-
-/// A command to run: the executable, its arguments, a working folder and environment changes.
+/// A command to run: the executable, its arguments, and how it runs (working folder, environment
+/// changes; stdout and stderr go into one text, as the tool wrote them).
 struct Command {
   std::filesystem::path executable;
   std::vector<std::string> args;  ///< argv[1..]
-  std::filesystem::path cwd;      ///< empty = inherit
-  std::vector<std::pair<std::string, std::string>> set_env;
-  std::vector<std::string> unset_env;
+  ProcessOptions options;
+
+  Command() { options.stderr_to = ChildOutput::to_stdout; }
+  [[nodiscard]] ProcessResult run() const {
+    std::vector<std::string> argv{executable.string()};
+    argv.insert(argv.end(), args.begin(), args.end());
+    return run_process(argv, options);
+  }
 };
 
 /// Shell-quoted form of the command (for records and messages; not used to run it).
@@ -83,90 +59,16 @@ std::string quoted(const Command& c) {
     return out + "'";
   };
   std::string out;
-  if (!c.cwd.empty()) out += "cd " + q(c.cwd.string()) + " && ";
-  if (!c.unset_env.empty()) {
+  if (!c.options.cwd.empty()) out += "cd " + q(c.options.cwd.string()) + " && ";
+  if (!c.options.unset_env.empty()) {
     out += "env";
-    for (const std::string& u : c.unset_env) out += " -u " + u;
+    for (const std::string& u : c.options.unset_env) out += " -u " + u;
     out += " ";
   }
-  for (const auto& [k, v] : c.set_env) out += k + "=" + q(v) + " ";
+  for (const auto& [k, v] : c.options.set_env) out += k + "=" + q(v) + " ";
   out += q(c.executable.string());
   for (const std::string& a : c.args) out += " " + q(a);
   return out;
-}
-
-/// Runs `c` with stdout and stderr sent to `out_fd` and waits for it. Returns the exit status, or
-/// 128 + signal for a killed process; ToolError when it cannot be started.
-int run_command(const Command& c, int out_fd) {
-  // Everything the child needs is prepared before fork(): after it only async-signal-safe calls.
-  std::vector<std::string> env_strings;
-  for (char** e = environ; e && *e; ++e) {
-    const std::string entry(*e);
-    const std::string key = entry.substr(0, entry.find('='));
-    const bool replaced = std::any_of(c.set_env.begin(), c.set_env.end(), [&](const auto& kv) { return kv.first == key; });
-    const bool removed = std::find(c.unset_env.begin(), c.unset_env.end(), key) != c.unset_env.end();
-    if (!replaced && !removed) env_strings.push_back(entry);
-  }
-  for (const auto& [k, v] : c.set_env) env_strings.push_back(k + "=" + v);
-  std::vector<char*> envp;
-  for (std::string& s : env_strings) envp.push_back(s.data());
-  envp.push_back(nullptr);
-  std::string exe = c.executable.string();
-  std::vector<std::string> arg_strings = c.args;
-  std::vector<char*> argv{exe.data()};
-  for (std::string& a : arg_strings) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  const std::string cwd = c.cwd.string();
-
-  const pid_t pid = ::fork();
-  if (pid < 0) throw ToolError(fmt::format("cannot start '{}': fork failed: {}", exe, std::strerror(errno)));
-  if (pid == 0) {
-    const int devnull = ::open("/dev/null", O_RDONLY);
-    if (devnull >= 0) ::dup2(devnull, 0);
-    ::dup2(out_fd, 1);
-    ::dup2(out_fd, 2);
-    if (!cwd.empty() && ::chdir(cwd.c_str()) != 0) ::_exit(126);
-    ::execve(exe.c_str(), argv.data(), envp.data());
-    ::_exit(127);
-  }
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) throw ToolError(fmt::format("waiting for '{}' failed: {}", exe, std::strerror(errno)));
-  }
-  if (WIFEXITED(status)) return WEXITSTATUS(status);
-  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
-  return -1;
-}
-
-/// Runs `c` and returns its exit status and its output (stdout and stderr together).
-std::pair<int, std::string> run_capture(const Command& c) {
-  int fds[2];
-  if (::pipe2(fds, O_CLOEXEC) != 0) throw ToolError(fmt::format("cannot run '{}': pipe failed: {}", c.executable.string(), std::strerror(errno)));
-  // The child writes into the pipe; the parent reads after the child ends, which is safe for the
-  // short version banner (far below the pipe's buffer). Longer output goes to a file instead.
-  int status = -1;
-  try {
-    status = run_command(c, fds[1]);
-  } catch (...) {
-    ::close(fds[0]);
-    ::close(fds[1]);
-    throw;
-  }
-  ::close(fds[1]);
-  std::string out;
-  char buf[4096];
-  for (;;) {
-    const ssize_t n = ::read(fds[0], buf, sizeof buf);
-    if (n > 0) {
-      out.append(buf, static_cast<std::size_t>(n));
-    } else if (n < 0 && errno == EINTR) {
-      continue;
-    } else {
-      break;
-    }
-  }
-  ::close(fds[0]);
-  return {status, out};
 }
 
 /// The last `n` non-empty lines of a text, each indented, for quoting in a message.
@@ -238,6 +140,7 @@ class PovrayProvider final : public TruthProvider {
     const auto start = std::chrono::steady_clock::now();
     probe();
     if (reason_) throw ToolError(*reason_);
+    const std::chrono::milliseconds limit = tool_timeout();  // InputError for a malformed value
 
     const EyeCamera eye = request.rig.eye(Eye::right);
     std::error_code ec;
@@ -269,9 +172,10 @@ class PovrayProvider final : public TruthProvider {
                                             : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     Command cmd;
     cmd.executable = info_.executable;
-    cmd.cwd = dir;
-    cmd.unset_env = {"DISPLAY"};
-    cmd.set_env = {{"POVINI", (dir / "povray.ini").string()}, {"HOME", dir.string()}};
+    cmd.options.cwd = dir;
+    cmd.options.unset_env = {"DISPLAY"};
+    cmd.options.set_env = {{"POVINI", (dir / "povray.ini").string()}, {"HOME", dir.string()}};
+    cmd.options.timeout = limit;
     cmd.args = {"+I" + exported.sdl_file.filename().string(),
                 "+O" + image_file.filename().string(),
                 "+FE",  // OpenEXR, half float, linear
@@ -289,30 +193,28 @@ class PovrayProvider final : public TruthProvider {
                 "+Q9",
                 fmt::format("+WT{}", threads)};
 
-    const int fd = ::open(log_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) throw IoError(fmt::format("cannot create the POV-Ray log '{}': {}", log_file.string(), std::strerror(errno)));
-    int status = -1;
-    try {
-      status = run_command(cmd, fd);
-    } catch (...) {
-      ::close(fd);
-      throw;
-    }
-    ::close(fd);
+    const ProcessResult run = cmd.run();
     const double render_seconds = seconds_since(start) - export_seconds;
-    std::string log;
-    try {
-      log = io::read_file(log_file);
-    } catch (const Error&) {
-      log = "(no output)";
-    }
+    const std::string& log = run.out;
+    io::write_text_atomically(log_file, log);
+    if (run.timed_out)
+      throw ToolError(fmt::format(
+          "POV-Ray did not finish rendering '{}' within {} and was stopped; {}; the scene file is kept there, rerun "
+          "it with: {}\nlast lines of its output ({}):{}",
+          exported.sdl_file.string(), format_limit(limit), tool_timeout_hint(), quoted(cmd), log_file.string(),
+          last_lines(log, kQuotedLines)));
     const bool have_image = std::filesystem::is_regular_file(image_file, ec);
-    if (status != 0 || !have_image)
+    if (!run.ok() || !have_image) {
+      std::string failure = "no image written";
+      if (run.signal != 0)
+        failure = fmt::format("killed by signal {}", run.signal);
+      else if (run.exit_code != 0)
+        failure = fmt::format("exit status {}", run.exit_code);
       throw ToolError(fmt::format(
           "POV-Ray failed ({}) rendering '{}'; the scene file is kept there, rerun it with: {}\nlast lines of its "
           "output ({}):{}",
-          status != 0 ? fmt::format("exit status {}", status) : std::string("no image written"),
-          exported.sdl_file.string(), quoted(cmd), log_file.string(), last_lines(log, kQuotedLines)));
+          failure, exported.sdl_file.string(), quoted(cmd), log_file.string(), last_lines(log, kQuotedLines)));
+    }
 
     Image raw;
     try {
@@ -358,7 +260,7 @@ class PovrayProvider final : public TruthProvider {
   /// Finds the executable and asks it for its version, once.
   void probe() const {
     std::call_once(probed_, [this] {
-      const std::optional<std::filesystem::path> exe = find_executable(requested_);
+      const std::optional<std::filesystem::path> exe = find_program(requested_);
       if (!exe) {
         reason_ = from_variable_
                       ? fmt::format("{}='{}' is not an executable file (nor a command on PATH); point it at POV-Ray "
@@ -372,19 +274,25 @@ class PovrayProvider final : public TruthProvider {
       Command cmd;
       cmd.executable = *exe;
       cmd.args = {"--version"};
-      cmd.unset_env = {"DISPLAY"};
-      std::pair<int, std::string> result;
+      cmd.options.unset_env = {"DISPLAY"};
+      cmd.options.timeout = kShortCommandTimeout;
+      ProcessResult result;
       try {
-        result = run_capture(cmd);
+        result = cmd.run();
       } catch (const Error& e) {
         reason_ = fmt::format("'{}' cannot be run: {}", exe->string(), e.what());
         return;
       }
+      if (result.timed_out) {
+        reason_ = fmt::format("'{} --version' did not answer within {} and was stopped; {}", exe->string(),
+                              format_limit(kShortCommandTimeout), kInstallHint);
+        return;
+      }
       static const std::regex version_line(R"(POV-Ray (\d+)\.(\d+)(\.\d+)*\S*)");
       std::smatch m;
-      if (!std::regex_search(result.second, m, version_line)) {
-        reason_ = fmt::format("'{} --version' did not report a POV-Ray version (exit status {});{} {}",
-                              exe->string(), result.first, last_lines(result.second, 5), kInstallHint);
+      if (!std::regex_search(result.out, m, version_line)) {
+        reason_ = fmt::format("'{} --version' did not report a POV-Ray version (it {});{} {}", exe->string(),
+                              result.describe(), last_lines(result.out, 5), kInstallHint);
         return;
       }
       info_.banner = m.str(0);

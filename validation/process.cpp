@@ -1,0 +1,377 @@
+// Runs external programs with posix_spawn: the child leads its own process group, both output
+// pipes are drained with poll(), and a time limit stops the whole group (SIGTERM, then SIGKILL).
+#include "validation/process.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/syscall.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <string_view>
+
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
+
+extern char** environ;
+
+namespace sb::validation {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+/// Signals an ignoring parent would pass on through exec; the child gets their default actions
+/// (SIGTERM must be able to stop it, SIGPIPE to end a writer whose reader is gone).
+constexpr std::array kDefaultedSignals = {SIGPIPE, SIGINT,  SIGQUIT, SIGTERM, SIGHUP,  SIGALRM,
+                                          SIGUSR1, SIGUSR2, SIGCHLD, SIGTSTP, SIGTTIN, SIGTTOU};
+
+/// An owned file descriptor.
+class Fd {
+ public:
+  Fd() = default;
+  explicit Fd(int fd) : fd_(fd) {}
+  Fd(const Fd&) = delete;
+  Fd& operator=(const Fd&) = delete;
+  ~Fd() { reset(); }
+  [[nodiscard]] int get() const { return fd_; }
+  void reset() {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
+  }
+  void take(int fd) {
+    reset();
+    fd_ = fd;
+  }
+
+ private:
+  int fd_ = -1;
+};
+
+/// A pipe whose ends are close-on-exec (no other child started meanwhile inherits them) and
+/// above 0..2, so that dup2 onto the child's stdout or stderr always makes a fresh descriptor.
+void open_pipe(Fd& read_end, Fd& write_end, const std::string& program) {
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) != 0)
+    throw ToolError(fmt::format("cannot create a pipe to run {}: {}", program, std::strerror(errno)));
+  read_end.take(fds[0]);
+  write_end.take(fds[1]);
+  for (Fd* end : {&read_end, &write_end}) {
+    if (end->get() > 2) continue;
+    const int moved = ::fcntl(end->get(), F_DUPFD_CLOEXEC, 3);
+    if (moved < 0) throw ToolError(fmt::format("cannot create a pipe to run {}: {}", program, std::strerror(errno)));
+    end->take(moved);
+  }
+}
+
+/// The spawned child until it is reaped: an exception kills its group and reaps it.
+class ChildGuard {
+ public:
+  ChildGuard() = default;
+  ChildGuard(const ChildGuard&) = delete;
+  ChildGuard& operator=(const ChildGuard&) = delete;
+  ~ChildGuard() {
+    if (pid_ <= 0) return;
+    ::kill(-pid_, SIGKILL);
+    int status = 0;
+    while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+    }
+  }
+  pid_t pid_ = -1;  ///< the child (and its process group), -1 once reaped
+};
+
+/// posix_spawn's attribute and file-action objects, destroyed on every path.
+struct SpawnSetup {
+  posix_spawnattr_t attr{};
+  posix_spawn_file_actions_t actions{};
+  SpawnSetup() {
+    posix_spawnattr_init(&attr);
+    posix_spawn_file_actions_init(&actions);
+  }
+  SpawnSetup(const SpawnSetup&) = delete;
+  SpawnSetup& operator=(const SpawnSetup&) = delete;
+  ~SpawnSetup() {
+    posix_spawn_file_actions_destroy(&actions);
+    posix_spawnattr_destroy(&attr);
+  }
+};
+
+/// This process's environment with `options`' changes applied, as "NAME=value" strings.
+std::vector<std::string> child_environment(const ProcessOptions& options) {
+  const auto changed = [&](std::string_view key) {
+    return std::any_of(options.set_env.begin(), options.set_env.end(), [&](const auto& kv) { return kv.first == key; }) ||
+           std::find(options.unset_env.begin(), options.unset_env.end(), key) != options.unset_env.end();
+  };
+  std::vector<std::string> env;
+  for (char** e = environ; e != nullptr && *e != nullptr; ++e) {
+    const std::string_view entry(*e);
+    if (!changed(entry.substr(0, entry.find('=')))) env.emplace_back(entry);
+  }
+  for (const auto& [key, value] : options.set_env) {
+    if (key.empty() || key.find('=') != std::string::npos)
+      throw InputError(fmt::format("'{}' is not an environment variable name", key));
+    env.push_back(key + "=" + value);
+  }
+  return env;
+}
+
+bool is_executable_file(const fs::path& p) {
+  struct stat st {};
+  return ::stat(p.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(p.c_str(), X_OK) == 0;
+}
+
+/// Whether the child has ended, without reaping it: the zombie keeps its process group id
+/// reserved, so the group can still be signalled safely. ToolError when the child is gone (reaped
+/// by someone else, e.g. under SIGCHLD ignored); the guard then forgets it.
+bool has_ended(ChildGuard& child, const std::string& program) {
+  siginfo_t info{};
+  info.si_pid = 0;
+  if (::waitid(P_PID, static_cast<id_t>(child.pid_), &info, WEXITED | WNOHANG | WNOWAIT) != 0) {
+    if (errno == EINTR) return false;
+    const pid_t pid = child.pid_;
+    child.pid_ = -1;
+    throw ToolError(fmt::format("lost track of {} (pid {}): {}", program, pid, std::strerror(errno)));
+  }
+  return info.si_pid != 0;
+}
+
+/// A descriptor that becomes readable when `pid` ends (Linux 5.3 and newer), or -1.
+int open_pid_fd(pid_t pid) {
+#ifdef SYS_pidfd_open
+  const long fd = ::syscall(SYS_pidfd_open, pid, 0);
+  if (fd >= 0) {
+    ::fcntl(static_cast<int>(fd), F_SETFD, FD_CLOEXEC);
+    return static_cast<int>(fd);
+  }
+#else
+  (void)pid;
+#endif
+  return -1;
+}
+
+}  // namespace
+
+std::string ProcessResult::describe() const {
+  if (timed_out) return "did not finish within its time limit and was stopped";
+  if (signal != 0) return fmt::format("was killed by signal {} ({})", signal, ::strsignal(signal));
+  return fmt::format("exited with code {}", exit_code);
+}
+
+std::optional<fs::path> find_program(const std::string& name) {
+  if (name.empty()) return std::nullopt;
+  if (name.find('/') != std::string::npos) {
+    if (is_executable_file(name)) return fs::path(name);
+    return std::nullopt;
+  }
+  const char* path_env = std::getenv("PATH");
+  std::string_view path = path_env != nullptr ? path_env : "";
+  while (!path.empty()) {
+    const size_t colon = path.find(':');
+    const std::string_view dir = path.substr(0, colon);
+    if (!dir.empty()) {
+      fs::path candidate = fs::path(std::string(dir)) / name;
+      if (is_executable_file(candidate)) return candidate;
+    }
+    if (colon == std::string_view::npos) break;
+    path.remove_prefix(colon + 1);
+  }
+  return std::nullopt;
+}
+
+ProcessResult run_process(const std::vector<std::string>& argv, const ProcessOptions& options) {
+  if (argv.empty() || argv[0].empty()) throw InputError("run_process: no program to run");
+  const std::string& program = argv[0];
+  const std::optional<fs::path> found = find_program(program);
+  if (!found)
+    throw ToolError(program.find('/') != std::string::npos
+                        ? fmt::format("cannot start '{}': it does not exist or is not an executable file", program)
+                        : fmt::format("cannot start '{}': not found on PATH", program));
+  // A relative path names a file relative to this process's folder, not the child's.
+  std::error_code ec;
+  const fs::path executable = options.cwd.empty() ? *found : fs::absolute(*found, ec);
+  if (!options.cwd.empty() && !fs::is_directory(options.cwd, ec))
+    throw ToolError(fmt::format("cannot start '{}' in '{}': no such folder", program, options.cwd.string()));
+  if (options.stdout_to == ChildOutput::to_stdout)
+    throw InputError("run_process: ChildOutput::to_stdout is for stderr only");
+
+  std::vector<std::string> env_strings = child_environment(options);
+  std::vector<char*> envp;
+  envp.reserve(env_strings.size() + 1);
+  for (std::string& s : env_strings) envp.push_back(s.data());
+  envp.push_back(nullptr);
+  std::vector<std::string> arg_strings = argv;
+  std::vector<char*> args;
+  args.reserve(arg_strings.size() + 1);
+  for (std::string& a : arg_strings) args.push_back(a.data());
+  args.push_back(nullptr);
+
+  // Pipes: [0] stdout (with stderr when merged), [1] stderr.
+  std::array<Fd, 2> read_ends, write_ends;
+  const bool capture_out = options.stdout_to == ChildOutput::capture;
+  const bool merged = options.stderr_to == ChildOutput::to_stdout;
+  const bool capture_err = options.stderr_to == ChildOutput::capture;
+  if (capture_out) open_pipe(read_ends[0], write_ends[0], program);
+  if (capture_err) open_pipe(read_ends[1], write_ends[1], program);
+
+  SpawnSetup setup;
+  sigset_t no_signals, defaulted;
+  sigemptyset(&no_signals);
+  sigemptyset(&defaulted);
+  for (int s : kDefaultedSignals) sigaddset(&defaulted, s);
+  posix_spawnattr_setflags(&setup.attr,
+                           static_cast<short>(POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF));
+  posix_spawnattr_setpgroup(&setup.attr, 0);
+  posix_spawnattr_setsigmask(&setup.attr, &no_signals);
+  posix_spawnattr_setsigdefault(&setup.attr, &defaulted);
+  posix_spawn_file_actions_t* fa = &setup.actions;
+  posix_spawn_file_actions_addopen(fa, 0, "/dev/null", O_RDONLY, 0);
+  if (capture_out)
+    posix_spawn_file_actions_adddup2(fa, write_ends[0].get(), 1);
+  else if (options.stdout_to == ChildOutput::discard)
+    posix_spawn_file_actions_addopen(fa, 1, "/dev/null", O_WRONLY, 0);
+  if (capture_err)
+    posix_spawn_file_actions_adddup2(fa, write_ends[1].get(), 2);
+  else if (merged)
+    posix_spawn_file_actions_adddup2(fa, 1, 2);
+  else if (options.stderr_to == ChildOutput::discard)
+    posix_spawn_file_actions_addopen(fa, 2, "/dev/null", O_WRONLY, 0);
+  const std::string cwd = options.cwd.string();
+  if (!cwd.empty()) posix_spawn_file_actions_addchdir_np(fa, cwd.c_str());
+
+  ChildGuard child;
+  const Clock::time_point start = Clock::now();
+  pid_t pid = 0;
+  const int spawn_error = ::posix_spawn(&pid, executable.c_str(), fa, &setup.attr, args.data(), envp.data());
+  if (spawn_error != 0)
+    throw ToolError(fmt::format("cannot start '{}'{}: {}", executable.string(),
+                                cwd.empty() ? "" : fmt::format(" in '{}'", cwd), std::strerror(spawn_error)));
+  child.pid_ = pid;
+  for (Fd& w : write_ends) w.reset();  // the child holds its own copies: EOF comes when it closes them
+  const Fd pid_fd(open_pid_fd(pid));
+
+  ProcessResult result;
+  result.pid = pid;
+  std::array<std::string*, 2> sinks{&result.out, &result.err};
+  std::array<pollfd, 3> fds{pollfd{read_ends[0].get(), POLLIN, 0}, pollfd{read_ends[1].get(), POLLIN, 0},
+                            pollfd{pid_fd.get(), POLLIN, 0}};
+  std::array<char, 65536> buffer{};
+  // A moment not (yet) set is kNever.
+  constexpr Clock::time_point kNever = Clock::time_point::max();
+  const Clock::time_point deadline = options.timeout.count() > 0 ? start + options.timeout : kNever;
+  Clock::time_point kill_at = kNever;     // SIGKILL after the SIGTERM of a timeout
+  Clock::time_point linger_end = kNever;  // the child has ended: how long its pipes may stay open
+  bool ended = false, killed = false;
+  for (;;) {
+    const Clock::time_point now = Clock::now();
+    if (!ended && has_ended(child, program)) {
+      ended = true;
+      linger_end = now + options.kill_grace;
+      fds[2].fd = -1;
+    }
+    const bool pipes_open = fds[0].fd >= 0 || fds[1].fd >= 0;
+    // Done when the child has ended and its pipes are closed; a descendant that still holds
+    // them open gets kill_grace to finish writing before the group is killed below.
+    if (ended && (!pipes_open || now >= linger_end)) break;
+    if (!ended && now >= deadline && !result.timed_out) {
+      result.timed_out = true;
+      ::kill(-pid, SIGTERM);
+      kill_at = now + options.kill_grace;
+    }
+    if (!ended && now >= kill_at && !killed) {
+      killed = true;
+      ::kill(-pid, SIGKILL);
+    }
+
+    // Sleep until output arrives, the child ends, or the next deadline; without a pid fd the
+    // end of the child is noticed by looking every 100 ms (10 ms once its pipes are closed).
+    Clock::time_point wake = linger_end;
+    if (!ended) {
+      if (!result.timed_out) wake = std::min(wake, deadline);
+      if (!killed) wake = std::min(wake, kill_at);
+      if (pid_fd.get() < 0) wake = std::min(wake, now + std::chrono::milliseconds(pipes_open ? 100 : 10));
+    }
+    int wait_ms = -1;
+    if (wake != kNever) {
+      const auto ms = std::chrono::ceil<std::chrono::milliseconds>(wake - now).count();
+      wait_ms = static_cast<int>(std::clamp<long long>(ms, 0, 60'000));
+    }
+    if (::poll(fds.data(), fds.size(), wait_ms) < 0) {
+      if (errno == EINTR) continue;
+      throw ToolError(fmt::format("cannot read the output of {}: poll failed: {}", program, std::strerror(errno)));
+    }
+    for (size_t i = 0; i < 2; ++i) {
+      if (fds[i].fd < 0 || (fds[i].revents & (POLLIN | POLLHUP | POLLERR)) == 0) continue;
+      const ssize_t n = ::read(fds[i].fd, buffer.data(), buffer.size());
+      if (n > 0) {
+        sinks[i]->append(buffer.data(), static_cast<size_t>(n));
+      } else if (n == 0 || (errno != EINTR && errno != EAGAIN)) {
+        read_ends[i].reset();
+        fds[i].fd = -1;
+      }
+    }
+  }
+
+  // Whatever the child left running in its group goes with it; then the zombie is reaped.
+  ::kill(-pid, SIGKILL);
+  for (Fd& r : read_ends) r.reset();
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) {
+      child.pid_ = -1;
+      throw ToolError(fmt::format("lost track of {} (pid {}): {}", program, pid, std::strerror(errno)));
+    }
+  }
+  child.pid_ = -1;
+  result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  if (WIFEXITED(status)) {
+    result.exit_code = WEXITSTATUS(status);
+  } else if (WIFSIGNALED(status)) {
+    result.signal = WTERMSIG(status);
+  }
+  return result;
+}
+
+std::chrono::milliseconds tool_timeout() {
+  const char* value = std::getenv(kToolTimeoutVariable);
+  if (value == nullptr || *value == '\0') return kDefaultToolTimeout;
+  char* end = nullptr;
+  errno = 0;
+  const double seconds = std::strtod(value, &end);
+  // At most ten years: beyond that the limit means nothing and milliseconds could overflow.
+  constexpr double kMaxSeconds = 10.0 * 365 * 24 * 3600;
+  if (end == value || *end != '\0' || errno != 0 || !std::isfinite(seconds) || seconds < 0.0 || seconds > kMaxSeconds ||
+      std::isspace(static_cast<unsigned char>(*value)))
+    throw InputError(fmt::format("{}='{}' is not a time limit: give the seconds one external render may take (e.g. "
+                                 "{}=3600), or 0 for no limit; unset it for the default of {}",
+                                 kToolTimeoutVariable, value, kToolTimeoutVariable, format_limit(kDefaultToolTimeout)));
+  if (seconds == 0.0) return std::chrono::milliseconds(0);
+  return std::chrono::milliseconds(std::max(1LL, std::llround(seconds * 1000.0)));
+}
+
+std::string tool_timeout_hint() {
+  const char* value = std::getenv(kToolTimeoutVariable);
+  const std::string now = value != nullptr && *value != '\0' ? fmt::format("{}={}", kToolTimeoutVariable, value)
+                                                               : fmt::format("the default, {} unset", kToolTimeoutVariable);
+  return fmt::format("if it is only slow, allow more with {}=<seconds> (0: no limit; now {})", kToolTimeoutVariable,
+                     now);
+}
+
+std::string format_limit(std::chrono::milliseconds limit) {
+  const long long ms = limit.count();
+  if (ms % 60'000 == 0 && ms >= 60'000) return fmt::format("{} min", ms / 60'000);
+  if (ms % 1000 == 0) return fmt::format("{} s", ms / 1000);
+  return fmt::format("{:g} s", static_cast<double>(ms) / 1000.0);
+}
+
+}  // namespace sb::validation
