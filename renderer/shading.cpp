@@ -73,11 +73,24 @@ vec3 albedo_at(const RenderScene& scene, const SurfacePoint& p, float lod) {
   return c;
 }
 
-float primary_cone_width(float t, float tan_spread, float cos_off_axis) {
-  return t * tan_spread * cos_off_axis * std::sqrt(cos_off_axis);
+ConeSection primary_cone(float t, float tan_spread, const vec3& dir, const vec3& view_dir) {
+  const float c = glm::dot(dir, view_dir);  // cos(phi)
+  // Radial direction: the viewing direction's component across the ray, reversed (pointing away
+  // from the axis); its length is sin(phi). On the axis any direction across the ray will do.
+  vec3 radial = c * dir - view_dir;
+  const float s = glm::length(radial);
+  if (s > 1e-6f) {
+    radial /= s;
+  } else {
+    const vec3 helper = std::fabs(dir.x) < 0.9f ? vec3(1.0f, 0.0f, 0.0f) : vec3(0.0f, 1.0f, 0.0f);
+    radial = glm::normalize(glm::cross(dir, helper));
+  }
+  const vec3 tangential = glm::cross(dir, radial);
+  const float w = t * tan_spread * c;
+  return {radial * (w * c), tangential * w};
 }
 
-float ray_cone_lod(const RenderScene& scene, const SurfacePoint& p, float cone_width, const vec3& dir) {
+float ray_cone_lod(const RenderScene& scene, const SurfacePoint& p, const ConeSection& cone, const vec3& dir) {
   const int tex = texture_of(scene, p);
   if (tex < 0) return 0.0f;
   const auto [mesh_index, tri] = scene.geometry().locate(p.prim);
@@ -86,8 +99,7 @@ float ray_cone_lod(const RenderScene& scene, const SurfacePoint& p, float cone_w
   const MipTexture& mt = scene.texture(tex);
   const float delta = ray_cone_triangle_lod(mesh.positions[i0], mesh.positions[i1], mesh.positions[i2], mesh.uvs[i0],
                                             mesh.uvs[i1], mesh.uvs[i2], mt.width(), mt.height());
-  const float cos_theta = std::fabs(glm::dot(dir, p.geometric_normal));
-  return lod_from_ray_cone(delta, cone_width, std::max(cos_theta, 1e-6f));
+  return lod_from_elliptic_cone(delta, cone.axis_a, cone.axis_b, p.geometric_normal, dir);
 }
 
 float derivative_lod(const RenderScene& scene, const SurfacePoint& p, const vec4& duv) {

@@ -29,17 +29,30 @@ struct SurfacePoint {
 /// Albedo = base colour factor x base colour texture (trilinear at `lod`), linear RGB.
 [[nodiscard]] vec3 albedo_at(const RenderScene& scene, const SurfacePoint& p, float lod);
 
-/// Texture level of detail by ray cones for a primary ray along unit `dir` whose cone is
-/// `cone_width` wide where it hits `p` (0 when the material has no texture).
-[[nodiscard]] float ray_cone_lod(const RenderScene& scene, const SurfacePoint& p, float cone_width, const vec3& dir);
+/// A ray cone's cross-section where it hits a surface: two perpendicular axes across the ray, each
+/// as long as the cone's full width along it (world units).
+struct ConeSection {
+  vec3 axis_a{0.0f};
+  vec3 axis_b{0.0f};
+};
 
-/// Width of a primary ray's cone at distance t: t * tan(alpha) * cos^1.5(phi), alpha the spread per
-/// pixel (ray_cone_spread) and phi the ray's angle to the optical axis. A pixel off the axis
-/// subtends alpha cos^2(phi) radially and alpha cos(phi) tangentially; the cone of the same solid
-/// angle (alpha^2 cos^3(phi)) has width alpha cos^1.5(phi). With it the ray-cone level stays within
-/// 0.31 of the derivative level over the whole frame up to a 60 degree vertical field of view
-/// (tests/texture/lod_test.cpp), where a constant width is off by up to 1.25 levels in the corners.
-[[nodiscard]] float primary_cone_width(float t, float tan_spread, float cos_off_axis);
+/// The cone of the primary ray along unit `dir` at hit distance t, for an eye whose unit viewing
+/// direction (its -Z) is `view_dir`, with tan_spread = tan(ray_cone_spread(vfov, H)) = 1 / f_px.
+///
+/// A pixel at angle phi from the viewing direction subtends alpha cos^2(phi) along the radial
+/// direction (in the plane of the ray and the viewing direction) and alpha cos(phi) across it,
+/// alpha the spread on the axis: the image plane is 1 / cos(phi) farther away along the ray and
+/// seen at angle phi radially. The cone takes these two spreads, so its section at t is an ellipse
+/// with axes t tan_spread cos^2(phi) (radial) and t tan_spread cos(phi) (tangential), the pixel's
+/// own angular footprint; on the axis it is the circle of width t tan_spread of Ray Tracing Gems
+/// ch. 20. No circular cone fits both extents: the best single width, t tan_spread cos^1.5(phi),
+/// is still up to 0.5 log2(1 / cos(phi)) levels off the rasterizer (texture.hpp, lod_from_ray_cone).
+[[nodiscard]] ConeSection primary_cone(float t, float tan_spread, const vec3& dir, const vec3& view_dir);
+
+/// Texture level of detail by ray cones (lod_from_elliptic_cone) for a ray along unit `dir` whose
+/// cone has section `cone` where it hits `p` (0 when the material has no texture).
+[[nodiscard]] float ray_cone_lod(const RenderScene& scene, const SurfacePoint& p, const ConeSection& cone,
+                                 const vec3& dir);
 
 /// Texture level of detail from screen-space UV derivatives (0 when the material has no texture).
 [[nodiscard]] float derivative_lod(const RenderScene& scene, const SurfacePoint& p, const vec4& duv);

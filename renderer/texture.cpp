@@ -186,4 +186,19 @@ float lod_from_ray_cone(float triangle_lod, float cone_width, float abs_cos_thet
                             std::log2(std::fabs(static_cast<double>(abs_cos_theta))));
 }
 
+float lod_from_elliptic_cone(float triangle_lod, const vec3& axis_a, const vec3& axis_b, const vec3& normal,
+                             const vec3& dir) {
+  // The cross-section's axes projected along the ray onto the tangent plane: w - (n.w / n.d) d.
+  const dvec3 n(normal), d(dir), a(axis_a), b(axis_b);
+  // A ray along the surface reads as |n.d| = 1e-6: a finite, very coarse level instead of inf - inf.
+  double nd = glm::dot(n, d);
+  if (!(std::fabs(nd) >= 1e-6)) nd = nd < 0.0 ? -1e-6 : 1e-6;
+  const dvec3 pa = a - (glm::dot(n, a) / nd) * d, pb = b - (glm::dot(n, b) / nd) * d;
+  // Largest eigenvalue of the 2x2 Gram matrix (the squared major axis), as in lod_from_derivatives.
+  const double e = glm::dot(pa, pa), g = glm::dot(pb, pb), f = glm::dot(pa, pb);
+  const double half_diff = 0.5 * (e - g);
+  const double sigma_max_sq = 0.5 * (e + g) + std::sqrt(half_diff * half_diff + f * f);
+  return static_cast<float>(static_cast<double>(triangle_lod) + 0.5 * std::log2(sigma_max_sq));
+}
+
 }  // namespace sb

@@ -64,19 +64,19 @@ class MipTexture {
 /// two columns (the pixel's x and y axes mapped to texels). This function takes rho = the largest
 /// singular value of J, the major axis of the footprint ellipse, and returns log2(rho).
 ///
-/// Why: a ray cone (lod_from_ray_cone) models the same footprint as a disc of diameter W across
-/// the ray, stretched by 1 / |cos theta| along the surface's tilt direction; its LOD is log2 of
-/// that ellipse's major axis in texels. The largest singular value is the same quantity for the
-/// rasterizer, so for a plane seen through the pixel on the optical axis both rules give the same
-/// level at every tilt (tests/texture/lod_test.cpp). The OpenGL max-axis rule is not invariant
-/// under rotating the tilt direction on screen: for a tilt along the screen diagonal it is lower
-/// by up to log2(sqrt 2) = 0.5 (0.17 at 40 degrees, 0.34 at 60, 0.48 at 80), so the raster path
-/// would drift to the edge of DESIGN §3's +-0.5 agreement. The largest singular value lies
-/// between the OpenGL value and sqrt(2) times it, so it never selects a sharper (more aliased)
-/// level than the OpenGL rule. The geometric mean sqrt|det J| (the cone's isotropic area) and
-/// the minor axis disagree with the cone by 1.26 and 2.5 levels at 80 degrees. Across a whole
-/// 40-degree 1920x1080 frame, with the primary cone width recommended at lod_from_ray_cone, the
-/// major axis stays within 0.16 levels of the cone and the OpenGL rule reaches 0.53 (40-degree tilt).
+/// Why: a ray cone models the same footprint as its cross-section across the ray (a disc of
+/// diameter W for a circular cone, lod_from_ray_cone; an ellipse for a primary ray's cone,
+/// lod_from_elliptic_cone) projected along the ray onto the surface, which stretches it by
+/// 1 / |cos theta| along the surface's tilt direction; its LOD is log2 of the major axis of that
+/// footprint in texels. The largest singular value is the same quantity for the rasterizer, so
+/// for a plane both rules give the same level at every pixel and tilt (tests/texture/lod_test.cpp).
+/// The OpenGL max-axis rule is not invariant under rotating the tilt direction on screen: for a
+/// tilt along the screen diagonal it is lower by up to log2(sqrt 2) = 0.5 (0.17 at 40 degrees,
+/// 0.34 at 60, 0.48 at 80), so the raster path would drift to the edge of DESIGN §3's +-0.5
+/// agreement. The largest singular value lies between the OpenGL value and sqrt(2) times it, so it
+/// never selects a sharper (more aliased) level than the OpenGL rule. The geometric mean
+/// sqrt|det J| (the cone's isotropic area) and the minor axis disagree with the cone by 1.26 and
+/// 2.5 levels at 80 degrees.
 ///
 /// The raw value is returned: -inf for a zero footprint (no UVs), very negative for
 /// magnification; sample_trilinear clamps it to [0, levels - 1].
@@ -84,8 +84,9 @@ class MipTexture {
 
 /// Ray-cone spread angle per pixel: alpha = atan(2 tan(vfov / 2) / H), the angle one pixel row
 /// subtends on the optical axis (the whole cone angle, not the half angle, as in Ray Tracing Gems
-/// ch. 20). A primary cone has width W = t * alpha at hit distance t (the chapter's small-angle
-/// form of 2 t tan(alpha / 2)). Throws InputError unless 0 < vfov < pi and H > 0.
+/// ch. 20). The pixel on the optical axis has a primary cone of width W = t * alpha at hit distance t
+/// (the chapter's small-angle form of 2 t tan(alpha / 2)); pixels off the axis subtend less
+/// (lod_from_ray_cone, primary_cone in shading.hpp). Throws InputError unless 0 < vfov < pi and H > 0.
 [[nodiscard]] double ray_cone_spread(double vfov, int height);
 
 /// The per-triangle constant of ray-cone LOD: 0.5 log2(texel-space area / world-space area), with
@@ -102,22 +103,43 @@ class MipTexture {
 /// |n . d| for unit n and d; both are used as absolute values. The result is raw (+-inf or NaN for
 /// degenerate inputs; sample_trilinear clamps it and reads NaN as level 0).
 ///
-/// Agreement with lod_from_derivatives: for the pixel on the optical axis, W = t * alpha is that
-/// pixel's footprint across the ray, so for an isotropically mapped surface the two LODs are equal
-/// at any distance and tilt. Away from the optical axis a pixel subtends less than alpha: alpha
-/// cos^2(phi) radially and alpha cos(phi) tangentially, phi the angle between the primary ray and
-/// the eye's viewing direction (its -Z; an off-axis eye's principal point is not the image
-/// centre). With the constant W = t * alpha the cone therefore picks a coarser level than
-/// the rasterizer by up to -2 log2 cos(phi) (head-on plane): 0.63 levels in the corners of a
-/// 40-degree 16:9 frame, 1.25 at 60 degrees. Scaling the primary width by cos^2(phi) (the radial
-/// axis; exact for head-on surfaces) leaves up to 0.32 levels at 40 degrees but 0.63 at 60 on
-/// tilted planes; scaling by cos^1.5(phi), the geometric mean of the two axes, keeps the worst
-/// difference over a 1920x1080 frame with tilts up to 80 degrees at 0.16 levels (40-degree vfov)
-/// and 0.31 (60-degree vfov), within DESIGN §3's +-0.5 (tests/texture/lod_test.cpp); at 90 degrees the
-/// two axes differ by more than one level in the corners and only an elliptical cone would do.
-/// Both statements assume isotropically mapped UVs: the triangle constant is area based, so
-/// where a triangle stretches the texture k times more along one surface axis than the other the
-/// cone sits 0.5 log2(k) below the rasterizer's major axis.
+/// A circular cone fits the pixel on the optical axis only: there W = t * alpha is the pixel's
+/// footprint across the ray, and for an isotropically mapped surface this LOD equals
+/// lod_from_derivatives at any distance and tilt. Away from the axis a pixel subtends alpha
+/// cos^2(phi) radially and alpha cos(phi) tangentially (phi the ray's angle to the eye's viewing
+/// direction, its -Z; an off-axis eye's principal point is not the image centre), and no single
+/// width fits both: W = t * alpha picks levels coarser than the rasterizer by up to -2 log2
+/// cos(phi) (0.63 levels in the corners of a 40-degree 16:9 frame), W = t * alpha cos^1.5(phi)
+/// (the geometric mean of the two axes) is still off by +-0.5 log2(1 / cos(phi)) wherever the
+/// surface's tilt runs radially or tangentially on screen: 0.128 levels at the sides of the
+/// 480x270 textured-plane frame, 0.16, 0.31 and 0.59 over 40-, 60- and 90-degree 1920x1080
+/// frames (tests/texture/lod_test.cpp).
+/// Primary rays therefore use lod_from_elliptic_cone.
 [[nodiscard]] float lod_from_ray_cone(float triangle_lod, float cone_width, float abs_cos_theta);
+
+/// Ray-cone LOD for a cone of elliptic cross-section: triangle constant + log2 of the major axis
+/// of the cone's footprint on the surface.
+///
+/// axis_a and axis_b are the principal axes of the cone's cross-section at the hit, perpendicular
+/// to the unit ray direction `dir`, each as long as the full width of the cone along it (world
+/// units); `normal` is the surface's unit normal. The footprint is the cross-section projected
+/// along the ray onto the surface's tangent plane, w -> w - (n . w) / (n . d) d; the result is
+/// triangle_lod + log2(sigma_max), sigma_max the largest singular value of the 3x2 matrix of the
+/// two projected axes (the major axis of the footprint ellipse). For a circular cross-section
+/// (|axis_a| = |axis_b| = W) that is W / |n . d|, lod_from_ray_cone exactly.
+///
+/// With the primary cone of shading.hpp (axes t alpha cos^2(phi) radially and t alpha cos(phi)
+/// tangentially, the pixel's exact angular extents) the footprint is the pixel's own footprint on
+/// the surface's tangent plane, so on an isotropically mapped plane this LOD equals
+/// lod_from_derivatives at every pixel, tilt and field of view (to float rounding:
+/// tests/texture/lod_test.cpp). Both rules see the flat triangle (the cone its geometric normal,
+/// the rasterizer its planar interpolation), so this holds triangle by triangle on curved meshes
+/// too. The triangle constant is area based: where a triangle stretches the texture k times more
+/// along one surface axis than the other, the cone's level differs from the rasterizer's major
+/// axis by up to 0.5 log2(k), depending on how the footprint lies. |n . d| is taken as at least
+/// 1e-6 (a ray along the surface reads as a very coarse level); otherwise the raw value is
+/// returned (-inf for a zero cross-section, NaN for non-finite input).
+[[nodiscard]] float lod_from_elliptic_cone(float triangle_lod, const vec3& axis_a, const vec3& axis_b,
+                                           const vec3& normal, const vec3& dir);
 
 }  // namespace sb

@@ -51,8 +51,8 @@ class PacketTracer {
       SurfacePoint& p = points_[m_];
       p = surface_at(scene_, hits[i].prim, hits[i].bary, vec3(origin_));
       const float cos_axis = cos_to_axis(eye_, rays[i].dir);
-      const float width = primary_cone_width(hits[i].t, tan_spread_, cos_axis);
-      albedo_[m_] = albedo_at(scene_, p, ray_cone_lod(scene_, p, width, rays[i].dir));
+      const ConeSection cone = primary_cone(hits[i].t, tan_spread_, rays[i].dir, vec3(-eye_.back));
+      albedo_[m_] = albedo_at(scene_, p, ray_cone_lod(scene_, p, cone, rays[i].dir));
       depth_[m_] = hits[i].t * cos_axis;
       where_[m_] = pixels[i];
       if (++m_ == kRayPacket) flush();

@@ -107,12 +107,11 @@ TEST_P(Visibility, RasterAndRayTracingAgree) {
     std::printf("%-15s %-5s primitive ids agree on %.4f %% (%zu differ)\n", GetParam().c_str(), eye_name(e), 100.0 * agree, differ);
   }
   const double psnr = test::psnr_srgb8(ra.right, rt.right);
-  // textured-plane is the mip-level stress scene (a full-contrast checker at grazing angles): the
-  // derivative rule and the ray-cone rule pick levels up to 0.128 apart there (TextureLod test, within
-  // DESIGN's 0.5), which its checker turns into 48.31 dB at 480x270 (measured). Everywhere else the
-  // 50 dB of the specification holds.
-  const double min_psnr = GetParam() == "textured-plane" ? 48.0 : 50.0;
-  EXPECT_GE(psnr, min_psnr) << GetParam();
+  // The specification's 50 dB on every scene. Measured at 480x270: textured-plane 75.07 dB (the
+  // mip-level stress scene: its full-contrast checker at grazing angles shows any difference
+  // between the raster's derivative LOD and the ray cone's, which the TextureLod test measures at
+  // 0.000 levels), bistro 65.56, atrium 60.69, spheres 59.45, temple 67.24, the others above 90 dB.
+  EXPECT_GE(psnr, 50.0) << GetParam();
   std::printf("%-15s right eye plain-raster vs plain-rt: %.2f dB\n", GetParam().c_str(), psnr);
 }
 

@@ -36,8 +36,7 @@ TEST(TextureLod, RasterDerivativesAndRayConesAgreeWithinHalfALevel) {
         const float raster_lod = derivative_lod(rs, p, g.duv[i]);
         const vec3 dir(cam.ray_direction(x + 0.5, y + 0.5));
         const float t = glm::length(p.position - eye);
-        const float width = primary_cone_width(t, tan_spread, glm::dot(dir, -vec3(cam.back)));
-        const float cone_lod = ray_cone_lod(rs, p, width, dir);
+        const float cone_lod = ray_cone_lod(rs, p, primary_cone(t, tan_spread, dir, -vec3(cam.back)), dir);
         // Levels below 0 all sample level 0: compare the levels actually used.
         const int levels = rs.texture(0).levels();
         const float a = std::clamp(raster_lod, 0.0f, float(levels - 1)), b = std::clamp(cone_lod, 0.0f, float(levels - 1));
@@ -47,9 +46,14 @@ TEST(TextureLod, RasterDerivativesAndRayConesAgreeWithinHalfALevel) {
         EXPECT_LE(std::fabs(a - b), 0.5f) << "pixel " << x << "," << y << " raster " << raster_lod << " cone " << cone_lod;
         ++compared;
       }
+    // Both rules compute the major axis of the pixel's footprint on the plane, from different
+    // inputs (the G-buffer's UV derivatives; the hit distance, normal and triangle constant). On
+    // this isotropically mapped plane they differ by float rounding only (measured 0.0000 levels at
+    // both sizes); a circular primary cone would be 0.128 levels off at the frame's sides.
+    EXPECT_LE(worst, 0.01) << w << "x" << h;
     EXPECT_GT(compared, size_t(w) * h / 3);
     EXPECT_GT(lod_max - lod_min, 3.0f) << "the plane should span several mip levels";
-    std::printf("%dx%d: %zu pixels, raster LOD %.2f..%.2f, max |raster - cone| %.3f levels\n", w, h, compared, lod_min,
+    std::printf("%dx%d: %zu pixels, raster LOD %.2f..%.2f, max |raster - cone| %.4f levels\n", w, h, compared, lod_min,
                 lod_max, worst);
   }
 }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "renderer/error.hpp"
+#include "renderer/shading.hpp"
 #include "renderer/texture.hpp"
 
 namespace sb {
@@ -74,8 +75,9 @@ struct PixelLods {
   double geometric_mean = 0.0;  ///< sqrt |det J|
   double minor_axis = 0.0;      ///< smallest singular value of J
   double cone = 0.0;            ///< lod_from_ray_cone with W = t alpha (Ray Tracing Gems ch. 20)
-  double cone_corrected = 0.0;  ///< lod_from_ray_cone with W = t alpha cos^1.5(phi) (texture.hpp)
+  double cone_corrected = 0.0;  ///< lod_from_ray_cone with W = t alpha cos^1.5(phi) (best circular width)
   double cone_cos2 = 0.0;       ///< lod_from_ray_cone with W = t alpha cos^2(phi) (exact head-on)
+  double cone_elliptic = 0.0;   ///< lod_from_elliptic_cone with primary_cone (the rule the ray tracer uses)
 };
 
 /// Both rules at the centre of pixel (x, y), from the exact screen derivatives of the plane's UVs
@@ -121,6 +123,10 @@ PixelLods lods_at(const PinholeCamera& cam, const TexturedPlane& plane, double x
                                          static_cast<float>(abs_cos));
   out.cone_cos2 = lod_from_ray_cone(triangle, static_cast<float>(t * alpha * out.cos_phi * out.cos_phi),
                                     static_cast<float>(abs_cos));
+  const vec3 dir(d / glm::length(d));
+  const ConeSection section =
+      primary_cone(static_cast<float>(t), static_cast<float>(std::tan(alpha)), dir, vec3(0.0f, 0.0f, -1.0f));
+  out.cone_elliptic = lod_from_elliptic_cone(triangle, section.axis_a, section.axis_b, vec3(plane.n), dir);
   return out;
 }
 
@@ -210,6 +216,8 @@ TEST(LodAgreement, TiltedPlaneOnTheOpticalAxis) {
         worst[1] = std::max(worst[1], std::fabs(l.cone - l.opengl));
         worst[2] = std::max(worst[2], std::fabs(l.cone - l.geometric_mean));
         worst[3] = std::max(worst[3], std::fabs(l.cone - l.minor_axis));
+        // On the axis the primary cone is circular: the elliptic form reduces to RTG's.
+        EXPECT_NEAR(l.cone_elliptic, l.cone, 1e-3) << "tilt " << tilt << " axis " << axis;
 
         // The OpenGL rule falls short of the footprint's major axis when the tilt is not along a
         // pixel axis: by 0.5 log2((cos^2 + 1) / 2) for a diagonal tilt (-> 0.5 at grazing angles).
@@ -229,34 +237,93 @@ TEST(LodAgreement, AcrossTheFrame) {
   // degrees about several screen axes; pixels that see the plane at more than 80 degrees from its
   // normal are left out. With RTG's constant primary spread the cone picks coarser levels off the
   // optical axis, -2 log2 cos(phi) for a head-on plane, whatever rho the rasterizer uses. The
-  // table also shows the primary widths t alpha cos^2(phi) and t alpha cos^1.5(phi) and the OpenGL
-  // max-axis rule; with cos^1.5, the one texture.hpp recommends, the paths agree within +-0.5.
-  for (const double vfov : {40.0, 60.0}) {
+  // table also shows circular cones of width t alpha cos^2(phi) and t alpha cos^1.5(phi), the
+  // elliptic primary cone the ray tracer uses (primary_cone: t alpha cos^2(phi) radially, t alpha
+  // cos(phi) tangentially), and the OpenGL max-axis rule. Only the elliptic cone matches the
+  // footprint's major axis at every pixel; circular cones are off by up to +-0.5 log2(1 / cos(phi))
+  // wherever the tilt runs radially or tangentially on screen.
+  for (const double vfov : {40.0, 60.0, 90.0}) {
     const PinholeCamera cam(1920, 1080, vfov);
     fmt::print("whole frame, max |ray cone - raster rule| in levels (vfov {:.0f}, 1920x1080)\n", vfov);
-    fmt::print("{:>6} {:>16} {:>16} {:>16} {:>16} {:>16} {:>16}\n", "tilt", "major t*alpha", "major cos^2",
-               "major cos^1.5", "opengl t*alpha", "opengl cos^2", "opengl cos^1.5");
+    fmt::print("{:>6} {:>14} {:>14} {:>14} {:>14} {:>14} {:>14} {:>14} {:>14}\n", "tilt", "major t*alpha",
+               "major cos^2", "major cos^1.5", "major ellipse", "opengl t*alpha", "opengl cos^2", "opengl cos^1.5",
+               "opengl ellipse");
     for (const double tilt : kTilts) {
-      // Rule x primary width: {major, opengl} x {t alpha, t alpha cos^2, t alpha cos^1.5}.
-      double worst[2][3] = {{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
+      // Rule x primary cone: {major, opengl} x {t alpha, t alpha cos^2, t alpha cos^1.5, elliptic}.
+      double worst[2][4] = {{0.0, 0.0, 0.0, 0.0}, {0.0, 0.0, 0.0, 0.0}};
       for (const double axis : kAxes)
         for (int j = 0; j < 7; ++j)
           for (int i = 0; i < 9; ++i) {
             const double x = 0.5 + i * (cam.width - 1) / 8.0, y = 0.5 + j * (cam.height - 1) / 6.0;
             const PixelLods l = lods_at(cam, TexturedPlane::tilted(3.0, tilt, axis), x, y);
             if (!l.visible || l.view_angle > 80.0) continue;
-            const double rules[2] = {l.derivative, l.opengl}, cones[3] = {l.cone, l.cone_cos2, l.cone_corrected};
+            const double rules[2] = {l.derivative, l.opengl};
+            const double cones[4] = {l.cone, l.cone_cos2, l.cone_corrected, l.cone_elliptic};
             for (int r = 0; r < 2; ++r)
-              for (int c = 0; c < 3; ++c) worst[r][c] = std::max(worst[r][c], std::fabs(cones[c] - rules[r]));
+              for (int c = 0; c < 4; ++c) worst[r][c] = std::max(worst[r][c], std::fabs(cones[c] - rules[r]));
             if (tilt == 0.0) {
               EXPECT_NEAR(l.cone - l.derivative, -2.0 * std::log2(l.cos_phi), 1e-4) << "pixel " << x << "," << y;
             }
           }
-      fmt::print("{:>6.0f} {:>16.4f} {:>16.4f} {:>16.4f} {:>16.4f} {:>16.4f} {:>16.4f}\n", tilt, worst[0][0],
-                 worst[0][1], worst[0][2], worst[1][0], worst[1][1], worst[1][2]);
-      EXPECT_LE(worst[0][2], kAgreement) << "vfov " << vfov << " tilt " << tilt;
+      fmt::print("{:>6.0f} {:>14.4f} {:>14.4f} {:>14.4f} {:>14.4f} {:>14.4f} {:>14.4f} {:>14.4f} {:>14.4f}\n", tilt,
+                 worst[0][0], worst[0][1], worst[0][2], worst[0][3], worst[1][0], worst[1][1], worst[1][2],
+                 worst[1][3]);
+      EXPECT_LE(worst[0][3], kAgreement) << "vfov " << vfov << " tilt " << tilt;
+      // The elliptic cone's footprint is the pixel's own footprint on the plane: the two rules
+      // compute the same major axis from different inputs and differ by float rounding only.
+      EXPECT_LE(worst[0][3], 1e-3) << "vfov " << vfov << " tilt " << tilt;
     }
   }
+}
+
+TEST(RayCone, EllipticConeWithACircularSectionIsTheCircularCone) {
+  // A ray and a surface in general position; a circular section of width 0.3 around the ray.
+  const vec3 d = glm::normalize(vec3(0.2f, -0.5f, -1.0f)), n = glm::normalize(vec3(0.1f, 1.0f, 0.3f));
+  const vec3 a = glm::normalize(glm::cross(d, vec3(1.0f, 0.0f, 0.0f))), b = glm::cross(d, a);
+  for (const float turn : {0.0f, 0.7f, 2.0f}) {  // the section's axes turned about the ray
+    const vec3 ta = std::cos(turn) * a + std::sin(turn) * b, tb = glm::cross(d, ta);
+    EXPECT_NEAR(lod_from_elliptic_cone(1.5f, 0.3f * ta, 0.3f * tb, n, d),
+                lod_from_ray_cone(1.5f, 0.3f, std::fabs(glm::dot(n, d))), 1e-5)
+        << "turn " << turn;
+  }
+  // Head-on, the footprint is the section itself: its longer axis counts.
+  EXPECT_NEAR(lod_from_elliptic_cone(0.0f, 0.25f * a, 2.0f * b, -d, d), 1.0f, 1e-6);
+  // Tilted about the short axis, the long axis is stretched by 1 / cos: 2 / 0.5 = 4 -> level 2.
+  const vec3 tilted = glm::normalize(-0.5f * d + std::sqrt(0.75f) * b);
+  EXPECT_NEAR(lod_from_elliptic_cone(0.0f, 0.25f * a, 2.0f * b, tilted, d), 2.0f, 1e-5);
+  // Tilted about the long axis, the short one is stretched: 0.25 / 0.5 = 0.5 < 2 -> level 1.
+  const vec3 tilted_a = glm::normalize(-0.5f * d + std::sqrt(0.75f) * a);
+  EXPECT_NEAR(lod_from_elliptic_cone(0.0f, 0.25f * a, 2.0f * b, tilted_a, d), 1.0f, 1e-5);
+  // A ray along the surface gives a finite, very coarse level (|n.d| read as 1e-6).
+  const float grazing = lod_from_elliptic_cone(0.0f, a, b, a, d);
+  EXPECT_TRUE(std::isfinite(grazing));
+  EXPECT_NEAR(grazing, std::log2(1e6), 1e-3);
+  // A zero section: -inf (level 0).
+  EXPECT_EQ(lod_from_elliptic_cone(0.0f, vec3(0.0f), vec3(0.0f), n, d), -std::numeric_limits<float>::infinity());
+}
+
+TEST(PrimaryCone, AxesAreThePixelsAngularExtents) {
+  const vec3 view(0.0f, 0.0f, -1.0f);
+  // On the optical axis: a circle of width t tan_spread across the ray.
+  const ConeSection on_axis = primary_cone(4.0f, 0.001f, view, view);
+  EXPECT_NEAR(glm::length(on_axis.axis_a), 0.004f, 1e-9f);
+  EXPECT_NEAR(glm::length(on_axis.axis_b), 0.004f, 1e-9f);
+  EXPECT_NEAR(glm::dot(on_axis.axis_a, view), 0.0f, 1e-9f);
+  EXPECT_NEAR(glm::dot(on_axis.axis_b, view), 0.0f, 1e-9f);
+  EXPECT_NEAR(glm::dot(on_axis.axis_a, on_axis.axis_b), 0.0f, 1e-12f);
+  // 40 degrees off the axis towards +x and +y: cos^2 radially, cos tangentially.
+  const float phi = static_cast<float>(degrees_to_radians(40.0)), c = std::cos(phi);
+  const vec3 dir = glm::normalize(vec3(std::sin(phi) * glm::normalize(vec3(1.0f, 1.0f, 0.0f)).x,
+                                       std::sin(phi) * glm::normalize(vec3(1.0f, 1.0f, 0.0f)).y, -c));
+  const ConeSection off = primary_cone(4.0f, 0.001f, dir, view);
+  EXPECT_NEAR(glm::length(off.axis_a), 0.004f * c * c, 1e-8f);
+  EXPECT_NEAR(glm::length(off.axis_b), 0.004f * c, 1e-8f);
+  EXPECT_NEAR(glm::dot(off.axis_a, dir), 0.0f, 1e-8f);
+  EXPECT_NEAR(glm::dot(off.axis_b, dir), 0.0f, 1e-8f);
+  // The radial axis lies in the plane of the ray and the viewing direction, pointing away from it.
+  EXPECT_NEAR(glm::dot(off.axis_a, glm::cross(dir, view)), 0.0f, 1e-8f);
+  EXPECT_GT(off.axis_a.x, 0.0f);
+  EXPECT_GT(off.axis_a.y, 0.0f);
 }
 
 }  // namespace
