@@ -123,6 +123,9 @@ enum class WarpPixel : uint8_t {
   /// threshold in disparity): that surface's silhouette lies up to a pixel before its first source
   /// pixel centre, so the pixel may belong to it. A hole for the filler.
   occluding_edge = 3,
+  /// Covered, but the target eye sees there a surface outside the source eye's frustum, which
+  /// no grid triangle carries (found by mark_outside_source_frustum, not by grid_warp). A hole.
+  outside_source = 4,
 };
 
 /// Counters of one warp.

@@ -6,6 +6,7 @@
 #include "renderer/error.hpp"
 #include "renderer/stages/eye_image.hpp"
 #include "renderer/stages/raster_eye.hpp"
+#include "renderer/stages/source_frustum.hpp"
 
 namespace sb {
 
@@ -22,6 +23,10 @@ std::vector<OptionSpec> grid_warp_option_specs(bool with_detection) {
     specs.push_back({"occluding_edge_px", "0.5",
                      "also fill the pixel just left of a surface that is nearer than its left neighbour by more than "
                      "this many pixels of disparity (its silhouette may reach it); 0 = off"});
+    specs.push_back({"source_frustum", "true",
+                     "also fill the right-eye pixels that see a surface outside the left frustum (near objects "
+                     "entering at the right edge), found with rays restricted to the part of each pixel ray the left "
+                     "eye cannot see"});
     specs.push_back({"discard", "triangle",
                      "which warped fragments are discarded: 'triangle' (grid triangles whose vertices are all flagged) "
                      "or 'interpolated' (the paper's: the measure interpolated, fragments above the threshold)"});
@@ -44,6 +49,7 @@ ReprojectionSettings ReprojectionSettings::from(const PipelineOptions& options, 
     s.warp.occluding_edge_px = options.get_double("occluding_edge_px");
     if (!(s.warp.occluding_edge_px >= 0.0))
       throw InputError(fmt::format("option occluding_edge_px={} must be 0 (off) or positive", s.warp.occluding_edge_px));
+    s.source_frustum = options.get_bool("source_frustum");
     const std::string& rule = options.get("discard");
     if (rule == "triangle") {
       s.warp.rule = DiscardRule::all_vertices;
@@ -72,11 +78,21 @@ std::vector<uint8_t> warp_left_to_right(const RenderScene& scene, const StereoRi
     grid = build_warp_grid(r.left.plane(planes::depth).f32(), left.width, left.height, gs, executor);
   }
   WarpStats ws;
+  SourceFrustumStats frustum;
   std::vector<uint8_t> states;
   {
     ScopedStage stage(r.timings, "grid_warp");
     r.right = make_eye_image(right.width, right.height);
     states = grid_warp(grid, r.left, left, right, e, settings.warp, executor, r.right, ws);
+    if (settings.warp.detect_disocclusions && settings.source_frustum) {
+      frustum = mark_outside_source_frustum(scene, left, right, executor, states,
+                                            static_cast<uint8_t>(WarpPixel::covered),
+                                            static_cast<uint8_t>(WarpPixel::outside_source));
+      EyeWriter out(r.right);
+      for (size_t i = 0; i < states.size(); ++i)
+        if (states[i] == static_cast<uint8_t>(WarpPixel::outside_source)) out.hole(i);
+      ws.pixels_covered -= frustum.pixels;
+    }
   }
   r.counters.set("grid_cells", static_cast<uint64_t>(grid.flagged.size()));
   r.counters.set("grid_cells_flagged", grid.flagged_count());
@@ -87,10 +103,15 @@ std::vector<uint8_t> warp_left_to_right(const RenderScene& scene, const StereoRi
   r.counters.set("grid_fragments", ws.fragments);
   r.counters.set("grid_fragments_discarded", ws.fragments_discarded);
   r.counters.set("pixels_reprojected_right", ws.pixels_covered);
-  r.counters.set("hole_pixels", ws.pixels_discarded + ws.pixels_uncovered + ws.pixels_occluding_edge);
+  r.counters.set("hole_pixels", ws.pixels_discarded + ws.pixels_uncovered + ws.pixels_occluding_edge + frustum.pixels);
   r.counters.set("hole_pixels_discarded", ws.pixels_discarded);
   r.counters.set("hole_pixels_occluding_edge", ws.pixels_occluding_edge);
   r.counters.set("hole_pixels_uncovered", ws.pixels_uncovered);
+  if (settings.warp.detect_disocclusions && settings.source_frustum) {
+    r.counters.set("hole_pixels_outside_frustum", frustum.pixels);
+    r.counters.set("frustum_triangles_near", frustum.triangles_near);
+    r.counters.set("frustum_rays", frustum.rays);
+  }
   if (settings.grid_overlay) r.extras.emplace_back("grid", grid_overlay(grid, r.left));
   return states;
 }

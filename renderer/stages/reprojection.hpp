@@ -19,6 +19,9 @@ struct ReprojectionSettings {
   double threshold_arcmin = 1.0;
   WarpOptions warp;
   bool grid_overlay = false;
+  /// With detection: also find the right-eye pixels whose visible surface lies outside the left
+  /// frustum (mark_outside_source_frustum) and leave them to the hole filler.
+  bool source_frustum = true;
   RasterOptions raster;
 
   /// From checked pipeline options (see grid_warp_option_specs); InputError for values out of range.
@@ -26,7 +29,8 @@ struct ReprojectionSettings {
 };
 
 /// Renders result.left by rasterization and warps it into a new result.right (stages left_gbuffer,
-/// left_shading, grid_metric, grid_warp). Returns the WarpPixel state of every right pixel; counts
+/// left_shading, grid_metric, grid_warp; the search for surfaces outside the left frustum is part of
+/// grid_warp). Returns the WarpPixel state of every right pixel; counts
 /// cells, grid triangles, fragments and hole pixels; adds the "grid" overlay to result.extras when
 /// asked for.
 std::vector<uint8_t> warp_left_to_right(const RenderScene& scene, const StereoRig& rig, const ReprojectionSettings& settings,
