@@ -1,5 +1,8 @@
 // `stereobench report`: the static HTML report of a sweep's results file (reports/, docs/report.md).
+#include <cmath>
 #include <cstdio>
+#include <limits>
+#include <vector>
 #include <filesystem>
 #include <memory>
 
@@ -8,6 +11,7 @@
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
 #include "reports/report.hpp"
+#include "validation/gate.hpp"
 #include "validation/history.hpp"
 
 namespace sb::cli {
@@ -21,6 +25,40 @@ struct ReportArgs {
   bool link_images = false;
   std::string history;
 };
+
+/// The median over the cells of one value of a pipeline, NaN when no cell has a number for it.
+double cell_median(const nlohmann::json& cells, const std::string& pipeline, const char* key) {
+  std::vector<double> values;
+  for (const nlohmann::json& c : cells) {
+    const auto p = c["pipelines"].find(pipeline);
+    if (p == c["pipelines"].end() || !p->contains(key)) continue;
+    const nlohmann::json& v = (*p)[key];
+    if (v.is_number()) values.push_back(v.get<double>());
+    if (v.is_string() && v.get<std::string>() == "inf") values.push_back(std::numeric_limits<double>::infinity());
+  }
+  return validation::median(std::move(values));
+}
+
+/// The report's "Summary per pipeline" on the terminal: medians over the cells.
+void print_summary_table(const reports::ReportSummary& s) {
+  if (!s.pipeline_names.is_array() || !s.cells.is_array() || s.cells.empty()) return;
+  const auto number = [](double v, int precision, double scale = 1.0) {
+    if (std::isnan(v)) return std::string("-");
+    if (std::isinf(v)) return std::string("inf");
+    return fmt::format("{:.{}f}", v * scale, precision);
+  };
+  fmt::print("\n{:<16} {:>8} {:>8} {:>8} {:>11} {:>9}   (medians over {} cell(s))\n", "pipeline", "PSNR dB", "SSIM",
+             "holes %", "time ms", "speed-up", s.cells.size());
+  for (const nlohmann::json& name : s.pipeline_names) {
+    const std::string p = name.get<std::string>();
+    const double speedup = cell_median(s.cells, p, "speedup");
+    fmt::print("{:<16} {:>8} {:>8} {:>8} {:>11} {:>9}\n", p, number(cell_median(s.cells, p, "psnr"), 2),
+               number(cell_median(s.cells, p, "ssim"), 4), number(cell_median(s.cells, p, "hole_fraction"), 3, 100.0),
+               number(cell_median(s.cells, p, "time_s"), 2, 1000.0),
+               std::isnan(speedup) ? std::string("-") : number(speedup, 2) + "x");
+  }
+  fmt::print("\n");
+}
 
 void run_report(const ReportArgs& a) {
   reports::ReportOptions options;
@@ -37,7 +75,8 @@ void run_report(const ReportArgs& a) {
   const reports::ResultsFile results = reports::read_results_file(a.results);
   const reports::ReportSummary s = reports::write_report(results, options);
   for (const std::string& w : s.warnings) std::fprintf(stderr, "stereobench: warning: %s\n", w.c_str());
-  fmt::print("report of {} cell(s) x {} pipeline(s), {} image(s) {}{}\nwrote {}\n", s.cells, s.pipelines, s.images,
+  print_summary_table(s);
+  fmt::print("report of {} cell(s) x {} pipeline(s), {} image(s) {}{}\nwrote {}\n", s.cell_count, s.pipelines, s.images,
              a.link_images ? "linked" : "copied",
              s.paper_experiment.empty() ? "" : fmt::format(", beside the paper's numbers ({})", s.paper_experiment),
              s.index_html.string());
