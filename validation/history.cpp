@@ -135,36 +135,17 @@ void check_history_line(const json& line, const std::string& where) {
 
 HistoryFile read_history(const fs::path& file) {
   HistoryFile out;
-  std::error_code ec;
-  if (!fs::exists(file, ec)) return out;
-  const std::string text = io::read_file(file);
   std::map<std::string, size_t> seen;  // run_id -> line
-  size_t start = 0, line_no = 0;
-  while (start < text.size()) {
-    ++line_no;
-    const size_t nl = text.find('\n', start);
-    if (nl == std::string::npos) {
-      out.warnings.push_back(fmt::format("{}:{}: unterminated last line (a run killed while writing it) skipped",
-                                         file.string(), line_no));
-      break;
-    }
-    const std::string line = text.substr(start, nl - start);
-    start = nl + 1;
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    const std::string where = fmt::format("{}:{}", file.string(), line_no);
-    json run;
-    try {
-      run = json::parse(line);
-    } catch (const json::parse_error& e) {
-      throw InputError(fmt::format("{}: not a JSON line ({}); fix or remove the line", where, e.what()));
-    }
-    check_history_line(run, where);
-    const std::string id = run["run_id"];
-    if (auto [it, fresh] = seen.emplace(id, line_no); !fresh)
-      throw InputError(fmt::format("{}: run_id '{}' appears twice (also on line {}); remove one of the lines", where,
-                                   id, it->second));
-    out.runs.push_back(std::move(run));
-  }
+  read_json_lines(file, "(a run killed while writing it) skipped", "fix or remove the line", out.warnings,
+                  [&](json&& run, size_t line_no, const std::string& where) {
+                    check_history_line(run, where);
+                    const std::string id = run["run_id"];
+                    if (auto [it, fresh] = seen.emplace(id, line_no); !fresh)
+                      throw InputError(fmt::format("{}: run_id '{}' appears twice (also on line {}); remove one of "
+                                                   "the lines",
+                                                   where, id, it->second));
+                    out.runs.push_back(std::move(run));
+                  });
   return out;
 }
 

@@ -141,50 +141,56 @@ void append_result(const fs::path& file, const json& cell) {
   (void)::flock(fd.get(), LOCK_UN);
 }
 
-ResultsFile read_results(const fs::path& file) {
-  ResultsFile out;
+void read_json_lines(const fs::path& file, const std::string& torn_note, const std::string& parse_hint,
+                     std::vector<std::string>& warnings,
+                     const std::function<void(json&& line, size_t line_no, const std::string& where)>& take) {
   std::error_code ec;
-  if (!fs::exists(file, ec)) return out;
+  if (!fs::exists(file, ec)) return;
   const std::string text = io::read_file(file);
-  std::map<std::string, size_t> seen;  // cell_id -> line
   size_t start = 0, line_no = 0;
   while (start < text.size()) {
     ++line_no;
     const size_t nl = text.find('\n', start);
     if (nl == std::string::npos) {
-      out.warnings.push_back(fmt::format("{}:{}: unterminated last line (a sweep killed while writing it) skipped; "
-                                         "its cell runs again when the sweep resumes",
-                                         file.string(), line_no));
+      warnings.push_back(fmt::format("{}:{}: unterminated last line {}", file.string(), line_no, torn_note));
       break;
     }
     const std::string line = text.substr(start, nl - start);
     start = nl + 1;
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    json cell;
+    const std::string where = fmt::format("{}:{}", file.string(), line_no);
+    json parsed;
     try {
-      cell = json::parse(line);
+      parsed = json::parse(line);
     } catch (const json::parse_error& e) {
-      throw InputError(fmt::format("{}:{}: not a JSON line ({}); a results file holds one JSON object per line",
-                                   file.string(), line_no, e.what()));
+      throw InputError(fmt::format("{}: not a JSON line ({}); {}", where, e.what(), parse_hint));
     }
-    if (!cell.is_object() || cell.value("kind", "") != kSweepCellKind)
-      throw InputError(fmt::format("{}:{}: not a sweep cell record (\"kind\" must be \"{}\")", file.string(), line_no,
-                                   kSweepCellKind));
-    if (!cell.contains("schema_version") || cell["schema_version"] != kSweepSchemaVersion)
-      throw InputError(fmt::format("{}:{}: schema_version {} is not {}, the version this stereobench reads",
-                                   file.string(), line_no, cell.value("schema_version", json(nullptr)).dump(),
-                                   kSweepSchemaVersion));
-    if (!cell.contains("cell_id") || !cell["cell_id"].is_string() || !cell.contains("cell_index") ||
-        !cell["cell_index"].is_number_unsigned())
-      throw InputError(fmt::format("{}:{}: a sweep cell record needs a string cell_id and a cell_index >= 0",
-                                   file.string(), line_no));
-    const std::string id = cell["cell_id"];
-    if (auto [it, fresh] = seen.emplace(id, line_no); !fresh)
-      throw InputError(fmt::format("{}:{}: cell_id '{}' appears twice (also on line {}); a results file holds each "
-                                   "cell once — remove one of the lines",
-                                   file.string(), line_no, id, it->second));
-    out.cells.push_back(std::move(cell));
+    take(std::move(parsed), line_no, where);
   }
+}
+
+ResultsFile read_results(const fs::path& file) {
+  ResultsFile out;
+  std::map<std::string, size_t> seen;  // cell_id -> line
+  read_json_lines(
+      file, "(a sweep killed while writing it) skipped; its cell runs again when the sweep resumes",
+      "a results file holds one JSON object per line", out.warnings,
+      [&](json&& cell, size_t line_no, const std::string& where) {
+        if (!cell.is_object() || cell.value("kind", "") != kSweepCellKind)
+          throw InputError(fmt::format("{}: not a sweep cell record (\"kind\" must be \"{}\")", where, kSweepCellKind));
+        if (!cell.contains("schema_version") || cell["schema_version"] != kSweepSchemaVersion)
+          throw InputError(fmt::format("{}: schema_version {} is not {}, the version this stereobench reads", where,
+                                       cell.value("schema_version", json(nullptr)).dump(), kSweepSchemaVersion));
+        if (!cell.contains("cell_id") || !cell["cell_id"].is_string() || !cell.contains("cell_index") ||
+            !cell["cell_index"].is_number_unsigned())
+          throw InputError(fmt::format("{}: a sweep cell record needs a string cell_id and a cell_index >= 0", where));
+        const std::string id = cell["cell_id"];
+        if (auto [it, fresh] = seen.emplace(id, line_no); !fresh)
+          throw InputError(fmt::format("{}: cell_id '{}' appears twice (also on line {}); a results file holds each "
+                                       "cell once — remove one of the lines",
+                                       where, id, it->second));
+        out.cells.push_back(std::move(cell));
+      });
   return out;
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,15 @@ struct ResultsFile {
 /// file and line for any other line that is not a sweep-cell record of this schema version, and
 /// for a cell_id that appears twice. IoError when it cannot be read.
 [[nodiscard]] ResultsFile read_results(const std::filesystem::path& file);
+
+/// Reads a JSON Lines file written by append_result: a missing file reads as empty; blank lines are
+/// skipped; an unterminated last line (a writer killed while writing it) is skipped with the
+/// warning "<file>:<n>: unterminated last line <torn_note>"; a line that is not JSON is an
+/// InputError "<file>:<n>: not a JSON line (<parser message>); <parse_hint>". Every parsed line
+/// goes to `take` with its 1-based number and its "<file>:<n>" position.
+void read_json_lines(const std::filesystem::path& file, const std::string& torn_note, const std::string& parse_hint,
+                     std::vector<std::string>& warnings,
+                     const std::function<void(nlohmann::json&& line, size_t line_no, const std::string& where)>& take);
 
 /// Image paths of a results line are relative to its file's folder: rewrites those of a cell moved
 /// from a file in folder `from` to a file in folder `to` so that they name the same files.

@@ -68,6 +68,14 @@ min_ssim = 0.6          # measured: repro-rt 0.9932, repro-warp 0.9892, plain-rt
 max_hole_fraction = 0.1 # measured: repro-rt 0.0104, repro-warp 0.0017, plain-rt 0
 )";
 
+/// The definition, the gate config and an empty baseline (every time_regression check is then a
+/// skip: no entry for the cell) that nightly_args names.
+void write_inputs(const test::ScratchDir& dir, const std::string& gate_config = kGateConfig) {
+  write_text(dir / "tiny.toml", kDefinition);
+  write_text(dir / "gate.toml", gate_config);
+  write_text(dir / "empty-baseline.json", "{}\n");
+}
+
 std::string nightly_args(const test::ScratchDir& dir) {
   return "nightly " + quoted(dir / "tiny.toml") + " --out " + quoted(dir / "runs") + " --gate-config " +
          quoted(dir / "gate.toml") + " --baseline " + quoted(dir / "empty-baseline.json") + " --scenes-dir " +
@@ -76,10 +84,7 @@ std::string nightly_args(const test::ScratchDir& dir) {
 
 TEST(NightlyTest, TwoRunsGiveHistoryGateFilesAndTrends) {
   test::ScratchDir dir;
-  write_text(dir / "tiny.toml", kDefinition);
-  write_text(dir / "gate.toml", kGateConfig);
-  // An empty baseline: every time_regression check is a skip (no entry for the cell).
-  write_text(dir / "empty-baseline.json", "{}\n");
+  write_inputs(dir);
 
   const test::CliRun first = test::run_cli(nightly_args(dir));
   ASSERT_EQ(first.code, 0) << first.out;
@@ -173,9 +178,7 @@ TEST(NightlyTest, TwoRunsGiveHistoryGateFilesAndTrends) {
 
 TEST(NightlyTest, ResumesAnUnfinishedRunAndRecordsItOnce) {
   test::ScratchDir dir;
-  write_text(dir / "tiny.toml", kDefinition);
-  write_text(dir / "gate.toml", kGateConfig);
-  write_text(dir / "empty-baseline.json", "{}\n");
+  write_inputs(dir);
   const test::CliRun first = test::run_cli(nightly_args(dir));
   ASSERT_EQ(first.code, 0) << first.out;
   std::vector<fs::path> runs;
@@ -199,10 +202,8 @@ TEST(NightlyTest, ResumesAnUnfinishedRunAndRecordsItOnce) {
 
 TEST(NightlyTest, FailingGateExitsTwoAndIsRecorded) {
   test::ScratchDir dir;
-  write_text(dir / "tiny.toml", kDefinition);
   // 45 dB is above both reprojections' PSNR (39.88 and 32.67 dB measured); plain-rt is inf.
-  write_text(dir / "gate.toml", "[defaults]\nmin_psnr = 45\n");
-  write_text(dir / "empty-baseline.json", "{}\n");
+  write_inputs(dir, "[defaults]\nmin_psnr = 45\n");
   const test::CliRun r = test::run_cli(nightly_args(dir));
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("gate verdict: fail (exit 2)"), std::string::npos) << r.out;
@@ -216,9 +217,7 @@ TEST(NightlyTest, FailingGateExitsTwoAndIsRecorded) {
 
 TEST(NightlyTest, MalformedHistoryIsBadInputNamingFileAndLine) {
   test::ScratchDir dir;
-  write_text(dir / "tiny.toml", kDefinition);
-  write_text(dir / "gate.toml", kGateConfig);
-  write_text(dir / "empty-baseline.json", "{}\n");
+  write_inputs(dir);
   const fs::path history = dir / "runs" / "history.jsonl";
   write_text(history, "\n{\"kind\": \"stereobench.nightly_run\", \"schema_version\": 1}\n");
   const test::CliRun r = test::run_cli(nightly_args(dir) + " --history " + quoted(history));
