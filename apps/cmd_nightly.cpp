@@ -39,6 +39,7 @@ using nlohmann::json;
 using namespace sb::validation;
 
 constexpr const char* kDefaultBaseline = "ci/baseline.json";
+constexpr const char* kDefaultGateConfig = "ci/gate.toml";
 /// Written last into a run folder: the run is complete (history line appended, report written).
 constexpr const char* kRunDoneFile = "nightly.json";
 
@@ -46,7 +47,7 @@ struct NightlyArgs {
   std::string definition;
   std::string out;
   std::string history;
-  std::string gate_config = "ci/gate.toml";
+  std::string gate_config;  ///< empty: the definition's [gate] config, else kDefaultGateConfig
   std::string baseline;
   std::string cache = "out/truth-cache";
   std::string scenes_dir;
@@ -138,7 +139,14 @@ fs::path choose_run_dir(const fs::path& out, const SweepDefinition& d, bool* res
 void run_nightly(const NightlyArgs& a) {
   if (a.jobs < 1 || a.jobs > 256) throw InputError(fmt::format("--jobs {} is outside 1..256", a.jobs));
   const SweepDefinition d = load_sweep(a.definition);
-  const GateConfig gate_config = load_gate_config(a.gate_config);
+  const std::string gate_file = !a.gate_config.empty() ? a.gate_config
+                                : d.gate_config        ? d.gate_config->string()
+                                                       : std::string(kDefaultGateConfig);
+  if (a.gate_config.empty() && d.gate_config && !fs::exists(*d.gate_config))
+    throw InputError(fmt::format("{}: [gate] config names {}, which does not exist; fix the path (relative to the "
+                                 "definition) or give --gate-config FILE",
+                                 d.file.string(), d.gate_config->string()));
+  const GateConfig gate_config = load_gate_config(gate_file);
   const fs::path out = a.out.empty() ? fs::path("out") / "nightly" / d.name : fs::path(a.out);
   const fs::path history_file = a.history.empty() ? out / "history.jsonl" : fs::path(a.history);
   // Read before any cell runs: a malformed history stops the run before it costs anything.
@@ -191,7 +199,7 @@ void run_nightly(const NightlyArgs& a) {
   fmt::print("{}", format_gate_table(gate));
   io::write_text_atomically(run_dir / "gate-junit.xml", junit_xml(gate, "stereobench nightly " + o.results.string()));
   io::write_text_atomically(run_dir / "gate.json",
-                            gate_report_json(gate, a.gate_config, o.results.string(),
+                            gate_report_json(gate, gate_file, o.results.string(),
                                              baseline_note.empty() ? baseline_file.string() : "")
                                     .dump(2) +
                                 "\n");
@@ -255,7 +263,9 @@ void register_nightly_command(CLI::App& root) {
   n->add_option("definition", a->definition, "Sweep definition (TOML), e.g. ci/nightly.toml")->required();
   n->add_option("--out", a->out, "Folder of the runs (default out/nightly/<sweep name>)");
   n->add_option("--history", a->history, "History file (JSON Lines; default <out>/history.jsonl)");
-  n->add_option("--gate-config", a->gate_config, "Gate thresholds (TOML)")->capture_default_str();
+  n->add_option("--gate-config", a->gate_config,
+                fmt::format("Gate thresholds (TOML); default the definition's [gate] config, else {}",
+                            kDefaultGateConfig));
   n->add_option("--baseline", a->baseline,
                 fmt::format("Timing baseline (JSON); default {} (if absent, no regression check)", kDefaultBaseline));
   n->add_option("--jobs,-j", a->jobs, "Cells run at once (1 keeps timings undisturbed)")->capture_default_str();

@@ -198,7 +198,7 @@ std::string option_text(const Where& where, const toml::node& node, const std::s
   where.fail(node, path, fmt::format("must be a string, number or boolean, not {}", type_name(node)));
 }
 
-const std::vector<std::string> kTopKeys = {"sweep", "timing", "options", "output", "path"};
+const std::vector<std::string> kTopKeys = {"sweep", "timing", "options", "output", "path", "gate"};
 const std::vector<std::string> kPathKeys = {"frames", "camera_keys", "spin", "bvh"};
 const std::vector<std::string> kSpinKeys = {"axis", "degrees_per_frame", "pivot", "mesh_prefix"};
 const std::vector<std::string> kSweepKeys = {"name",          "description",      "scenes",        "pipelines",
@@ -206,6 +206,7 @@ const std::vector<std::string> kSweepKeys = {"name",          "description",    
                                              "convergence_m", "resolutions",      "lights",        "truths"};
 const std::vector<std::string> kTimingKeys = {"repetitions", "warmup"};
 const std::vector<std::string> kOutputKeys = {"images", "exr"};
+const std::vector<std::string> kGateKeys = {"config"};
 
 /// `count` finite numbers from an array, e.g. a point [x, y, z] in meters.
 std::vector<double> numbers_at(const Where& where, const toml::node& node, const std::string& path, size_t count,
@@ -514,6 +515,18 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
     if (const toml::node* v = output.get("exr")) d.exr = bool_at(where, *v, "output.exr");
     if (d.exr && !d.images)
       where.fail(*output.get("exr"), "output.exr", "EXR images need output.images = true");
+  }
+
+  // The gate config `stereobench nightly` applies unless told otherwise.
+  if (const toml::node* n = root.get("gate")) {
+    const toml::table& gate = table_at(where, *n, "gate");
+    check_keys(where, gate, "gate", kGateKeys);
+    if (const toml::node* v = gate.get("config")) {
+      const std::string name = string_at(where, *v, "gate.config");
+      if (name.empty()) where.fail(*v, "gate.config", "must name a gate config file (TOML), e.g. \"gate-nightly.toml\"");
+      const fs::path config(name);
+      d.gate_config = config.is_absolute() ? config : file.parent_path() / config;
+    }
   }
   return d;
 }

@@ -69,6 +69,10 @@ struct SweepDefinition {
 
   bool images = true;  ///< PNG images per cell
   bool exr = false;    ///< also the EXR of every right eye and ground truth
+
+  /// `[gate] config`: the gate thresholds written for this sweep's cells (a path relative to the
+  /// definition file), which `stereobench nightly` applies when no --gate-config is given.
+  std::optional<std::filesystem::path> gate_config;
 };
 
 /// One cell: a combination of the axes. Every pipeline of the definition runs in it.

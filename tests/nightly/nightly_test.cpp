@@ -76,10 +76,12 @@ void write_inputs(const test::ScratchDir& dir, const std::string& gate_config = 
   write_text(dir / "empty-baseline.json", "{}\n");
 }
 
-std::string nightly_args(const test::ScratchDir& dir) {
-  return "nightly " + quoted(dir / "tiny.toml") + " --out " + quoted(dir / "runs") + " --gate-config " +
-         quoted(dir / "gate.toml") + " --baseline " + quoted(dir / "empty-baseline.json") + " --scenes-dir " +
-         quoted(dir / "scenes") + " --cache '' --threads 1";
+/// The nightly command line of the tiny sweep; without `gate_flag` the gate config is the
+/// definition's [gate] config (or ci/gate.toml).
+std::string nightly_args(const test::ScratchDir& dir, bool gate_flag = true) {
+  return "nightly " + quoted(dir / "tiny.toml") + " --out " + quoted(dir / "runs") +
+         (gate_flag ? " --gate-config " + quoted(dir / "gate.toml") : std::string()) + " --baseline " +
+         quoted(dir / "empty-baseline.json") + " --scenes-dir " + quoted(dir / "scenes") + " --cache '' --threads 1";
 }
 
 TEST(NightlyTest, TwoRunsGiveHistoryGateFilesAndTrends) {
@@ -213,6 +215,35 @@ TEST(NightlyTest, FailingGateExitsTwoAndIsRecorded) {
   EXPECT_EQ(history[0]["gate"]["exit_code"], 2);
   EXPECT_EQ(history[0]["gate"]["counts"]["fail"], 2);  // the PSNR of repro-rt and repro-warp
   EXPECT_EQ(history[0]["gate"]["counts"]["pass"], 1);  // plain-rt's infinite PSNR
+}
+
+TEST(NightlyTest, DefinitionNamesItsGateConfigAndTheFlagOverridesIt) {
+  test::ScratchDir dir;
+  write_inputs(dir);  // gate.toml passes
+  // The definition's own gate config (relative to the definition) fails: 45 dB is above both
+  // reprojections' PSNR (39.88 and 32.67 dB measured).
+  write_text(dir / "tiny.toml", std::string(kDefinition) + "\n[gate]\nconfig = \"strict-gate.toml\"\n");
+  write_text(dir / "strict-gate.toml", "[defaults]\nmin_psnr = 45\n");
+  const test::CliRun r = test::run_cli(nightly_args(dir, false));
+  EXPECT_EQ(r.code, 2) << r.out;
+  const std::vector<json> history = json_lines(dir / "runs" / "history.jsonl");
+  ASSERT_EQ(history.size(), 1u);
+  EXPECT_EQ(history[0]["gate"]["counts"]["fail"], 2);
+  const fs::path run = dir / "runs" / history[0]["run_id"].get<std::string>();
+  const json gate = json::parse(test::read_text(run / "gate.json"));
+  EXPECT_EQ(fs::path(gate["config"].get<std::string>()), dir / "strict-gate.toml") << gate["config"];
+
+  // --gate-config wins over the definition's: the next run (same sweep, cells already measured in a
+  // new run folder) passes.
+  const test::CliRun r2 = test::run_cli(nightly_args(dir, true));
+  EXPECT_EQ(r2.code, 0) << r2.out;
+
+  // A [gate] config that does not exist is bad input naming the definition and the path.
+  write_text(dir / "tiny.toml", std::string(kDefinition) + "\n[gate]\nconfig = \"missing.toml\"\n");
+  const test::CliRun r3 = test::run_cli(nightly_args(dir, false));
+  EXPECT_EQ(r3.code, 3) << r3.out;
+  EXPECT_NE(r3.out.find("missing.toml"), std::string::npos) << r3.out;
+  EXPECT_NE(r3.out.find("[gate] config"), std::string::npos) << r3.out;
 }
 
 TEST(NightlyTest, MalformedHistoryIsBadInputNamingFileAndLine) {

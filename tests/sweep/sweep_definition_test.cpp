@@ -8,6 +8,7 @@
 #include "renderer/error.hpp"
 #include "renderer/pipeline.hpp"
 #include "support/scratch_dir.hpp"
+#include "validation/gate.hpp"
 #include "validation/sweep.hpp"
 
 namespace sb {
@@ -112,6 +113,10 @@ TEST(SweepDefinition, UnknownKeysNameTheKeyAndLine) {
   EXPECT_NE(in_timing.find("def.toml:3: timing.repetition: unknown key"), std::string::npos) << in_timing;
   const std::string in_output = error_of("[sweep]\n[output]\npng = true\n");
   EXPECT_NE(in_output.find("def.toml:3: output.png: unknown key"), std::string::npos) << in_output;
+  const std::string in_gate = error_of("[sweep]\n[gate]\nthresholds = \"g.toml\"\n");
+  EXPECT_NE(in_gate.find("def.toml:3: gate.thresholds: unknown key"), std::string::npos) << in_gate;
+  const std::string gate_type = error_of("[sweep]\n[gate]\nconfig = 3\n");
+  EXPECT_NE(gate_type.find("def.toml:3: gate.config: must be a string"), std::string::npos) << gate_type;
 
   const std::string option = error_of("[sweep]\npipelines = [\"repro-rt\"]\n[options.repro-rt]\nthreshold = 2\n");
   EXPECT_NE(option.find("def.toml:4: options.repro-rt.threshold"), std::string::npos) << option;
@@ -174,6 +179,13 @@ TEST(SweepDefinition, GltfScenesResolveAgainstTheDefinitionsFolder) {
   EXPECT_FALSE(d.scenes[0].builtin);
   EXPECT_EQ(d.scenes[0].file, dir / "defs" / "scenes" / "a.gltf");
   EXPECT_EQ(d.scenes[0].label, "scenes/a.gltf");  // ids do not depend on where the checkout is
+}
+
+TEST(SweepDefinition, GateConfigResolvesAgainstTheDefinitionsFolder) {
+  const SweepDefinition d = parse_sweep("[sweep]\n[gate]\nconfig = \"gates/g.toml\"\n", fs::path("/defs/x.toml"));
+  ASSERT_TRUE(d.gate_config.has_value());
+  EXPECT_EQ(*d.gate_config, fs::path("/defs/gates/g.toml"));
+  EXPECT_FALSE(parse_sweep("[sweep]\n", fs::path("/defs/x.toml")).gate_config.has_value());
 }
 
 TEST(SweepDefinition, CellOrderAndIdsAreStable) {
@@ -340,8 +352,15 @@ TEST(SweepDefinition, ShippedDefinitionsLoad) {
   size_t on_disk = 0;
   for (const fs::path& dir : {ci, ci / "presets"})
     for (const auto& entry : fs::directory_iterator(dir))
-      if (entry.path().extension() == ".toml" && entry.path().filename() != "gate.toml") ++on_disk;
+      if (entry.path().extension() == ".toml" && !entry.path().filename().string().starts_with("gate")) ++on_disk;
   EXPECT_EQ(on_disk, checked);
+
+  // The nightly names its own gate thresholds, and they load.
+  const SweepDefinition nightly = validation::load_sweep(ci / "nightly.toml");
+  ASSERT_TRUE(nightly.gate_config.has_value());
+  EXPECT_EQ(*nightly.gate_config, ci / "gate-nightly.toml");
+  const validation::GateConfig gate = validation::load_gate_config(*nightly.gate_config);
+  EXPECT_GE(gate.rules.size(), 6u * 3u * n_pipelines) << "a rule per scene, max disparity and pipeline";
 }
 
 }  // namespace
