@@ -771,9 +771,12 @@
     let active = false;
     return {
       root,
-      /** Builds the views (and so loads the images) the first time the cell is opened. */
-      activate() { if (!active) { active = true; render(); } else if (mode === 'flicker') startFlicker(); },
-      deactivate() { stopFlicker(); },
+      /** Builds the views (and so loads the images) when the cell is opened. */
+      activate() { if (!active) { active = true; render(); } },
+      /** Drops the views (and so the decoded images) when the cell is closed: a nightly report has
+       * hundreds of HD and 4K images, and only the open cells hold theirs. Mode, pipeline and
+       * divider position stay for the next opening. */
+      deactivate() { stopFlicker(); views.replaceChildren(); active = false; },
     };
   }
 

@@ -228,8 +228,20 @@ try {
       imagesChecked += imgs.length;
     }
     await cell.locator('button[data-mode="slider"]').click();
+    // Closing a cell drops its views and so its decoded images (a nightly report has thousands).
+    await cell.evaluate((d) => { d.open = false; });
+    await page.waitForFunction((id) => document.querySelector(`#${id} .views`).children.length === 0, cellId, { timeout: 3000 })
+      .catch(() => problems.push(`cell ${ci + 1}: closing it kept its views`));
   }
   report.images_checked = imagesChecked;
+  // Reopened, the first cell builds its views again, in the mode it was left in.
+  const first = page.locator('details.cell').first();
+  await first.evaluate((d) => { d.open = true; });
+  await page.waitForFunction(() => {
+    const d = document.querySelector('details.cell');
+    const view = d.querySelector('.view[data-view="slider"]');
+    return view && !view.hidden && [...view.querySelectorAll('img')].every((i) => i.complete && i.naturalWidth > 0);
+  }, null, { timeout: 10000 }).catch(() => problems.push('cell 1: reopened, it did not show its slider view with loaded images'));
   if (!quick) {
     await page.locator('details.cell').first().locator('button[data-mode="anaglyph"]').click();
     await page.locator('details.cell').first().locator('[data-view="anaglyph"] canvas[data-drawn="true"]').waitFor();
