@@ -140,10 +140,7 @@ HistoryFile read_history(const fs::path& file) {
                   [&](json&& run, size_t line_no, const std::string& where) {
                     check_history_line(run, where);
                     const std::string id = run["run_id"];
-                    if (auto [it, fresh] = seen.emplace(id, line_no); !fresh)
-                      throw InputError(fmt::format("{}: run_id '{}' appears twice (also on line {}); remove one of "
-                                                   "the lines",
-                                                   where, id, it->second));
+                    require_unique_id(seen, id, line_no, where, "run_id", "remove one of the lines");
                     out.runs.push_back(std::move(run));
                   });
   return out;

@@ -185,10 +185,8 @@ ResultsFile read_results(const fs::path& file) {
             !cell["cell_index"].is_number_unsigned())
           throw InputError(fmt::format("{}: a sweep cell record needs a string cell_id and a cell_index >= 0", where));
         const std::string id = cell["cell_id"];
-        if (auto [it, fresh] = seen.emplace(id, line_no); !fresh)
-          throw InputError(fmt::format("{}: cell_id '{}' appears twice (also on line {}); a results file holds each "
-                                       "cell once — remove one of the lines",
-                                       where, id, it->second));
+        require_unique_id(seen, id, line_no, where, "cell_id",
+                          "a results file holds each cell once — remove one of the lines");
         out.cells.push_back(std::move(cell));
       });
   return out;
@@ -208,6 +206,12 @@ void rebase_strings(json& value, const fs::path& from, const fs::path& to) {
 fs::path folder_of(const fs::path& file) { return fs::absolute(file).lexically_normal().parent_path(); }
 
 }  // namespace
+
+void require_unique_id(std::map<std::string, size_t>& seen, const std::string& id, size_t line_no,
+                       const std::string& where, const char* key, const std::string& advice) {
+  if (auto [it, fresh] = seen.emplace(id, line_no); !fresh)
+    throw InputError(fmt::format("{}: {} '{}' appears twice (also on line {}); {}", where, key, id, it->second, advice));
+}
 
 void rebase_image_paths(json& cell, const fs::path& from, const fs::path& to) {
   const fs::path a = fs::absolute(from).lexically_normal(), b = fs::absolute(to).lexically_normal();

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,11 @@ struct ResultsFile {
 void read_json_lines(const std::filesystem::path& file, const std::string& torn_note, const std::string& parse_hint,
                      std::vector<std::string>& warnings,
                      const std::function<void(nlohmann::json&& line, size_t line_no, const std::string& where)>& take);
+
+/// Remembers that `id` (the value of `key`) was read at line `line_no`; InputError
+/// "<where>: <key> '<id>' appears twice (also on line <n>); <advice>" if it was read before.
+void require_unique_id(std::map<std::string, size_t>& seen, const std::string& id, size_t line_no,
+                       const std::string& where, const char* key, const std::string& advice);
 
 /// Image paths of a results line are relative to its file's folder: rewrites those of a cell moved
 /// from a file in folder `from` to a file in folder `to` so that they name the same files.
