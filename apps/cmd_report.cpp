@@ -76,7 +76,7 @@ void run_report(const ReportArgs& a) {
   const reports::ReportSummary s = reports::write_report(results, options);
   for (const std::string& w : s.warnings) std::fprintf(stderr, "stereobench: warning: %s\n", w.c_str());
   print_summary_table(s);
-  fmt::print("report of {} cell(s) x {} pipeline(s), {} image(s) {}{}\nwrote {}\n", s.cell_count, s.pipelines, s.images,
+  fmt::print("report of {} cell(s) x {} pipeline(s), {} image(s) {}{}\nwrote {}\n", s.cells.size(), s.pipeline_names.size(), s.images,
              a.link_images ? "linked" : "copied",
              s.paper_experiment.empty() ? "" : fmt::format(", beside the paper's numbers ({})", s.paper_experiment),
              s.index_html.string());

@@ -388,8 +388,6 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
   }
   json data = report_data(results, title, papers, image_path);
   if (!options.history.is_null()) data["history"] = options.history;
-  summary.cell_count = data["cells"].size();
-  summary.pipelines = data["pipelines"].size();
   summary.paper_experiment = data["paper"].is_object() ? data["paper"]["experiment"].get<std::string>() : "";
   summary.pipeline_names = data["pipelines"];
   summary.cells = data["cells"];

@@ -37,13 +37,12 @@ struct ReportOptions {
 /// What write_report produced.
 struct ReportSummary {
   std::filesystem::path index_html;
-  size_t cell_count = 0;
-  size_t pipelines = 0;
   size_t images = 0;                  ///< images referenced (copied or linked)
   std::string paper_experiment;       ///< "kim-table2", ... or empty when the sweep is no paper preset
   std::vector<std::string> warnings;  ///< skipped lines, missing images
   /// The page data's pipeline names (baseline first) and cells (each with "pipelines": name ->
-  /// psnr, ssim, hole_fraction, time_s, speedup, ...), for a summary on the terminal.
+  /// psnr, ssim, hole_fraction, time_s, speedup, ...): what the report counts, and a summary on
+  /// the terminal.
   nlohmann::json pipeline_names;
   nlohmann::json cells;
 };

@@ -238,14 +238,14 @@ ProcessResult run_process(const std::vector<std::string>& argv, const ProcessOpt
   posix_spawn_file_actions_addopen(fa, 0, "/dev/null", O_RDONLY, 0);
   if (capture_out)
     posix_spawn_file_actions_adddup2(fa, write_ends[0].get(), 1);
-  else if (options.stdout_to == ChildOutput::discard)
-    posix_spawn_file_actions_addopen(fa, 1, "/dev/null", O_WRONLY, 0);
+  else
+    posix_spawn_file_actions_addopen(fa, 1, "/dev/null", O_WRONLY, 0);  // ChildOutput::discard
   if (capture_err)
     posix_spawn_file_actions_adddup2(fa, write_ends[1].get(), 2);
   else if (merged)
     posix_spawn_file_actions_adddup2(fa, 1, 2);
-  else if (options.stderr_to == ChildOutput::discard)
-    posix_spawn_file_actions_addopen(fa, 2, "/dev/null", O_WRONLY, 0);
+  else
+    posix_spawn_file_actions_addopen(fa, 2, "/dev/null", O_WRONLY, 0);  // ChildOutput::discard
   const std::string cwd = options.cwd.string();
   if (!cwd.empty()) posix_spawn_file_actions_addchdir_np(fa, cwd.c_str());
 

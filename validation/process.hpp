@@ -1,5 +1,5 @@
 // Runs external programs (Blender, POV-Ray, the Slurm client commands, git): an argv without a
-// shell, stdin from /dev/null, stdout and stderr captured, merged, discarded or passed through,
+// shell, stdin from /dev/null, stdout and stderr captured, merged or discarded,
 // and a time limit after which the program's whole process group is stopped.
 #pragma once
 
@@ -17,7 +17,6 @@ enum class ChildOutput {
   capture,    ///< into ProcessResult::out (stdout) or ProcessResult::err (stderr)
   to_stdout,  ///< stderr only: into the same pipe as stdout, interleaved as written
   discard,    ///< /dev/null
-  inherit,    ///< this process's own stream
 };
 
 /// How a program runs.

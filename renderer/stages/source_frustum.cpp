@@ -294,9 +294,7 @@ SourceFrustumStats mark_outside_source_frustum(const RenderScene& scene, const E
     std::vector<uint64_t> chunk_near(chunks, 0);
     executor.for_each(chunks, [&](size_t k) {
       const size_t begin = k * kGrain, end = std::min(begin + kGrain, triangles);
-      size_t m = static_cast<size_t>(std::upper_bound(geometry.first_triangle.begin(), geometry.first_triangle.end(),
-                                                      static_cast<uint32_t>(begin)) -
-                                     geometry.first_triangle.begin()) - 1;
+      size_t m = geometry.locate(static_cast<uint32_t>(begin)).first;
       for (size_t t = begin; t < end; ++t) {
         while (t >= geometry.first_triangle[m + 1]) ++m;
         const Mesh& mesh = s.meshes[m];
