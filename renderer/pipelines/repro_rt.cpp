@@ -27,8 +27,8 @@ class ReproRt final : public Pipeline {
     TraceCounts counts;
     {
       ScopedStage stage(r.timings, "hole_fill");
-      const std::vector<uint32_t> holes = hole_pixels(states);
-      trace_pixels(scene, rig.eye(Eye::right), ctx.executor, holes, r.right, counts, Source::reshaded_traced);
+      trace_unless(scene, rig.eye(Eye::right), ctx.executor, states, static_cast<uint8_t>(WarpPixel::covered), r.right,
+                   counts, Source::reshaded_traced);
     }
     add_counts(r.counters, counts, "right", true);
     return r;

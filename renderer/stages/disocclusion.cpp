@@ -20,12 +20,12 @@ VisibleSurfaces trace_visible_surfaces(const RenderScene& scene, const EyeCamera
   VisibleSurfaces v{w, h, std::vector<float>(n, std::numeric_limits<float>::infinity()),
                     std::vector<uint32_t>(n, kNoPrimitive)};
   executor.for_tiles(w, h, kTraceTile, [&](const PixelRect& tile) {
-    for_pixel_blocks(tile, w, [&](const uint32_t* pixels, int count) {
+    for_pixel_blocks(tile, w, [&](const PixelBlock& block) {
       RayQuery rays[kRayPacket];
       RayHit hits[kRayPacket];
-      for (int i = 0; i < count; ++i)
-        rays[i] = primary_ray(eye, static_cast<int>(pixels[i] % static_cast<uint32_t>(w)),
-                              static_cast<int>(pixels[i] / static_cast<uint32_t>(w)));
+      const int count = block.n;
+      const uint32_t* pixels = block.index;
+      for (int i = 0; i < count; ++i) rays[i] = primary_ray(eye, block.x[i], block.y[i]);
       scene.rays().intersect(std::span<const RayQuery>(rays, static_cast<size_t>(count)),
                              std::span<RayHit>(hits, static_cast<size_t>(count)));
       for (int i = 0; i < count; ++i) {

@@ -16,7 +16,7 @@ namespace sb {
 
 namespace {
 
-enum class RightState : uint8_t { missed = 0, reprojected = 1, blocked = 2 };
+enum class RightState : uint8_t { missed = 0, reprojected = kApproved, blocked = 2 };
 
 }  // namespace
 
@@ -33,23 +33,22 @@ Validation validate_and_copy(const RenderScene& scene, const PixelReprojector& r
   const float* left_depth = left.data_f32(planes::depth);
   const EyeCamera& eye = reprojector.right();
   const auto length = static_cast<float>(1.0 - margin);
+  const PrimaryRays pixel_rays(eye);
+  // Restricted rays in the 4x4 packets of a whole-eye trace: each reprojected pixel's verdict.
   executor.for_tiles(w, h, kTraceTile, [&](const PixelRect& tile) {
-    const EyeReader from(left);
-    EyeWriter out(right);
     RayQuery queries[kRayPacket];
     uint32_t where[kRayPacket];
     uint64_t local = 0, local_absent = 0;
-    for_pixel_blocks(tile, w, [&](const uint32_t* pixels, int n) {
+    for_pixel_blocks(tile, w, [&](const PixelBlock& block) {
       int m = 0;
-      for (int i = 0; i < n; ++i) {
-        const int x = static_cast<int>(pixels[i] % static_cast<uint32_t>(w));
-        const int y = static_cast<int>(pixels[i] / static_cast<uint32_t>(w));
-        const int32_t src = sources.column[pixels[i]];
+      for (int i = 0; i < block.n; ++i) {
+        const uint32_t p = block.index[i];
+        const int32_t src = sources.column[p];
         if (src == kNoSource) continue;
-        RayQuery q = primary_ray(eye, x, y);
-        q.tfar = length * left_depth[static_cast<size_t>(y) * w + src] / cos_to_axis(eye, q.dir);
+        RayQuery q = pixel_rays.depth_ray(block.x[i], block.y[i]);
+        q.tfar = length * left_depth[p - static_cast<uint32_t>(block.x[i]) + static_cast<uint32_t>(src)];
         queries[m] = q;
-        where[m++] = pixels[i];
+        where[m++] = p;
       }
       if (m == 0) return;
       uint8_t blocked[kRayPacket];
@@ -78,29 +77,38 @@ Validation validate_and_copy(const RenderScene& scene, const PixelReprojector& r
             ++local_absent;
           }
       }
-      for (int k = 0; k < m; ++k) {
-        const uint32_t p = where[k];
-        if (blocked[k]) {
-          state[p] = static_cast<uint8_t>(RightState::blocked);
-          continue;
-        }
-        state[p] = static_cast<uint8_t>(RightState::reprojected);
-        // Same row: the rig's baseline is horizontal.
-        out.copy(p, from, p - p % static_cast<uint32_t>(w) + static_cast<uint32_t>(sources.column[p]),
-                 Source::reprojected);
-      }
+      for (int k = 0; k < m; ++k)
+        state[where[k]] = static_cast<uint8_t>(blocked[k] ? RightState::blocked : RightState::reprojected);
     });
     rays += local;
     absent += local_absent;
   });
+  // The approved pixels copied row by row (streaming through both images' planes rather than
+  // block by block; a row's sources lie in the same row: the rig's baseline is horizontal), the
+  // others counted.
+  std::atomic<uint64_t> missed{0}, blocked{0};
+  executor.for_range(static_cast<size_t>(h), 8, [&](size_t begin, size_t end) {
+    const EyeReader from(left);
+    EyeWriter out(right);
+    uint64_t local_missed = 0, local_blocked = 0;
+    for (size_t row = begin * static_cast<size_t>(w); row < end * static_cast<size_t>(w); row += static_cast<size_t>(w))
+      for (size_t p = row; p < row + static_cast<size_t>(w); ++p)
+        switch (static_cast<RightState>(state[p])) {
+          case RightState::reprojected:
+            out.copy(p, from, row + static_cast<size_t>(sources.column[p]), Source::reprojected);
+            break;
+          case RightState::missed: ++local_missed; break;
+          case RightState::blocked: ++local_blocked; break;
+        }
+    missed += local_missed;
+    blocked += local_blocked;
+  });
   Validation v;
-  v.restricted_rays = rays;
+  v.state = std::move(state);
+  v.missed = missed;
+  v.blocked = blocked;
   v.absent = absent;
-  for (size_t p = 0; p < state.size(); ++p) {
-    if (state[p] == static_cast<uint8_t>(RightState::reprojected)) continue;
-    (state[p] == static_cast<uint8_t>(RightState::missed) ? v.missed : v.blocked)++;
-    v.to_trace.push_back(static_cast<uint32_t>(p));
-  }
+  v.restricted_rays = rays;
   return v;
 }
 
@@ -135,7 +143,7 @@ void complete_right_eye(const RenderScene& scene, const StereoRig& rig, const Pi
   TraceCounts counts;
   {
     ScopedStage stage(r.timings, "right_trace");
-    trace_pixels(scene, rig.eye(Eye::right), executor, v.to_trace, r.right, counts, Source::reshaded_traced);
+    trace_unless(scene, rig.eye(Eye::right), executor, v.state, kApproved, r.right, counts, Source::reshaded_traced);
   }
   add_counts(r.counters, counts, "right", true);
   r.counters.set("missed", v.missed);

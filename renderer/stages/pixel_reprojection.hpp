@@ -73,12 +73,15 @@ struct ValidationSettings {
 /// The validation options rt-buffer and rt-atomic declare.
 [[nodiscard]] std::vector<OptionSpec> validation_option_specs();
 
+/// Validation::state of a right pixel written from its source.
+inline constexpr uint8_t kApproved = 1;
+
 /// Outcome of the validation of the reprojected right pixels.
 struct Validation {
-  std::vector<uint32_t> to_trace;  ///< missed and blocked pixels, ascending (y * width + x)
-  uint64_t missed = 0;             ///< no reprojection reached them
-  uint64_t blocked = 0;            ///< traced although reprojected: bad (occluded) or absent
-  uint64_t absent = 0;             ///< with confirm_surface: no surface within the margin beyond
+  std::vector<uint8_t> state;  ///< per right pixel: kApproved, or to be traced (missed or blocked)
+  uint64_t missed = 0;         ///< no reprojection reached them
+  uint64_t blocked = 0;        ///< traced although reprojected: bad (occluded) or absent
+  uint64_t absent = 0;         ///< with confirm_surface: no surface within the margin beyond
   uint64_t restricted_rays = 0;
 };
 
@@ -104,7 +107,7 @@ void add_reprojection_counters(const PixelReprojector& reprojector, const Stereo
 
 /// The right eye of the parallel pipelines (rt-buffer, rt-atomic) from the winning sources:
 /// validate_and_copy into a new result.right (stage "validate"), then the missed and blocked
-/// pixels traced in full with trace_pixels, tag `reshaded_traced` (stage "right_trace"). Counts
+/// pixels traced in full with trace_unless, tag `reshaded_traced` (stage "right_trace"). Counts
 /// missed, bad (blocked) and traced pixels, restricted rays, and the usual ray counters.
 void complete_right_eye(const RenderScene& scene, const StereoRig& rig, const PixelReprojector& reprojector,
                         const RightSources& sources, const ValidationSettings& settings, const Executor& executor,

@@ -116,11 +116,4 @@ std::vector<uint8_t> warp_left_to_right(const RenderScene& scene, const StereoRi
   return states;
 }
 
-std::vector<uint32_t> hole_pixels(const std::vector<uint8_t>& states) {
-  std::vector<uint32_t> out;
-  for (size_t i = 0; i < states.size(); ++i)
-    if (states[i] != static_cast<uint8_t>(WarpPixel::covered)) out.push_back(static_cast<uint32_t>(i));
-  return out;
-}
-
 }  // namespace sb

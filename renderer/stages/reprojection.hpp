@@ -36,7 +36,4 @@ struct ReprojectionSettings {
 std::vector<uint8_t> warp_left_to_right(const RenderScene& scene, const StereoRig& rig, const ReprojectionSettings& settings,
                                         const Executor& executor, StereoResult& result);
 
-/// Indices (y * width + x, ascending) of the pixels that are not WarpPixel::covered.
-[[nodiscard]] std::vector<uint32_t> hole_pixels(const std::vector<uint8_t>& states);
-
 }  // namespace sb

@@ -20,24 +20,23 @@ namespace {
 /// Traces packets of up to 16 pixels; the surfaces they hit are shaded in batches of up to 16.
 class PacketTracer {
  public:
-  PacketTracer(const RenderScene& scene, const EyeCamera& eye, Image& image, Source source, TraceCounts& counts)
-      : scene_(scene), eye_(eye), writer_(image), width_(image.width()),
+  PacketTracer(const RenderScene& scene, const EyeCamera& eye, const PrimaryRays& rays, Image& image, Source source,
+               TraceCounts& counts)
+      : scene_(scene), eye_(eye), rays_(rays), writer_(image),
         tan_spread_(static_cast<float>(std::tan(ray_cone_spread(2.0 * std::atan(0.5 * eye.height / eye.f_px), eye.height)))),
         origin_(eye.origin), source_(source), counts_(counts) {}
   PacketTracer(const PacketTracer&) = delete;
   PacketTracer& operator=(const PacketTracer&) = delete;
   ~PacketTracer() { flush(); }
 
-  /// Traces the rays of `pixels` as one packet and queues the lanes whose bit is set in `wanted`
-  /// (bit i for pixels[i]) for shading; background lanes are written at once.
-  void trace(const uint32_t* pixels, int n, uint32_t wanted) {
+  /// Traces the rays of a block as one packet and queues the lanes whose bit is set in `wanted`
+  /// (bit i for lane i) for shading; background lanes are written at once.
+  void trace(const PixelBlock& block, uint32_t wanted) {
     RayQuery rays[kRayPacket];
     RayHit hits[kRayPacket];
-    for (int i = 0; i < n; ++i) {
-      const int x = static_cast<int>(pixels[i] % static_cast<uint32_t>(width_));
-      const int y = static_cast<int>(pixels[i] / static_cast<uint32_t>(width_));
-      rays[i] = primary_ray(eye_, x, y);
-    }
+    const int n = block.n;
+    const uint32_t* pixels = block.index;
+    for (int i = 0; i < n; ++i) rays[i] = rays_(block.x[i], block.y[i]);
     scene_.rays().intersect(std::span<const RayQuery>(rays, static_cast<size_t>(n)),
                             std::span<RayHit>(hits, static_cast<size_t>(n)));
     counts_.primary_rays += static_cast<uint64_t>(n);
@@ -76,8 +75,8 @@ class PacketTracer {
  private:
   const RenderScene& scene_;
   const EyeCamera& eye_;
+  const PrimaryRays& rays_;
   EyeWriter writer_;
-  int width_;
   float tan_spread_;
   dvec3 origin_;
   Source source_;
@@ -115,6 +114,18 @@ struct PixelBlocks {
   std::vector<uint32_t> listed;  ///< blocks with a listed pixel
 };
 
+/// Lane of pixel (x, y) in its 4x4 block (row-major inside the block, clipped at the image's
+/// right edge as for_pixel_blocks clips it).
+uint32_t lane_bit(int x, int y, int w) {
+  const int bx = x / 4, by = y / 4;
+  return 1u << ((y - 4 * by) * std::min(4, w - 4 * bx) + (x - 4 * bx));
+}
+
+void list_blocks(PixelBlocks& b) {
+  for (size_t k = 0; k < b.masks.size(); ++k)
+    if (b.masks[k] != 0) b.listed.push_back(static_cast<uint32_t>(k));
+}
+
 PixelBlocks pixel_blocks(std::span<const uint32_t> pixels, int w, int h) {
   PixelBlocks b;
   b.blocks_x = (w + 3) / 4;
@@ -123,48 +134,84 @@ PixelBlocks pixel_blocks(std::span<const uint32_t> pixels, int w, int h) {
   for (const uint32_t p : pixels) {
     const int x = static_cast<int>(p % static_cast<uint32_t>(w)), y = static_cast<int>(p / static_cast<uint32_t>(w));
     if (y >= h) throw InputError(fmt::format("trace_pixels: pixel index {} lies outside the {}x{} image", p, w, h));
-    const int bx = x / 4, by = y / 4;
-    const int lane = (y - 4 * by) * std::min(4, w - 4 * bx) + (x - 4 * bx);
-    b.masks[static_cast<size_t>(by) * b.blocks_x + bx] |= 1u << lane;
+    b.masks[static_cast<size_t>(y / 4) * b.blocks_x + x / 4] |= lane_bit(x, y, w);
   }
-  for (size_t k = 0; k < b.masks.size(); ++k)
-    if (b.masks[k] != 0) b.listed.push_back(static_cast<uint32_t>(k));
+  list_blocks(b);
+  return b;
+}
+
+/// The blocks of the pixels whose state differs from `done`, gathered a row of blocks per task.
+PixelBlocks state_blocks(std::span<const uint8_t> states, uint8_t done, int w, int h, const Executor& executor) {
+  if (states.size() != static_cast<size_t>(w) * static_cast<size_t>(h))
+    throw std::logic_error(fmt::format("trace_unless: {} states for a {}x{} image", states.size(), w, h));
+  PixelBlocks b;
+  b.blocks_x = (w + 3) / 4;
+  const int blocks_y = (h + 3) / 4;
+  b.masks.assign(static_cast<size_t>(b.blocks_x) * static_cast<size_t>(blocks_y), 0);
+  executor.for_range(static_cast<size_t>(blocks_y), 4, [&](size_t begin, size_t end) {
+    for (size_t by = begin; by < end; ++by)
+      for (int y = 4 * static_cast<int>(by); y < std::min(4 * static_cast<int>(by) + 4, h); ++y)
+        for (int x = 0; x < w; ++x)
+          if (states[static_cast<size_t>(y) * w + x] != done)
+            b.masks[by * b.blocks_x + static_cast<size_t>(x / 4)] |= lane_bit(x, y, w);
+  });
+  list_blocks(b);
   return b;
 }
 
 /// Traces blocks listed[begin, end) in the calling thread; the listed pixels of consecutive blocks
 /// fill the shading batches.
-void trace_blocks(const RenderScene& scene, const EyeCamera& eye, const PixelBlocks& b, size_t begin, size_t end,
-                  Image& image, Source source, TraceCounts& counts) {
+void trace_blocks(const RenderScene& scene, const EyeCamera& eye, const PrimaryRays& rays, const PixelBlocks& b,
+                  size_t begin, size_t end, Image& image, Source source, TraceCounts& counts) {
   const int w = image.width(), h = image.height();
-  PacketTracer tracer(scene, eye, image, source, counts);
+  PacketTracer tracer(scene, eye, rays, image, source, counts);
   for (size_t k = begin; k < end; ++k) {
     const uint32_t block = b.listed[k];
     const int bx = static_cast<int>(block % static_cast<uint32_t>(b.blocks_x));
     const int by = static_cast<int>(block / static_cast<uint32_t>(b.blocks_x));
     const PixelRect rect{4 * bx, 4 * by, std::min(4 * bx + 4, w), std::min(4 * by + 4, h)};
-    for_pixel_blocks(rect, w, [&](const uint32_t* pixels, int n) { tracer.trace(pixels, n, b.masks[block]); });
+    for_pixel_blocks(rect, w, [&](const PixelBlock& pixels) { tracer.trace(pixels, b.masks[block]); });
   }
+}
+
+/// Traces the listed blocks, a range of them per task.
+void trace_listed(const RenderScene& scene, const EyeCamera& eye, const Executor& executor, const PixelBlocks& blocks,
+                  Image& image, TraceCounts& counts, Source source) {
+  const PrimaryRays rays(eye);
+  std::atomic<uint64_t> totals[4] = {0, 0, 0, 0};
+  executor.for_range(blocks.listed.size(), 16, [&](size_t begin, size_t end) {
+    TraceCounts local;
+    trace_blocks(scene, eye, rays, blocks, begin, end, image, source, local);
+    accumulate(totals, local);
+  });
+  add_totals(counts, totals);
+}
+
+/// trace_rect with the eye's rays for the rectangle given.
+void trace_rect_with(const RenderScene& scene, const EyeCamera& eye, const PrimaryRays& rays, const PixelRect& rect,
+                     Image& image, TraceCounts& counts) {
+  PacketTracer tracer(scene, eye, rays, image, Source::traced, counts);
+  // One shading batch per block: a block's surfaces are shaded together.
+  for_pixel_blocks(rect, image.width(), [&](const PixelBlock& block) {
+    tracer.trace(block, kAllLanes);
+    tracer.flush();
+  });
 }
 
 }  // namespace
 
 void trace_rect(const RenderScene& scene, const EyeCamera& eye, const PixelRect& rect, Image& image,
                 TraceCounts& counts) {
-  PacketTracer tracer(scene, eye, image, Source::traced, counts);
-  // One shading batch per block: a block's surfaces are shaded together.
-  for_pixel_blocks(rect, image.width(), [&](const uint32_t* block, int n) {
-    tracer.trace(block, n, kAllLanes);
-    tracer.flush();
-  });
+  trace_rect_with(scene, eye, PrimaryRays(eye, rect), rect, image, counts);
 }
 
 void trace_eye(const RenderScene& scene, const EyeCamera& eye, const Executor& executor, Image& image,
                TraceCounts& counts) {
+  const PrimaryRays rays(eye);
   std::atomic<uint64_t> totals[4] = {0, 0, 0, 0};
   executor.for_tiles(image.width(), image.height(), kTraceTile, [&](const PixelRect& tile) {
     TraceCounts local;
-    trace_rect(scene, eye, tile, image, local);
+    trace_rect_with(scene, eye, rays, tile, image, local);
     accumulate(totals, local);
   });
   add_totals(counts, totals);
@@ -172,20 +219,19 @@ void trace_eye(const RenderScene& scene, const EyeCamera& eye, const Executor& e
 
 void trace_pixels(const RenderScene& scene, const EyeCamera& eye, const Executor& executor,
                   std::span<const uint32_t> pixels, Image& image, TraceCounts& counts, Source source) {
-  const PixelBlocks blocks = pixel_blocks(pixels, image.width(), image.height());
-  std::atomic<uint64_t> totals[4] = {0, 0, 0, 0};
-  executor.for_range(blocks.listed.size(), 16, [&](size_t begin, size_t end) {
-    TraceCounts local;
-    trace_blocks(scene, eye, blocks, begin, end, image, source, local);
-    accumulate(totals, local);
-  });
-  add_totals(counts, totals);
+  trace_listed(scene, eye, executor, pixel_blocks(pixels, image.width(), image.height()), image, counts, source);
+}
+
+void trace_unless(const RenderScene& scene, const EyeCamera& eye, const Executor& executor,
+                  std::span<const uint8_t> states, uint8_t done, Image& image, TraceCounts& counts, Source source) {
+  trace_listed(scene, eye, executor, state_blocks(states, done, image.width(), image.height(), executor), image,
+               counts, source);
 }
 
 void trace_pixels_here(const RenderScene& scene, const EyeCamera& eye, std::span<const uint32_t> pixels, Image& image,
                        TraceCounts& counts, Source source) {
   const PixelBlocks blocks = pixel_blocks(pixels, image.width(), image.height());
-  trace_blocks(scene, eye, blocks, 0, blocks.listed.size(), image, source, counts);
+  trace_blocks(scene, eye, PrimaryRays(eye), blocks, 0, blocks.listed.size(), image, source, counts);
 }
 
 void add_counts(Counters& counters, const TraceCounts& counts, const char* eye, bool traced) {

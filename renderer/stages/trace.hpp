@@ -33,6 +33,13 @@ void trace_eye(const RenderScene& scene, const EyeCamera& eye, const Executor& e
 void trace_pixels(const RenderScene& scene, const EyeCamera& eye, const Executor& executor,
                   std::span<const uint32_t> pixels, Image& image, TraceCounts& counts, Source source = Source::traced);
 
+/// trace_pixels for the pixels whose entry in `states` (one byte per pixel, row-major, the image's
+/// size) differs from `done`: the same packets and bits, the blocks gathered in parallel without a
+/// pixel list. std::logic_error when `states` does not match the image.
+void trace_unless(const RenderScene& scene, const EyeCamera& eye, const Executor& executor,
+                  std::span<const uint8_t> states, uint8_t done, Image& image, TraceCounts& counts,
+                  Source source = Source::traced);
+
 /// trace_eye's work for one rectangle of pixels (4-aligned, as trace_eye's tiles are), in the
 /// calling thread: the same packets and shading batches, so the same bits.
 void trace_rect(const RenderScene& scene, const EyeCamera& eye, const PixelRect& rect, Image& image,

@@ -11,6 +11,7 @@
 #include "renderer/error.hpp"
 #include "renderer/scene.hpp"
 #include "renderer/stages/pixel_reprojection.hpp"
+#include "renderer/stages/primary_rays.hpp"
 #include "support/render_support.hpp"
 #include "support/scene_lists.hpp"
 
@@ -155,6 +156,34 @@ TEST(ThinPole, GapBesideThePoleIsRetracedNotSmeared) {
     }
     EXPECT_GT(pole, 0u);
     EXPECT_EQ(smeared, 0u) << pipeline << ": pixels show the pole where plain-rt shows what lies behind it, or not";
+  }
+}
+
+TEST(PrimaryRays, SameBitsAsPrimaryRayAndDepthRaysEndAtTheirDepth) {
+  // Off-axis eyes of an odd-sized image, the whole image and a rectangle inside it.
+  const Scene scene = test::load_builtin("spheres");
+  const StereoRig rig = rig_with_disparity(scene, 203, 117, 15.0);
+  for (const Eye e : {Eye::left, Eye::right}) {
+    const EyeCamera eye = rig.eye(e);
+    const PrimaryRays whole(eye);
+    const PixelRect rect{37, 11, 101, 90};
+    const PrimaryRays part(eye, rect);
+    size_t differ = 0;
+    for (int y = 0; y < eye.height; ++y)
+      for (int x = 0; x < eye.width; ++x) {
+        const RayQuery a = primary_ray(eye, x, y);
+        const RayQuery b = whole(x, y);
+        differ += std::memcmp(&a.dir, &b.dir, sizeof a.dir) != 0 || std::memcmp(&a.origin, &b.origin, sizeof a.origin) != 0;
+        if (x >= rect.x0 && x < rect.x1 && y >= rect.y0 && y < rect.y1) {
+          const RayQuery c = part(x, y);
+          differ += std::memcmp(&a.dir, &c.dir, sizeof a.dir) != 0;
+        }
+        // The depth ray points the same way and its parameter is the linear depth.
+        const RayQuery d = whole.depth_ray(x, y);
+        EXPECT_NEAR(glm::dot(d.dir, vec3(-eye.back)), 1.0f, 1e-6f);
+        EXPECT_NEAR(glm::dot(glm::normalize(d.dir), a.dir), 1.0f, 1e-6f);
+      }
+    EXPECT_EQ(differ, 0u) << "pixels whose precomputed ray differs from primary_ray";
   }
 }
 
