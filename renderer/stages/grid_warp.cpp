@@ -73,6 +73,13 @@ class Reprojector {
         guard_(4.0 * std::max(to.width, to.height) + 64.0) {
     const dmat4 view_from = from.view_matrix();
     matrix_ = to.projection_matrix() * to.view_matrix() * glm::inverse(view_from);
+    // The clip position M·(X, Y, −1, 1/z) is linear in X, Y and 1/z: a term per lattice column,
+    // one per lattice row (with the −1), and 1/z times M's last column.
+    column_.reserve(static_cast<size_t>(from.width) + 2);
+    for (int i = -1; i <= from.width; ++i) column_.push_back((lattice_x(i) - from.cx) / from.f_px * matrix_[0]);
+    row_.reserve(static_cast<size_t>(from.height) + 2);
+    for (int j = -1; j <= from.height; ++j)
+      row_.push_back((from.cy - lattice_y(j)) / from.f_px * matrix_[1] - matrix_[2]);
   }
 
   /// Target pixel position of source pixel position (x, y) at inverse depth inv_z (0: infinity),
@@ -87,21 +94,21 @@ class Reprojector {
   /// The warped vertex of source pixel centre (i, j).
   [[nodiscard]] GridVertex vertex(int i, int j) const {
     GridVertex v;
-    // Lattice points are pixel centres; the extra ring outside the image sits on its edges.
-    const double sx = i < 0 ? 0.0 : i >= from_.width ? from_.width : i + 0.5;
-    const double sy = j < 0 ? 0.0 : j >= from_.height ? from_.height : j + 0.5;
-    v.sx = static_cast<float>(sx);
-    v.sy = static_cast<float>(sy);
+    v.sx = static_cast<float>(lattice_x(i));
+    v.sy = static_cast<float>(lattice_y(j));
     const size_t p = static_cast<size_t>(std::clamp(j, 0, grid_.height - 1)) * grid_.width +
                      static_cast<size_t>(std::clamp(i, 0, grid_.width - 1));
     const double inv_z = grid_.inverse_depth[p];
-    double w = 1.0;
-    const std::optional<dvec2> at = position(sx, sy, inv_z, &w);
+    // position() with the matrix product split into the precomputed terms.
+    const dvec4 c = column_[static_cast<size_t>(i + 1)] + row_[static_cast<size_t>(j + 1)] + inv_z * matrix_[3];
+    if (!(c.w > 0.0)) return v;  // behind the target eye
+    const double inv_w = 1.0 / c.w;
+    const double x = (c.x * inv_w + 1.0) * 0.5 * to_w_, y = (1.0 - c.y * inv_w) * 0.5 * to_h_;
     // A vertex too far outside the target image cannot be rasterized in fixed point.
-    if (!at || !(std::abs(at->x) < guard_ && std::abs(at->y) < guard_)) return v;
-    v.x = static_cast<int32_t>(std::floor(at->x * kSubOne + 0.5));
-    v.y = static_cast<int32_t>(std::floor(at->y * kSubOne + 0.5));
-    v.q = static_cast<float>(inv_z / w);
+    if (!(std::abs(x) < guard_ && std::abs(y) < guard_)) return v;
+    v.x = static_cast<int32_t>(std::floor(x * kSubOne + 0.5));
+    v.y = static_cast<int32_t>(std::floor(y * kSubOne + 0.5));
+    v.q = static_cast<float>(inv_z * inv_w);
     // The discontinuity measure: the larger excess opening of the two source gaps beside the vertex.
     const bool inside_row = i >= 0 && i < grid_.width;
     const float left_gap = inside_row && i > 0 ? grid_.excess[p - 1] : 0.0f;
@@ -112,6 +119,11 @@ class Reprojector {
   }
 
  private:
+  /// Source position of lattice column i / row j: pixel centres, and the extra ring outside the
+  /// image on its edges.
+  [[nodiscard]] double lattice_x(int i) const { return i < 0 ? 0.0 : i >= from_.width ? from_.width : i + 0.5; }
+  [[nodiscard]] double lattice_y(int j) const { return j < 0 ? 0.0 : j >= from_.height ? from_.height : j + 0.5; }
+
   const WarpGrid& grid_;
   EyeCamera from_;
   int to_w_;
@@ -119,6 +131,8 @@ class Reprojector {
   double step_scale_;
   double guard_;
   dmat4 matrix_{1.0};
+  std::vector<dvec4> column_;  ///< X·M[0] per lattice column i + 1
+  std::vector<dvec4> row_;     ///< Y·M[1] − M[2] per lattice row j + 1
 };
 
 /// Calls emit(i0, j0, i1, j1, i2, j2) for every triangle of cell (cx, cy), in source lattice
