@@ -21,7 +21,12 @@ enum class RightState : uint8_t { missed = 0, reprojected = kApproved, blocked =
 }  // namespace
 
 PixelReprojector::PixelReprojector(const StereoRig& rig)
-    : left_(rig.eye(Eye::left)), right_(rig.eye(Eye::right)), motion_(rig, Eye::left), width_(rig.params().width) {}
+    : left_(rig.eye(Eye::left)),
+      right_(rig.eye(Eye::right)),
+      left_rays_(left_),
+      right_rays_(right_),
+      motion_(rig, Eye::left),
+      width_(rig.params().width) {}
 
 Validation validate_and_copy(const RenderScene& scene, const PixelReprojector& reprojector, const RightSources& sources,
                              const Image& left, const ValidationSettings& settings, const Executor& executor,
@@ -31,9 +36,8 @@ Validation validate_and_copy(const RenderScene& scene, const PixelReprojector& r
   std::vector<uint8_t> state(static_cast<size_t>(w) * h, static_cast<uint8_t>(RightState::missed));
   std::atomic<uint64_t> rays{0}, absent{0};
   const float* left_depth = left.data_f32(planes::depth);
-  const EyeCamera& eye = reprojector.right();
   const auto length = static_cast<float>(1.0 - margin);
-  const PrimaryRays pixel_rays(eye);
+  const PrimaryRays& pixel_rays = reprojector.right_rays();
   // Restricted rays in the 4x4 packets of a whole-eye trace: each reprojected pixel's verdict.
   executor.for_tiles(w, h, kTraceTile, [&](const PixelRect& tile) {
     RayQuery queries[kRayPacket];

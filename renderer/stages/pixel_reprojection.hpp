@@ -17,6 +17,7 @@
 #include "renderer/render_scene.hpp"
 #include "renderer/rig.hpp"
 #include "renderer/stages/eye_image.hpp"
+#include "renderer/stages/primary_rays.hpp"
 #include "renderer/stages/row_warp.hpp"
 #include "renderer/stages/trace.hpp"
 #include "renderer/stats.hpp"
@@ -44,10 +45,15 @@ class PixelReprojector {
 
   [[nodiscard]] const EyeCamera& left() const { return left_; }
   [[nodiscard]] const EyeCamera& right() const { return right_; }
+  /// Each eye's primary rays, for every pixel.
+  [[nodiscard]] const PrimaryRays& left_rays() const { return left_rays_; }
+  [[nodiscard]] const PrimaryRays& right_rays() const { return right_rays_; }
 
  private:
   EyeCamera left_;
   EyeCamera right_;
+  PrimaryRays left_rays_;
+  PrimaryRays right_rays_;
   DisparityMotion motion_;
   int width_ = 0;
 };

@@ -25,22 +25,19 @@ inline constexpr int kTraceTile = 32;
   return q;
 }
 
-/// The primary rays of an eye through the pixel centres of a rectangle, with the per-column and
-/// per-row terms of EyeCamera::ray_direction computed once: the same operations in the same order,
-/// so the same bits as primary_ray, for two divisions fewer per ray in loops that cast one per pixel.
+/// The primary rays of an eye through its pixel centres, with the per-column and per-row terms of
+/// EyeCamera::ray_direction computed once: the same operations in the same order, so the same bits
+/// as primary_ray, for two divisions fewer per ray in loops that cast one per pixel.
 class PrimaryRays {
  public:
-  PrimaryRays(const EyeCamera& eye, const PixelRect& rect)
-      : origin_(eye.origin), back_(eye.back), x0_(rect.x0), y0_(rect.y0) {
-    column_.reserve(static_cast<size_t>(rect.width()));
-    for (int x = rect.x0; x < rect.x1; ++x) column_.push_back((x + 0.5 - eye.cx) / eye.f_px * eye.right);
-    row_.reserve(static_cast<size_t>(rect.height()));
-    for (int y = rect.y0; y < rect.y1; ++y) row_.push_back((eye.cy - (y + 0.5)) / eye.f_px * eye.up);
+  explicit PrimaryRays(const EyeCamera& eye) : origin_(eye.origin), back_(eye.back) {
+    column_.reserve(static_cast<size_t>(eye.width));
+    for (int x = 0; x < eye.width; ++x) column_.push_back((x + 0.5 - eye.cx) / eye.f_px * eye.right);
+    row_.reserve(static_cast<size_t>(eye.height));
+    for (int y = 0; y < eye.height; ++y) row_.push_back((eye.cy - (y + 0.5)) / eye.f_px * eye.up);
   }
-  /// Every pixel of the eye's image.
-  explicit PrimaryRays(const EyeCamera& eye) : PrimaryRays(eye, PixelRect{0, 0, eye.width, eye.height}) {}
 
-  /// primary_ray(eye, x, y) for a pixel inside the rectangle.
+  /// primary_ray(eye, x, y) for a pixel of the image.
   [[nodiscard]] RayQuery operator()(int x, int y) const {
     RayQuery q;
     q.origin = vec3(origin_);
@@ -59,10 +56,9 @@ class PrimaryRays {
 
  private:
   [[nodiscard]] dvec3 axial(int x, int y) const {
-    return column_[static_cast<size_t>(x - x0_)] + row_[static_cast<size_t>(y - y0_)] - back_;
+    return column_[static_cast<size_t>(x)] + row_[static_cast<size_t>(y)] - back_;
   }
   dvec3 origin_, back_;
-  int x0_, y0_;
   std::vector<dvec3> column_, row_;
 };
 

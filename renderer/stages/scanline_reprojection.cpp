@@ -73,7 +73,7 @@ void scanline_band(const RenderScene& scene, const PixelReprojector& reprojector
                    Image& right, ScanlineCounts& counts) {
   const int w = left.width();
   auto start = Clock::now();
-  trace_rect(scene, reprojector.left(), PixelRect{0, y0, w, y1}, left, counts.left);
+  trace_rect(scene, reprojector.left(), reprojector.left_rays(), PixelRect{0, y0, w, y1}, left, counts.left);
   counts.left_seconds += since(start);
 
   start = Clock::now();
@@ -95,7 +95,8 @@ void scanline_band(const RenderScene& scene, const PixelReprojector& reprojector
   counts.reproject_seconds += since(start);
 
   start = Clock::now();
-  trace_pixels_here(scene, reprojector.right(), no_hit, right, counts.right, Source::reshaded_traced);
+  trace_pixels_here(scene, reprojector.right(), reprojector.right_rays(), no_hit, right, counts.right,
+                    Source::reshaded_traced);
   counts.right_seconds += since(start);
 }
 

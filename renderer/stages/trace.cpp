@@ -197,9 +197,10 @@ void trace_listed(const RenderScene& scene, const EyeCamera& eye, const Executor
   add_totals(counts, totals);
 }
 
-/// trace_rect with the eye's rays for the rectangle given.
-void trace_rect_with(const RenderScene& scene, const EyeCamera& eye, const PrimaryRays& rays, const PixelRect& rect,
-                     Image& image, TraceCounts& counts) {
+}  // namespace
+
+void trace_rect(const RenderScene& scene, const EyeCamera& eye, const PrimaryRays& rays, const PixelRect& rect,
+                Image& image, TraceCounts& counts) {
   PacketTracer tracer(scene, eye, rays, image, Source::traced, counts);
   // One shading batch per block: a block's surfaces are shaded together.
   for_pixel_blocks(rect, image.width(), [&](const PixelBlock& block) {
@@ -208,20 +209,13 @@ void trace_rect_with(const RenderScene& scene, const EyeCamera& eye, const Prima
   });
 }
 
-}  // namespace
-
-void trace_rect(const RenderScene& scene, const EyeCamera& eye, const PixelRect& rect, Image& image,
-                TraceCounts& counts) {
-  trace_rect_with(scene, eye, PrimaryRays(eye, rect), rect, image, counts);
-}
-
 void trace_eye(const RenderScene& scene, const EyeCamera& eye, const Executor& executor, Image& image,
                TraceCounts& counts) {
   const PrimaryRays rays(eye);
   std::atomic<uint64_t> totals[4] = {0, 0, 0, 0};
   executor.for_tiles(image.width(), image.height(), kTraceTile, [&](const PixelRect& tile) {
     TraceCounts local;
-    trace_rect_with(scene, eye, rays, tile, image, local);
+    trace_rect(scene, eye, rays, tile, image, local);
     accumulate(totals, local);
   });
   add_totals(counts, totals);
@@ -238,10 +232,10 @@ void trace_unless(const RenderScene& scene, const EyeCamera& eye, const Executor
                counts, source);
 }
 
-void trace_pixels_here(const RenderScene& scene, const EyeCamera& eye, std::span<const uint32_t> pixels, Image& image,
-                       TraceCounts& counts, Source source) {
+void trace_pixels_here(const RenderScene& scene, const EyeCamera& eye, const PrimaryRays& rays,
+                       std::span<const uint32_t> pixels, Image& image, TraceCounts& counts, Source source) {
   const PixelBlocks blocks = pixel_blocks(pixels, image.width(), image.height());
-  trace_blocks(scene, eye, PrimaryRays(eye), blocks, 0, blocks.listed.size(), image, source, counts);
+  trace_blocks(scene, eye, rays, blocks, 0, blocks.listed.size(), image, source, counts);
 }
 
 void add_counts(Counters& counters, const TraceCounts& counts, const char* eye, bool traced) {

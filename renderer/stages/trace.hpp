@@ -9,6 +9,7 @@
 #include "renderer/parallel.hpp"
 #include "renderer/render_scene.hpp"
 #include "renderer/rig.hpp"
+#include "renderer/stages/primary_rays.hpp"
 #include "renderer/stats.hpp"
 
 namespace sb {
@@ -41,14 +42,16 @@ void trace_unless(const RenderScene& scene, const EyeCamera& eye, const Executor
                   Source source = Source::traced);
 
 /// trace_eye's work for one rectangle of pixels (4-aligned, as trace_eye's tiles are), in the
-/// calling thread: the same packets and shading batches, so the same bits.
-void trace_rect(const RenderScene& scene, const EyeCamera& eye, const PixelRect& rect, Image& image,
-                TraceCounts& counts);
+/// calling thread: the same packets and shading batches, so the same bits. `rays` are the eye's
+/// (PrimaryRays covering the rectangle).
+void trace_rect(const RenderScene& scene, const EyeCamera& eye, const PrimaryRays& rays, const PixelRect& rect,
+                Image& image, TraceCounts& counts);
 
 /// trace_pixels in the calling thread (for pipelines that are sequential by design, or that run
 /// their own parallel loop around it).
-void trace_pixels_here(const RenderScene& scene, const EyeCamera& eye, std::span<const uint32_t> pixels, Image& image,
-                       TraceCounts& counts, Source source = Source::traced);
+void trace_pixels_here(const RenderScene& scene, const EyeCamera& eye, const PrimaryRays& rays,
+                       std::span<const uint32_t> pixels, Image& image, TraceCounts& counts,
+                       Source source = Source::traced);
 
 /// Adds trace counts to a pipeline's counters: primary_rays and shadow_rays (totals) and
 /// pixels_shaded_<eye>; with `traced` also pixels_traced_<eye> (pixels written from a primary ray).
