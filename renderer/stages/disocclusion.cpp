@@ -19,13 +19,14 @@ VisibleSurfaces trace_visible_surfaces(const RenderScene& scene, const EyeCamera
   const size_t n = static_cast<size_t>(w) * static_cast<size_t>(h);
   VisibleSurfaces v{w, h, std::vector<float>(n, std::numeric_limits<float>::infinity()),
                     std::vector<uint32_t>(n, kNoPrimitive)};
+  const PrimaryRays primary(eye);
   executor.for_tiles(w, h, kTraceTile, [&](const PixelRect& tile) {
     for_pixel_blocks(tile, w, [&](const PixelBlock& block) {
       RayQuery rays[kRayPacket];
       RayHit hits[kRayPacket];
       const int count = block.n;
       const uint32_t* pixels = block.index;
-      for (int i = 0; i < count; ++i) rays[i] = primary_ray(eye, block.x[i], block.y[i]);
+      for (int i = 0; i < count; ++i) rays[i] = primary(block.x[i], block.y[i]);
       scene.rays().intersect(std::span<const RayQuery>(rays, static_cast<size_t>(count)),
                              std::span<RayHit>(hits, static_cast<size_t>(count)));
       for (int i = 0; i < count; ++i) {
