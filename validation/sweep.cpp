@@ -44,6 +44,11 @@ class Where {
     fail(at.source(), key_path, what);
   }
   [[nodiscard]] const fs::path& file() const { return file_; }
+  /// A path written in the definition: absolute as given, otherwise relative to its folder.
+  [[nodiscard]] fs::path beside(const std::string& path) const {
+    const fs::path p(path);
+    return p.is_absolute() ? p : file_.parent_path() / p;
+  }
 
  private:
   fs::path file_;
@@ -151,7 +156,7 @@ SweepScene parse_scene_entry(const Where& where, const toml::node& node, const s
   s.builtin = false;
   s.label = text;
   s.name = text;
-  s.file = fs::path(text).is_absolute() ? fs::path(text) : where.file().parent_path() / text;
+  s.file = where.beside(text);
   std::error_code ec;
   if (!fs::is_regular_file(s.file, ec))
     where.fail(node, path,
@@ -524,8 +529,7 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
     if (const toml::node* v = gate.get("config")) {
       const std::string name = string_at(where, *v, "gate.config");
       if (name.empty()) where.fail(*v, "gate.config", "must name a gate config file (TOML), e.g. \"gate-nightly.toml\"");
-      const fs::path config(name);
-      d.gate_config = config.is_absolute() ? config : file.parent_path() / config;
+      d.gate_config = where.beside(name);
     }
   }
   return d;

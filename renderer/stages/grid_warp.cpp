@@ -82,14 +82,21 @@ class Reprojector {
       row_.push_back((from.cy - lattice_y(j)) / from.f_px * matrix_[1] - matrix_[2]);
   }
 
-  /// Target pixel position of source pixel position (x, y) at inverse depth inv_z (0: infinity),
-  /// or nothing when it lies behind the target eye.
-  [[nodiscard]] std::optional<dvec2> position(double x, double y, double inv_z, double* target_w = nullptr) const {
-    const dvec4 c = matrix_ * dvec4((x - from_.cx) / from_.f_px, (from_.cy - y) / from_.f_px, -1.0, inv_z);
+  /// Target pixel position of lattice point (i, j) at inverse depth inv_z (0: infinity), or
+  /// nothing when it lies behind the target eye; `inv_w` receives 1 / the clip w. The matrix
+  /// product is split into the precomputed terms.
+  [[nodiscard]] std::optional<dvec2> position(int i, int j, double inv_z, double* inv_w = nullptr) const {
+    const dvec4 c = column_[static_cast<size_t>(i + 1)] + row_[static_cast<size_t>(j + 1)] + inv_z * matrix_[3];
     if (!(c.w > 0.0)) return std::nullopt;
-    if (target_w != nullptr) *target_w = c.w;
-    return dvec2((c.x / c.w + 1.0) * 0.5 * to_w_, (1.0 - c.y / c.w) * 0.5 * to_h_);
+    const double r = 1.0 / c.w;
+    if (inv_w != nullptr) *inv_w = r;
+    return dvec2((c.x * r + 1.0) * 0.5 * to_w_, (1.0 - c.y * r) * 0.5 * to_h_);
   }
+
+  /// Source position of lattice column i / row j: pixel centres, and the extra ring outside the
+  /// image on its edges.
+  [[nodiscard]] double lattice_x(int i) const { return i < 0 ? 0.0 : i >= from_.width ? from_.width : i + 0.5; }
+  [[nodiscard]] double lattice_y(int j) const { return j < 0 ? 0.0 : j >= from_.height ? from_.height : j + 0.5; }
 
   /// The warped vertex of source pixel centre (i, j).
   [[nodiscard]] GridVertex vertex(int i, int j) const {
@@ -99,15 +106,12 @@ class Reprojector {
     const size_t p = static_cast<size_t>(std::clamp(j, 0, grid_.height - 1)) * grid_.width +
                      static_cast<size_t>(std::clamp(i, 0, grid_.width - 1));
     const double inv_z = grid_.inverse_depth[p];
-    // position() with the matrix product split into the precomputed terms.
-    const dvec4 c = column_[static_cast<size_t>(i + 1)] + row_[static_cast<size_t>(j + 1)] + inv_z * matrix_[3];
-    if (!(c.w > 0.0)) return v;  // behind the target eye
-    const double inv_w = 1.0 / c.w;
-    const double x = (c.x * inv_w + 1.0) * 0.5 * to_w_, y = (1.0 - c.y * inv_w) * 0.5 * to_h_;
+    double inv_w = 1.0;
+    const std::optional<dvec2> at = position(i, j, inv_z, &inv_w);
     // A vertex too far outside the target image cannot be rasterized in fixed point.
-    if (!(std::abs(x) < guard_ && std::abs(y) < guard_)) return v;
-    v.x = static_cast<int32_t>(std::floor(x * kSubOne + 0.5));
-    v.y = static_cast<int32_t>(std::floor(y * kSubOne + 0.5));
+    if (!at || !(std::abs(at->x) < guard_ && std::abs(at->y) < guard_)) return v;
+    v.x = static_cast<int32_t>(std::floor(at->x * kSubOne + 0.5));
+    v.y = static_cast<int32_t>(std::floor(at->y * kSubOne + 0.5));
     v.q = static_cast<float>(inv_z * inv_w);
     // The discontinuity measure: the larger excess opening of the two source gaps beside the vertex.
     const bool inside_row = i >= 0 && i < grid_.width;
@@ -119,11 +123,6 @@ class Reprojector {
   }
 
  private:
-  /// Source position of lattice column i / row j: pixel centres, and the extra ring outside the
-  /// image on its edges.
-  [[nodiscard]] double lattice_x(int i) const { return i < 0 ? 0.0 : i >= from_.width ? from_.width : i + 0.5; }
-  [[nodiscard]] double lattice_y(int j) const { return j < 0 ? 0.0 : j >= from_.height ? from_.height : j + 0.5; }
-
   const WarpGrid& grid_;
   EyeCamera from_;
   int to_w_;
@@ -439,11 +438,11 @@ void resolve_rows(const WarpTarget& t, const Image& source, int y0, int y1, Imag
 /// depths from the near plane to infinity. A stereo rig with a horizontal baseline gives 0.
 double vertical_displacement_bound(const Reprojector& reproject, const EyeCamera& from) {
   double bound = 0.0;
-  for (const double x : {0.5, from.width - 0.5})
-    for (const double y : {0.5, from.height - 0.5})
+  for (const int i : {0, from.width - 1})
+    for (const int j : {0, from.height - 1})
       for (const double inv_z : {0.0, 1.0 / from.znear}) {
-        const std::optional<dvec2> p = reproject.position(x, y, inv_z);
-        bound = p ? std::max(bound, std::abs(p->y - y)) : std::numeric_limits<double>::infinity();
+        const std::optional<dvec2> p = reproject.position(i, j, inv_z);
+        bound = p ? std::max(bound, std::abs(p->y - reproject.lattice_y(j))) : std::numeric_limits<double>::infinity();
       }
   return bound;
 }

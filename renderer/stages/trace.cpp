@@ -106,8 +106,8 @@ void add_totals(TraceCounts& counts, const std::atomic<uint64_t>* totals) {
 
 constexpr uint32_t kAllLanes = (1u << kRayPacket) - 1u;
 
-/// The listed pixels as lane masks of trace_eye's 4x4 blocks (4-aligned, clipped at the image):
-/// the blocks holding a listed pixel, in ascending order, and each one's mask.
+/// The pixels to trace as lane masks of trace_eye's 4x4 blocks (4-aligned, clipped at the image):
+/// each block's mask, and the blocks holding a pixel to trace in list_blocks' order.
 struct PixelBlocks {
   int blocks_x = 0;
   std::vector<uint32_t> masks;   ///< per block of the image
@@ -136,11 +136,16 @@ void list_blocks(PixelBlocks& b) {
         }
 }
 
-PixelBlocks pixel_blocks(std::span<const uint32_t> pixels, int w, int h) {
+/// The blocks of a w x h image, none with a pixel to trace yet.
+PixelBlocks empty_blocks(int w, int h) {
   PixelBlocks b;
   b.blocks_x = (w + 3) / 4;
-  const int blocks_y = (h + 3) / 4;
-  b.masks.assign(static_cast<size_t>(b.blocks_x) * static_cast<size_t>(blocks_y), 0);
+  b.masks.assign(static_cast<size_t>(b.blocks_x) * static_cast<size_t>((h + 3) / 4), 0);
+  return b;
+}
+
+PixelBlocks pixel_blocks(std::span<const uint32_t> pixels, int w, int h) {
+  PixelBlocks b = empty_blocks(w, h);
   for (const uint32_t p : pixels) {
     const int x = static_cast<int>(p % static_cast<uint32_t>(w)), y = static_cast<int>(p / static_cast<uint32_t>(w));
     if (y >= h) throw InputError(fmt::format("trace_pixels: pixel index {} lies outside the {}x{} image", p, w, h));
@@ -154,11 +159,8 @@ PixelBlocks pixel_blocks(std::span<const uint32_t> pixels, int w, int h) {
 PixelBlocks state_blocks(std::span<const uint8_t> states, uint8_t done, int w, int h, const Executor& executor) {
   if (states.size() != static_cast<size_t>(w) * static_cast<size_t>(h))
     throw std::logic_error(fmt::format("trace_unless: {} states for a {}x{} image", states.size(), w, h));
-  PixelBlocks b;
-  b.blocks_x = (w + 3) / 4;
-  const int blocks_y = (h + 3) / 4;
-  b.masks.assign(static_cast<size_t>(b.blocks_x) * static_cast<size_t>(blocks_y), 0);
-  executor.for_range(static_cast<size_t>(blocks_y), 4, [&](size_t begin, size_t end) {
+  PixelBlocks b = empty_blocks(w, h);
+  executor.for_range(static_cast<size_t>((h + 3) / 4), 4, [&](size_t begin, size_t end) {
     for (size_t by = begin; by < end; ++by)
       for (int y = 4 * static_cast<int>(by); y < std::min(4 * static_cast<int>(by) + 4, h); ++y)
         for (int x = 0; x < w; ++x)
