@@ -27,14 +27,16 @@ from collections import defaultdict
 def records(paths):
     for path in paths:
         with open(path, encoding="utf-8") as f:
-            for line in f:
-                line = line.strip()
-                if not line:
+            lines = f.read().split("\n")
+        for n, line in enumerate(lines, 1):
+            if not line.strip():
+                continue
+            try:
+                yield path, json.loads(line)
+            except json.JSONDecodeError as e:
+                if n == len(lines):  # a torn last line of an interrupted run (no newline after it)
                     continue
-                try:
-                    yield path, json.loads(line)
-                except json.JSONDecodeError:
-                    continue  # a torn last line of an interrupted run
+                sys.exit(f"derive_gate_rules: {path}:{n}: not JSON ({e}); fix or remove the line")
 
 
 def group_key(cell_id):
