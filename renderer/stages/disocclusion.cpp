@@ -60,11 +60,12 @@ struct SurfaceHit {
 class DisocclusionTester {
  public:
   DisocclusionTester(const RenderScene& scene, const StereoRig& rig)
-      : scene_(scene), right_(rig.eye(Eye::right)), left_(rig.eye(Eye::left)), eps_(scene.ray_epsilon()) {}
+      : scene_(scene), right_(rig.eye(Eye::right)), left_(rig.eye(Eye::left)), right_rays_(right_),
+        eps_(scene.ray_epsilon()) {}
 
   /// The verdict for right-eye pixel (x, y), which sees `prim` at linear `depth` (or nothing).
   [[nodiscard]] Verdict classify(int x, int y, uint32_t prim, float depth) const {
-    const RayQuery ray = primary_ray(right_, x, y);
+    const RayQuery ray = right_rays_(x, y);
     return prim == kNoPrimitive ? classify_background(ray) : classify_surface(ray, prim, depth);
   }
 
@@ -141,6 +142,7 @@ class DisocclusionTester {
   const RenderScene& scene_;
   EyeCamera right_;
   EyeCamera left_;
+  PrimaryRays right_rays_;
   float eps_;
 };
 

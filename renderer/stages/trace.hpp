@@ -43,7 +43,7 @@ void trace_unless(const RenderScene& scene, const EyeCamera& eye, const Executor
 
 /// trace_eye's work for one rectangle of pixels (4-aligned, as trace_eye's tiles are), in the
 /// calling thread: the same packets and shading batches, so the same bits. `rays` are the eye's
-/// (PrimaryRays covering the rectangle).
+/// primary rays, built once per eye and frame.
 void trace_rect(const RenderScene& scene, const EyeCamera& eye, const PrimaryRays& rays, const PixelRect& rect,
                 Image& image, TraceCounts& counts);
 
