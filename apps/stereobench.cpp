@@ -1,10 +1,7 @@
 // stereobench: the command-line tool. Maps subcommands to library calls and errors to exit codes.
-#include <climits>
 #include <cstdio>
 #include <exception>
 #include <string>
-
-#include <malloc.h>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -13,19 +10,10 @@
 #include "renderer/error.hpp"
 #include "renderer/io/gltf_loader.hpp"
 #include "renderer/io/image_io.hpp"
+#include "renderer/memory.hpp"
 #include "sb_version.hpp"
 
 namespace {
-
-/// Frame-sized buffers (eye images, G-buffers, warp buffers: ~100 MB per eye at 1920x1080) are
-/// allocated for every render. glibc maps each such block afresh and unmaps it when freed, so every
-/// render pays the kernel's page faults again — measured at 55 ms per 100 MB here, as much as a
-/// whole stage. Keeping freed memory in the heap lets later renders (benchmark repetitions) reuse
-/// it, as a real-time renderer keeps its frame buffers; every pipeline gains alike.
-void keep_freed_memory() {
-  mallopt(M_MMAP_MAX, 0);
-  mallopt(M_TRIM_THRESHOLD, INT_MAX);
-}
 
 /// The command line as typed, arguments with spaces or quotes single-quoted (for provenance).
 std::string command_line(int argc, char** argv) {
@@ -48,7 +36,7 @@ std::string command_line(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  keep_freed_memory();
+  sb::keep_freed_memory();
   CLI::App app{"stereobench: offline validation and benchmarking of accelerated stereo rendering.\n"
                "Renders stereo pairs with every pipeline of the source papers, measures the synthesized\n"
                "right eye against ground truth, and reports quality, holes and time.",

@@ -55,17 +55,20 @@ std::optional<Source> source_from_u32(uint32_t value) {
 
 // ---- Plane ----------------------------------------------------------------------------------
 
-Plane::Plane(std::string name, int channels, PlaneType type, int width, int height)
+Plane::Plane(std::string name, int channels, PlaneType type, int width, int height, PlaneInit init)
     : name_(std::move(name)), channels_(channels), type_(type), width_(width), height_(height) {
   if (channels < 1 || channels > 64)
     throw InputError(fmt::format("plane '{}': {} channels requested; a plane has 1 to 64 channels", name_, channels));
   if (width < 0 || height < 0 || width > kMaxImageDimension || height > kMaxImageDimension)
     throw InputError(
         fmt::format("plane '{}': size {}x{} is out of range 0..{}", name_, width, height, kMaxImageDimension));
-  if (type == PlaneType::f32)
-    f32_.assign(value_count(), 0.0f);
-  else
-    u32_.assign(value_count(), name_ == planes::primid ? kNoPrimitive : 0u);
+  if (type == PlaneType::f32) {
+    f32_.resize(value_count());
+    if (init == PlaneInit::filled) fill(0.0f);
+  } else {
+    u32_.resize(value_count());
+    if (init == PlaneInit::filled) fill(name_ == planes::primid ? kNoPrimitive : 0u);
+  }
 }
 
 float* Plane::data_f32() {
@@ -105,7 +108,7 @@ Image::Image(int width, int height) : width_(width), height_(height) {
         fmt::format("image size {}x{} is out of range; each side must be in 0..{}", width, height, kMaxImageDimension));
 }
 
-Plane& Image::add_plane(std::string_view name, int channels, PlaneType type) {
+Plane& Image::add_plane(std::string_view name, int channels, PlaneType type, PlaneInit init) {
   if (!is_plane_identifier(name))
     throw InputError(
         fmt::format("plane name '{}' is invalid; use a lowercase identifier such as 'motion_x' "
@@ -116,18 +119,18 @@ Plane& Image::add_plane(std::string_view name, int channels, PlaneType type) {
   if (const auto shape = standard_plane_shape(name); shape && (shape->channels != channels || shape->type != type))
     throw InputError(fmt::format("standard plane '{}' must have {} {} channel(s), not {} {}", name, shape->channels,
                                  to_string(shape->type), channels, to_string(type)));
-  planes_.emplace_back(std::string(name), channels, type, width_, height_);
+  planes_.emplace_back(std::string(name), channels, type, width_, height_, init);
   return planes_.back();
 }
 
-Plane& Image::add_plane(std::string_view standard_name) {
+Plane& Image::add_plane(std::string_view standard_name, PlaneInit init) {
   const auto shape = standard_plane_shape(standard_name);
   if (!shape)
     throw InputError(
         fmt::format("'{}' is not a standard plane name (rgb, alpha, depth, normal, albedo, primid, "
                     "source); give its channel count and type",
                     standard_name));
-  return add_plane(standard_name, shape->channels, shape->type);
+  return add_plane(standard_name, shape->channels, shape->type, init);
 }
 
 bool Image::remove_plane(std::string_view name) {

@@ -10,6 +10,8 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace sb {
@@ -67,12 +69,39 @@ inline constexpr std::size_t kSourceCount = 7;
 /// The tag with numeric value `value`, or nothing if it is out of range (e.g. read from a file).
 [[nodiscard]] std::optional<Source> source_from_u32(uint32_t value);
 
+/// Whether a new plane's samples are set: to the plane's empty value (0, kNoPrimitive for
+/// "primid"), or left unset for a writer that sets every sample before anything reads one (it
+/// saves a pass over the memory; an unset sample that is read is undefined).
+enum class PlaneInit : uint8_t { filled, unset };
+
+/// Allocator of plane samples: a resize default-initializes new samples, which for float and
+/// uint32 leaves them unset, so that PlaneInit::unset costs nothing and `filled` fills once.
+template <class T>
+struct SampleAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = SampleAllocator<U>;
+  };
+  SampleAllocator() = default;
+  template <class U>
+  SampleAllocator(const SampleAllocator<U>& /*other*/) noexcept {}
+  template <class U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
 /// One named plane of an image: `channels` interleaved samples per pixel, row-major, row 0 at the
 /// top, stored contiguously as float32 or uint32 (only the vector matching the type is used).
 class Plane {
  public:
-  /// A zero-filled plane (kNoPrimitive-filled for "primid"); throws InputError for a bad shape.
-  Plane(std::string name, int channels, PlaneType type, int width, int height);
+  /// A zero-filled plane (kNoPrimitive-filled for "primid"), or one with unset samples; throws
+  /// InputError for a bad shape.
+  Plane(std::string name, int channels, PlaneType type, int width, int height, PlaneInit init = PlaneInit::filled);
 
   [[nodiscard]] const std::string& name() const noexcept { return name_; }
   [[nodiscard]] int channels() const noexcept { return channels_; }
@@ -128,8 +157,8 @@ class Plane {
   PlaneType type_ = PlaneType::f32;
   int width_ = 0;
   int height_ = 0;
-  std::vector<float> f32_;
-  std::vector<uint32_t> u32_;
+  std::vector<float, SampleAllocator<float>> f32_;
+  std::vector<uint32_t, SampleAllocator<uint32_t>> u32_;
 };
 
 /// One eye's image: a size and an ordered list of planes of that size. Plane lookup by name is a
@@ -147,12 +176,12 @@ class Image {
   }
   [[nodiscard]] bool empty() const noexcept { return pixel_count() == 0; }
 
-  /// Adds a zero-filled plane (kNoPrimitive for "primid") and returns it. Throws InputError if the
+  /// Adds a zero-filled plane (kNoPrimitive for "primid"; unset samples with PlaneInit::unset) and returns it. Throws InputError if the
   /// name is taken, is not a lowercase identifier ([a-z][a-z0-9_]*, at most 64 characters; not
   /// "left" or "right", the EXR eye layers), or is a standard name with another shape. References to planes stay valid when more planes are added (not on removal).
-  Plane& add_plane(std::string_view name, int channels, PlaneType type);
+  Plane& add_plane(std::string_view name, int channels, PlaneType type, PlaneInit init = PlaneInit::filled);
   /// Adds a standard plane with its fixed shape; throws InputError for a non-standard name.
-  Plane& add_plane(std::string_view standard_name);
+  Plane& add_plane(std::string_view standard_name, PlaneInit init = PlaneInit::filled);
   /// Removes a plane if present; returns whether it was.
   bool remove_plane(std::string_view name);
 

@@ -3,10 +3,10 @@
 
 namespace sb {
 
-Image make_eye_image(int width, int height) {
+Image make_eye_image(int width, int height, PlaneInit init) {
   Image image(width, height);
   for (std::string_view name : {planes::rgb, planes::depth, planes::normal, planes::albedo, planes::primid, planes::source})
-    image.add_plane(name);
+    image.add_plane(name, init);
   return image;
 }
 

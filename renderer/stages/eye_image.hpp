@@ -9,8 +9,9 @@
 
 namespace sb {
 
-/// A width x height image with planes rgb, depth, normal, albedo, primid and source.
-[[nodiscard]] Image make_eye_image(int width, int height);
+/// A width x height image with planes rgb, depth, normal, albedo, primid and source: empty
+/// (radiance 0, kNoPrimitive, tag hole), or with unset samples for a stage that writes every pixel.
+[[nodiscard]] Image make_eye_image(int width, int height, PlaneInit init = PlaneInit::filled);
 
 /// Cached plane pointers of an eye image (made by make_eye_image) for per-pixel reads in hot loops.
 class EyeReader {

@@ -344,19 +344,22 @@ class CellRowVertices {
 
   /// Computes the vertices cell (cx) uses: its whole block when it is subdivided or thin,
   /// otherwise its corners, its centre and every point of its edges (the fine ones need them all).
+  /// Called for the cells of the row in order cx = 0, 1, ...: a cell's first column is the last
+  /// column of the cell before, which computed all of it either way.
   void prepare(int cx, int cy) {
     const int x0 = g_.x0(cx), x1 = g_.x1(cx), y1 = g_.y1(cy);
+    const int first = cx > 0 ? x0 + 1 : x0;
     if (g_.subdivided[g_.cell(cx, cy)] || x1 - x0 < 2 || y1 - y0_ < 2) {
       for (int j = y0_; j <= y1; ++j)
-        for (int i = x0; i <= x1; ++i) set(i, j);
+        for (int i = first; i <= x1; ++i) set(i, j);
       return;
     }
-    for (int i = x0; i <= x1; ++i) {
+    for (int i = first; i <= x1; ++i) {
       set(i, y0_);
       set(i, y1);
     }
     for (int j = y0_ + 1; j < y1; ++j) {
-      set(x0, j);
+      if (cx == 0) set(x0, j);
       set(x1, j);
     }
     set((x0 + x1) / 2, (y0_ + y1) / 2);
@@ -424,8 +427,9 @@ void resolve_rows(const WarpTarget& t, const Image& source, int y0, int y1, Imag
       };
       const int i0 = static_cast<int>(fu), j0 = static_cast<int>(fv);
       const vec3 top = at(i0, j0) + ax * (at(i0 + 1, j0) - at(i0, j0));
-      const vec3 bottom = at(i0, j0 + 1) + ax * (at(i0 + 1, j0 + 1) - at(i0, j0 + 1));
-      const vec3 rgb = top + ay * (bottom - top);
+      // On a row of source pixel centres (every position a horizontal rig gives native cells) the
+      // lower row has weight 0: the lookup is the upper row's, without reading the lower one.
+      const vec3 rgb = ay == 0.0f ? top : top + ay * ((at(i0, j0 + 1) + ax * (at(i0 + 1, j0 + 1) - at(i0, j0 + 1))) - top);
       // The other AOVs come from the source pixel the position falls in.
       const size_t n = static_cast<size_t>(std::clamp(static_cast<int>(std::floor(s.y)), 0, sh - 1)) * sw +
                        static_cast<size_t>(std::clamp(static_cast<int>(std::floor(s.x)), 0, sw - 1));

@@ -141,7 +141,8 @@ struct WarpStats {
 };
 
 /// Warps `source` (an eye image with rgb, depth, normal, albedo and primid planes, seen by `from`)
-/// into `target` (an eye image of the same size made by make_eye_image, seen by `to`). Covered
+/// into `target` (an eye image of the same size made by make_eye_image, seen by `to`; every sample
+/// of every plane is written, so it may be made with PlaneInit::unset). Covered
 /// pixels get the bilinear radiance at their source position, the reprojected depth, the nearest
 /// source pixel's normal, albedo and primitive id, and source tag `reprojected`; the others are
 /// written as holes (radiance 0, depth +inf, tag `hole`). Returns a WarpPixel per target pixel.

@@ -82,7 +82,8 @@ std::vector<uint8_t> warp_left_to_right(const RenderScene& scene, const StereoRi
   std::vector<uint8_t> states;
   {
     ScopedStage stage(r.timings, "grid_warp");
-    r.right = make_eye_image(right.width, right.height);
+    // grid_warp writes every pixel of every plane.
+    r.right = make_eye_image(right.width, right.height, PlaneInit::unset);
     states = grid_warp(grid, r.left, left, right, e, settings.warp, executor, r.right, ws);
     if (settings.warp.detect_disocclusions && settings.source_frustum) {
       frustum = mark_outside_source_frustum(scene, left, right, executor, states,

@@ -204,7 +204,7 @@ RowWarpStats row_warp(const Image& source, const MotionField& motion, const RowW
 }
 
 Image make_hole_image(int width, int height, const Executor& executor) {
-  Image image = make_eye_image(width, height);
+  Image image = make_eye_image(width, height, PlaneInit::unset);  // every pixel is written below
   EyeWriter out(image);
   executor.for_range(image.pixel_count(), 4096, [&](size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) out.hole(i);

@@ -33,6 +33,21 @@ TEST(ImageTest, StandardPlanesHaveTheirFixedShapes) {
   EXPECT_THROW(Image(kMaxImageDimension + 1, 2), InputError);
 }
 
+TEST(ImageTest, UnsetPlanesHaveTheirShapeAndTakeWrites) {
+  Image image(5, 4);
+  Plane& rgb = image.add_plane(planes::rgb, PlaneInit::unset);
+  Plane& primid = image.add_plane(planes::primid, PlaneInit::unset);
+  EXPECT_EQ(rgb.value_count(), 5u * 4u * 3u);
+  EXPECT_EQ(primid.value_count(), 5u * 4u);
+  rgb.fill(0.25f);
+  primid.fill(7u);
+  EXPECT_EQ(image.rgb_at(4, 3)[2], 0.25f);
+  EXPECT_EQ(primid.at_u32(4, 3), 7u);
+  // Filled is still the default.
+  for (const float v : image.add_plane(planes::depth).f32()) EXPECT_EQ(v, 0.0f);
+  EXPECT_THROW(image.add_plane(planes::albedo, 4, PlaneType::f32, PlaneInit::unset), InputError);
+}
+
 TEST(ImageTest, MissingPlaneErrorNamesItAndListsThePresentOnes) {
   Image image(2, 2);
   image.add_plane(planes::rgb);

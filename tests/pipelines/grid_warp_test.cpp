@@ -4,10 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <numbers>
 
 #include "renderer/error.hpp"
 #include "renderer/stages/disocclusion.hpp"
+#include "renderer/stages/eye_image.hpp"
 #include "renderer/stages/grid_warp.hpp"
 #include "support/lit_plane.hpp"
 #include "support/render_support.hpp"
@@ -191,6 +193,52 @@ TEST(GridWarp, NoCracksOnASlantedPlane) {
 TEST(GridWarp, NoCracksOnSpheres) {
   const Coverage c = coverage("spheres", 1920, 1080);
   EXPECT_EQ(c.slivers, 0u);
+}
+
+/// repro-rt makes its right eye with unset samples (PlaneInit::unset), so grid_warp must write
+/// every sample of every plane: on a target pre-filled with a sentinel none may remain, with and
+/// without disocclusion detection.
+TEST(GridWarp, WritesEverySampleOfTheTarget) {
+  const Scene scene = test::load_builtin("spheres");
+  const RenderScene prepared(scene);
+  const StereoRig rig = test::rig_at(scene, 240, 135);
+  const StereoResult r = test::render_with("plain-raster", prepared, rig, 2);
+  const EyeCamera left = rig.eye(Eye::left), right = rig.eye(Eye::right);
+  const Executor executor(2);
+  GridSettings gs = settings(1.0);
+  gs.focal_px = left.f_px;
+  const WarpGrid grid = build_warp_grid(r.left.plane(planes::depth).f32(), left.width, left.height, gs, executor);
+  constexpr uint32_t kSentinel = 0x7fc0dead;  // a NaN no stage writes
+  for (const bool detect : {false, true}) {
+    Image target = make_eye_image(right.width, right.height, PlaneInit::unset);
+    for (const Plane& plane : target.planes()) {
+      Plane& p = target.plane(plane.name());
+      if (p.type() == PlaneType::u32) {
+        p.fill(kSentinel);
+      } else {
+        for (float& v : p.f32()) std::memcpy(&v, &kSentinel, sizeof v);
+      }
+    }
+    WarpOptions options;
+    options.detect_disocclusions = detect;
+    WarpStats stats;
+    const std::vector<uint8_t> states = grid_warp(grid, r.left, left, right, kInteraxial, options, executor, target, stats);
+    EXPECT_EQ(states.size(), target.pixel_count());
+    EXPECT_GT(stats.pixels_covered, target.pixel_count() / 2);
+    for (const Plane& plane : target.planes()) {
+      size_t left_over = 0;
+      if (plane.type() == PlaneType::u32) {
+        for (const uint32_t v : plane.u32()) left_over += v == kSentinel ? 1 : 0;
+      } else {
+        for (const float v : plane.f32()) {
+          uint32_t bits = 0;
+          std::memcpy(&bits, &v, sizeof bits);
+          left_over += bits == kSentinel ? 1 : 0;
+        }
+      }
+      EXPECT_EQ(left_over, 0u) << "plane " << plane.name() << ", detection " << detect;
+    }
+  }
 }
 
 TEST(GridWarp, OverlayTintsFlaggedCells) {
