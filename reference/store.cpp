@@ -30,6 +30,8 @@ namespace {
 constexpr const char* kProvenance = "provenance.json";
 constexpr const char* kImage = "right.exr";
 constexpr const char* kPreview = "right.png";
+/// Stands in the provenance for the provider's scratch folder, which is removed once stored.
+constexpr const char* kWorkPlaceholder = "$WORK";
 
 template <class T>
 json optional_json(const std::optional<T>& v) {
@@ -68,6 +70,23 @@ ReferenceSpec spec_from_json(const json& j) {
   s.rig.height = optional_from<int>(r, "height");
   s.rig.vfov = optional_from<double>(r, "vfov_rad");
   return s;
+}
+
+/// Every occurrence of `from` in `text` replaced by `to`.
+std::string replace_all(std::string text, const std::string& from, const std::string& to) {
+  if (from.empty()) return text;
+  for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
+    text.replace(at, from.size(), to);
+  return text;
+}
+
+/// `value` with the scratch folder's path in every string replaced by kWorkPlaceholder.
+json without_scratch_paths(const json& value, const std::string& scratch) {
+  if (value.is_string()) return replace_all(value.get<std::string>(), scratch, kWorkPlaceholder);
+  if (!value.is_structured()) return value;
+  json out = value;
+  for (auto& item : out.items()) item.value() = without_scratch_paths(item.value(), scratch);
+  return out;
 }
 
 std::string reference_id(const Scene& scene, const ReferenceSpec& spec, const StereoRig& rig) {
@@ -178,6 +197,9 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
     const RenderScene prepared(scene);
     const validation::TruthRequest request{prepared, p.loaded.file, *p.rig, staged / "work", executor.threads()};
     const validation::TruthRender render = provider->render(request);
+    // The provider ran its tool in a scratch folder inside the staging folder, both gone once the
+    // reference is stored: its paths are written as $WORK, and how to get the folder back beside.
+    const std::string scratch = fs::absolute(request.work_dir).lexically_normal().string();
     const Image right = validation::rgb_plane_only(render.right);
     io::write_exr(staged / kImage, right);
     validation::write_png(staged / kPreview, validation::encode_srgb8(right, "the reference"));
@@ -195,7 +217,14 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
         {"spec", spec_to_json(spec)},
         {"provider",
          {{"name", render.provider}, {"tool_version", render.tool_version}, {"revision", provider->revision()},
-          {"settings", render.settings}, {"command", render.command}, {"seconds", render.seconds}}},
+          {"settings", without_scratch_paths(render.settings, scratch)},
+          {"command", replace_all(render.command, scratch, kWorkPlaceholder)},
+          {"work_folder",
+           fmt::format("{} is the folder the provider exported the scene to and ran its tool in; it is removed once "
+                       "the reference is stored. `stereobench reference generate` with this spec makes it again "
+                       "(`stereobench validate --truth {} --out DIR` keeps its own in DIR/work/{}).",
+                       kWorkPlaceholder, render.provider, render.provider)},
+          {"seconds", render.seconds}}},
         {"scene",
          {{"name", scene.name}, {"file", p.loaded.file.string()}, {"file_sha256", validation::hash_file(p.loaded.file)},
           {"content_sha256", validation::hash_scene(scene)}, {"triangles", scene.triangle_count()},

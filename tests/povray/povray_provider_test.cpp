@@ -17,6 +17,7 @@
 
 #include <fmt/format.h>
 
+#include "reference/store.hpp"
 #include "renderer/error.hpp"
 #include "renderer/render_scene.hpp"
 #include "scenes/catalog.hpp"
@@ -305,6 +306,28 @@ TEST(PovrayRecords, VersionCommandAndSettingsAreRecorded) {
   EXPECT_TRUE(std::filesystem::is_regular_file(dir / "work" / "povray.log"));
   EXPECT_FALSE(povray->revision().empty());
   EXPECT_GT(r.seconds, 0.0);
+}
+
+TEST(PovrayRecords, StoredReferenceNamesNoScratchPath) {
+  // A reference's provider renders in a scratch folder that is removed once the entry is stored;
+  // its provenance must not point there.
+  SB_REQUIRE_POVRAY(povray);
+  const test::ScratchDir dir;
+  const reference::ReferenceStore store(dir / "store");
+  reference::ReferenceSpec spec;
+  spec.scene = "box-wall";
+  spec.provider = "povray";
+  spec.rig.width = 64;
+  spec.rig.height = 36;
+  const std::string id =
+      store.generate(spec, std::filesystem::path(SB_BINARY_DIR) / "Testing" / "scenes-cache", "test", Executor(1));
+  const nlohmann::json p = store.provenance(id);
+  const std::string command = p.at("provider").at("command").get<std::string>();
+  EXPECT_NE(command.find("$WORK/povray.ini"), std::string::npos) << command;
+  const std::string all = p.dump();
+  EXPECT_EQ(all.find((dir / "store").string()), std::string::npos) << all;
+  EXPECT_EQ(all.find(".new-"), std::string::npos) << all;
+  EXPECT_NE(p.at("provider").at("work_folder").get<std::string>().find("$WORK"), std::string::npos);
 }
 
 // ---------------------------------------------------------------------------------------------
