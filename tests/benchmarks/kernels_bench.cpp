@@ -1,9 +1,11 @@
 // Google Benchmark micro-benchmarks of the hot kernels: rasterizing a G-buffer, shading it, and
 // tracing a whole eye, on a built-in scene at 960x540; the adaptive grid warp of the repro-*
-// pipelines at 1920x1080. Run `build/tests/sb_kernels_bench`.
+// pipelines at 1920x1080 on temple and bistro. Run `build/tests/sb_kernels_bench`.
 #include <benchmark/benchmark.h>
 
+#include <map>
 #include <memory>
+#include <string>
 
 #include "renderer/memory.hpp"
 #include "renderer/raster/rasterizer.hpp"
@@ -65,16 +67,10 @@ void BM_TraceEye(benchmark::State& state) {
   }
 }
 
-/// temple's left eye at 1920x1080, rasterized once, and its warping grid: the input of the warp
+/// A scene's left eye at 1920x1080, rasterized once, and its warping grid: the input of the warp
 /// into the right eye (repro-rt's grid_warp stage without the source-frustum search).
 struct WarpFixture {
-  Scene scene = test::load_builtin("temple");
-  RenderScene prepared{scene};
-  StereoRig rig = test::rig_at(scene, 1920, 1080);
-  Image left;
-  GridSettings settings;  ///< repro-rt's defaults
-  WarpGrid grid;
-  WarpFixture() {
+  explicit WarpFixture(const std::string& name) : scene(test::load_builtin(name)) {
     const Executor executor(0);
     StereoResult r;
     left = raster_eye(prepared, rig, Eye::left, RasterOptions{}, executor, r);
@@ -83,16 +79,25 @@ struct WarpFixture {
     settings.opening_px = WarpOptions{}.discontinuity_px;
     grid = build_warp_grid(left.plane(planes::depth).f32(), left.width(), left.height(), settings, executor);
   }
+  Scene scene;
+  RenderScene prepared{scene};
+  StereoRig rig = test::rig_at(scene, 1920, 1080);
+  Image left;
+  GridSettings settings;  ///< repro-rt's defaults
+  WarpGrid grid;
 };
 
-WarpFixture& warp_fixture() {
-  static WarpFixture f;
-  return f;
+/// temple (half the cells at native resolution) or bistro (five in six).
+WarpFixture& warp_fixture(const std::string& name) {
+  static std::map<std::string, std::unique_ptr<WarpFixture>> fixtures;
+  std::unique_ptr<WarpFixture>& f = fixtures[name];
+  if (!f) f = std::make_unique<WarpFixture>(name);
+  return *f;
 }
 
 /// The grid metric: per-cell depth range, parallax and subdivision.
-void BM_GridMetric(benchmark::State& state) {
-  WarpFixture& f = warp_fixture();
+void BM_GridMetric(benchmark::State& state, const std::string& scene) {
+  WarpFixture& f = warp_fixture(scene);
   const Executor executor(static_cast<int>(state.range(0)));
   for (auto _ : state)
     benchmark::DoNotOptimize(
@@ -100,8 +105,8 @@ void BM_GridMetric(benchmark::State& state) {
 }
 
 /// The warp with disocclusion detection, into a right eye made as repro-rt makes it.
-void BM_GridWarp(benchmark::State& state) {
-  WarpFixture& f = warp_fixture();
+void BM_GridWarp(benchmark::State& state, const std::string& scene) {
+  WarpFixture& f = warp_fixture(scene);
   const Executor executor(static_cast<int>(state.range(0)));
   const EyeCamera left = f.rig.eye(Eye::left), right = f.rig.eye(Eye::right);
   WarpStats stats;
@@ -144,8 +149,9 @@ BENCHMARK(BM_CompareImages4k)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Rasterize)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ShadeGBuffer)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_TraceEye)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_GridMetric)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_GridWarp)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_GridMetric, temple, std::string("temple"))->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_GridWarp, temple, std::string("temple"))->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_GridWarp, bistro, std::string("bistro"))->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace sb
