@@ -496,30 +496,46 @@ WarpGrid build_warp_grid(std::span<const float> depth, int width, int height, co
   g.subdivided.assign(cells, 0);
   g.inverse_depth.resize(depth.size());
   g.excess.resize(depth.size());
-  executor.for_range(static_cast<size_t>(height), 8, [&](size_t begin, size_t end) {
-    for (size_t j = begin; j < end; ++j) gap_row(depth, width, static_cast<int>(j), g.inverse_depth.data(), g.excess.data());
-  });
   // The excess opening, in units of f e, above which a cell opens a gap (none when not asked).
   const double opening_limit = settings.opening_px > 0.0 ? settings.opening_px / (settings.focal_px * interaxial)
                                                          : std::numeric_limits<double>::infinity();
+  // Per pixel row: its gaps, then per cell column the depth range over the cell's lattice span
+  // (columns 16 cx .. 16 cx + 16, clipped) and whether a gap in its own columns opens.
+  const size_t row_cells = static_cast<size_t>(height) * g.cells_x;
+  std::vector<float> row_lo(row_cells), row_hi(row_cells);
+  std::vector<uint8_t> row_open(row_cells);
+  executor.for_range(static_cast<size_t>(height), 8, [&](size_t begin, size_t end) {
+    for (size_t j = begin; j < end; ++j) {
+      gap_row(depth, width, static_cast<int>(j), g.inverse_depth.data(), g.excess.data());
+      const float* z = depth.data() + j * width;
+      const float* excess = g.excess.data() + j * width;
+      for (int cx = 0; cx < g.cells_x; ++cx) {
+        float lo = std::numeric_limits<float>::infinity(), hi = 0.0f;
+        for (int x = std::max(g.x0(cx), 0); x <= std::min(g.x1(cx), width - 1); ++x) {
+          lo = std::min(lo, z[x]);
+          hi = std::max(hi, z[x]);
+        }
+        bool open = false;
+        if (std::isfinite(opening_limit))
+          for (int x = std::max(g.x0(cx), 0); x < std::min(g.x1(cx), width - 1); ++x) open |= excess[x] > opening_limit;
+        const size_t k = j * g.cells_x + static_cast<size_t>(cx);
+        row_lo[k] = lo;
+        row_hi[k] = hi;
+        row_open[k] = open ? 1 : 0;
+      }
+    }
+  });
   executor.for_each(static_cast<size_t>(g.cells_y), [&](size_t row) {
     const int cy = static_cast<int>(row);
     for (int cx = 0; cx < g.cells_x; ++cx) {
       float lo = std::numeric_limits<float>::infinity(), hi = 0.0f;
-      for (int y = std::max(g.y0(cy), 0); y <= std::min(g.y1(cy), height - 1); ++y)
-        for (int x = std::max(g.x0(cx), 0); x <= std::min(g.x1(cx), width - 1); ++x) {
-          const float z = depth[static_cast<size_t>(y) * width + x];
-          lo = std::min(lo, z);
-          hi = std::max(hi, z);
-        }
       const size_t c = g.cell(cx, cy);
-      if (std::isfinite(opening_limit))
-        for (int y = std::max(g.y0(cy), 0); y <= std::min(g.y1(cy), height - 1) && !g.opening[c]; ++y)
-          for (int x = std::max(g.x0(cx), 0); x < std::min(g.x1(cx), width - 1); ++x)
-            if (g.excess[static_cast<size_t>(y) * width + x] > opening_limit) {
-              g.opening[c] = 1;
-              break;
-            }
+      for (int y = std::max(g.y0(cy), 0); y <= std::min(g.y1(cy), height - 1); ++y) {
+        const size_t k = static_cast<size_t>(y) * g.cells_x + static_cast<size_t>(cx);
+        lo = std::min(lo, row_lo[k]);
+        hi = std::max(hi, row_hi[k]);
+        g.opening[c] |= row_open[k];
+      }
       g.zmin[c] = lo;
       g.zmax[c] = hi;
       g.parallax_arcmin[c] = static_cast<float>(parallax_difference_arcmin(interaxial, lo, hi));
