@@ -80,12 +80,20 @@ std::string replace_all(std::string text, const std::string& from, const std::st
   return text;
 }
 
-/// `value` with the scratch folder's path in every string replaced by kWorkPlaceholder.
-json without_scratch_paths(const json& value, const std::string& scratch) {
-  if (value.is_string()) return replace_all(value.get<std::string>(), scratch, kWorkPlaceholder);
+/// `text` with the scratch folder written as kWorkPlaceholder: its absolute path as the providers
+/// write it (fs::absolute, not normalized: a store given as a/../b keeps its ".."), then the
+/// path as given, which the absolute one contains.
+std::string without_scratch_path(std::string text, const fs::path& scratch) {
+  text = replace_all(std::move(text), fs::absolute(scratch).string(), kWorkPlaceholder);
+  return replace_all(std::move(text), scratch.string(), kWorkPlaceholder);
+}
+
+/// `value` with the scratch folder written as kWorkPlaceholder in every string.
+json without_scratch_path(const json& value, const fs::path& scratch) {
+  if (value.is_string()) return without_scratch_path(value.get<std::string>(), scratch);
   if (!value.is_structured()) return value;
   json out = value;
-  for (auto& item : out.items()) item.value() = without_scratch_paths(item.value(), scratch);
+  for (auto& item : out.items()) item.value() = without_scratch_path(item.value(), scratch);
   return out;
 }
 
@@ -197,9 +205,6 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
     const RenderScene prepared(scene);
     const validation::TruthRequest request{prepared, p.loaded.file, *p.rig, staged / "work", executor.threads()};
     const validation::TruthRender render = provider->render(request);
-    // The provider ran its tool in a scratch folder inside the staging folder, both gone once the
-    // reference is stored: its paths are written as $WORK, and how to get the folder back beside.
-    const std::string scratch = fs::absolute(request.work_dir).lexically_normal().string();
     const Image right = validation::rgb_plane_only(render.right);
     io::write_exr(staged / kImage, right);
     validation::write_png(staged / kPreview, validation::encode_srgb8(right, "the reference"));
@@ -217,8 +222,10 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
         {"spec", spec_to_json(spec)},
         {"provider",
          {{"name", render.provider}, {"tool_version", render.tool_version}, {"revision", provider->revision()},
-          {"settings", without_scratch_paths(render.settings, scratch)},
-          {"command", replace_all(render.command, scratch, kWorkPlaceholder)},
+          // The provider ran its tool in request.work_dir inside the staging folder, both gone once
+          // the entry is stored: the provenance writes that folder as $WORK and says so.
+          {"settings", without_scratch_path(render.settings, request.work_dir)},
+          {"command", without_scratch_path(render.command, request.work_dir)},
           {"work_folder",
            fmt::format("{} is the folder the provider exported the scene to and ran its tool in; it is removed once "
                        "the reference is stored. `stereobench reference generate` with this spec makes it again "
