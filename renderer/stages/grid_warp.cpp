@@ -426,10 +426,11 @@ void resolve_rows(const WarpTarget& t, const Image& source, int y0, int y1, Imag
         return from.rgb(static_cast<size_t>(std::clamp(j, 0, sh - 1)) * sw + static_cast<size_t>(std::clamp(i, 0, sw - 1)));
       };
       const int i0 = static_cast<int>(fu), j0 = static_cast<int>(fv);
-      const vec3 top = at(i0, j0) + ax * (at(i0 + 1, j0) - at(i0, j0));
+      const auto row_lerp = [&](int j) { return at(i0, j) + ax * (at(i0 + 1, j) - at(i0, j)); };
       // On a row of source pixel centres (every position a horizontal rig gives native cells) the
       // lower row has weight 0: the lookup is the upper row's, without reading the lower one.
-      const vec3 rgb = ay == 0.0f ? top : top + ay * ((at(i0, j0 + 1) + ax * (at(i0 + 1, j0 + 1) - at(i0, j0 + 1))) - top);
+      const vec3 top = row_lerp(j0);
+      const vec3 rgb = ay == 0.0f ? top : top + ay * (row_lerp(j0 + 1) - top);
       // The other AOVs come from the source pixel the position falls in.
       const size_t n = static_cast<size_t>(std::clamp(static_cast<int>(std::floor(s.y)), 0, sh - 1)) * sw +
                        static_cast<size_t>(std::clamp(static_cast<int>(std::floor(s.x)), 0, sw - 1));

@@ -3,8 +3,8 @@
 // plane and on `spheres`, the grid overlay, and option checks.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
-#include <cstring>
 #include <numbers>
 
 #include "renderer/error.hpp"
@@ -209,6 +209,15 @@ TEST(GridWarp, WritesEverySampleOfTheTarget) {
   gs.focal_px = left.f_px;
   const WarpGrid grid = build_warp_grid(r.left.plane(planes::depth).f32(), left.width, left.height, gs, executor);
   constexpr uint32_t kSentinel = 0x7fc0dead;  // a NaN no stage writes
+  const auto sentinels = [&](const Plane& plane) {
+    size_t n = 0;
+    if (plane.type() == PlaneType::u32) {
+      for (const uint32_t v : plane.u32()) n += v == kSentinel ? 1 : 0;
+    } else {
+      for (const float v : plane.f32()) n += std::bit_cast<uint32_t>(v) == kSentinel ? 1 : 0;
+    }
+    return n;
+  };
   for (const bool detect : {false, true}) {
     Image target = make_eye_image(right.width, right.height, PlaneInit::unset);
     for (const Plane& plane : target.planes()) {
@@ -216,8 +225,9 @@ TEST(GridWarp, WritesEverySampleOfTheTarget) {
       if (p.type() == PlaneType::u32) {
         p.fill(kSentinel);
       } else {
-        for (float& v : p.f32()) std::memcpy(&v, &kSentinel, sizeof v);
+        p.fill(std::bit_cast<float>(kSentinel));
       }
+      ASSERT_EQ(sentinels(p), p.value_count()) << p.name();  // the fill kept the NaN's bits
     }
     WarpOptions options;
     options.detect_disocclusions = detect;
@@ -225,19 +235,8 @@ TEST(GridWarp, WritesEverySampleOfTheTarget) {
     const std::vector<uint8_t> states = grid_warp(grid, r.left, left, right, kInteraxial, options, executor, target, stats);
     EXPECT_EQ(states.size(), target.pixel_count());
     EXPECT_GT(stats.pixels_covered, target.pixel_count() / 2);
-    for (const Plane& plane : target.planes()) {
-      size_t left_over = 0;
-      if (plane.type() == PlaneType::u32) {
-        for (const uint32_t v : plane.u32()) left_over += v == kSentinel ? 1 : 0;
-      } else {
-        for (const float v : plane.f32()) {
-          uint32_t bits = 0;
-          std::memcpy(&bits, &v, sizeof bits);
-          left_over += bits == kSentinel ? 1 : 0;
-        }
-      }
-      EXPECT_EQ(left_over, 0u) << "plane " << plane.name() << ", detection " << detect;
-    }
+    for (const Plane& plane : target.planes())
+      EXPECT_EQ(sentinels(plane), 0u) << "plane " << plane.name() << ", detection " << detect;
   }
 }
 
