@@ -14,7 +14,8 @@ namespace sb {
 class RenderScene {
  public:
   /// Prepares `scene`, which must outlive this object. With `refittable`, the BVH is built for
-  /// update_geometry() to refit it (animated scenes).
+  /// update_geometry() to refit it (animated scenes). InputError when the scene's geometry reaches
+  /// beyond ±kMaxSceneCoordinate (loaders check their files first, naming the node).
   explicit RenderScene(const Scene& scene, bool refittable = false);
   RenderScene(const RenderScene&) = delete;
   RenderScene& operator=(const RenderScene&) = delete;
@@ -33,7 +34,8 @@ class RenderScene {
   /// After the scene's vertex positions and normals changed in place (rigid animation: same
   /// meshes and topology, see renderer/animation.hpp): updates the BVH (refit or rebuild). Returns
   /// the seconds taken. Materials, textures and lights are read from the scene as they are.
-  double update_geometry() { return rays_.update(); }
+  /// InputError when the moved geometry leaves the range a scene may span (kMaxSceneCoordinate).
+  double update_geometry();
 
  private:
   const Scene* scene_;

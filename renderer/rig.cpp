@@ -48,6 +48,10 @@ void RigParams::validate() const {
 CameraPose CameraPose::from_matrix(const dmat4& m) {
   CameraPose p;
   p.position = dvec3(m[3]);
+  if (!within_scene_range(p.position))
+    throw InputError(fmt::format("camera position ({:g}, {:g}, {:g}) m lies beyond the ±{:g} m a scene may span; "
+                                 "check the camera's translation and its units",
+                                 p.position.x, p.position.y, p.position.z, kMaxSceneCoordinate));
   dvec3 back = dvec3(m[2]);
   dvec3 up = dvec3(m[1]);
   if (glm::length(back) == 0.0 || glm::length(up) == 0.0)

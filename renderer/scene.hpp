@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -58,6 +59,19 @@ struct Light {
   float inner_cone = 0.0f;
   float outer_cone = 0.78539816f;
 };
+
+/// Largest coordinate magnitude, in metres, a scene may use: vertices, cameras and lights. Embree
+/// rejects ray origins beyond about 1.8e18; this leaves room for the scale-aware shadow-ray offset
+/// and is far beyond any real scene (the Earth's orbit is 1.5e11 m across).
+inline constexpr double kMaxSceneCoordinate = 1e15;
+
+/// Whether every component of p is finite and within ±kMaxSceneCoordinate.
+template <class Vec>
+[[nodiscard]] bool within_scene_range(const Vec& p) {
+  for (int k = 0; k < 3; ++k)
+    if (!(std::abs(static_cast<double>(p[k])) <= kMaxSceneCoordinate)) return false;
+  return true;
+}
 
 /// A perspective camera placed in the scene.
 struct SceneCamera {

@@ -262,6 +262,10 @@ GateConfig parse_gate_config(const std::string& text, const std::string& source)
                    fmt::format("unknown key '{}'; a gate config has [defaults], [regression] and [[rule]] tables", k));
     }
   }
+  if (config.defaults.empty() && config.rules.empty() && !root.contains("regression"))
+    throw InputError(fmt::format("{}: the gate config sets no threshold and no [regression]: it would pass anything; "
+                                 "add a [defaults] table or [[rule]] tables (see docs/gate.md)",
+                                 source));
   return config;
 }
 
@@ -533,6 +537,48 @@ std::string reproduce_command(const GateCell& cell, const std::string& pipeline,
   return join_args(args);
 }
 
+namespace {
+
+/// Whether the results hold every cell of their sweep: a results file left by a sweep that stopped
+/// early (killed, a full disk) must not pass. Nothing when the records do not say how many cells
+/// the sweep has.
+std::optional<GateCheck> completeness_check(const GateResults& results) {
+  std::set<uint64_t> indices;
+  uint64_t expected = 0;
+  std::string definition;
+  for (const GateCell& cell : results.cells) {
+    const json& r = cell.record;
+    const auto count = [&](const char* key) -> std::optional<uint64_t> {
+      if (!r.contains(key) || !r[key].is_number_integer() || r[key].get<int64_t>() < 0) return std::nullopt;
+      return r[key].get<uint64_t>();
+    };
+    const std::optional<uint64_t> index = count("cell_index"), total = count("cell_count");
+    if (!index || !total) return std::nullopt;
+    expected = std::max(expected, *total);
+    indices.insert(*index);
+    if (definition.empty() && r.value("definition", json()).is_string()) definition = r["definition"].get<std::string>();
+  }
+  GateCheck check;
+  check.check = kCompleteCheck;
+  check.cell_id = "(all cells)";
+  check.pipeline = "(all)";
+  check.measured = static_cast<double>(indices.size());
+  check.fail_limit = static_cast<double>(expected);
+  check.reproduce = fmt::format("stereobench sweep run {} --out {}", definition.empty() ? "DEFINITION" : shell_quote(definition),
+                                shell_quote(results.file.parent_path().empty() ? "." : results.file.parent_path().string()));
+  if (indices.size() >= expected) {
+    check.message = fmt::format("all {} cells of the sweep have results", expected);
+    return check;
+  }
+  check.verdict = Verdict::fail;
+  check.message = fmt::format("{} holds {} of the sweep's {} cells: the sweep did not finish; run it again with the "
+                              "same --out to resume it",
+                              results.file.string(), indices.size(), expected);
+  return check;
+}
+
+}  // namespace
+
 GateReport evaluate_gate(const GateConfig& config, const GateResults& results, const Baseline& baseline,
                          const ReproduceSettings& reproduce) {
   GateReport report;
@@ -636,6 +682,7 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
       add(std::move(check));
     }
   }
+  if (std::optional<GateCheck> complete = completeness_check(results)) report.checks.push_back(std::move(*complete));
   for (const GateCheck& c : report.checks) {
     ++report.counts[c.verdict];
     report.worst = std::max(report.worst, c.verdict);
@@ -683,7 +730,8 @@ std::string format_gate_table(const GateReport& report) {
     return it == report.counts.end() ? 0 : it->second;
   };
   std::set<std::string> cells;
-  for (const GateCheck& c : report.checks) cells.insert(c.cell_id);
+  for (const GateCheck& c : report.checks)
+    if (c.check != kCompleteCheck) cells.insert(c.cell_id);
   out << fmt::format("gate: {} checks over {} cells: {} pass, {} warn, {} fail, {} skipped -> {} (exit {})\n",
                      report.checks.size(), cells.size(), count(Verdict::pass), count(Verdict::warn),
                      count(Verdict::fail), count(Verdict::skip),

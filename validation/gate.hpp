@@ -53,6 +53,8 @@ inline constexpr MetricCheck kMetricChecks[] = {
 
 /// Name of the time-regression check.
 inline constexpr const char* kRegressionCheck = "time_regression";
+/// The check that the results hold every cell of the sweep (records carry cell_index and cell_count).
+inline constexpr const char* kCompleteCheck = "sweep_complete";
 
 /// Threshold values by gate.toml key; std::nullopt where a table turns a threshold off (`= false`).
 using ThresholdValues = std::map<std::string, std::optional<double>>;
@@ -147,7 +149,7 @@ struct GateCheck {
   std::string cell_id;
   std::string scene;
   std::string pipeline;
-  std::string check;  ///< a kMetricChecks name or kRegressionCheck
+  std::string check;  ///< a kMetricChecks name, kRegressionCheck or kCompleteCheck
   Verdict verdict = Verdict::pass;
   double measured = 0.0;             ///< NaN when there is no value
   std::optional<double> fail_limit;  ///< the limit in force (regression: the tolerance)

@@ -78,6 +78,9 @@ void write_text_atomically(const fs::path& path, const std::string& text) {
 }
 
 std::string read_file(const fs::path& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec))
+    throw InputError(fmt::format("{} is a folder, not a file; give the path of the file to read", path.string()));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(fmt::format("cannot read {}: {}", path.string(), std::strerror(errno)));
   std::ostringstream ss;

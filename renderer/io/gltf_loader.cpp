@@ -565,8 +565,15 @@ class Converter {
       const std::vector<float> pos = read_floats(pos_it->second, 3, ppath + "/attributes/POSITION");
       const size_t nv = pos.size() / 3;
       mesh.positions.resize(nv);
-      for (size_t v = 0; v < nv; ++v)
-        mesh.positions[v] = vec3(world * dvec4(pos[v * 3], pos[v * 3 + 1], pos[v * 3 + 2], 1.0));
+      for (size_t v = 0; v < nv; ++v) {
+        const dvec3 p = dvec3(world * dvec4(pos[v * 3], pos[v * 3 + 1], pos[v * 3 + 2], 1.0));
+        if (!within_scene_range(p))
+          fail(fmt::format("/nodes/{}", ni),
+               fmt::format("places vertex {} of mesh '{}' at ({:g}, {:g}, {:g}) m, beyond the ±{:g} m a scene may "
+                           "span; check the node's scale and the file's units",
+                           v, mesh.name, p.x, p.y, p.z, kMaxSceneCoordinate));
+        mesh.positions[v] = vec3(p);
+      }
       if (auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
         const std::vector<float> nrm = read_floats(it->second, 3, ppath + "/attributes/NORMAL");
         if (nrm.size() != pos.size())
@@ -631,6 +638,11 @@ class Converter {
       warn("ortho", "orthographic cameras are ignored");
       return;
     }
+    if (!within_scene_range(dvec3(world[3])))
+      fail(fmt::format("/nodes/{}", ni),
+           fmt::format("places the camera at ({:g}, {:g}, {:g}) m, beyond the ±{:g} m a scene may span; check the "
+                       "node's translation and the file's units",
+                       world[3].x, world[3].y, world[3].z, kMaxSceneCoordinate));
     SceneCamera cam;
     cam.name = n.name.empty() ? (gc.name.empty() ? fmt::format("camera{}", n.camera) : gc.name) : n.name;
     cam.node = ni;
@@ -669,6 +681,11 @@ class Converter {
       l.inner_cone = s.value("innerConeAngle", 0.0f);
       l.outer_cone = s.value("outerConeAngle", 0.78539816f);
     }
+    if (l.type != Light::Type::directional && !within_scene_range(dvec3(world[3])))
+      fail(fmt::format("/extensions/KHR_lights_punctual/lights/{}", li),
+           fmt::format("light '{}' is placed at ({:g}, {:g}, {:g}) m, beyond the ±{:g} m a scene may span; check "
+                       "its node's translation and the file's units",
+                       l.name, world[3].x, world[3].y, world[3].z, kMaxSceneCoordinate));
     l.position = vec3(world[3]);
     const dvec3 d = dvec3(world * dvec4(0.0, 0.0, -1.0, 0.0));
     l.direction = glm::length(d) > 0.0 ? vec3(glm::normalize(d)) : vec3(0.0f, 0.0f, -1.0f);

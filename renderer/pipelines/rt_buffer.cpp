@@ -90,11 +90,20 @@ class RtBuffer final : public Pipeline {
   }
 
  private:
+  static constexpr int kMaxDepth = 4096;
+
   static int buffer_depth(int option, const StereoRig& rig) {
-    const int t = option > 0 ? option : std::max(1, static_cast<int>(std::ceil(2.0 * rig.max_disparity_px())));
-    if (option < 0 || t > 4096)
-      throw InputError(fmt::format("rt-buffer: option depth={} is out of range; use 0 (2 x max disparity) or 1..4096",
-                                   option));
+    if (option < 0 || option > kMaxDepth)
+      throw InputError(fmt::format("rt-buffer: option depth={} is out of range; use 0 (2 x max disparity) or 1..{}",
+                                   option, kMaxDepth));
+    // The default t = 2e is computed in double and bounded before it becomes an int.
+    const double automatic = std::max(1.0, std::ceil(2.0 * rig.max_disparity_px()));
+    if (option == 0 && !(automatic <= kMaxDepth))
+      throw InputError(fmt::format("rt-buffer: the default depth t = 2 x max disparity = {:g} exceeds {} entries per "
+                                   "pixel; lower the interaxial (or raise the convergence distance), or set the "
+                                   "option depth to a fixed t in 1..{}",
+                                   automatic, kMaxDepth, kMaxDepth));
+    const int t = option > 0 ? option : static_cast<int>(automatic);
     const uint64_t bytes = uint64_t{static_cast<uint64_t>(t)} * sizeof(int32_t) *
                            static_cast<uint64_t>(rig.params().width) * static_cast<uint64_t>(rig.params().height);
     if (bytes > kMaxBufferBytes)

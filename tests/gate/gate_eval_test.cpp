@@ -312,14 +312,43 @@ TEST(GateCli, BadInputIsExitThree) {
   EXPECT_EQ(run.code, 3) << run.out;
   EXPECT_NE(run.out.find("appears twice"), std::string::npos) << run.out;
 
-  // A torn last line (killed writer) is skipped with a warning; the rest is gated.
+  // A torn last line (killed writer) is skipped with a warning; the rest is gated, and the sweep
+  // it left unfinished fails: one of its two cells has results.
   const std::string torn = passing_cells()[0].dump() + "\n" + passing_cells()[1].dump().substr(0, 200);
   write_file(dir / "torn.jsonl", torn);
   write_file(dir / "baseline.json", "{}\n");
   run = run_cli("gate" + config + " --baseline " + (dir / "baseline.json").string() + " --results " +
                 (dir / "torn.jsonl").string());
-  EXPECT_EQ(run.code, 0) << run.out;
+  EXPECT_EQ(run.code, 2) << run.out;
   EXPECT_NE(run.out.find("torn.jsonl:2"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("holds 1 of the sweep's 2 cells"), std::string::npos) << run.out;
+
+  // A folder given as the config, and a config without a single threshold, are bad input: both
+  // passed every results file before.
+  run = run_cli("gate --config " + dir.path().string() + " --results " + (dir / "pass.jsonl").string());
+  EXPECT_EQ(run.code, 3) << run.out;
+  EXPECT_NE(run.out.find("is a folder"), std::string::npos) << run.out;
+  write_file(dir / "empty.toml", "# nothing\n");
+  run = run_cli("gate --config " + (dir / "empty.toml").string() + " --results " + (dir / "pass.jsonl").string());
+  EXPECT_EQ(run.code, 3) << run.out;
+  EXPECT_NE(run.out.find("sets no threshold"), std::string::npos) << run.out;
+}
+
+TEST(GateEval, AnUnfinishedSweepFails) {
+  const validation::GateReport whole = evaluate(passing_cells());
+  const validation::GateReport part = evaluate({passing_cells()[1]});
+  const auto complete = [](const validation::GateReport& r) -> const validation::GateCheck* {
+    for (const validation::GateCheck& c : r.checks)
+      if (c.check == validation::kCompleteCheck) return &c;
+    return nullptr;
+  };
+  ASSERT_NE(complete(whole), nullptr);
+  EXPECT_EQ(complete(whole)->verdict, Verdict::pass);
+  ASSERT_NE(complete(part), nullptr);
+  EXPECT_EQ(complete(part)->verdict, Verdict::fail);
+  EXPECT_EQ(complete(part)->measured, 1.0);
+  EXPECT_EQ(complete(part)->fail_limit, 2.0);
+  EXPECT_EQ(part.worst, Verdict::fail);
 }
 
 TEST(GateEval, AFrameOfAPathIsReproducedByRunningItsCellAgain) {

@@ -41,6 +41,7 @@ json validated_cell(const std::vector<std::pair<std::string, std::map<std::strin
   const validation::ValidationTarget target =
       validation::prepare_target(prepared, file, rig, *provider, nullptr, kScenes / "gate-work", executor);
   json cell = fake_cell(0, 0.064, {});
+  cell["cell_count"] = 1;  // the results files below hold this one cell: a whole sweep
   cell["rig"] = json::object();
   for (const auto& [name, options] : runs) {
     const Pipeline& p = find_pipeline(name);

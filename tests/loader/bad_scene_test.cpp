@@ -94,6 +94,9 @@ std::vector<BadCase> corpus() {
     float nan = std::nanf("");
     std::memcpy(g.bin.data() + 4, &nan, 4);
   }), "non-finite"});
+  // Finite but beyond the coordinates rays can use (Embree aborted on such ray origins).
+  c.push_back({"scale_beyond_range", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["scale"] = {1e25, 1e25, 1e25}; }), "/nodes/0: places vertex"});
+  c.push_back({"translation_beyond_range", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["translation"] = {0, 0, 1e19}; }), "beyond the"});
   c.push_back({"node_cycle", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["children"] = {0}; }), "/nodes/0: node is reached twice"});
   c.push_back({"missing_bin", "a.gltf", [](const std::filesystem::path& p) {
     MiniGltf g;

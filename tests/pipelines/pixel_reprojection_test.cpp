@@ -189,6 +189,14 @@ TEST(PixelReprojection, BadOptionsAreRejected) {
   EXPECT_THROW((void)test::render_with("rt-buffer", prepared, rig, 1, {{"margin", "-0.1"}}), InputError);
   EXPECT_THROW((void)test::render_with("rt-buffer", prepared, rig, 1, {{"depth", "-1"}}), InputError);
   EXPECT_THROW((void)test::render_with("rt-buffer", prepared, rig, 1, {{"depth", "5000"}}), InputError);
+  // The default depth 2e for an absurd interaxial: rejected before it is converted to an int
+  // (it overflowed to a depth of 1 before).
+  try {
+    (void)test::render_with("rt-buffer", prepared, rig_with_disparity(scene, 64, 36, 1.2e10), 1, {});
+    ADD_FAILURE() << "a 2.4e10-entry buffer depth was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("exceeds 4096"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
