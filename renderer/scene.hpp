@@ -62,7 +62,7 @@ struct Light {
 
 /// Largest coordinate magnitude, in metres, a scene may use: vertices, cameras and lights. Embree
 /// rejects ray origins beyond about 1.8e18; this leaves room for the scale-aware shadow-ray offset
-/// and is far beyond any real scene (the Earth's orbit is 1.5e11 m across).
+/// and is far beyond any real scene (the Earth lies 1.5e11 m from the Sun).
 inline constexpr double kMaxSceneCoordinate = 1e15;
 
 /// Whether every component of p is finite and within ±kMaxSceneCoordinate.
