@@ -38,12 +38,12 @@ class RenderScene {
   double update_geometry();
 
  private:
+  float ray_epsilon_;  ///< first: computed from the range-checked bounds before the BVH is built
   const Scene* scene_;
   SceneGeometry geometry_;
   RayScene rays_;
   std::vector<MipTexture> textures_;
   double texture_seconds_ = 0.0;
-  float ray_epsilon_ = 1e-4f;
 };
 
 }  // namespace sb

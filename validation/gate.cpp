@@ -709,7 +709,8 @@ std::string format_gate_table(const GateReport& report) {
         header = true;
       }
       const std::optional<double> lim = c.verdict == Verdict::fail || !c.warn_limit ? c.fail_limit : c.warn_limit;
-      const bool at_least = c.check != kRegressionCheck &&
+      // A minimum (the completeness check's cell count, and the at-least metrics) or a maximum.
+      const bool at_least = c.check == kCompleteCheck ||
                             std::any_of(std::begin(kMetricChecks), std::end(kMetricChecks), [&](const MetricCheck& m) {
                               return c.check == m.name && m.direction == Direction::at_least;
                             });

@@ -188,15 +188,16 @@ void check_compression(const std::string& compression, const fs::path& path) {
 /// Reads back the first and the last scan line of a just-written EXR. The OpenEXR writer's final
 /// flush can fail (a full disk) without close() reporting it, which leaves a short file; reading
 /// the last chunk through the offset table finds that before the file takes its final name.
-void verify_exr_ends(const fs::path& tmp, const fs::path& path, const OIIO::ImageSpec& spec) {
+void verify_exr_ends(const fs::path& tmp, const fs::path& path) {
   auto in = OIIO::ImageInput::open(tmp.string());
   const auto incomplete = [&](const std::string& why) {
     return IoError(fmt::format("cannot finish {}: the written file is incomplete ({}); check free disk space",
                                path.string(), why));
   };
   if (!in) throw incomplete(oiio_global_error());
-  std::vector<unsigned char> line(in->spec().scanline_bytes(true));
-  for (const int y : {0, spec.height - 1})
+  const OIIO::ImageSpec& spec = in->spec();
+  std::vector<unsigned char> line(spec.scanline_bytes(true));
+  for (const int y : {spec.y, spec.y + spec.height - 1})
     if (!in->read_scanlines(0, 0, y, y + 1, 0, 0, spec.nchannels, TypeDesc::UNKNOWN, line.data()))
       throw incomplete(oiio_error(in.get()));
 }
@@ -256,7 +257,7 @@ void write_exr_layers(const fs::path& path, const std::vector<std::pair<std::str
     }
     if (!out->close())
       throw IoError(fmt::format("cannot finish {}: {}; check free disk space", path.string(), oiio_error(out.get())));
-    verify_exr_ends(tmp, path, spec);
+    verify_exr_ends(tmp, path);
   });
 }
 

@@ -322,6 +322,7 @@ TEST(GateCli, BadInputIsExitThree) {
   EXPECT_EQ(run.code, 2) << run.out;
   EXPECT_NE(run.out.find("torn.jsonl:2"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("holds 1 of the sweep's 2 cells"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("sweep_complete            1  >= 2"), std::string::npos) << run.out;  // a minimum
 
   // A folder given as the config, and a config without a single threshold, are bad input: both
   // passed every results file before.
