@@ -76,7 +76,11 @@ std::map<std::string, std::string> parse_key_values(const std::vector<std::strin
     const size_t eq = item.find('=');
     if (eq == std::string::npos || eq == 0)
       throw InputError(fmt::format("{} '{}' is not NAME=VALUE", option, item));
-    out[item.substr(0, eq)] = item.substr(eq + 1);
+    const std::string name = item.substr(0, eq);
+    if (const auto it = out.find(name); it != out.end())
+      throw InputError(fmt::format("{} gives {} twice ({} and {}); give each name once", option, name, it->second,
+                                   item.substr(eq + 1)));
+    out[name] = item.substr(eq + 1);
   }
   return out;
 }

@@ -56,6 +56,10 @@ void run_generate(const ReferenceArgs& a) {
 
 /// Verifies the chosen entries, prints one line each, and returns the results.
 std::vector<reference::VerifyResult> verify_all(const ReferenceArgs& a, const reference::ReferenceStore& store) {
+  if (!(a.min_psnr > 0.0))
+    throw InputError(fmt::format("--min-psnr {} is not a PSNR in dB; give a positive value (e.g. 60), or leave it "
+                                 "out to demand identical images",
+                                 a.min_psnr));
   const Executor executor(checked_threads(a.threads));
   const reference::VerifyOptions options{!a.no_render, a.min_psnr};
   std::vector<reference::VerifyResult> results;

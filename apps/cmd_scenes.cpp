@@ -143,7 +143,9 @@ void register_scenes_command(CLI::App& root) {
   g->add_option("names", gen->names, "Scenes to generate (see `scenes list`)");
   g->add_flag("--all", gen->all, "Generate every built-in scene with default parameters");
   g->add_option("--out,-o", gen->out_dir, "Output folder")->capture_default_str();
-  g->add_option("--seed", gen->seed, "Random seed; same seed, same file")->capture_default_str();
+  g->add_option("--seed", gen->seed, "Random seed; same seed, same file")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   g->add_option("--param,-p", gen->params, "Generator parameter NAME=VALUE (see `scenes list`)");
   g->callback([gen] { generate_scenes(*gen); });
 

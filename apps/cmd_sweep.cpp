@@ -202,6 +202,10 @@ void register_csv(CLI::App& sweep) {
     if (!fs::exists(a->results)) throw InputError(fmt::format("{}: results file does not exist", a->results));
     const ResultsFile r = read_results(a->results);
     for (const std::string& w : r.warnings) fmt::print(stderr, "warning: {}\n", w);
+    if (r.cells.empty())
+      throw InputError(fmt::format("{}: holds no finished cell; run the sweep (stereobench sweep run) first, or give "
+                                   "the results file it wrote",
+                                   a->results));
     const std::string text = results_csv(r.cells);
     if (a->out.empty()) {
       fmt::print("{}", text);
@@ -230,6 +234,10 @@ void register_collect(CLI::App& sweep) {
     std::vector<std::string> warnings;
     const std::vector<nlohmann::json> cells = collect_results(inputs, a->out, &warnings);
     for (const std::string& w : warnings) fmt::print(stderr, "warning: {}\n", w);
+    if (cells.empty())
+      throw InputError(fmt::format("the {} input file(s) hold no finished cell; {} not written (check that the shards "
+                                   "ran, and their results paths)",
+                                   inputs.size(), a->out));
     io::write_text_atomically(a->out, results_text(cells));
     fmt::print("wrote {}: {} cells from {} files\n", a->out, cells.size(), inputs.size());
   });

@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <exception>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -33,6 +34,43 @@ std::string command_line(int argc, char** argv) {
   return out;
 }
 
+/// An empty --out (an unset shell variable, say) would write into the current folder: refused.
+void refuse_empty_out(CLI::App& app) {
+  if (CLI::Option* out = app.get_option_no_throw("--out"))
+    out->check(CLI::Validator(
+        [](const std::string& value) {
+          return value.empty() ? std::string("--out is empty; give a file or folder name") : std::string();
+        },
+        "", "non-empty"));
+  for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) refuse_empty_out(*sub);
+}
+
+/// When parsing stopped for want of a subcommand: the first word after the commands given that
+/// names none of the next level's, with those names ("" when every word is a command or option).
+std::string unknown_command_message(const CLI::App& app, int argc, char** argv) {
+  const CLI::App* level = &app;
+  std::string path = "stereobench";
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word.empty() || word[0] == '-') return "";
+    std::vector<std::string> names;
+    const CLI::App* next = nullptr;
+    for (const CLI::App* s : level->get_subcommands([](const CLI::App*) { return true; })) {
+      names.push_back(s->get_name());
+      if (s->get_name() == word) next = s;
+    }
+    if (names.empty()) return "";
+    if (!next) {
+      std::string list;
+      for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+      return fmt::format("'{}' is not a command of {}; its commands: {}", word, path, list);
+    }
+    level = next;
+    path += " " + word;
+  }
+  return "";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -57,6 +95,7 @@ int main(int argc, char** argv) {
   sb::cli::register_reference_command(app, command_line(argc, argv));
   sb::cli::register_report_command(app);
   sb::cli::register_path_command(app);
+  refuse_empty_out(app);
 
   try {
     app.parse(argc, argv);
@@ -65,7 +104,11 @@ int main(int argc, char** argv) {
   } catch (const CLI::Success& e) {
     return app.exit(e);  // --help, --version
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
+    const std::string unknown = unknown_command_message(app, argc, argv);
+    if (!unknown.empty())
+      std::fprintf(stderr, "stereobench: error: %s\n", unknown.c_str());
+    else
+      app.exit(e);
     std::fprintf(stderr, "Run `stereobench --help` (or `stereobench SUBCOMMAND --help`) for usage.\n");
     return static_cast<int>(sb::ExitCode::bad_input);
   } catch (const sb::Error& e) {

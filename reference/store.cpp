@@ -57,6 +57,46 @@ json spec_to_json(const ReferenceSpec& s) {
             {"vfov_rad", optional_json(s.rig.vfov)}}}};
 }
 
+/// The rig as a provenance records it: its parameters and the camera pose.
+json rig_record(const StereoRig& rig) {
+  json out = io::rig_to_json(rig);
+  const CameraPose& pose = rig.pose();
+  out["pose"] = {{"position", {pose.position.x, pose.position.y, pose.position.z}},
+                 {"right", {pose.right.x, pose.right.y, pose.right.z}},
+                 {"up", {pose.up.x, pose.up.y, pose.up.z}},
+                 {"back", {pose.back.x, pose.back.y, pose.back.z}}};
+  return out;
+}
+
+/// Two records equal in structure, strings and booleans, their numbers within 1e-9 (relative):
+/// a record read back from JSON against one computed now.
+bool same_record(const json& a, const json& b) {
+  if (a.is_number() && b.is_number()) {
+    const double x = a.get<double>(), y = b.get<double>();
+    return std::fabs(x - y) <= 1e-9 * std::max({1.0, std::fabs(x), std::fabs(y)});
+  }
+  if (a.type() != b.type()) return false;
+  if (a.is_object()) {
+    if (a.size() != b.size()) return false;
+    for (auto it = a.begin(); it != a.end(); ++it)
+      if (!b.contains(it.key()) || !same_record(it.value(), b[it.key()])) return false;
+    return true;
+  }
+  if (a.is_array()) {
+    if (a.size() != b.size()) return false;
+    for (size_t i = 0; i < a.size(); ++i)
+      if (!same_record(a[i], b[i])) return false;
+    return true;
+  }
+  return a == b;
+}
+
+/// A record's JSON cut to 120 characters, for a message.
+std::string brief(const json& j) {
+  const std::string text = j.dump();
+  return text.size() <= 120 ? text : text.substr(0, 117) + "...";
+}
+
 ReferenceSpec spec_from_json(const json& j) {
   ReferenceSpec s;
   s.scene = j.at("scene").get<std::string>();
@@ -209,12 +249,6 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
     io::write_exr(staged / kImage, right);
     validation::write_png(staged / kPreview, validation::encode_srgb8(right, "the reference"));
     fs::remove_all(staged / "work", ec);
-    json rig = io::rig_to_json(*p.rig);
-    const CameraPose& pose = p.rig->pose();
-    rig["pose"] = {{"position", {pose.position.x, pose.position.y, pose.position.z}},
-                   {"right", {pose.right.x, pose.right.y, pose.right.z}},
-                   {"up", {pose.up.x, pose.up.y, pose.up.z}},
-                   {"back", {pose.back.x, pose.back.y, pose.back.z}}};
     const json provenance = {
         {"kind", "stereobench.reference"},
         {"version", 1},
@@ -236,7 +270,7 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
          {{"name", scene.name}, {"file", p.loaded.file.string()}, {"file_sha256", validation::hash_file(p.loaded.file)},
           {"content_sha256", validation::hash_scene(scene)}, {"triangles", scene.triangle_count()},
           {"lights", scene.lights.size()}, {"lights_in_file", p.loaded.lights_in_file}}},
-        {"rig", rig},
+        {"rig", rig_record(*p.rig)},
         {"image",
          {{"file", kImage}, {"preview", kPreview}, {"width", right.width()}, {"height", right.height()},
           {"sha256", validation::hash_file(staged / kImage)}, {"content_sha256", validation::hash_image(right)}}},
@@ -257,17 +291,29 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
                                     const Executor& executor) const {
   VerifyResult r;
   r.id = id;
-  const json prov = provenance(id);
+  const fs::path prov_file = root_ / id / kProvenance;
+  std::error_code ec;
+  json prov;
+  ReferenceSpec spec;
+  try {
+    prov = provenance(id);
+    spec = spec_of(id);
+  } catch (const InputError& e) {
+    if (!fs::exists(prov_file, ec)) throw;  // an id the store does not hold
+    // A damaged entry is a finding of the verification, not a reason to stop it.
+    r.status = Status::corrupt;
+    r.detail = e.what();
+    return r;
+  }
   const fs::path image_file = root_ / id / kImage;
   std::string stored_hash;
   try {
     stored_hash = prov.at("image").at("sha256").get<std::string>();
   } catch (const json::exception&) {
     r.status = Status::corrupt;
-    r.detail = "the provenance has no image hash";
+    r.detail = fmt::format("{}: the provenance has no image hash (image.sha256)", prov_file.string());
     return r;
   }
-  std::error_code ec;
   if (!fs::exists(image_file, ec)) {
     r.status = Status::corrupt;
     r.detail = fmt::format("{} is missing", image_file.string());
@@ -280,7 +326,6 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
                            stored_hash.substr(0, 12));
     return r;
   }
-  const ReferenceSpec spec = spec_of(id);
   const Prepared p = prepare(spec, scenes_dir);
   const std::string scene_hash = validation::hash_scene(p.loaded.scene);
   const json& scene_record = prov.value("scene", json::object());
@@ -292,8 +337,16 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
                            spec.scene, p.loaded.file.string(), scene_hash.substr(0, 12), recorded_scene.substr(0, 12));
     return r;
   }
+  // The rig the spec resolves to now must be the one recorded: the stored image shows that view.
+  const json rig_now = rig_record(*p.rig);
+  if (!prov.contains("rig") || !same_record(prov["rig"], rig_now)) {
+    r.status = Status::corrupt;
+    r.detail = fmt::format("{}: the recorded rig {} is not the rig its spec resolves to ({}); regenerate the entry",
+                           prov_file.string(), brief(prov.value("rig", json(nullptr))), brief(rig_now));
+    return r;
+  }
   if (!options.rerender) {
-    r.detail = "image and scene hashes match (not rendered again)";
+    r.detail = "image, scene and rig match their records (not rendered again)";
     return r;
   }
   const std::unique_ptr<validation::TruthProvider> provider = validation::make_truth_provider(spec.provider);

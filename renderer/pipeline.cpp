@@ -51,6 +51,7 @@ PipelineOptions::PipelineOptions(const PipelineInfo& info, const std::map<std::s
     }
     values_[key] = value;
   }
+  if (info.check_options) info.check_options(*this);
 }
 
 const std::string& PipelineOptions::get(const std::string& name) const {
@@ -67,8 +68,11 @@ double PipelineOptions::get_double(const std::string& name) const {
 
 int PipelineOptions::get_int(const std::string& name) const {
   const double x = get_double(name);
-  if (x != std::floor(x) || std::fabs(x) > 1e9)
+  if (x != std::floor(x))
     throw InputError(fmt::format("pipeline '{}': option {}={} is not a whole number", pipeline_, name, get(name)));
+  if (std::fabs(x) > 1e9)
+    throw InputError(fmt::format("pipeline '{}': option {}={} is beyond the ±1e9 an integer option takes", pipeline_,
+                                 name, get(name)));
   return static_cast<int>(x);
 }
 

@@ -17,6 +17,8 @@
 
 namespace sb {
 
+class PipelineOptions;
+
 /// One option a pipeline accepts, with its default and help.
 struct OptionSpec {
   std::string name;
@@ -34,10 +36,14 @@ struct PipelineInfo {
   std::vector<OptionSpec> options;
   double min_psnr_left = 50.0;   ///< dB against plain-rt's left eye on the analytic scenes
   double min_psnr_right = 50.0;  ///< dB against plain-rt's right eye on the analytic scenes
+  /// Checks option values (ranges, choices) the way render() reads them, throwing InputError naming
+  /// the option; PipelineOptions calls it, so a bad value is refused before anything renders.
+  void (*check_options)(const PipelineOptions&) = nullptr;
 };
 
 /// Options after checking: every key is one the pipeline declared (InputError otherwise, naming
-/// the key and listing the valid ones); missing keys take their defaults.
+/// the key and listing the valid ones), every value one the pipeline accepts (its check_options);
+/// missing keys take their defaults.
 class PipelineOptions {
  public:
   PipelineOptions() = default;

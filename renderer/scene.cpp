@@ -37,4 +37,11 @@ void keep_first_lights(Scene& scene, int count) {
   scene.lights.resize(static_cast<size_t>(count));
 }
 
+bool is_unlit(const Scene& scene) {
+  if (scene.ambient > 0.0f) return false;
+  for (const Light& l : scene.lights)
+    if (l.intensity > 0.0f && (l.color.x > 0.0f || l.color.y > 0.0f || l.color.z > 0.0f)) return false;
+  return true;
+}
+
 }  // namespace sb

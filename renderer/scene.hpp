@@ -116,4 +116,8 @@ struct Scene {
 /// number of lights when `count` < 1 or more than the scene has.
 void keep_first_lights(Scene& scene, int count);
 
+/// True when nothing lights the scene: no light with a non-zero intensity and colour, and no
+/// ambient term. Every surface of such a scene renders black.
+[[nodiscard]] bool is_unlit(const Scene& scene);
+
 }  // namespace sb

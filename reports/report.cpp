@@ -180,15 +180,21 @@ std::string fill_template(const std::string& text, const std::map<std::string, s
   return out;
 }
 
-/// Prepares the output folder: new, empty, or an earlier report whose index, assets and images go.
+/// Written into a report folder before anything else, so that a report stopped half-way (a full
+/// disk, a kill) is recognised as ours and replaced by the next run, although it has no index.
+constexpr const char* kReportMarker = ".stereobench-report";
+
+/// Prepares the output folder: new, empty, or an earlier report (finished, or stopped before its
+/// index was written) whose index, assets and images go. A folder holding anything else is refused.
 void prepare_out_dir(const fs::path& out) {
   std::error_code ec;
   if (fs::exists(out, ec) && !fs::is_directory(out, ec))
     throw InputError(fmt::format("--out {} is a file; give a folder for the report", out.string()));
   if (fs::exists(out, ec) && !fs::is_empty(out, ec)) {
     const fs::path index = out / "index.html";
-    const bool ours = fs::exists(index, ec) && io::read_file(index).find(fmt::format("content=\"{}", kGenerator)) !=
-                                                    std::string::npos;
+    const bool ours = fs::exists(out / kReportMarker, ec) ||
+                      (fs::exists(index, ec) &&
+                       io::read_file(index).find(fmt::format("content=\"{}", kGenerator)) != std::string::npos);
     if (!ours)
       throw InputError(fmt::format("--out {} is not empty and holds no stereobench report; give a new or empty folder",
                                    out.string()));
@@ -197,9 +203,13 @@ void prepare_out_dir(const fs::path& out) {
       fs::remove_all(out / sub, ec);
       if (ec) throw IoError(fmt::format("cannot remove the earlier report's {}: {}", (out / sub).string(), ec.message()));
     }
+    // An index being written when a run was killed.
+    for (const fs::directory_entry& e : fs::directory_iterator(out, ec))
+      if (e.path().filename().string().starts_with(".index.html.tmp-")) fs::remove(e.path(), ec);
   }
   fs::create_directories(out, ec);
   if (ec) throw IoError(fmt::format("cannot create the report folder {}: {}", out.string(), ec.message()));
+  io::write_text_atomically(out / kReportMarker, fmt::format("{} {}\n", kGenerator, SB_VERSION_STRING));
 }
 
 /// Copies a file atomically (the destination's folders are created).

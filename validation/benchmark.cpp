@@ -22,14 +22,23 @@ Summary summarize(std::vector<double> v) {
 }
 
 void BenchConfig::validate() const {
-  if (repetitions < 1) throw InputError(fmt::format("--repetitions {} must be at least 1", repetitions));
-  if (warmup < 0) throw InputError(fmt::format("--warmup {} must not be negative", warmup));
-  for (const std::string& name : pipelines) (void)find_pipeline(name);
+  // The same bounds as a sweep's [timing].
+  if (repetitions < 1 || repetitions > 10000)
+    throw InputError(fmt::format("--repetitions {} is outside 1..10000", repetitions));
+  if (warmup < 0 || warmup > 10000) throw InputError(fmt::format("--warmup {} is outside 0..10000", warmup));
+  for (size_t i = 0; i < pipelines.size(); ++i) {
+    (void)find_pipeline(pipelines[i]);
+    if (std::find(pipelines.begin(), pipelines.begin() + static_cast<std::ptrdiff_t>(i), pipelines[i]) !=
+        pipelines.begin() + static_cast<std::ptrdiff_t>(i))
+      throw InputError(fmt::format("--pipelines names '{}' twice; name each pipeline once", pipelines[i]));
+  }
   if (std::find(pipelines.begin(), pipelines.end(), baseline) == pipelines.end())
     throw InputError(fmt::format("baseline '{}' is not among the benchmarked pipelines", baseline));
-  for (const auto& [name, o] : options)
+  for (const auto& [name, o] : options) {
     if (std::find(pipelines.begin(), pipelines.end(), name) == pipelines.end())
       throw InputError(fmt::format("options given for pipeline '{}', which is not benchmarked", name));
+    (void)PipelineOptions(find_pipeline(name).info(), o);  // the values, as the pipeline reads them
+  }
 }
 
 BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const BenchConfig& config,

@@ -78,6 +78,12 @@ ThresholdValues read_thresholds(const toml::table& table, const std::string& tab
                    fmt::format("unknown key '{}' in {}; known keys: {}", k, table_name, joined(known)));
     }
     values[k] = threshold_value(node, k, source);
+    for (const MetricCheck& c : kMetricChecks)
+      if ((k == c.fail_key || k == c.warn_key) && values[k] && *values[k] > c.largest)
+        config_error(source, node.source(),
+                     fmt::format("{} = {} is above {:g}, the largest {}; {}", k, *values[k], c.largest, c.label,
+                                 c.direction == Direction::at_least ? "no cell could pass"
+                                                                    : "the limit could never be reached"));
   }
   // A warning level must be reached before the failure level.
   for (const MetricCheck& c : kMetricChecks) {
@@ -584,9 +590,15 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
   GateReport report;
   report.notes = results.warnings;
   const RegressionSettings& reg = config.regression;
+  std::vector<bool> rule_used(config.rules.size(), false);
   for (const GateCell& cell : results.cells) {
     const std::string where = fmt::format("{}: cell '{}'", results.file.string(), cell.cell_id);
     for (const auto& [pipeline, entry] : cell.record["pipelines"].items()) {
+      for (size_t i = 0; i < config.rules.size(); ++i) {
+        const GateRule& r = config.rules[i];
+        if (glob_matches(r.pipeline, pipeline) && glob_matches(r.scene, cell.scene) && glob_matches(r.cell, cell.cell_id))
+          rule_used[i] = true;
+      }
       const ThresholdValues limits = thresholds_for(config, pipeline, cell.scene, cell.cell_id);
       const std::string command = reproduce_command(cell, pipeline, reproduce);
       auto limit = [&](const char* key) -> std::optional<double> {
@@ -683,6 +695,19 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
     }
   }
   if (std::optional<GateCheck> complete = completeness_check(results)) report.checks.push_back(std::move(*complete));
+  // A rule that applies nowhere is a rule for another sweep or a misspelt glob whose limits would
+  // pass silently: named in one note.
+  std::vector<std::string> unused;
+  for (size_t i = 0; i < config.rules.size(); ++i)
+    if (!rule_used[i])
+      unused.push_back(fmt::format("line {} (pipeline '{}', scene '{}', cell '{}')", config.rules[i].line,
+                                   config.rules[i].pipeline, config.rules[i].scene, config.rules[i].cell));
+  if (!unused.empty())
+    report.notes.push_back(fmt::format("{}: {} [[rule]] table{} match{} no pipeline of any cell in {}, so {} limits "
+                                       "apply nowhere here (rules for another sweep, or misspelt globs): {}",
+                                       config.source, unused.size(), unused.size() == 1 ? "" : "s",
+                                       unused.size() == 1 ? "es" : "", results.file.string(),
+                                       unused.size() == 1 ? "its" : "their", joined(unused)));
   for (const GateCheck& c : report.checks) {
     ++report.counts[c.verdict];
     report.worst = std::max(report.worst, c.verdict);

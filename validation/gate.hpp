@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <optional>
 #include <span>
@@ -36,18 +37,19 @@ struct MetricCheck {
   Direction direction;
   const char* pointer;  ///< JSON pointer into the pipeline entry of a results line
   const char* label;    ///< what the number is, for messages ("PSNR")
+  double largest = std::numeric_limits<double>::infinity();  ///< the largest value the metric takes
 };
 
 /// Every threshold check, in report order. The time regression is separate (RegressionSettings).
 inline constexpr MetricCheck kMetricChecks[] = {
     {"psnr", "min_psnr", "warn_psnr", Direction::at_least, "/validation/metrics/psnr", "PSNR"},
-    {"ssim", "min_ssim", "warn_ssim", Direction::at_least, "/validation/metrics/ssim", "SSIM"},
+    {"ssim", "min_ssim", "warn_ssim", Direction::at_least, "/validation/metrics/ssim", "SSIM", 1.0},
     {"error_fraction", "max_error_fraction", "warn_error_fraction", Direction::at_most,
-     "/validation/metrics/error_fraction", "error-pixel fraction"},
+     "/validation/metrics/error_fraction", "error-pixel fraction", 1.0},
     {"hole_fraction", "max_hole_fraction", "warn_hole_fraction", Direction::at_most, "/validation/holes/hole_fraction",
-     "hole fraction"},
+     "hole fraction", 1.0},
     {"disocclusion_recall", "min_recall", "warn_recall", Direction::at_least,
-     "/validation/holes/not_reprojected/recall", "disocclusion recall"},
+     "/validation/holes/not_reprojected/recall", "disocclusion recall", 1.0},
     {"speedup", "min_speedup", "warn_speedup", Direction::at_least, "/timing/speedup_median", "median speed-up"},
 };
 

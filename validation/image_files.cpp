@@ -47,13 +47,15 @@ Image read_exr_image(const fs::path& path, std::string_view eye, std::string& ta
   try {
     return io::read_exr(path);
   } catch (const InputError&) {
-    // Either a stereo pair or an unreadable file: tell them apart by reading it as a pair.
+    // Either a stereo pair or an unreadable file. A pair that cannot be read reports its own fault
+    // (a truncated file, say), not that it is a pair.
+    bool stereo = false;
     try {
-      pair = io::read_exr_stereo(path);
+      stereo = io::exr_holds_stereo_pair(path);
     } catch (const Error&) {
-      pair.reset();
     }
-    if (!pair) throw;
+    if (!stereo) throw;
+    pair = io::read_exr_stereo(path);
   }
   if (eye.empty())
     throw InputError(

@@ -506,6 +506,11 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
           where.fail(option.source(), option_path, err.what());
         }
       }
+      try {  // the values together, as the cells will use them
+        (void)PipelineOptions(find_pipeline(pipeline).info(), values);
+      } catch (const InputError& err) {
+        where.fail(key.source(), path, err.what());
+      }
       d.options[pipeline] = values;
     }
   }

@@ -145,6 +145,7 @@ class SceneCache {
     if (!loaded_ || file != file_) {
       reset();
       loaded_ = std::make_unique<Scene>(io::load_gltf(file));
+      for (const std::string& w : loaded_->warnings) fmt::print(stderr, "warning: {}\n", w);
       file_ = file;
     }
     // A light count above the scene's keeps all of its lights (the record says how many).

@@ -78,6 +78,20 @@ class Checker {
     return x;
   }
 
+  /// A number in [lo, hi]; `what` says what the range means.
+  double number_in(const json& v, const std::string& path, double lo, double hi, std::string_view what) const {
+    const double x = number(v, path);
+    if (x < lo || x > hi) fail(path, fmt::format("value {:g} is out of range [{:g}, {:g}] ({})", x, lo, hi, what));
+    return x;
+  }
+
+  /// A number greater than zero.
+  double positive(const json& v, const std::string& path, std::string_view what) const {
+    const double x = number(v, path);
+    if (!(x > 0.0)) fail(path, fmt::format("value {:g} must be positive ({})", x, what));
+    return x;
+  }
+
   void boolean(const json& v, const std::string& path) const {
     if (!v.is_boolean()) fail(path, fmt::format("must be true or false, found {} {}", v.type_name(), v.dump()));
   }
@@ -130,6 +144,15 @@ class Checker {
     if (const json* v = member(obj, key, path)) number_array(*v, path + "/" + key, len);
   }
 
+  /// An optional array of `len` numbers, each in [lo, hi].
+  void opt_number_array_in(const json& obj, const std::string& key, const std::string& path, size_t len, double lo,
+                           double hi, std::string_view what) const {
+    const json* v = member(obj, key, path);
+    if (!v) return;
+    number_array(*v, path + "/" + key, len);
+    for (size_t i = 0; i < len; ++i) number_in((*v)[i], fmt::format("{}/{}/{}", path, key, i), lo, hi, what);
+  }
+
   void opt_object(const json& obj, const std::string& key, const std::string& path) const {
     if (const json* v = member(obj, key, path)) require_object(*v, path + "/" + key);
   }
@@ -163,12 +186,13 @@ class Checker {
     if (!sb) return;
     const std::string p = path + "/extras/stereobench";
     require_object(*sb, p);
-    opt_number(*sb, "interaxial", p);
-    opt_number(*sb, "convergence", p);
+    if (const json* v = member(*sb, "interaxial", p)) positive(*v, p + "/interaxial", "the eye separation in metres");
+    if (const json* v = member(*sb, "convergence", p))
+      positive(*v, p + "/convergence", "the zero-parallax distance in metres");
     opt_integer(*sb, "width", p, 1, 16384);
     opt_integer(*sb, "height", p, 1, 16384);
-    opt_number_array(*sb, "background", p, 3);
-    opt_number(*sb, "ambient", p);
+    opt_number_array_in(*sb, "background", p, 3, 0.0, 1e6, "linear radiance");
+    if (const json* v = member(*sb, "ambient", p)) number_in(*v, p + "/ambient", 0.0, 1e6, "the ambient term");
   }
 
   void run() const {
@@ -203,7 +227,14 @@ class Checker {
       opt_index(n, "camera", p, "cameras");
       opt_number_array(n, "matrix", p, 16);
       opt_number_array(n, "translation", p, 3);
-      opt_number_array(n, "rotation", p, 4);
+      if (const json* r = member(n, "rotation", p)) {
+        number_array(*r, p + "/rotation", 4);
+        double norm2 = 0.0;
+        for (const json& c : *r) norm2 += c.get<double>() * c.get<double>();
+        if (!(norm2 > 1e-12))
+          fail(p + "/rotation", "the quaternion has length zero; a rotation is a unit quaternion [x, y, z, w], "
+                                "e.g. [0, 0, 0, 1] for none");
+      }
       opt_number_array(n, "scale", p, 3);
       if (const json* ext = member(n, "extensions", p)) {
         require_object(*ext, p + "/extensions");
@@ -281,14 +312,16 @@ class Checker {
       if (const json* pbr = member(m, "pbrMetallicRoughness", p)) {
         const std::string pp = p + "/pbrMetallicRoughness";
         require_object(*pbr, pp);
-        opt_number_array(*pbr, "baseColorFactor", pp, 4);
+        opt_number_array_in(*pbr, "baseColorFactor", pp, 4, 0.0, 1.0, "glTF colour factors are linear, 0..1");
+        for (const char* f : {"metallicFactor", "roughnessFactor"})
+          if (const json* v = member(*pbr, f, pp)) number_in(*v, pp + "/" + f, 0.0, 1.0, "glTF factors are 0..1");
         texture_info(*pbr, "baseColorTexture", pp);
         texture_info(*pbr, "metallicRoughnessTexture", pp);
       }
       texture_info(m, "normalTexture", p);
       texture_info(m, "occlusionTexture", p);
       texture_info(m, "emissiveTexture", p);
-      opt_number_array(m, "emissiveFactor", p, 3);
+      opt_number_array_in(m, "emissiveFactor", p, 3, 0.0, 1.0, "glTF colour factors are linear, 0..1");
       opt_bool(m, "doubleSided", p);
       opt_string(m, "alphaMode", p);
     });

@@ -3,6 +3,7 @@
 #include "renderer/io/gltf_loader.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -48,9 +49,20 @@ uint32_t read_u32(const std::string& bytes, size_t offset) {
 }
 
 /// Splits a .glb container into its JSON chunk, checking every length against the file.
-GlbParts split_container(const std::string& bytes, const std::string& file) {
+GlbParts split_container(const std::string& bytes, const std::string& file, bool glb_name) {
   GlbParts parts;
-  if (bytes.size() < 4 || bytes.compare(0, 4, "glTF") != 0) {
+  const bool magic = bytes.size() >= 4 && bytes.compare(0, 4, "glTF") == 0;
+  if (glb_name && !magic) {
+    std::string head;
+    for (size_t i = 0; i < std::min<size_t>(4, bytes.size()); ++i) {
+      const unsigned char c = static_cast<unsigned char>(bytes[i]);
+      head += std::isprint(c) ? std::string(1, static_cast<char>(c)) : fmt::format("\\x{:02x}", c);
+    }
+    throw InputError(fmt::format("{}: not a binary glTF file: it starts with '{}', not the magic 'glTF'; the file is "
+                                 "damaged or not a .glb (a JSON glTF file is named .gltf)",
+                                 file, head));
+  }
+  if (!magic) {
     parts.json_text = bytes;
     return parts;
   }
@@ -86,6 +98,18 @@ GlbParts split_container(const std::string& bytes, const std::string& file) {
   }
   parts.json_text = bytes.substr(20, json_len);
   return parts;
+}
+
+/// A JSON parser message with the token it last read cut to 40 characters: a syntax error inside
+/// a data URI would otherwise quote kilobytes of base64.
+std::string short_parse_error(const std::string& what) {
+  const std::string key = "last read: '";
+  const size_t at = what.find(key);
+  if (at == std::string::npos) return what;
+  const size_t start = at + key.size();
+  const size_t end = what.rfind('\'');
+  if (end == std::string::npos || end <= start || end - start <= 40) return what;
+  return what.substr(0, start + 40) + "...' (" + std::to_string(end - start) + " characters)" + what.substr(end + 1);
 }
 
 bool is_data_uri(const std::string& uri) { return uri.rfind("data:", 0) == 0; }
@@ -250,6 +274,12 @@ class Converter {
     for (const auto& [key, count] : warning_counts_)
       scene.warnings.push_back(count > 1 ? fmt::format("{} ({} occurrences)", warning_text_[key], count)
                                          : warning_text_[key]);
+    if (is_unlit(scene))
+      scene.warnings.push_back(fmt::format(
+          "{}: the scene is unlit ({}, ambient 0): every surface renders black, so a comparison sees at most "
+          "silhouettes against the background and cannot tell pipelines apart; add a KHR_lights_punctual light or set "
+          "the scene's extras.ambient",
+          file_, scene.lights.empty() ? "no lights" : "every light has zero intensity or colour"));
     return scene;
   }
 
@@ -732,12 +762,15 @@ Scene load_gltf(const fs::path& path, const GltfLoadOptions& options) {
     throw InputError(e.what());
   }
   if (bytes.empty()) throw InputError(fmt::format("{}: the file is empty; give a .gltf or .glb file", file));
-  const GlbParts parts = split_container(bytes, file);
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const GlbParts parts = split_container(bytes, file, extension == ".glb");
   json doc;
   try {
     doc = json::parse(parts.json_text);
   } catch (const json::parse_error& e) {
-    throw InputError(fmt::format("{}: not valid JSON at byte {}: {}", file, e.byte, e.what()));
+    throw InputError(fmt::format("{}: not valid JSON at byte {}: {}", file, e.byte, short_parse_error(e.what())));
   }
   check_gltf_json(doc, file);
   const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();

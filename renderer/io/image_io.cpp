@@ -863,6 +863,14 @@ std::pair<Image, Image> read_exr_stereo(const fs::path& path) {
   });
 }
 
+bool exr_holds_stereo_pair(const fs::path& path) {
+  return guarded_read(path, [&] {
+    const InputFile file = open_file(path);
+    return std::any_of(file.channels.begin(), file.channels.end(),
+                       [](const InChannel& ch) { return ch.eye != EyeTag::none; });
+  });
+}
+
 Image read_exr(const fs::path& path) {
   return guarded_read(path, [&] {
     InputFile file = open_file(path);

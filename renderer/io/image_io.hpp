@@ -58,6 +58,10 @@ void write_exr(const std::filesystem::path& path, const Image& image, const Imag
 /// InputError if the file is missing, unreadable, not an image or has no stereo pair.
 [[nodiscard]] std::pair<Image, Image> read_exr_stereo(const std::filesystem::path& path);
 
+/// True when the file's header tags any channel with an eye (a 'left.'/'right.' layer or a part
+/// named left/right): read_exr_stereo is the reader for it. Reads the header only.
+[[nodiscard]] bool exr_holds_stereo_pair(const std::filesystem::path& path);
+
 /// Reads a single-image EXR (or any file OpenImageIO reads as float) with the channel mapping of
 /// read_exr_stereo: a plain R,G,B(,A) file gives "rgb" (and "alpha"), "Z" gives "depth".
 /// InputError if the file is missing, unreadable, or holds a stereo pair (use read_exr_stereo).

@@ -17,7 +17,8 @@ class BidirWarp final : public Pipeline {
     static const PipelineInfo i{"bidir-warp", "Kim", "§3 (visibility redirection, 1-D warping, composition)",
                                 "each triangle rendered by the eye that sees it best; the two partial images warped "
                                 "row-wise into each other, composed by depth, cracks filled",
-                                bidir_option_specs(), 35.5, 29.0};
+                                bidir_option_specs(), 35.5, 29.0,
+                                [](const PipelineOptions& o) { (void)BidirSettings::from("bidir-warp", o); }};
     return i;
   }
 

@@ -15,7 +15,7 @@ class BidirWarpRt final : public Pipeline {
     // 37.70 dB (box-wall), right 39.24 dB (box-wall). Hence 37.5 and 39 dB.
     static const PipelineInfo i{"bidir-warp-rt", "Kim; Wißmann et al. 2020 (ray-traced filling)", "§3 + hole tracing",
                                 "bidir-warp with the remaining holes of both eyes traced", bidir_option_specs(), 37.5,
-                                39.0};
+                                39.0, [](const PipelineOptions& o) { (void)BidirSettings::from("bidir-warp-rt", o); }};
     return i;
   }
 

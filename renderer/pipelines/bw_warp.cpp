@@ -222,7 +222,7 @@ class BwWarp final : public Pipeline {
           "linear: disparity and radiance interpolated between left pixel centres (not across a disparity step of "
           "0.5 px or more); nearest: the left pixel containing the position"},
          {"max_crack", "2", "widest run of unresolved pixels in a row that is filled by linear interpolation"}},
-        50.0, 26.5};
+        50.0, 26.5, [](const PipelineOptions& o) { (void)BwSettings::from(o); }};
     return i;
   }
 

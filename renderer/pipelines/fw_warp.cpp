@@ -138,7 +138,7 @@ class FwWarp final : public Pipeline {
           "1-D warp of Kim §3.2 (same image)"},
          {"segment", "256", "with warp=rows: target-row segment length in pixels (the image does not depend on it)"},
          {"background", "true", "warp the pixels that see the background, with the disparity at infinity"}},
-        50.0, 26.0};
+        50.0, 26.0, [](const PipelineOptions& o) { (void)FwSettings::from(o); }};
     return i;
   }
 

@@ -18,7 +18,8 @@ class PlainRaster final : public Pipeline {
     static const PipelineInfo i{
         "plain-raster", "Wißmann et al. 2020; Kim", "Plain Stereo; 2-Pass",
         "rasterize a G-buffer and run the lighting pass for each eye",
-        {tile_option_spec()}};
+        {tile_option_spec()}, 50.0, 50.0,
+        [](const PipelineOptions& o) { (void)raster_options("plain-raster", o); }};
     return i;
   }
 

@@ -16,7 +16,8 @@ class ReproReraster final : public Pipeline {
     static const PipelineInfo i{"repro-reraster", "Wißmann et al. 2020", "3.5 (Repro ReRaster)",
                                 "as repro-rt, but holes re-rasterized under a stencil mask: all geometry processed, only "
                                 "masked pixels shaded",
-                                grid_warp_option_specs(true), 50.0, 40.0};
+                                grid_warp_option_specs(true), 50.0, 40.0,
+                                [](const PipelineOptions& o) { (void)ReprojectionSettings::from(o, true); }};
     return i;
   }
 

@@ -15,7 +15,8 @@ class ReproRt final : public Pipeline {
     // measured 45.11 dB on the analytic scenes (textured-plane, 320x180).
     static const PipelineInfo i{"repro-rt", "Wißmann et al. 2020", "3.1-3.4 (Repro RT)",
                                 "left eye rasterized, adaptive grid warp, disocclusion detection, holes ray traced",
-                                grid_warp_option_specs(true), 50.0, 40.0};
+                                grid_warp_option_specs(true), 50.0, 40.0,
+                                [](const PipelineOptions& o) { (void)ReprojectionSettings::from(o, true); }};
     return i;
   }
 

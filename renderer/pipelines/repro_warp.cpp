@@ -13,7 +13,8 @@ class ReproWarp final : public Pipeline {
     // disoccluded; lowest measured 26.73 dB (textured-plane, 320x180). Hence 26 dB.
     static const PipelineInfo i{"repro-warp", "Wißmann et al. 2020", "3.1-3.2, Fig. 6a (grid warp only)",
                                 "left eye rasterized, adaptive grid warp to the right eye, no hole handling (rubber sheets)",
-                                grid_warp_option_specs(false), 50.0, 26.0};
+                                grid_warp_option_specs(false), 50.0, 26.0,
+                                [](const PipelineOptions& o) { (void)ReprojectionSettings::from(o, false); }};
     return i;
   }
 

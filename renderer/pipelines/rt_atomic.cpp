@@ -22,7 +22,8 @@ class RtAtomic final : public Pipeline {
         "rt-atomic", "Al-Hagri 2012", "3.1.2.2, 3.3.2 (Algorithms 4-5)",
         "per-pixel parallel reprojection with an atomic max of the source x per right pixel, length-restricted "
         "validation rays, missed and blocked pixels traced",
-        validation_option_specs(), 200.0, 36.0};
+        validation_option_specs(), 200.0, 36.0,
+        [](const PipelineOptions& o) { (void)ValidationSettings::from("rt-atomic", o); }};
     return i;
   }
 

@@ -34,7 +34,10 @@ class RtBuffer final : public Pipeline {
         "rt-buffer", "Al-Hagri 2012", "3.1.2.1, 3.3.1 (Algorithms 2-3)",
         "per-pixel parallel reprojection into a w x h x t buffer (max source x wins), length-restricted validation "
         "rays, missed and blocked pixels traced",
-        buffer_option_specs(), 200.0, 36.0};
+        buffer_option_specs(), 200.0, 36.0, [](const PipelineOptions& o) {
+          (void)ValidationSettings::from("rt-buffer", o);
+          (void)depth_option(o);
+        }};
     return i;
   }
 
@@ -42,7 +45,7 @@ class RtBuffer final : public Pipeline {
                       const RenderContext& ctx) const override {
     const ValidationSettings validation = ValidationSettings::from("rt-buffer", options);
     const int w = rig.params().width, h = rig.params().height;
-    const int t = buffer_depth(options.get_int("depth"), rig);
+    const int t = buffer_depth(depth_option(options), rig);
     StereoResult r;
     trace_left_eye(scene, rig, ctx.executor, r);
     const PixelReprojector reprojector(rig);
@@ -92,10 +95,16 @@ class RtBuffer final : public Pipeline {
  private:
   static constexpr int kMaxDepth = 4096;
 
-  static int buffer_depth(int option, const StereoRig& rig) {
+  /// The option depth, 0 (t = 2e, bounded by buffer_depth once the rig is known) or a fixed t.
+  static int depth_option(const PipelineOptions& options) {
+    const int option = options.get_int("depth");
     if (option < 0 || option > kMaxDepth)
       throw InputError(fmt::format("rt-buffer: option depth={} is out of range; use 0 (2 x max disparity) or 1..{}",
                                    option, kMaxDepth));
+    return option;
+  }
+
+  static int buffer_depth(int option, const StereoRig& rig) {
     // The default t = 2e is computed in double and bounded before it becomes an int.
     const double automatic = std::max(1.0, std::ceil(2.0 * rig.max_disparity_px()));
     if (option == 0 && !(automatic <= kMaxDepth))

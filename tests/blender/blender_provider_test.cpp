@@ -246,6 +246,17 @@ TEST(BlenderFailure, MissingExecutableIsUnavailableAndAToolError) {
   EXPECT_THROW((void)provider->tool_version(), ToolError);
 }
 
+TEST(BlenderFailure, AnExecutableThatIsNotBlenderIsUnavailable) {
+  // It exists and runs, but `--version` fails: found before anything renders, with the variable named.
+  const ScopedEnv env("STEREOBENCH_BLENDER", "/bin/false");
+  const auto why = validation::make_truth_provider("blender")->unavailable_reason();
+  ASSERT_TRUE(why.has_value());
+  EXPECT_NE(why->find("'/bin/false --version' failed (it exited with code 1)"), std::string::npos) << *why;
+  EXPECT_NE(why->find("$STEREOBENCH_BLENDER='/bin/false' names it: point $STEREOBENCH_BLENDER at Blender 3.4"),
+            std::string::npos)
+      << *why;
+}
+
 TEST(BlenderFailure, MissingFromPathIsUnavailable) {
   const ScopedEnv unset("STEREOBENCH_BLENDER", std::nullopt);
   const ScopedEnv path("PATH", "/nonexistent");

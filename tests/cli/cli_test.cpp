@@ -60,8 +60,11 @@ TEST(Cli, BadArgumentsExitWith3AndSayWhy) {
       {"scenes generate spheres --param nonsense=1 --out '" + dir.path().string() + "'", "nonsense"},
       {"scenes generate spheres --param count=abc --out '" + dir.path().string() + "'", "not a finite number"},
       {"scenes generate --out '" + dir.path().string() + "'", "name the scenes"},
-      {"scenes frobnicate", "frobnicate"},
+      {"scenes frobnicate", "'frobnicate' is not a command of stereobench scenes; its commands: list, generate, info"},
+      {"frobnicate", "'frobnicate' is not a command of stereobench; its commands: scenes, render"},
+      {"sweep runn x.toml", "'runn' is not a command of stereobench sweep; its commands: run"},
       {"", "subcommand"},
+      {"scenes generate spheres --seed -1 --out '" + dir.path().string() + "'", "--seed"},
   };
   for (const Case& c : cases) {
     const CliRun r = run(c.args);
@@ -144,6 +147,18 @@ TEST(Cli, RenderAndBenchRejectBadArguments) {
       {"render --scene box-wall --pipeline plain-rt --threads -1" + common, "--threads -1 is out of range"},
       {"bench --scene box-wall -n 0 --pipelines plain-rt --baseline plain-rt" + bench_common, "--repetitions 0"},
       {"bench --scene box-wall --pipelines plain-rt --baseline plain-rt --option tile=4" + bench_common, "PIPELINE.OPTION"},
+      // Option values are checked as the pipeline reads them, before any scene loads.
+      {"bench --scene box-wall --pipelines bw-warp --baseline bw-warp --option bw-warp.iterations=99" + bench_common,
+       "option iterations=99 is out of range 0..64"},
+      {"render --scene box-wall --pipeline bw-warp --option iterations=2000000000" + common,
+       "iterations=2000000000 is beyond the ±1e9"},
+      {"render --scene box-wall --pipeline plain-raster --option tile=8 --option tile=16" + common,
+       "--option gives tile twice (8 and 16)"},
+      {"render --scene box-wall --pipeline plain-rt --resolution 32x18 --out ''", "--out is empty"},
+      {"bench --scene box-wall -n 20000 --pipelines plain-rt --baseline plain-rt" + bench_common,
+       "--repetitions 20000 is outside 1..10000"},
+      {"bench --scene box-wall --pipelines plain-rt,plain-rt --baseline plain-rt" + bench_common,
+       "--pipelines names 'plain-rt' twice"},
   };
   for (const Case& c : cases) {
     const CliRun r = run(c.args);

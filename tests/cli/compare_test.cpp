@@ -25,6 +25,7 @@
 namespace sb {
 namespace {
 
+namespace fs = std::filesystem;
 using test::CliRun;
 using validation::Srgb8Image;
 
@@ -207,6 +208,15 @@ TEST_F(Compare, StereoExrNeedsAnEye) {
   EXPECT_NE(r.out.find("inf dB"), std::string::npos) << r.out;
   r = compare(q(path("pair.exr")) + " " + q(path("a.png")) + " --eye left --fail-psnr 1000");
   EXPECT_EQ(r.code, 2) << r.out;
+
+  // A damaged pair reports the damage, not that it is a pair.
+  fs::copy_file(path("pair.exr"), path("cut.exr"));
+  fs::resize_file(path("cut.exr"), fs::file_size(path("cut.exr")) - 64);
+  r = compare(q(path("cut.exr")) + " " + q(path("a.png")) + " --eye right");
+  EXPECT_EQ(r.code, 3) << r.out;
+  EXPECT_NE(r.out.find(path("cut.exr").string()), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("holds a stereo pair"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("read_exr_stereo"), std::string::npos) << "an internal name: " << r.out;
 }
 
 TEST(CompareHelp, ExplainsMetricsAndExitCodes) {

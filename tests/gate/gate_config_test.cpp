@@ -55,6 +55,13 @@ TEST(GateConfig, BadValuesAreRejected) {
   EXPECT_NE(looser.find("warn_psnr"), std::string::npos) << looser;
   EXPECT_NE(config_error("[defaults]\nmax_hole_fraction = 0.1\nwarn_hole_fraction = 0.2\n").find("warn_hole_fraction"),
             std::string::npos);
+  // Limits beyond what the metric can take: no cell could pass, or the limit could never be reached.
+  const std::string ssim = config_error("[defaults]\nmin_ssim = 2\n");
+  EXPECT_NE(ssim.find("test.toml:2: min_ssim = 2 is above 1, the largest SSIM; no cell could pass"), std::string::npos)
+      << ssim;
+  const std::string holes = config_error("[[rule]]\npipeline = \"repro-*\"\nmax_hole_fraction = 1.5\n");
+  EXPECT_NE(holes.find("test.toml:3: max_hole_fraction = 1.5 is above 1"), std::string::npos) << holes;
+  EXPECT_NE(config_error("[defaults]\nwarn_recall = 1.01\n").find("warn_recall"), std::string::npos);
 }
 
 TEST(GateConfig, RulesOverrideDefaultsInFileOrder) {

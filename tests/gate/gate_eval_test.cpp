@@ -352,6 +352,27 @@ TEST(GateEval, AnUnfinishedSweepFails) {
   EXPECT_EQ(part.worst, Verdict::fail);
 }
 
+TEST(GateEval, ARuleThatMatchesNothingIsNoted) {
+  const auto notes_about_rules = [](const validation::GateReport& r) {
+    std::vector<std::string> out;
+    for (const std::string& n : r.notes)
+      if (n.find("[[rule]]") != std::string::npos) out.push_back(n);
+    return out;
+  };
+  EXPECT_TRUE(notes_about_rules(evaluate(passing_cells())).empty()) << "kConfig's rule matches repro-rt";
+  const validation::GateReport typo =
+      evaluate(passing_cells(), {}, kConfig + "[[rule]]\npipeline = \"repro_rt\"\nmin_psnr = 99\n");
+  const std::vector<std::string> notes = notes_about_rules(typo);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("test.toml: 1 [[rule]] table matches no pipeline of any cell in results.jsonl, so its "
+                          "limits apply nowhere here (rules for another sweep, or misspelt globs): line 15 (pipeline "
+                          "'repro_rt', scene '*', cell '*')"),
+            std::string::npos)
+      << notes[0];
+  EXPECT_EQ(typo.worst, evaluate(passing_cells()).worst) << "a note, not a verdict";
+  EXPECT_EQ(typo.checks.size(), evaluate(passing_cells()).checks.size());
+}
+
 TEST(GateEval, AFrameOfAPathIsReproducedByRunningItsCellAgain) {
   json cell = fake_cell(1, 0.064, {FakePipeline{}});
   cell["cell"]["frame"] = 2;

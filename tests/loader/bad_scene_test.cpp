@@ -148,6 +148,12 @@ std::vector<BadCase> corpus() {
     g.doc["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}});
     g.doc["meshes"][0]["primitives"][0]["material"] = 0;
   }), "/images/0: cannot decode"});
+  c.push_back({"rig_extras_negative_convergence", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["extras"]["stereobench"]["convergence"] = -1; }), "/nodes/0/extras/stereobench/convergence: value -1 must be positive"});
+  c.push_back({"zero_quaternion", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["rotation"] = {0, 0, 0, 0}; }), "/nodes/0/rotation: the quaternion has length zero"});
+  c.push_back({"base_color_above_one", "a.gltf", edited([](MiniGltf& g) { g.doc["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorFactor", {2, 0.5, 0.5, 1}}}}}}); }), "/materials/0/pbrMetallicRoughness/baseColorFactor/0: value 2 is out of range [0, 1]"});
+  c.push_back({"negative_ambient", "a.gltf", edited([](MiniGltf& g) { g.doc["scenes"][0]["extras"]["stereobench"]["ambient"] = -0.5; }), "/scenes/0/extras/stereobench/ambient: value -0.5 is out of range"});
+  c.push_back({"glb_bad_magic", "a.glb", [](auto& p) { write_text(p, std::string("XglT\x02\0\0\0", 8) + std::string(40, ' ')); }, "not a binary glTF file: it starts with 'XglT'"});
+  c.push_back({"syntax_error_in_data_uri", "a.gltf", [](auto& p) { write_text(p, "{\"asset\": {\"version\": \"2.0\"}, \"buffers\": [{\"uri\": \"data:" + std::string(3000, 'A') + "}"); }, "'\"data:AAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAA...' (3007 characters)"});
   c.push_back({"missing_image_file", "a.gltf", edited([](MiniGltf& g) { g.doc["images"] = json::array({{{"uri", "nope.png"}}}); }), "/images/0/uri: referenced file"});
   return c;
 }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 
 #include "renderer/color.hpp"
 #include "renderer/io/gltf_loader.hpp"
@@ -273,4 +274,31 @@ TEST(GltfLoader, UnsupportedFeaturesAreNamedOnce) {
 }
 
 }  // namespace
+TEST(GltfLoader, AnUnlitSceneIsWarnedAbout) {
+  const ScratchDir dir("unlit");
+  const auto unlit_warning = [&](const std::function<void(MiniGltf&)>& edit) -> std::string {
+    MiniGltf g;
+    g.add_triangle();
+    edit(g);
+    g.write_gltf(dir / "s.gltf");
+    for (const std::string& w : io::load_gltf(dir / "s.gltf").warnings)
+      if (w.find("the scene is unlit") != std::string::npos) return w;
+    return "";
+  };
+  const std::string dark = unlit_warning([](MiniGltf&) {});
+  EXPECT_NE(dark.find("(no lights, ambient 0): every surface renders black"), std::string::npos) << dark;
+  EXPECT_NE(dark.find("s.gltf"), std::string::npos) << dark;
+  const auto light = [](double intensity) {
+    return [intensity](MiniGltf& g) {
+      g.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array({{{"type", "point"}, {"intensity", intensity}}});
+      g.doc["nodes"][0]["extensions"]["KHR_lights_punctual"]["light"] = 0;
+    };
+  };
+  const std::string off = unlit_warning(light(0.0));
+  EXPECT_NE(off.find("every light has zero intensity or colour"), std::string::npos) << off;
+  EXPECT_EQ(unlit_warning(light(5.0)), "") << "a lit scene";
+  EXPECT_EQ(unlit_warning([](MiniGltf& g) { g.doc["scenes"][0]["extras"]["stereobench"]["ambient"] = 0.2; }), "")
+      << "ambient light alone";
+}
+
 }  // namespace sb

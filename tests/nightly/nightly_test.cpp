@@ -187,8 +187,11 @@ TEST(NightlyTest, ResumesAnUnfinishedRunAndRecordsItOnce) {
   for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs"))
     if (e.is_directory()) runs.push_back(e.path());
   ASSERT_EQ(runs.size(), 1u);
-  // As if killed after appending its history line: the run has no nightly.json.
+  // As if killed after appending its history line, while writing the report: the run has no
+  // nightly.json, and its report folder holds assets but no index.html.
   fs::remove(runs[0] / "nightly.json");
+  fs::remove(runs[0] / "report" / "index.html");
+  ASSERT_TRUE(fs::is_directory(runs[0] / "report" / "assets"));
   const test::CliRun again = test::run_cli(nightly_args(dir));
   ASSERT_EQ(again.code, 0) << again.out;
   EXPECT_NE(again.out.find("run " + runs[0].filename().string() + " (resumed): 1 cells × 3 pipelines, 1 finished already, 0 to run"),
@@ -196,6 +199,7 @@ TEST(NightlyTest, ResumesAnUnfinishedRunAndRecordsItOnce) {
       << again.out;
   EXPECT_NE(again.out.find("not appended again"), std::string::npos) << again.out;
   EXPECT_TRUE(fs::is_regular_file(runs[0] / "nightly.json"));
+  EXPECT_TRUE(fs::is_regular_file(runs[0] / "report" / "index.html")) << "the half-written report was replaced";
   EXPECT_EQ(json_lines(dir / "runs" / "history.jsonl").size(), 1u);
   size_t folders = 0;
   for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs")) folders += e.is_directory() ? 1 : 0;
@@ -256,6 +260,14 @@ TEST(NightlyTest, MalformedHistoryIsBadInputNamingFileAndLine) {
   EXPECT_NE(r.out.find(history.string() + ":2:"), std::string::npos) << r.out;
   // Read before the sweep: nothing ran.
   size_t run_folders = 0;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs")) run_folders += e.is_directory() ? 1 : 0;
+  EXPECT_EQ(run_folders, 0u);
+
+  // A folder given as the history is bad input, also found before the sweep.
+  const test::CliRun folder = test::run_cli(nightly_args(dir) + " --history " + quoted(dir / "runs"));
+  EXPECT_EQ(folder.code, 3) << folder.out;
+  EXPECT_NE(folder.out.find("is a folder, not a file"), std::string::npos) << folder.out;
+  run_folders = 0;
   for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs")) run_folders += e.is_directory() ? 1 : 0;
   EXPECT_EQ(run_folders, 0u);
 

@@ -102,6 +102,31 @@ TEST(ReferenceStore, VerifyUpdateOnlyFailingAndCorruption) {
   EXPECT_EQ(test::run_cli(ref(dir, "verify")).code, 0);
 }
 
+TEST(ReferenceStore, DamagedProvenanceIsAFindingNotAStop) {
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene box-wall --resolution 64x36").code, 0);
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene thin-pole --resolution 48x32").code, 0);
+  const std::string box = "box-wall_full_64x36_e64.0mm_c4.08m";
+  const std::string pole = "thin-pole_full_48x32_e64.0mm_c2m";
+  // The first entry's provenance is not JSON; the second records a rig of the wrong type.
+  std::ofstream(dir / "store" / box / "provenance.json", std::ios::trunc) << "{\"kind\": \"stereobench.ref";
+  json p = json::parse(test::read_text(dir / "store" / pole / "provenance.json"));
+  p["rig"] = "wide";
+  std::ofstream(dir / "store" / pole / "provenance.json", std::ios::trunc) << p.dump(2);
+
+  const test::CliRun r = test::run_cli(ref(dir, "verify") + " --no-render");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("corrupt        " + box), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("is not valid JSON"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("corrupt        " + pole), std::string::npos) << "verification went on past the first: " << r.out;
+  EXPECT_NE(r.out.find("the recorded rig \"wide\" is not the rig its spec resolves to"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("0 of 2 reference(s) verified"), std::string::npos) << r.out;
+
+  const test::CliRun negative = test::run_cli(ref(dir, "verify") + " --min-psnr -1");
+  EXPECT_EQ(negative.code, 3) << negative.out;
+  EXPECT_NE(negative.out.find("--min-psnr -1 is not a PSNR in dB"), std::string::npos) << negative.out;
+}
+
 TEST(ReferenceStore, ChangedSceneIsReported) {
   test::ScratchDir dir;
   // A scene file of our own, changed after the reference was made.

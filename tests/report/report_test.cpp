@@ -232,6 +232,15 @@ TEST(Report, WarnsOnTornTailAndMissingImagesAndGuardsForeignFolders) {
   for (const char* asset : {"report.js", "report.css", "chart.umd.min.js"})
     EXPECT_TRUE(fs::exists(dir / "out" / "assets" / asset)) << asset;
 
+  // A report stopped before its index (a full disk, a kill) is replaced by the next run.
+  fs::remove(dir / "out" / "index.html");
+  write_text(dir / "out" / ".index.html.tmp-123-0", "<html");
+  ASSERT_TRUE(fs::exists(dir / "out" / ".stereobench-report"));
+  const test::CliRun again = test::run_cli("report " + quoted(dir / "results.jsonl") + " --out " + quoted(dir / "out"));
+  EXPECT_EQ(again.code, 0) << again.out;
+  EXPECT_TRUE(fs::exists(dir / "out" / "index.html"));
+  EXPECT_FALSE(fs::exists(dir / "out" / ".index.html.tmp-123-0")) << "the killed write's leftover goes";
+
   // A folder that holds something else is not overwritten.
   write_text(dir / "mine" / "notes.txt", "keep");
   const test::CliRun foreign = test::run_cli("report " + quoted(dir / "results.jsonl") + " --out " + quoted(dir / "mine"));

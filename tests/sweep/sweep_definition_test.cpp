@@ -128,6 +128,20 @@ TEST(SweepDefinition, UnknownKeysNameTheKeyAndLine) {
       << other;
 }
 
+TEST(SweepDefinition, OptionValuesAreCheckedBeforeAnyCellRuns) {
+  // Each value as the pipeline reads it, at its line: a range, a type, a choice.
+  const std::string range = error_of("[sweep]\npipelines = [\"repro-rt\"]\n[options.repro-rt]\nthreshold_arcmin = -5\n");
+  EXPECT_NE(range.find("def.toml:4: options.repro-rt.threshold_arcmin"), std::string::npos) << range;
+  EXPECT_NE(range.find("threshold_arcmin=-5 must be positive"), std::string::npos) << range;
+  const std::string type = error_of("[sweep]\npipelines = [\"bw-warp\"]\n[options.bw-warp]\niterations = \"many\"\n");
+  EXPECT_NE(type.find("def.toml:4: options.bw-warp.iterations"), std::string::npos) << type;
+  EXPECT_NE(type.find("iterations=many is not a finite number"), std::string::npos) << type;
+  const std::string choice = error_of("[sweep]\npipelines = [\"fw-warp\"]\n[options.fw-warp]\nwarp = \"fast\"\n");
+  EXPECT_NE(choice.find("def.toml:4: options.fw-warp.warp"), std::string::npos) << choice;
+  const std::string depth = error_of("[sweep]\npipelines = [\"rt-buffer\"]\n[options.rt-buffer]\ndepth = 5000\n");
+  EXPECT_NE(depth.find("depth=5000 is out of range"), std::string::npos) << depth;
+}
+
 TEST(SweepDefinition, BothInteraxialKindsRejected) {
   const std::string e = error_of("[sweep]\ninteraxial_m = [0.064]\nmax_disparity_px = [30]\n");
   EXPECT_NE(e.find("def.toml:3: sweep.max_disparity_px"), std::string::npos) << e;

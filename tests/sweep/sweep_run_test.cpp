@@ -201,6 +201,18 @@ TEST(SweepRun, ShardsCollectedEqualAnUnshardedRun) {
   const std::string text = test::read_text(dir / "m.csv");
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1 + 6 * 5);
   EXPECT_EQ(text.rfind("cell_index,cell_id,", 0), 0u);
+
+  // A results file without a finished cell is nothing to export or merge.
+  std::ofstream(dir / "empty.jsonl").flush();
+  const test::CliRun empty_csv = test::run_cli("sweep csv " + quoted(dir / "empty.jsonl") + " --out " + quoted(dir / "e.csv"));
+  EXPECT_EQ(empty_csv.code, 3) << empty_csv.out;
+  EXPECT_NE(empty_csv.out.find("holds no finished cell"), std::string::npos) << empty_csv.out;
+  EXPECT_FALSE(fs::exists(dir / "e.csv"));
+  const test::CliRun empty_merge =
+      test::run_cli("sweep collect " + quoted(dir / "e.jsonl") + " " + quoted(dir / "empty.jsonl"));
+  EXPECT_EQ(empty_merge.code, 3) << empty_merge.out;
+  EXPECT_NE(empty_merge.out.find("hold no finished cell"), std::string::npos) << empty_merge.out;
+  EXPECT_FALSE(fs::exists(dir / "e.jsonl"));
 }
 
 TEST(SweepRun, SmokeSweepRunsAndEveryLineIsWellFormed) {

@@ -105,10 +105,17 @@ std::string query_version(const fs::path& executable) {
     }
   }
   while (!version.empty() && std::isspace(static_cast<unsigned char>(version.back()))) version.pop_back();
-  if (!r.ok() || version.empty())
-    throw ToolError(fmt::format("'{} --version' failed (it {}){}; check the Blender installation "
-                                "(`ci/install-deps.sh blender`)",
-                                executable.string(), r.describe(), last_lines(r.out, kQuotedLines)));
+  if (!r.ok() || version.empty()) {
+    const char* configured = std::getenv(kExecutableVariable);
+    const std::string remedy =
+        configured != nullptr && *configured != '\0'
+            ? fmt::format("${}='{}' names it: point ${} at Blender 3.4, or unset it to use blender from PATH "
+                          "(`ci/install-deps.sh blender` installs it)",
+                          kExecutableVariable, configured, kExecutableVariable)
+            : std::string("check the Blender installation (`ci/install-deps.sh blender`)");
+    throw ToolError(fmt::format("'{} --version' failed (it {}){}; {}", executable.string(), r.describe(),
+                                last_lines(r.out, kQuotedLines), remedy));
+  }
   cache.emplace(executable.string(), version);
   return version;
 }
@@ -232,6 +239,11 @@ class BlenderProvider final : public TruthProvider {
   std::optional<std::string> unavailable_reason() const override {
     const Located found = locate_blender();
     if (!found.problem.empty()) return found.problem;
+    try {  // an executable that is not Blender fails here, before anything renders
+      (void)query_version(found.executable);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
     return std::nullopt;
   }
   std::string tool_version() const override { return query_version(executable()); }
