@@ -116,11 +116,30 @@ int run_update(const ReferenceArgs& a) {
   } else {
     targets = chosen_ids(store, a.ids);
   }
+  // An entry whose spec cannot be read cannot be made again: named, and the others still rewritten.
+  std::vector<std::string> unreadable;
+  size_t written_count = 0;
   for (const std::string& id : targets) {
-    const std::string written = store.generate(store.spec_of(id), a.scenes_dir, a.command_line, executor);
+    reference::ReferenceSpec spec;
+    try {
+      spec = store.spec_of(id);
+    } catch (const InputError& e) {
+      unreadable.push_back(fmt::format("{} ({})", id, e.what()));
+      continue;
+    }
+    const std::string written = store.generate(spec, a.scenes_dir, a.command_line, executor);
     fmt::print("updated {}\n", (store.root() / written).string());
+    ++written_count;
   }
-  fmt::print("{} reference(s) rewritten\n", targets.size());
+  fmt::print("{} reference(s) rewritten\n", written_count);
+  if (!unreadable.empty()) {
+    std::string list;
+    for (const std::string& u : unreadable) list += "\n  " + u;
+    throw InputError(fmt::format("{} reference(s) could not be rewritten, their provenance gives no spec to render "
+                                 "them from; remove each and run `stereobench reference generate` with its "
+                                 "scene and rig:{}",
+                                 unreadable.size(), list));
+  }
   return 0;
 }
 

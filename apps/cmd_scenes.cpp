@@ -144,7 +144,11 @@ void register_scenes_command(CLI::App& root) {
   g->add_flag("--all", gen->all, "Generate every built-in scene with default parameters");
   g->add_option("--out,-o", gen->out_dir, "Output folder")->capture_default_str();
   g->add_option("--seed", gen->seed, "Random seed; same seed, same file")
-      ->check(CLI::NonNegativeNumber)
+      ->check(CLI::Validator(
+          [](const std::string& v) {
+            return !v.empty() && v[0] == '-' ? "a seed is a whole number of 0 or more, not " + v : std::string();
+          },
+          "", "non-negative"))
       ->capture_default_str();
   g->add_option("--param,-p", gen->params, "Generator parameter NAME=VALUE (see `scenes list`)");
   g->callback([gen] { generate_scenes(*gen); });

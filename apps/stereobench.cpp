@@ -39,7 +39,9 @@ void refuse_empty_out(CLI::App& app) {
   if (CLI::Option* out = app.get_option_no_throw("--out"))
     out->check(CLI::Validator(
         [](const std::string& value) {
-          return value.empty() ? std::string("--out is empty; give a file or folder name") : std::string();
+          return value.empty() ? std::string("is empty; give a file or folder name, or leave the option out for its "
+                                             "default")
+                               : std::string();
         },
         "", "non-empty"));
   for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) refuse_empty_out(*sub);

@@ -119,8 +119,9 @@ def main(paths):
         for key in ("error_fraction", "hole_fraction"):
             if got[key]:
                 hi = max(got[key])
-                t["max_" + key] = fmt(ceil_to(1.25 * hi + 0.002, 0.001), 3)
-                t["warn_" + key] = fmt(ceil_to(1.12 * hi + 0.001, 0.001), 3)
+                # A fraction is at most 1, and the gate refuses a limit above it.
+                t["max_" + key] = fmt(min(1.0, ceil_to(1.25 * hi + 0.002, 0.001)), 3)
+                t["warn_" + key] = fmt(min(1.0, ceil_to(1.12 * hi + 0.001, 0.001)), 3)
                 note.append(f"{key.split('_')[0]} {min(got[key]):.4f}..{hi:.4f}")
         if got["recall"] and min(got["recall"]) >= 0.5:  # pipelines that leave holes open score low: unchecked
             lo = min(got["recall"])

@@ -68,16 +68,34 @@ json rig_record(const StereoRig& rig) {
   return out;
 }
 
-/// Two records equal in structure, strings and booleans, their numbers within 1e-9 (relative):
-/// a record read back from JSON against one computed now.
-bool same_record(const json& a, const json& b) {
+/// Whether a recorded rig has the shape rig_record writes (the keys that fix the view, each a number,
+/// and the pose's four vectors); an edited or damaged record does not.
+bool well_formed_rig(const json& rig) {
+  if (!rig.is_object()) return false;
+  for (const char* key : {"width", "height", "vfov_deg", "interaxial_m", "convergence_m"})
+    if (!rig.contains(key) || !rig[key].is_number()) return false;
+  if (!rig.contains("pose") || !rig["pose"].is_object()) return false;
+  for (const char* key : {"position", "right", "up", "back"}) {
+    const json& v = rig["pose"].value(key, json());
+    if (!v.is_array() || v.size() != 3) return false;
+    for (const json& c : v)
+      if (!c.is_number()) return false;
+  }
+  return true;
+}
+
+/// A recorded record against one computed now: every value the recorded one holds equal in type,
+/// strings and booleans, numbers within 1e-9 (relative). Keys only the new record has (fields added
+/// to the record since) are not compared.
+bool same_record(const json& recorded, const json& now) {
+  const json& a = recorded;
+  const json& b = now;
   if (a.is_number() && b.is_number()) {
     const double x = a.get<double>(), y = b.get<double>();
     return std::fabs(x - y) <= 1e-9 * std::max({1.0, std::fabs(x), std::fabs(y)});
   }
   if (a.type() != b.type()) return false;
   if (a.is_object()) {
-    if (a.size() != b.size()) return false;
     for (auto it = a.begin(); it != a.end(); ++it)
       if (!b.contains(it.key()) || !same_record(it.value(), b[it.key()])) return false;
     return true;
@@ -326,11 +344,21 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
                            stored_hash.substr(0, 12));
     return r;
   }
-  const Prepared p = prepare(spec, scenes_dir);
+  std::optional<Prepared> loaded;
+  try {
+    loaded.emplace(prepare(spec, scenes_dir));
+  } catch (const InputError& e) {  // the scene is gone or no longer loads, or the spec's rig is invalid
+    r.status = Status::scene_changed;
+    r.detail = fmt::format("the scene or rig of its spec cannot be prepared: {}", e.what());
+    return r;
+  }
+  const Prepared& p = *loaded;
   const std::string scene_hash = validation::hash_scene(p.loaded.scene);
-  const json& scene_record = prov.value("scene", json::object());
-  const std::string recorded_scene =
-      scene_record.is_object() ? scene_record.value("content_sha256", std::string()) : std::string();
+  const json scene_record = prov.value("scene", json::object());
+  const std::string recorded_scene = scene_record.is_object() && scene_record.contains("content_sha256") &&
+                                             scene_record["content_sha256"].is_string()
+                                         ? scene_record["content_sha256"].get<std::string>()
+                                         : std::string();
   if (scene_hash != recorded_scene) {
     r.status = Status::scene_changed;
     r.detail = fmt::format("scene '{}' ({}) now hashes to {}, the reference was rendered from {}; regenerate it",
@@ -338,11 +366,20 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
     return r;
   }
   // The rig the spec resolves to now must be the one recorded: the stored image shows that view.
+  // The scene hash covers geometry, materials and lights, not the camera, so a moved camera shows here.
+  const json recorded_rig = prov.value("rig", json(nullptr));
   const json rig_now = rig_record(*p.rig);
-  if (!prov.contains("rig") || !same_record(prov["rig"], rig_now)) {
+  if (!well_formed_rig(recorded_rig)) {
     r.status = Status::corrupt;
-    r.detail = fmt::format("{}: the recorded rig {} is not the rig its spec resolves to ({}); regenerate the entry",
-                           prov_file.string(), brief(prov.value("rig", json(nullptr))), brief(rig_now));
+    r.detail = fmt::format("{}: the recorded rig {} is not a rig record; regenerate the entry", prov_file.string(),
+                           brief(recorded_rig));
+    return r;
+  }
+  if (!same_record(recorded_rig, rig_now)) {
+    r.status = Status::scene_changed;
+    r.detail = fmt::format("its spec now resolves to another rig than the recorded one (now {}, recorded {}): the "
+                           "scene's camera or the rig defaults changed; regenerate the entry",
+                           brief(rig_now), brief(recorded_rig));
     return r;
   }
   if (!options.rerender) {

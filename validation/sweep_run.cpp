@@ -145,7 +145,8 @@ class SceneCache {
     if (!loaded_ || file != file_) {
       reset();
       loaded_ = std::make_unique<Scene>(io::load_gltf(file));
-      for (const std::string& w : loaded_->warnings) fmt::print(stderr, "warning: {}\n", w);
+      if (warned_.insert(file).second)  // once per file, however often the cells switch scenes
+        for (const std::string& w : loaded_->warnings) fmt::print(stderr, "warning: {}\n", w);
       file_ = file;
     }
     // A light count above the scene's keeps all of its lights (the record says how many).
@@ -192,6 +193,7 @@ class SceneCache {
   }
 
   fs::path file_;
+  std::set<fs::path> warned_;  ///< files whose loader warnings were printed
   bool refit_ = true;
   std::unique_ptr<Scene> loaded_;
   std::unique_ptr<Scene> used_;

@@ -231,7 +231,7 @@ class Checker {
         number_array(*r, p + "/rotation", 4);
         double norm2 = 0.0;
         for (const json& c : *r) norm2 += c.get<double>() * c.get<double>();
-        if (!(norm2 > 1e-12))
+        if (!(norm2 > 0.0))
           fail(p + "/rotation", "the quaternion has length zero; a rotation is a unit quaternion [x, y, z, w], "
                                 "e.g. [0, 0, 0, 1] for none");
       }

@@ -107,7 +107,9 @@ std::string short_parse_error(const std::string& what) {
   const size_t at = what.find(key);
   if (at == std::string::npos) return what;
   const size_t start = at + key.size();
-  const size_t end = what.rfind('\'');
+  // The token ends at the quote before "; expected ..." when the parser adds that, else at the last quote.
+  const size_t expected = what.find("'; expected ", start);
+  const size_t end = expected != std::string::npos ? expected : what.rfind('\'');
   if (end == std::string::npos || end <= start || end - start <= 40) return what;
   return what.substr(0, start + 40) + "...' (" + std::to_string(end - start) + " characters)" + what.substr(end + 1);
 }

@@ -17,14 +17,16 @@ class ReproReraster final : public Pipeline {
                                 "as repro-rt, but holes re-rasterized under a stencil mask: all geometry processed, only "
                                 "masked pixels shaded",
                                 grid_warp_option_specs(true), 50.0, 40.0,
-                                [](const PipelineOptions& o) { (void)ReprojectionSettings::from(o, true); }};
+                                [](const PipelineOptions& o) {
+                                  (void)ReprojectionSettings::from("repro-reraster", o, true);
+                                }};
     return i;
   }
 
   StereoResult render(const RenderScene& scene, const StereoRig& rig, const PipelineOptions& options,
                       const RenderContext& ctx) const override {
     StereoResult r;
-    const ReprojectionSettings settings = ReprojectionSettings::from(options, true);
+    const ReprojectionSettings settings = ReprojectionSettings::from("repro-reraster", options, true);
     std::vector<uint8_t> states = warp_left_to_right(scene, rig, settings, ctx.executor, r);
     TraceCounts counts;
     RasterStats rs;

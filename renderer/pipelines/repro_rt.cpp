@@ -16,7 +16,9 @@ class ReproRt final : public Pipeline {
     static const PipelineInfo i{"repro-rt", "Wißmann et al. 2020", "3.1-3.4 (Repro RT)",
                                 "left eye rasterized, adaptive grid warp, disocclusion detection, holes ray traced",
                                 grid_warp_option_specs(true), 50.0, 40.0,
-                                [](const PipelineOptions& o) { (void)ReprojectionSettings::from(o, true); }};
+                                [](const PipelineOptions& o) {
+                                  (void)ReprojectionSettings::from("repro-rt", o, true);
+                                }};
     return i;
   }
 
@@ -24,7 +26,7 @@ class ReproRt final : public Pipeline {
                       const RenderContext& ctx) const override {
     StereoResult r;
     const std::vector<uint8_t> states =
-        warp_left_to_right(scene, rig, ReprojectionSettings::from(options, true), ctx.executor, r);
+        warp_left_to_right(scene, rig, ReprojectionSettings::from("repro-rt", options, true), ctx.executor, r);
     TraceCounts counts;
     {
       ScopedStage stage(r.timings, "hole_fill");

@@ -14,14 +14,16 @@ class ReproWarp final : public Pipeline {
     static const PipelineInfo i{"repro-warp", "Wißmann et al. 2020", "3.1-3.2, Fig. 6a (grid warp only)",
                                 "left eye rasterized, adaptive grid warp to the right eye, no hole handling (rubber sheets)",
                                 grid_warp_option_specs(false), 50.0, 26.0,
-                                [](const PipelineOptions& o) { (void)ReprojectionSettings::from(o, false); }};
+                                [](const PipelineOptions& o) {
+                                  (void)ReprojectionSettings::from("repro-warp", o, false);
+                                }};
     return i;
   }
 
   StereoResult render(const RenderScene& scene, const StereoRig& rig, const PipelineOptions& options,
                       const RenderContext& ctx) const override {
     StereoResult r;
-    (void)warp_left_to_right(scene, rig, ReprojectionSettings::from(options, false), ctx.executor, r);
+    (void)warp_left_to_right(scene, rig, ReprojectionSettings::from("repro-warp", options, false), ctx.executor, r);
     return r;
   }
 };

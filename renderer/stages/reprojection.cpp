@@ -34,21 +34,25 @@ std::vector<OptionSpec> grid_warp_option_specs(bool with_detection) {
   return specs;
 }
 
-ReprojectionSettings ReprojectionSettings::from(const PipelineOptions& options, bool with_detection) {
+ReprojectionSettings ReprojectionSettings::from(const std::string& pipeline, const PipelineOptions& options,
+                                                bool with_detection) {
   ReprojectionSettings s;
   s.threshold_arcmin = options.get_double("threshold_arcmin");
   if (!(s.threshold_arcmin > 0.0))
-    throw InputError(fmt::format("option threshold_arcmin={} must be positive (1.0 is the paper's value)", s.threshold_arcmin));
+    throw InputError(fmt::format("{}: option threshold_arcmin={} must be positive (1.0 is the paper's value)", pipeline,
+                                 s.threshold_arcmin));
   s.grid_overlay = options.get_bool("grid_overlay");
-  s.raster = raster_options(with_detection ? "repro-rt/repro-reraster" : "repro-warp", options);
+  s.raster = raster_options(pipeline, options);
   s.warp.detect_disocclusions = with_detection;
   if (with_detection) {
     s.warp.discontinuity_px = options.get_double("discontinuity_px");
     if (!(s.warp.discontinuity_px > 0.0))
-      throw InputError(fmt::format("option discontinuity_px={} must be positive", s.warp.discontinuity_px));
+      throw InputError(
+          fmt::format("{}: option discontinuity_px={} must be positive", pipeline, s.warp.discontinuity_px));
     s.warp.occluding_edge_px = options.get_double("occluding_edge_px");
     if (!(s.warp.occluding_edge_px >= 0.0))
-      throw InputError(fmt::format("option occluding_edge_px={} must be 0 (off) or positive", s.warp.occluding_edge_px));
+      throw InputError(fmt::format("{}: option occluding_edge_px={} must be 0 (off) or positive", pipeline,
+                                   s.warp.occluding_edge_px));
     s.source_frustum = options.get_bool("source_frustum");
     const std::string& rule = options.get("discard");
     if (rule == "triangle") {
@@ -56,7 +60,8 @@ ReprojectionSettings ReprojectionSettings::from(const PipelineOptions& options, 
     } else if (rule == "interpolated") {
       s.warp.rule = DiscardRule::interpolated;
     } else {
-      throw InputError(fmt::format("option discard={} is not a rule; use 'triangle' or 'interpolated'", rule));
+      throw InputError(
+          fmt::format("{}: option discard={} is not a rule; use 'triangle' or 'interpolated'", pipeline, rule));
     }
   }
   return s;

@@ -25,7 +25,8 @@ struct ReprojectionSettings {
   RasterOptions raster;
 
   /// From checked pipeline options (see grid_warp_option_specs); InputError for values out of range.
-  static ReprojectionSettings from(const PipelineOptions& options, bool with_detection);
+  /// Messages name `pipeline`.
+  static ReprojectionSettings from(const std::string& pipeline, const PipelineOptions& options, bool with_detection);
 };
 
 /// Renders result.left by rasterization and warps it into a new result.right (stages left_gbuffer,

@@ -64,7 +64,8 @@ TEST(Cli, BadArgumentsExitWith3AndSayWhy) {
       {"frobnicate", "'frobnicate' is not a command of stereobench; its commands: scenes, render"},
       {"sweep runn x.toml", "'runn' is not a command of stereobench sweep; its commands: run"},
       {"", "subcommand"},
-      {"scenes generate spheres --seed -1 --out '" + dir.path().string() + "'", "--seed"},
+      {"scenes generate spheres --seed -1 --out '" + dir.path().string() + "'",
+       "--seed: a seed is a whole number of 0 or more, not -1"},
   };
   for (const Case& c : cases) {
     const CliRun r = run(c.args);
@@ -154,7 +155,7 @@ TEST(Cli, RenderAndBenchRejectBadArguments) {
        "iterations=2000000000 is beyond the ±1e9"},
       {"render --scene box-wall --pipeline plain-raster --option tile=8 --option tile=16" + common,
        "--option gives tile twice (8 and 16)"},
-      {"render --scene box-wall --pipeline plain-rt --resolution 32x18 --out ''", "--out is empty"},
+      {"render --scene box-wall --pipeline plain-rt --resolution 32x18 --out ''", "--out: is empty; give a file"},
       {"bench --scene box-wall -n 20000 --pipelines plain-rt --baseline plain-rt" + bench_common,
        "--repetitions 20000 is outside 1..10000"},
       {"bench --scene box-wall --pipelines plain-rt,plain-rt --baseline plain-rt" + bench_common,

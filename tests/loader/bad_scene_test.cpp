@@ -154,6 +154,7 @@ std::vector<BadCase> corpus() {
   c.push_back({"negative_ambient", "a.gltf", edited([](MiniGltf& g) { g.doc["scenes"][0]["extras"]["stereobench"]["ambient"] = -0.5; }), "/scenes/0/extras/stereobench/ambient: value -0.5 is out of range"});
   c.push_back({"glb_bad_magic", "a.glb", [](auto& p) { write_text(p, std::string("XglT\x02\0\0\0", 8) + std::string(40, ' ')); }, "not a binary glTF file: it starts with 'XglT'"});
   c.push_back({"syntax_error_in_data_uri", "a.gltf", [](auto& p) { write_text(p, "{\"asset\": {\"version\": \"2.0\"}, \"buffers\": [{\"uri\": \"data:" + std::string(3000, 'A') + "}"); }, "'\"data:AAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAA...' (3007 characters)"});
+  c.push_back({"long_token_before_expected", "a.gltf", [](auto& p) { write_text(p, "{\"asset\": {\"version\" \"" + std::string(100, 'A')); }, "...' (101 characters); expected ':'"});
   c.push_back({"missing_image_file", "a.gltf", edited([](MiniGltf& g) { g.doc["images"] = json::array({{{"uri", "nope.png"}}}); }), "/images/0/uri: referenced file"});
   return c;
 }

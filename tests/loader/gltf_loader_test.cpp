@@ -273,7 +273,6 @@ TEST(GltfLoader, UnsupportedFeaturesAreNamedOnce) {
   EXPECT_TRUE(counted);
 }
 
-}  // namespace
 TEST(GltfLoader, AnUnlitSceneIsWarnedAbout) {
   const ScratchDir dir("unlit");
   const auto unlit_warning = [&](const std::function<void(MiniGltf&)>& edit) -> std::string {
@@ -301,4 +300,5 @@ TEST(GltfLoader, AnUnlitSceneIsWarnedAbout) {
       << "ambient light alone";
 }
 
+}  // namespace
 }  // namespace sb
