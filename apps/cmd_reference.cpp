@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
@@ -132,14 +133,11 @@ int run_update(const ReferenceArgs& a) {
     ++written_count;
   }
   fmt::print("{} reference(s) rewritten\n", written_count);
-  if (!unreadable.empty()) {
-    std::string list;
-    for (const std::string& u : unreadable) list += "\n  " + u;
+  if (!unreadable.empty())
     throw InputError(fmt::format("{} reference(s) could not be rewritten, their provenance gives no spec to render "
                                  "them from; remove each and run `stereobench reference generate` with its "
-                                 "scene and rig:{}",
-                                 unreadable.size(), list));
-  }
+                                 "scene and rig:\n  {}",
+                                 unreadable.size(), fmt::join(unreadable, "\n  ")));
   return 0;
 }
 

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
@@ -62,11 +63,7 @@ std::string unknown_command_message(const CLI::App& app, int argc, char** argv) 
       if (s->get_name() == word) next = s;
     }
     if (names.empty()) return "";
-    if (!next) {
-      std::string list;
-      for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
-      return fmt::format("'{}' is not a command of {}; its commands: {}", word, path, list);
-    }
+    if (!next) return fmt::format("'{}' is not a command of {}; its commands: {}", word, path, fmt::join(names, ", "));
     level = next;
     path += " " + word;
   }

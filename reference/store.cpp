@@ -88,25 +88,23 @@ bool well_formed_rig(const json& rig) {
 /// strings and booleans, numbers within 1e-9 (relative). Keys only the new record has (fields added
 /// to the record since) are not compared.
 bool same_record(const json& recorded, const json& now) {
-  const json& a = recorded;
-  const json& b = now;
-  if (a.is_number() && b.is_number()) {
-    const double x = a.get<double>(), y = b.get<double>();
+  if (recorded.is_number() && now.is_number()) {
+    const double x = recorded.get<double>(), y = now.get<double>();
     return std::fabs(x - y) <= 1e-9 * std::max({1.0, std::fabs(x), std::fabs(y)});
   }
-  if (a.type() != b.type()) return false;
-  if (a.is_object()) {
-    for (auto it = a.begin(); it != a.end(); ++it)
-      if (!b.contains(it.key()) || !same_record(it.value(), b[it.key()])) return false;
+  if (recorded.type() != now.type()) return false;
+  if (recorded.is_object()) {
+    for (auto it = recorded.begin(); it != recorded.end(); ++it)
+      if (!now.contains(it.key()) || !same_record(it.value(), now[it.key()])) return false;
     return true;
   }
-  if (a.is_array()) {
-    if (a.size() != b.size()) return false;
-    for (size_t i = 0; i < a.size(); ++i)
-      if (!same_record(a[i], b[i])) return false;
+  if (recorded.is_array()) {
+    if (recorded.size() != now.size()) return false;
+    for (size_t i = 0; i < recorded.size(); ++i)
+      if (!same_record(recorded[i], now[i])) return false;
     return true;
   }
-  return a == b;
+  return recorded == now;
 }
 
 /// A record's JSON cut to 120 characters, for a message.
@@ -128,6 +126,15 @@ ReferenceSpec spec_from_json(const json& j) {
   s.rig.height = optional_from<int>(r, "height");
   s.rig.vfov = optional_from<double>(r, "vfov_rad");
   return s;
+}
+
+/// The spec a provenance (read from `file`) records; InputError naming the file when it is malformed.
+ReferenceSpec spec_in(const json& provenance, const fs::path& file) {
+  try {
+    return spec_from_json(provenance.at("spec"));
+  } catch (const json::exception& e) {
+    throw InputError(fmt::format("{}: field 'spec' is malformed ({})", file.string(), e.what()));
+  }
 }
 
 /// Every occurrence of `from` in `text` replaced by `to`.
@@ -238,12 +245,7 @@ json ReferenceStore::provenance(const std::string& id) const {
 }
 
 ReferenceSpec ReferenceStore::spec_of(const std::string& id) const {
-  const json p = provenance(id);
-  try {
-    return spec_from_json(p.at("spec"));
-  } catch (const json::exception& e) {
-    throw InputError(fmt::format("{}: field 'spec' is malformed ({})", (root_ / id / kProvenance).string(), e.what()));
-  }
+  return spec_in(provenance(id), root_ / id / kProvenance);
 }
 
 std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& scenes_dir,
@@ -315,7 +317,7 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
   ReferenceSpec spec;
   try {
     prov = provenance(id);
-    spec = spec_of(id);
+    spec = spec_in(prov, prov_file);
   } catch (const InputError& e) {
     if (!fs::exists(prov_file, ec)) throw;  // an id the store does not hold
     // A damaged entry is a finding of the verification, not a reason to stop it.

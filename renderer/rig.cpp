@@ -9,6 +9,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/scene.hpp"
+#include "renderer/text.hpp"
 
 namespace sb {
 
@@ -217,8 +218,7 @@ ivec2 parse_resolution(const std::string& text) {
   static const std::pair<const char*, ivec2> named[] = {
       {"hd", {1920, 1080}}, {"fhd", {1920, 1080}}, {"1080p", {1920, 1080}}, {"720p", {1280, 720}},
       {"qhd", {2560, 1440}}, {"4k", {3840, 2160}},  {"uhd", {3840, 2160}},  {"8k", {7680, 4320}}};
-  std::string lower;
-  for (char ch : text) lower.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(ch))));
+  const std::string lower = lowercase(text);
   for (const auto& [name, size] : named)
     if (lower == name) return size;
   const size_t x = lower.find('x');

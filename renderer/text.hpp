@@ -1,10 +1,13 @@
-// Parsing of numbers given as text (command-line values, option strings).
+// Small text helpers: parsing numbers given as text (command-line values, option strings), case.
 #pragma once
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <exception>
 #include <optional>
 #include <string>
+#include <string_view>
 
 namespace sb {
 
@@ -19,6 +22,13 @@ namespace sb {
   }
   if (used != text.size() || !std::isfinite(v)) return std::nullopt;
   return v;
+}
+
+/// `s` with ASCII letters in lower case (names, extensions, tokens compared without case).
+[[nodiscard]] inline std::string lowercase(std::string_view s) {
+  std::string out(s);
+  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return out;
 }
 
 }  // namespace sb

@@ -283,13 +283,15 @@ GateConfig load_gate_config(const std::filesystem::path& file) {
 }
 
 ThresholdValues thresholds_for(const GateConfig& config, const std::string& pipeline, const std::string& scene,
-                               const std::string& cell_id) {
+                               const std::string& cell_id, std::vector<bool>* rule_used) {
   ThresholdValues values = config.defaults;
   values[kToleranceKey] = config.regression.tolerance;
-  for (const GateRule& rule : config.rules) {
+  for (size_t i = 0; i < config.rules.size(); ++i) {
+    const GateRule& rule = config.rules[i];
     if (!glob_matches(rule.pipeline, pipeline) || !glob_matches(rule.scene, scene) || !glob_matches(rule.cell, cell_id))
       continue;
     for (const auto& [key, value] : rule.values) values[key] = value;
+    if (rule_used) (*rule_used)[i] = true;
   }
   return values;
 }
@@ -594,12 +596,7 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
   for (const GateCell& cell : results.cells) {
     const std::string where = fmt::format("{}: cell '{}'", results.file.string(), cell.cell_id);
     for (const auto& [pipeline, entry] : cell.record["pipelines"].items()) {
-      for (size_t i = 0; i < config.rules.size(); ++i) {
-        const GateRule& r = config.rules[i];
-        if (glob_matches(r.pipeline, pipeline) && glob_matches(r.scene, cell.scene) && glob_matches(r.cell, cell.cell_id))
-          rule_used[i] = true;
-      }
-      const ThresholdValues limits = thresholds_for(config, pipeline, cell.scene, cell.cell_id);
+      const ThresholdValues limits = thresholds_for(config, pipeline, cell.scene, cell.cell_id, &rule_used);
       const std::string command = reproduce_command(cell, pipeline, reproduce);
       auto limit = [&](const char* key) -> std::optional<double> {
         const auto it = limits.find(key);

@@ -97,9 +97,11 @@ struct GateConfig {
 [[nodiscard]] GateConfig load_gate_config(const std::filesystem::path& file);
 
 /// The thresholds in force for one (pipeline, scene, cell): the defaults with every matching rule
-/// applied in file order; the regression tolerance under the key "regression_tolerance".
+/// applied in file order; the regression tolerance under the key "regression_tolerance". With
+/// `rule_used` (one flag per rule), the matching rules' flags are set.
 [[nodiscard]] ThresholdValues thresholds_for(const GateConfig& config, const std::string& pipeline,
-                                             const std::string& scene, const std::string& cell_id);
+                                             const std::string& scene, const std::string& cell_id,
+                                             std::vector<bool>* rule_used = nullptr);
 
 /// One finished cell of a sweep's results file, as the gate reads it.
 struct GateCell {

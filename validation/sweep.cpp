@@ -496,20 +496,17 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
       if (std::find(d.pipelines.begin(), d.pipelines.end(), pipeline) == d.pipelines.end())
         where.fail(key.source(), path,
                    fmt::format("options for a pipeline the sweep does not run; its pipelines: {}", join(d.pipelines)));
+      // Checked as they accumulate, the way the cells will read them: an error names the option
+      // that made the table invalid, and the last check covers the whole table.
       std::map<std::string, std::string> values;
       for (auto&& [option, value] : table_at(where, node, path)) {
         const std::string option_path = path + "." + std::string(option.str());
         values[std::string(option.str())] = option_text(where, value, option_path);
         try {
-          (void)PipelineOptions(find_pipeline(pipeline).info(), {{std::string(option.str()), values[std::string(option.str())]}});
+          (void)PipelineOptions(find_pipeline(pipeline).info(), values);
         } catch (const InputError& err) {
           where.fail(option.source(), option_path, err.what());
         }
-      }
-      try {  // the values together, as the cells will use them
-        (void)PipelineOptions(find_pipeline(pipeline).info(), values);
-      } catch (const InputError& err) {
-        where.fail(key.source(), path, err.what());
       }
       d.options[pipeline] = values;
     }

@@ -24,6 +24,7 @@
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/gltf_check.hpp"
 #include "renderer/io/image_io.hpp"
+#include "renderer/text.hpp"
 
 namespace sb::io {
 
@@ -764,10 +765,7 @@ Scene load_gltf(const fs::path& path, const GltfLoadOptions& options) {
     throw InputError(e.what());
   }
   if (bytes.empty()) throw InputError(fmt::format("{}: the file is empty; give a .gltf or .glb file", file));
-  std::string extension = path.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  const GlbParts parts = split_container(bytes, file, extension == ".glb");
+  const GlbParts parts = split_container(bytes, file, lowercase(path.extension().string()) == ".glb");
   json doc;
   try {
     doc = json::parse(parts.json_text);

@@ -24,6 +24,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/text.hpp"
 
 namespace sb::io {
 
@@ -264,13 +265,6 @@ void write_exr_layers(const fs::path& path, const std::vector<std::pair<std::str
 // ---- EXR reading: channel classification ----------------------------------------------------
 
 enum class EyeTag : uint8_t { none, left, right };
-
-std::string lowercase(std::string_view s) {
-  std::string out(s);
-  std::transform(out.begin(), out.end(), out.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return out;
-}
 
 EyeTag eye_tag(std::string_view token) {
   const std::string t = lowercase(token);
