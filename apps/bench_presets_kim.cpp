@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "apps/bench_presets.hpp"
 #include "apps/cli_common.hpp"
@@ -76,12 +77,6 @@ bool reset_peak_resident() {
   return static_cast<bool>(out);
 }
 
-std::string join(const std::vector<std::string>& items, const char* sep) {
-  std::string out;
-  for (const std::string& s : items) out += (out.empty() ? "" : sep) + s;
-  return out;
-}
-
 bool contains(const std::vector<std::string>& items, const std::string& name) {
   return std::find(items.begin(), items.end(), name) != items.end();
 }
@@ -115,8 +110,9 @@ nlohmann::json scene_json(const Scene& scene, const PresetRow& row) {
 
 void print_run_head(const PresetRun& run, const Executor& executor) {
   fmt::print("preset {}: {}\n", run.preset->name, run.preset->summary);
-  fmt::print("{}; baseline {}; {} threads, {} warm-up + {} repetitions per row\n", join(run.config.pipelines, ", "),
-             run.config.baseline, executor.threads(), run.config.warmup, run.config.repetitions);
+  fmt::print("{}; baseline {}; {} threads, {} warm-up + {} repetitions per row\n",
+             fmt::join(run.config.pipelines, ", "), run.config.baseline, executor.threads(), run.config.warmup,
+             run.config.repetitions);
   fmt::print("times: median over repetitions of each pipeline's total; speed-up = median over repetitions of {}'s "
              "total / the pipeline's total, paired per repetition\n",
              run.config.baseline);
@@ -461,7 +457,7 @@ void run_kim_complexity(const PresetRun& run, const Executor& executor) {
                      fmt::format("{:.2f}x", b.speedup.median), peak_text);
           if (!g.other_stages.empty())
             fmt::print("{:<14} note: {} has stages of neither group ({}), {:.2f} ms, in its total only\n", "", b.name,
-                       join(g.other_stages, ", "), g.other_ms);
+                       fmt::join(g.other_stages, ", "), g.other_ms);
           groups[b.name] = {{"rendering_ms", g.rendering_ms},
                             {"warping_ms", g.warping_ms},
                             {"other_ms", g.other_ms},
@@ -506,16 +502,17 @@ void run_kim_complexity(const PresetRun& run, const Executor& executor) {
                         : measured_values.size() == 1
                             ? measured_values.front()
                             : measured_values.front() + " to " + measured_values.back();
-    if (!skipped.empty()) range += "; skipped for memory: " + join(skipped, ", ");
+    if (!skipped.empty()) range += fmt::format("; skipped for memory: {}", fmt::join(skipped, ", "));
     std::string line;
     if (cross) {
       line = fmt::format("crossover: {}'s median total is below {}'s from {} triangles on (measured: {})",
                          kBidirectional, kReference, measured_values[*cross], range);
     } else {
-      line = fmt::format("crossover: none in the measured range ({}): {}'s median total is below {}'s {}",
-                         range, kBidirectional, kReference,
-                         faster.empty() ? std::string("in no measured row")
-                                        : fmt::format("at {} but not in the largest measured row", join(faster, ", ")));
+      line = fmt::format("crossover: none in the measured range ({}): {}'s median total is below {}'s {}", range,
+                         kBidirectional, kReference,
+                         faster.empty()
+                             ? std::string("in no measured row")
+                             : fmt::format("at {} but not in the largest measured row", fmt::join(faster, ", ")));
     }
     fmt::print("\n{}\n", line);
     out["crossover"] = {{"triangles", cross ? nlohmann::json(measured_triangles[*cross]) : nlohmann::json()},

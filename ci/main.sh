@@ -9,7 +9,8 @@ jobs=$(nproc)
 
 bash ci/install-deps.sh report
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build build -j"$jobs"
+# Only the tool: the tests and benchmarks are built by ci/test.sh.
+cmake --build build -j"$jobs" --target stereobench
 
 sb=./build/apps/stereobench
 out=out/main

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <toml++/toml.h>
 
 #include "renderer/error.hpp"
@@ -35,12 +36,6 @@ std::vector<std::string> threshold_keys() {
     keys.emplace_back(c.warn_key);
   }
   return keys;
-}
-
-std::string joined(const std::vector<std::string>& items) {
-  std::string out;
-  for (const std::string& s : items) out += (out.empty() ? "" : ", ") + s;
-  return out;
 }
 
 [[noreturn]] void config_error(const std::string& source, const toml::source_region& where, const std::string& what) {
@@ -75,7 +70,7 @@ ThresholdValues read_thresholds(const toml::table& table, const std::string& tab
       std::vector<std::string> known = keys;
       known.insert(known.end(), extra.begin(), extra.end());
       config_error(source, key.source(),
-                   fmt::format("unknown key '{}' in {}; known keys: {}", k, table_name, joined(known)));
+                   fmt::format("unknown key '{}' in {}; known keys: {}", k, table_name, fmt::join(known, ", ")));
     }
     values[k] = threshold_value(node, k, source);
     for (const MetricCheck& c : kMetricChecks)
@@ -429,8 +424,8 @@ std::vector<BaselineChange> update_baseline(Baseline& baseline, const GateResult
     for (const auto& [pipeline, entry] : cell.record["pipelines"].items()) present.insert(pipeline);
   for (const std::string& p : selection.pipelines)
     if (!present.count(p))
-      throw InputError(fmt::format("--only {}: no cell of {} has that pipeline (it has: {})", p, name,
-                                   joined({present.begin(), present.end()})));
+      throw InputError(
+          fmt::format("--only {}: no cell of {} has that pipeline (it has: {})", p, name, fmt::join(present, ", ")));
   std::vector<BaselineChange> changes;
   for (const GateCell& cell : results.cells) {
     if (!selection.cells.empty() && !glob_matches(selection.cells, cell.cell_id)) continue;
@@ -585,6 +580,53 @@ std::optional<GateCheck> completeness_check(const GateResults& results) {
   return check;
 }
 
+/// Why a rule applied to no (cell, pipeline) of the results: the first of its globs that matches
+/// nothing there, or the combination.
+std::string why_unused(const GateRule& rule, const GateResults& results) {
+  std::set<std::string> scenes, pipelines;
+  bool scene_hit = false, pipeline_hit = false, cell_hit = false;
+  for (const GateCell& cell : results.cells) {
+    scenes.insert(cell.scene);
+    scene_hit = scene_hit || glob_matches(rule.scene, cell.scene);
+    cell_hit = cell_hit || glob_matches(rule.cell, cell.cell_id);
+    for (const auto& item : cell.record["pipelines"].items()) {
+      pipelines.insert(item.key());
+      pipeline_hit = pipeline_hit || glob_matches(rule.pipeline, item.key());
+    }
+  }
+  if (!scene_hit) return fmt::format("scene '{}' matches none of its scenes ({})", rule.scene, fmt::join(scenes, ", "));
+  if (!pipeline_hit)
+    return fmt::format("pipeline '{}' matches none of its pipelines ({})", rule.pipeline, fmt::join(pipelines, ", "));
+  if (!cell_hit) return fmt::format("cell '{}' matches none of its cell ids", rule.cell);
+  return fmt::format("pipeline '{}', scene '{}' and cell '{}' each match, but never in the same cell", rule.pipeline,
+                     rule.scene, rule.cell);
+}
+
+/// A rule that applies nowhere is a rule for another sweep or a misspelt glob whose limits would
+/// pass silently: one note names them, grouped by the reason, with their lines.
+std::optional<std::string> unused_rules_note(const GateConfig& config, const GateResults& results,
+                                             const std::vector<bool>& rule_used) {
+  std::vector<std::pair<std::string, std::vector<int>>> groups;  // reason, lines; in file order
+  size_t count = 0;
+  for (size_t i = 0; i < config.rules.size(); ++i) {
+    if (rule_used[i]) continue;
+    ++count;
+    const std::string reason = why_unused(config.rules[i], results);
+    auto it = std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return g.first == reason; });
+    if (it == groups.end()) it = groups.insert(groups.end(), {reason, {}});
+    it->second.push_back(config.rules[i].line);
+  }
+  if (count == 0) return std::nullopt;
+  std::vector<std::string> parts;
+  for (const auto& [reason, lines] : groups)
+    parts.push_back(fmt::format("{} ({} {})", reason, lines.size() == 1 ? "line" : "lines", fmt::join(lines, ", ")));
+  return fmt::format(
+      "{}: {} [[rule]] table{} appl{} to no cell of {} (rules for another sweep, or misspelt globs), "
+      "so {} limits are not checked: {}",
+      config.source, count, count == 1 ? "" : "s", count == 1 ? "ies" : "y", results.file.string(),
+      count == 1 ? "its" : "their", fmt::join(parts, "; "));
+}
+
 }  // namespace
 
 GateReport evaluate_gate(const GateConfig& config, const GateResults& results, const Baseline& baseline,
@@ -692,19 +734,7 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
     }
   }
   if (std::optional<GateCheck> complete = completeness_check(results)) report.checks.push_back(std::move(*complete));
-  // A rule that applies nowhere is a rule for another sweep or a misspelt glob whose limits would
-  // pass silently: named in one note.
-  std::vector<std::string> unused;
-  for (size_t i = 0; i < config.rules.size(); ++i)
-    if (!rule_used[i])
-      unused.push_back(fmt::format("line {} (pipeline '{}', scene '{}', cell '{}')", config.rules[i].line,
-                                   config.rules[i].pipeline, config.rules[i].scene, config.rules[i].cell));
-  if (!unused.empty())
-    report.notes.push_back(fmt::format("{}: {} [[rule]] table{} match{} no pipeline of any cell in {}, so {} limits "
-                                       "apply nowhere here (rules for another sweep, or misspelt globs): {}",
-                                       config.source, unused.size(), unused.size() == 1 ? "" : "s",
-                                       unused.size() == 1 ? "es" : "", results.file.string(),
-                                       unused.size() == 1 ? "its" : "their", joined(unused)));
+  if (std::optional<std::string> note = unused_rules_note(config, results, rule_used)) report.notes.push_back(*note);
   for (const GateCheck& c : report.checks) {
     ++report.counts[c.verdict];
     report.worst = std::max(report.worst, c.verdict);

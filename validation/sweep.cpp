@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <toml++/toml.h>
 
 #include "renderer/error.hpp"
@@ -25,12 +26,6 @@ using nlohmann::json;
 std::string number_text(double value) { return fmt::format("{}", value); }
 
 namespace {
-
-std::string join(const std::vector<std::string>& items) {
-  std::string out;
-  for (const std::string& s : items) out += (out.empty() ? "" : ", ") + s;
-  return out;
-}
 
 /// Reports problems at a place in the definition: "<file>:<line>: <key path>: <what>".
 class Where {
@@ -61,8 +56,8 @@ void check_keys(const Where& where, const toml::table& table, const std::string&
     const std::string name(key.str());
     if (std::find(valid.begin(), valid.end(), name) != valid.end()) continue;
     where.fail(key.source(), prefix.empty() ? name : prefix + "." + name,
-               fmt::format("unknown key; valid keys{}: {}", prefix.empty() ? " at the top level" : " in [" + prefix + "]",
-                           join(valid)));
+               fmt::format("unknown key; valid keys{}: {}",
+                           prefix.empty() ? " at the top level" : " in [" + prefix + "]", fmt::join(valid, ", ")));
   }
 }
 
@@ -326,7 +321,7 @@ SweepScene parse_builtin_scene(const std::string& text) {
         std::vector<std::string> known;
         for (const scenes::GeneratorParam& p : info.params) known.push_back(p.name);
         throw InputError(fmt::format("scene '{}': '{}' has no parameter '{}' (its parameters: {})", text, s.name, key,
-                                     known.empty() ? std::string("none") : join(known)));
+                                     known.empty() ? std::string("none") : fmt::format("{}", fmt::join(known, ", "))));
       }
       double value = 0.0;
       size_t used = 0;
@@ -464,7 +459,8 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
     for (const toml::node* e : axis_entries(where, *n, "sweep.truths")) {
       const std::string name = string_at(where, *e, "sweep.truths");
       if (std::find(known.begin(), known.end(), name) == known.end())
-        where.fail(*e, "sweep.truths", fmt::format("unknown ground-truth provider '{}' (providers: {})", name, join(known)));
+        where.fail(*e, "sweep.truths",
+                   fmt::format("unknown ground-truth provider '{}' (providers: {})", name, fmt::join(known, ", ")));
       if (std::find(d.truths.begin(), d.truths.end(), name) != d.truths.end())
         where.fail(*e, "sweep.truths", fmt::format("lists '{}' twice", name));
       d.truths.push_back(name);
@@ -495,7 +491,8 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
       const std::string path = "options." + pipeline;
       if (std::find(d.pipelines.begin(), d.pipelines.end(), pipeline) == d.pipelines.end())
         where.fail(key.source(), path,
-                   fmt::format("options for a pipeline the sweep does not run; its pipelines: {}", join(d.pipelines)));
+                   fmt::format("options for a pipeline the sweep does not run; its pipelines: {}",
+                               fmt::join(d.pipelines, ", ")));
       // Checked as they accumulate, the way the cells will read them: an error names the option
       // that made the table invalid, and the last check covers the whole table.
       std::map<std::string, std::string> values;

@@ -364,11 +364,30 @@ TEST(GateEval, ARuleThatMatchesNothingIsNoted) {
       evaluate(passing_cells(), {}, kConfig + "[[rule]]\npipeline = \"repro_rt\"\nmin_psnr = 99\n");
   const std::vector<std::string> notes = notes_about_rules(typo);
   ASSERT_EQ(notes.size(), 1u);
-  EXPECT_NE(notes[0].find("test.toml: 1 [[rule]] table matches no pipeline of any cell in results.jsonl, so its "
-                          "limits apply nowhere here (rules for another sweep, or misspelt globs): line 15 (pipeline "
-                          "'repro_rt', scene '*', cell '*')"),
+  EXPECT_NE(notes[0].find("test.toml: 1 [[rule]] table applies to no cell of results.jsonl (rules for another "
+                          "sweep, or misspelt globs), so its limits are not checked: pipeline 'repro_rt' matches none "
+                          "of its pipelines (plain-rt, repro-rt) (line 15)"),
             std::string::npos)
       << notes[0];
+  // Several rules: grouped by the glob that matches nothing, each group with its lines. A rule
+  // whose globs each match something, but never together, says so.
+  std::vector<json> cells = passing_cells();
+  cells.push_back(fake_cell(2, 0.064, {{"plain-rt", 90, 1.0, 0, 0, 1, 1.0}}, "spheres"));
+  const validation::GateReport several = evaluate(
+      cells, {},
+      kConfig + "[[rule]]\nscene = \"atrium\"\nmin_psnr = 99\n[[rule]]\nscene = \"atrium\"\n"
+                "pipeline = \"plain-*\"\nmin_psnr = 99\n[[rule]]\npipeline = \"repro_rt\"\nmin_psnr = 99\n"
+                "[[rule]]\npipeline = \"plain-rt\"\ncell = \"nowhere*\"\nmin_psnr = 99\n"
+                "[[rule]]\npipeline = \"repro-rt\"\nscene = \"spheres\"\nmin_psnr = 99\n");
+  const std::vector<std::string> grouped = notes_about_rules(several);
+  ASSERT_EQ(grouped.size(), 1u);
+  EXPECT_NE(grouped[0].find("5 [[rule]] tables apply to no cell"), std::string::npos) << grouped[0];
+  EXPECT_NE(grouped[0].find("so their limits are not checked: scene 'atrium' matches none of its scenes (box-wall, "
+                            "spheres) (lines 15, 18); pipeline 'repro_rt' matches none of its pipelines (plain-rt, "
+                            "repro-rt) (line 22); cell 'nowhere*' matches none of its cell ids (line 25); pipeline "
+                            "'repro-rt', scene 'spheres' and cell '*' each match, but never in the same cell (line 29)"),
+            std::string::npos)
+      << grouped[0];
   EXPECT_EQ(typo.worst, evaluate(passing_cells()).worst) << "a note, not a verdict";
   EXPECT_EQ(typo.checks.size(), evaluate(passing_cells()).checks.size());
 }
