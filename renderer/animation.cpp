@@ -24,6 +24,28 @@ dmat3 rotation(const dvec3& axis, double radians) {
                t * x * z + s * y, t * y * z - s * x, t * z * z + c);
 }
 
+/// Where `frame` lies on a path of two or more keys spread evenly over `frames` frames: between
+/// keys `segment` and `segment + 1`, at parameter `t` in [0, 1].
+struct PathPlace {
+  size_t segment = 0;
+  double t = 0.0;
+};
+
+PathPlace place_of(size_t keys, int frames, int frame) {
+  const double u = static_cast<double>(frame) / static_cast<double>(frames - 1) * static_cast<double>(keys - 1);
+  const size_t i = std::min(static_cast<size_t>(u), keys - 2);
+  return {i, u - static_cast<double>(i)};
+}
+
+/// The centre camera's position and target at a place of the path: piecewise linear.
+CameraKey interpolated_key(const std::vector<CameraKey>& keys, const PathPlace& at) {
+  const CameraKey& a = keys[at.segment];
+  const CameraKey& b = keys[at.segment + 1];
+  return {glm::mix(a.position, b.position, at.t), glm::mix(a.target, b.target, at.t)};
+}
+
+bool looks_at_itself(const CameraKey& k) { return glm::length(k.target - k.position) < 1e-9; }
+
 }  // namespace
 
 void PathSpec::validate() const {
@@ -33,14 +55,29 @@ void PathSpec::validate() const {
     const CameraKey& k = camera_keys[i];
     if (!finite(k.position) || !finite(k.target))
       throw InputError(fmt::format("camera key {} has a non-finite coordinate", i + 1));
-    if (glm::length(k.target - k.position) < 1e-9)
+    if (looks_at_itself(k))
       throw InputError(fmt::format("camera key {} looks at its own position; give a target elsewhere", i + 1));
   }
+  // Between two valid keys the camera may still pass through its target (keys that swap position
+  // and target): every frame's pose must have a view direction.
+  if (camera_keys.size() >= 2 && frames > 1)
+    for (int f = 0; f < frames; ++f) {
+      const PathPlace at = place_of(camera_keys.size(), frames, f);
+      if (looks_at_itself(interpolated_key(camera_keys, at)))
+        throw InputError(fmt::format("frame {} of {}: the camera reaches its target between camera keys {} and {} "
+                                     "(position and target cross), so it has no view direction; move a target "
+                                     "or add a key between them",
+                                     f, frames, at.segment + 1, at.segment + 2));
+    }
   if (spin) {
     if (!finite(spin->axis) || glm::length(spin->axis) < 1e-12)
       throw InputError("the spin axis is zero or not finite; give a direction such as 0,1,0");
-    if (!std::isfinite(spin->degrees_per_frame))
-      throw InputError("the spin angle per frame is not finite");
+    // More than a turn per frame is the same motion as its remainder, and large values would
+    // overflow frame x angle.
+    if (!(std::abs(spin->degrees_per_frame) <= 360.0))
+      throw InputError(fmt::format("the spin angle per frame {} is not within ±360 degrees (one turn per frame); give "
+                                   "the angle turned between two frames",
+                                   spin->degrees_per_frame));
     if (spin->pivot && !finite(*spin->pivot)) throw InputError("the spin pivot is not finite");
   }
 }
@@ -82,12 +119,8 @@ CameraPose SceneAnimator::camera_at(int frame, const CameraPose& base) const {
   const std::vector<CameraKey>& keys = path_.camera_keys;
   if (keys.empty()) return base;
   if (keys.size() == 1 || path_.frames == 1) return CameraPose::look_at(keys.front().position, keys.front().target);
-  const double u = static_cast<double>(frame) / static_cast<double>(path_.frames - 1) * static_cast<double>(keys.size() - 1);
-  const size_t i = std::min(static_cast<size_t>(u), keys.size() - 2);
-  const double t = u - static_cast<double>(i);
-  const dvec3 position = glm::mix(keys[i].position, keys[i + 1].position, t);
-  const dvec3 target = glm::mix(keys[i].target, keys[i + 1].target, t);
-  return CameraPose::look_at(position, target);
+  const CameraKey k = interpolated_key(keys, place_of(keys.size(), path_.frames, frame));
+  return CameraPose::look_at(k.position, k.target);
 }
 
 std::vector<CameraKey> parse_camera_keys(const std::string& text) {

@@ -13,9 +13,21 @@ namespace sb {
 
 namespace {
 
-/// The scene's bounds; InputError when its geometry reaches beyond the coordinate range rays can use.
+/// The scene's bounds; InputError when a vertex is not a finite point (NaN positions would drop out
+/// of the bounds and of every ray query, leaving an empty image that compares as perfect) or the
+/// geometry reaches beyond the coordinate range rays can use.
 Bounds3 checked_bounds(const Scene& scene) {
-  const Bounds3 b = scene.bounds();
+  Bounds3 b;
+  for (const Mesh& m : scene.meshes)
+    for (size_t i = 0; i < m.positions.size(); ++i) {
+      const vec3& p = m.positions[i];
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+        throw InputError(fmt::format("scene '{}'{}: vertex {} of mesh '{}' is not a finite point ({}, {}, {}); check "
+                                     "the scene's positions and its animation",
+                                     scene.name, scene.path.empty() ? "" : " (" + scene.path + ")", i, m.name, p.x,
+                                     p.y, p.z));
+      b.extend(p);
+    }
   if (b.empty() || (within_scene_range(b.lo) && within_scene_range(b.hi))) return b;
   throw InputError(fmt::format("scene '{}'{}: its geometry spans ({:g}, {:g}, {:g}) to ({:g}, {:g}, {:g}) m, beyond the "
                                "±{:g} m a scene may span; check its scale and units (and its animation)",

@@ -264,8 +264,9 @@ void parse_path(const Where& where, const toml::node& node, SweepDefinition& d) 
     }
     if (const toml::node* v = spin.get("degrees_per_frame")) {
       s.degrees_per_frame = number_at(where, *v, "path.spin.degrees_per_frame");
-      if (!std::isfinite(s.degrees_per_frame))
-        where.fail(*v, "path.spin.degrees_per_frame", "is not a finite number of degrees");
+      if (!(std::abs(s.degrees_per_frame) <= 360.0))
+        where.fail(*v, "path.spin.degrees_per_frame",
+                   fmt::format("{} is not within ±360 (degrees turned between two frames)", s.degrees_per_frame));
     }
     if (const toml::node* v = spin.get("pivot")) s.pivot = point_at(where, *v, "path.spin.pivot", "[0, 0.5, 0]");
     if (const toml::node* v = spin.get("mesh_prefix")) s.mesh_prefix = string_at(where, *v, "path.spin.mesh_prefix");

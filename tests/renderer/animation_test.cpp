@@ -2,6 +2,9 @@
 // poses, and a refit or rebuilt BVH sees the moved geometry exactly as a freshly built one does.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <string>
+
 #include "renderer/animation.hpp"
 #include "renderer/error.hpp"
 #include "renderer/parallel.hpp"
@@ -57,6 +60,48 @@ TEST(Animation, CameraFollowsKeysAndBadPathsAreRejected) {
   PathSpec nothing;
   nothing.spin = Spin{{0.0, 1.0, 0.0}, std::nullopt, 1.0, "no-such-mesh"};
   EXPECT_THROW(SceneAnimator(scene, nothing), InputError);
+}
+
+TEST(Animation, APathWhoseCameraReachesItsTargetIsRejected) {
+  // Each key is valid, but position and target swap places: frame 1 of 3 stands on its target.
+  PathSpec crossing;
+  crossing.frames = 3;
+  crossing.camera_keys = parse_camera_keys("0,1,4>0,1,3;0,1,3>0,1,4");
+  try {
+    crossing.validate();
+    ADD_FAILURE() << "a camera on its own target has no view direction";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("frame 1 of 3: the camera reaches its target between camera keys 1 and 2"),
+              std::string::npos)
+        << e.what();
+  }
+  crossing.frames = 2;  // only the keys themselves: each looks somewhere
+  EXPECT_NO_THROW(crossing.validate());
+}
+
+TEST(Animation, SpinAnglesBeyondATurnPerFrameAndNonFiniteGeometryAreRejected) {
+  PathSpec path;
+  path.frames = 3;
+  path.spin = Spin{{0.0, 1.0, 0.0}, std::nullopt, 360.0, ""};
+  EXPECT_NO_THROW(path.validate());
+  path.spin->degrees_per_frame = -360.5;
+  EXPECT_THROW(path.validate(), InputError);
+  path.spin->degrees_per_frame = 1e308;  // frame 2 would turn by inf degrees: NaN vertices
+  EXPECT_THROW(path.validate(), InputError);
+
+  // Geometry that became NaN (by any route) is an error when the BVH is updated, not an empty
+  // image that would compare as identical to an equally empty truth.
+  Scene scene = test::load_builtin("box-wall");
+  RenderScene prepared(scene, true);
+  scene.meshes[0].positions[3] = vec3(std::nanf(""), 0.0f, 0.0f);
+  try {
+    (void)prepared.update_geometry();
+    ADD_FAILURE() << "a NaN vertex must not reach the BVH";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("vertex 3 of mesh '" + scene.meshes[0].name + "' is not a finite point"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 /// What the right eye's primary rays hit after the scene moved: through an updated BVH (refit or

@@ -297,6 +297,10 @@ TEST(SweepDefinition, RejectsBadPaths) {
       {"[sweep]\ntruths = [\"blender\"]\n[path]\nframes = 3\n[path.spin]\n",
        "def.toml:3: path.spin: truth 'blender' renders the scene file, which does not turn"},
       {"[sweep]\n[path]\nframes = 3\n[path.spin]\nmesh_prefix = 4\n", "def.toml:5: path.spin.mesh_prefix: must be a string"},
+      {"[sweep]\n[path]\nframes = 3\n[path.spin]\ndegrees_per_frame = 1e308\n",
+       "def.toml:5: path.spin.degrees_per_frame: 1e+308 is not within ±360"},
+      {"[sweep]\n[path]\nframes = 3\ncamera_keys = [[0, 1, 4, 0, 1, 3], [0, 1, 3, 0, 1, 4]]\n",
+       "def.toml:2: path: frame 1 of 3: the camera reaches its target between camera keys 1 and 2"},
   };
   for (const auto& c : cases) {
     const std::string e = error_of(c.toml);
