@@ -33,6 +33,10 @@ void require_positive(double value, const char* name, const char* hint) {
 
 void RigParams::validate() const {
   require_positive(interaxial, "interaxial", "give the eye separation in meters, e.g. 0.064");
+  if (interaxial > kMaxSceneCoordinate)
+    throw InputError(fmt::format("interaxial {:g} m is beyond the ±{:g} m a scene may span; give the eye separation "
+                                 "in meters, e.g. 0.064",
+                                 interaxial, kMaxSceneCoordinate));
   require_positive(convergence, "convergence",
                    "give the zero-parallax distance in meters, e.g. 2.0");
   if (width < 1 || width > kMaxImageSide || height < 1 || height > kMaxImageSide)
@@ -41,6 +45,12 @@ void RigParams::validate() const {
   if (!std::isfinite(vfov) || vfov <= 0.0 || vfov >= kPi)
     throw InputError(fmt::format("vertical field of view {} degrees is out of range (0, 180)",
                                  radians_to_degrees(vfov)));
+  const double disparity = max_disparity_from_interaxial(interaxial, convergence, vfov, height);
+  if (!(disparity <= kMaxDisparityPx))
+    throw InputError(fmt::format("interaxial {:g} m with convergence {:g} m gives a disparity at infinity of {:g} px "
+                                 "at {} px height, beyond the {:g} px a rig may have; increase the convergence "
+                                 "distance or reduce the interaxial",
+                                 interaxial, convergence, disparity, height, kMaxDisparityPx));
   require_positive(znear, "znear", "the near plane must lie in front of the camera");
   if (!std::isfinite(zfar) || zfar <= znear)
     throw InputError(fmt::format("zfar {} must be finite and greater than znear {}", zfar, znear));
@@ -205,6 +215,10 @@ StereoRig resolve_rig(const Scene& scene, const RigOverrides& o) {
   if (o.max_disparity_px) {
     require_positive(*o.max_disparity_px, "max disparity",
                      "give the disparity at infinity in pixels, e.g. 30");
+    if (*o.max_disparity_px > kMaxDisparityPx)
+      throw InputError(fmt::format("max disparity {:g} px is beyond the {:g} px a rig may have; give the disparity at "
+                                   "infinity in pixels, e.g. 30",
+                                   *o.max_disparity_px, kMaxDisparityPx));
     require_positive(p.convergence, "convergence", "give the zero-parallax distance in meters");
     p.interaxial = interaxial_from_max_disparity(*o.max_disparity_px, p.convergence, p.vfov, p.height);
   }

@@ -17,6 +17,11 @@ enum class Eye { left, right, center };
 /// Largest image side the suite accepts, per axis.
 constexpr int kMaxImageSide = 16384;
 
+/// Largest disparity at infinity (f_px·e/c, pixels) a rig may have: a million pixels, a sensor
+/// shift hundreds of image widths wide. Beyond it (a convergence of nanometres, an interaxial of
+/// light years) the eyes' frusta hold no common point and the ray setup loses its precision.
+constexpr double kMaxDisparityPx = 1e6;
+
 /// The rig's parameters. Lengths are meters, angles radians.
 struct RigParams {
   double interaxial = 0.064;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <string_view>
 
@@ -14,6 +15,7 @@
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/pipeline.hpp"
 #include "renderer/rig.hpp"
+#include "renderer/scene.hpp"
 #include "scenes/generators.hpp"
 #include "validation/content_hash.hpp"
 #include "validation/truth.hpp"
@@ -118,12 +120,16 @@ double positive_at(const Where& where, const toml::node& node, const std::string
   return v;
 }
 
-/// A numeric axis; repeated values are an error (they would give cells with one id).
+/// A numeric axis of positive values up to `largest`; repeated values are an error (they would
+/// give cells with one id).
 std::vector<std::optional<double>> positive_axis(const Where& where, const toml::node& node, const std::string& path,
-                                                 const char* hint) {
+                                                 const char* hint, double largest) {
   std::vector<std::optional<double>> out;
   for (const toml::node* e : axis_entries(where, node, path)) {
     const double v = positive_at(where, *e, path, hint);
+    if (v > largest)
+      where.fail(*e, path, fmt::format("{} is beyond the largest value a rig takes, {:g}; {}", number_text(v), largest,
+                                       hint));
     for (const auto& seen : out)
       if (*seen == v) where.fail(*e, path, fmt::format("lists {} twice", number_text(v)));
     out.push_back(v);
@@ -421,12 +427,16 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
                            "way only",
                            interaxial->source().begin.line));
   if (interaxial)
-    d.interaxial_m = positive_axis(where, *interaxial, "sweep.interaxial_m", "give eye separations in meters, e.g. 0.064");
+    d.interaxial_m = positive_axis(where, *interaxial, "sweep.interaxial_m",
+                                   "give eye separations in meters, e.g. 0.064", kMaxSceneCoordinate);
   if (disparity)
     d.max_disparity_px =
-        positive_axis(where, *disparity, "sweep.max_disparity_px", "give disparities at infinity in pixels, e.g. 30");
+        positive_axis(where, *disparity, "sweep.max_disparity_px", "give disparities at infinity in pixels, e.g. 30",
+                      kMaxDisparityPx);
   if (const toml::node* n = sweep.get("convergence_m"))
-    d.convergence_m = positive_axis(where, *n, "sweep.convergence_m", "give zero-parallax distances in meters, e.g. 2.0");
+    d.convergence_m = positive_axis(where, *n, "sweep.convergence_m",
+                                    "give zero-parallax distances in meters, e.g. 2.0",
+                                    std::numeric_limits<double>::max());
   if (const toml::node* n = sweep.get("resolutions")) {
     d.resolutions.clear();
     for (const toml::node* e : axis_entries(where, *n, "sweep.resolutions")) {

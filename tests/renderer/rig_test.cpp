@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "renderer/error.hpp"
 #include "renderer/rig.hpp"
@@ -126,6 +127,26 @@ TEST(Rig, BadParametersAreInputErrors) {
   both.interaxial = 0.06;
   both.max_disparity_px = 20.0;
   EXPECT_THROW((void)resolve_rig(empty, both), InputError);
+
+  // Rigs whose rays cannot be set up: an interaxial beyond the span of a scene (1e20 m aborted the
+  // ray tracer on NaN rays), a convergence so near that the sensor shift is infinite, a disparity
+  // of a billion pixels. The largest accepted ones still render.
+  for (const auto& [e, c] : {std::pair{1e20, 2.0}, std::pair{1.0, 1e-6}, std::pair{0.064, 1e-300}}) {
+    try {
+      make_rig(e, c);
+      ADD_FAILURE() << "e " << e << " c " << c;
+    } catch (const InputError& err) {
+      EXPECT_NE(std::string(err.what()).find(e > kMaxSceneCoordinate ? "a scene may span" : "a rig may have"),
+                std::string::npos)
+          << err.what();
+    }
+  }
+  EXPECT_NO_THROW(make_rig(1e15, 1e15));
+  RigOverrides wide;
+  wide.max_disparity_px = 1e9;
+  EXPECT_THROW((void)resolve_rig(empty, wide), InputError);
+  wide.max_disparity_px = kMaxDisparityPx;
+  EXPECT_NO_THROW((void)resolve_rig(empty, wide));
 }
 
 TEST(Rig, ResolutionNamesAndErrors) {
