@@ -8,7 +8,9 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
-#include <sstream>
+#include <new>
+#include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -83,10 +85,22 @@ std::string read_file(const fs::path& path) {
     throw InputError(fmt::format("{} is a folder, not a file; give the path of the file to read", path.string()));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(fmt::format("cannot read {}: {}", path.string(), std::strerror(errno)));
-  std::ostringstream ss;
-  ss << in.rdbuf();
+  // Read in blocks rather than through a stream buffer copy, which would swallow a failed
+  // allocation and return the file cut short.
+  std::string text;
+  try {
+    const uintmax_t size = fs::file_size(path, ec);
+    if (!ec) text.reserve(static_cast<size_t>(size));
+    std::vector<char> block(size_t{1} << 16);
+    while (in.read(block.data(), static_cast<std::streamsize>(block.size())) || in.gcount() > 0)
+      text.append(block.data(), static_cast<size_t>(in.gcount()));
+  } catch (const std::bad_alloc&) {
+    throw IoError(fmt::format("not enough memory to read {} ({} bytes); free memory or raise the process's memory "
+                              "limit",
+                              path.string(), fs::file_size(path, ec)));
+  }
   if (in.bad()) throw IoError(fmt::format("error while reading {}", path.string()));
-  return ss.str();
+  return text;
 }
 
 }  // namespace sb::io

@@ -758,12 +758,8 @@ Scene load_gltf(const fs::path& path, const GltfLoadOptions& options) {
                                  "`stereobench scenes list` for the built-in scenes", file));
   if (!fs::is_regular_file(path, ec))
     throw InputError(fmt::format("{}: not a regular file; give a .gltf or .glb file", file));
-  std::string bytes;
-  try {
-    bytes = read_file(path);
-  } catch (const IoError& e) {
-    throw InputError(e.what());
-  }
+  // A file that cannot be read (permissions, a failing disk, too little memory) is an I/O failure.
+  const std::string bytes = read_file(path);
   if (bytes.empty()) throw InputError(fmt::format("{}: the file is empty; give a .gltf or .glb file", file));
   const GlbParts parts = split_container(bytes, file, lowercase(path.extension().string()) == ".glb");
   json doc;

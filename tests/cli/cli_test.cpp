@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cstdint>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -84,6 +87,21 @@ TEST(Cli, SceneInfoPrintsRigAndDisparities) {
   EXPECT_NE(r.out.find("1 triangles"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("640x360"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("max disparity 20.00 px"), std::string::npos) << r.out;
+}
+
+TEST(Cli, AFileLargerThanTheMemoryLimitIsAnIoErrorNotATruncatedFile) {
+  // A 4 GiB file (sparse: no disk used) read under a 3 GB address-space limit: the read fails
+  // for memory (exit 4) instead of returning the file cut short, which the loader reported as a
+  // damaged file (exit 3).
+  test::ScratchDir dir("bigread");
+  const std::filesystem::path big = dir / "big.gltf";
+  { std::ofstream(big).put(' '); }
+  std::filesystem::resize_file(big, uintmax_t{4} << 30);
+  const CliRun r = test::run_shell("ulimit -v 3000000 && " + std::string(SB_CLI_PATH) + " scenes info " +
+                                   test::quoted(big));
+  EXPECT_EQ(r.code, 4) << r.out;
+  EXPECT_NE(r.out.find("not enough memory to read " + big.string() + " (4294967296 bytes)"), std::string::npos)
+      << r.out;
 }
 
 TEST(Cli, RenderWritesEveryOutputAndBenchPrintsATable) {
