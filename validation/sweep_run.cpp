@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
+#include <cstring>
 #include <chrono>
 #include <ctime>
 #include <exception>
@@ -19,6 +21,7 @@
 
 #include "renderer/animation.hpp"
 #include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
 #include "renderer/io/gltf_loader.hpp"
 #include "renderer/io/render_output.hpp"
 #include "renderer/parallel.hpp"
@@ -78,8 +81,7 @@ SweepPlan plan_sweep(const SweepDefinition& definition, const fs::path& results,
     if (sweep != definition.name || sha != definition.sha256)
       throw InputError(fmt::format(
           "{} holds cells of sweep '{}' (definition sha256 {}), not of this definition '{}' ({}, sha256 {}); "
-          "the definition changed since those cells ran: give another --out or --results, or delete the file to "
-          "start over",
+          "the definition changed since those cells ran: give another --out, or delete the file to start over",
           results.string(), sweep, sha.substr(0, 12), definition.name, definition.file.string(),
           definition.sha256.substr(0, 12)));
     if (!known.count(id))
@@ -339,6 +341,49 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
 
 }  // namespace
 
+namespace {
+
+/// The marker that gives an output folder to one sweep definition.
+constexpr const char* kOutMarker = ".stereobench-sweep.json";
+
+/// Claims the output folder for this definition before any cell runs: a folder made for another
+/// definition (its marker names it) is refused, since the cells' images, whose folders are named by
+/// cell index, would overwrite that sweep's; the shards of one sweep share it. Also shows that the
+/// folder and the results file's folder can be written (IoError otherwise), before any work.
+void claim_out_folder(const SweepDefinition& d, const SweepRunOptions& options) {
+  for (const fs::path& dir : {options.out_dir, options.results.has_parent_path() ? options.results.parent_path()
+                                                                                  : fs::path(".")}) {
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (!fs::is_directory(dir))
+      throw IoError(fmt::format("cannot use {} as an output folder: {}; give --out (or --results) a folder you can "
+                                "write",
+                                dir.string(), ec ? ec.message() : "it exists and is not a folder"));
+    if (::access(dir.c_str(), W_OK) != 0)
+      throw IoError(fmt::format("cannot write into {}: {}; give --out (or --results) a folder you can write",
+                                dir.string(), std::strerror(errno)));
+  }
+  const fs::path marker = options.out_dir / kOutMarker;
+  const json mine = {{"sweep", d.name}, {"definition_sha256", d.sha256}, {"definition", d.file.string()}};
+  if (fs::exists(marker)) {
+    json theirs;
+    try {
+      theirs = json::parse(io::read_file(marker));
+    } catch (const json::exception&) {
+      theirs = json::object();
+    }
+    if (theirs.value("sweep", "") == d.name && theirs.value("definition_sha256", "") == d.sha256) return;
+    throw InputError(fmt::format(
+        "{} holds the cells of sweep '{}' ({}, sha256 {}), not of this definition '{}' ({}, sha256 {}); its images "
+        "would be overwritten: give another --out, or delete the folder to start over",
+        options.out_dir.string(), theirs.value("sweep", "?"), theirs.value("definition", "?"),
+        theirs.value("definition_sha256", "?").substr(0, 12), d.name, d.file.string(), d.sha256.substr(0, 12)));
+  }
+  io::write_text_atomically(marker, mine.dump(2) + "\n");
+}
+
+}  // namespace
+
 void prepare_sweep(const SweepDefinition& d, const std::vector<SweepCell>& cells, const std::vector<size_t>& todo,
                    const SweepRunOptions& options) {
   std::set<std::string> truths, scenes_done;
@@ -348,6 +393,7 @@ void prepare_sweep(const SweepDefinition& d, const std::vector<SweepCell>& cells
     if (auto why = provider->unavailable_reason())
       throw ToolError(fmt::format("{}: truth '{}' is unavailable: {}", d.file.string(), name, *why));
   }
+  claim_out_folder(d, options);
   for (size_t i : todo)
     if (scenes_done.insert(cells[i].scene.label).second) (void)scene_file(cells[i].scene, options.scenes_dir);
 }

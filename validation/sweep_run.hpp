@@ -54,7 +54,9 @@ struct SweepPlan {
 [[nodiscard]] std::string cell_dir_name(size_t index, size_t cell_count);
 
 /// Checks what the cells need before any runs: every truth provider available (ToolError naming
-/// it and why otherwise), every scene resolvable (built-in scenes generated now, once).
+/// it and why otherwise), the output folder writable and not another definition's (a marker file
+/// gives it to this definition; InputError if it names another), every scene resolvable
+/// (built-in scenes generated now, once).
 void prepare_sweep(const SweepDefinition& definition, const std::vector<SweepCell>& cells,
                    const std::vector<size_t>& todo, const SweepRunOptions& options);
 

@@ -152,6 +152,15 @@ TEST(SweepRun, ResumesAfterKillWithoutLosingOrDuplicatingCells) {
                                              quoted(dir / "out") + " --scenes-dir " + quoted(dir / "scenes"));
   EXPECT_EQ(changed.code, 3) << changed.out;
   EXPECT_NE(changed.out.find("the definition changed"), std::string::npos) << changed.out;
+  // Nor does it share the folder through a results file of its own: its cells' images would
+  // overwrite these (their folders are named by cell index).
+  const test::CliRun beside = test::run_cli("sweep run " + quoted(dir / "tiny.toml") + " --out " + quoted(dir / "out") +
+                                            " --results " + quoted(dir / "other.jsonl") + " --scenes-dir " +
+                                            quoted(dir / "scenes"));
+  EXPECT_EQ(beside.code, 3) << beside.out;
+  EXPECT_NE(beside.out.find("holds the cells of sweep 'tiny'"), std::string::npos) << beside.out;
+  EXPECT_NE(beside.out.find("its images would be overwritten: give another --out"), std::string::npos) << beside.out;
+  EXPECT_FALSE(fs::exists(dir / "other.jsonl"));
 }
 
 TEST(SweepRun, ShardsCollectedEqualAnUnshardedRun) {
@@ -390,6 +399,16 @@ TEST(SweepRun, BadDefinitionAndShardAreUsageErrors) {
   std::ofstream(dir / "ok.toml") << kTinySweep;
   const test::CliRun shard = test::run_cli("sweep run " + quoted(dir / "ok.toml") + " --shard 2/2 --out " + quoted(dir / "o"));
   EXPECT_EQ(shard.code, 3) << shard.out;
+  // An output folder that cannot be one fails before any cell runs.
+  std::ofstream(dir / "afile") << "x";
+  const test::CliRun unusable =
+      test::run_cli("sweep run " + quoted(dir / "ok.toml") + " --out " + quoted(dir / "afile") + " --results " +
+                    quoted(dir / "r.jsonl") + " --scenes-dir " + quoted(dir / "scenes"));
+  EXPECT_EQ(unusable.code, 4) << unusable.out;
+  EXPECT_NE(unusable.out.find("cannot use " + (dir / "afile").string() + " as an output folder"), std::string::npos)
+      << unusable.out;
+  EXPECT_EQ(unusable.out.find("[1/6]"), std::string::npos) << "no cell may run: " << unusable.out;
+  EXPECT_FALSE(fs::exists(dir / "r.jsonl"));
 }
 
 }  // namespace
