@@ -104,6 +104,9 @@ void check_cell_line(const json& line, const std::string& where) {
   require(line, where, "", "cell_id", Kind::string);
   if (line["cell_id"].get<std::string>().empty()) throw InputError(fmt::format("{}: cell_id is empty", where));
   require(line, where, "", "cell_index", Kind::integer);
+  if (line["cell_index"].get<long long>() < 0)
+    throw InputError(fmt::format("{}: cell_index {} is negative; cells are numbered from 0", where,
+                                 line["cell_index"].dump()));
   require(line, where, "", "cell", Kind::object);
   require(line, where, "", "cell.scene", Kind::string);
   require(line, where, "", "cell.resolution", Kind::string);
@@ -172,6 +175,7 @@ ResultsFile read_results_file(const fs::path& path) {
   ResultsFile out;
   out.path = path;
   std::map<std::string, size_t> seen;  // cell_id -> line
+  std::map<long long, size_t> seen_index;  // cell_index -> line
   size_t line_no = 0;
   size_t pos = 0;
   while (pos < text.size()) {
@@ -194,12 +198,31 @@ ResultsFile read_results_file(const fs::path& path) {
       throw InputError(fmt::format("{}: not a JSON line: {}", where, e.what()));
     }
     check_cell_line(parsed, where);
+    // One sweep per file: the report's summary, charts and cell numbers are those of one definition.
+    if (!out.cells.empty()) {
+      const json& first = out.cells.front().json;
+      if (parsed["sweep"] != first["sweep"] ||
+          parsed.value("definition_sha256", "") != first.value("definition_sha256", ""))
+        throw InputError(fmt::format(
+            "{}: a cell of sweep '{}' (definition sha256 {}), but line {} is of sweep '{}' (sha256 {}); a report "
+            "covers one sweep: give one sweep's results file (the shards of one definition merge with `stereobench "
+            "sweep collect`)",
+            where, parsed["sweep"].get<std::string>(), parsed.value("definition_sha256", "?").substr(0, 12),
+            out.cells.front().line, first["sweep"].get<std::string>(),
+            first.value("definition_sha256", "?").substr(0, 12)));
+    }
     const std::string id = parsed["cell_id"].get<std::string>();
     const auto [it, fresh] = seen.emplace(id, line_no);
     if (!fresh)
       throw InputError(fmt::format("{}: cell_id '{}' appears again (first on line {}); a results file holds each cell "
                                    "once — merge shards with `stereobench sweep collect`",
                                    where, id, it->second));
+    const auto [at, new_index] = seen_index.emplace(parsed["cell_index"].get<long long>(), line_no);
+    if (!new_index)
+      throw InputError(fmt::format("{}: cell_index {} is also the index of line {}, a different cell; the file is "
+                                   "damaged or was joined by hand — rerun the sweep or merge with `stereobench sweep "
+                                   "collect`",
+                                   where, parsed["cell_index"].dump(), at->second));
     out.cells.push_back({line_no, std::move(parsed)});
   }
   if (out.cells.empty())

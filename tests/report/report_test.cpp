@@ -181,6 +181,10 @@ TEST(Report, MalformedResultsExit3NamingFileAndLine) {
   newer["schema_version"] = 2;
   json bad_metric = minimal_line("b", 1);
   bad_metric["pipelines"]["plain-rt"]["validation"]["metrics"]["psnr"] = "high";
+  json other_sweep = minimal_line("b", 1);
+  other_sweep["sweep"] = "other";
+  json other_version = minimal_line("b", 1);
+  other_version["definition_sha256"] = "0123456789abcdef";
   const std::vector<Case> cases = {
       {good + "{\"kind\": \"stereobench.sweep_cell\", oops}\n" + minimal_line("c", 2).dump() + "\n",
        "results.jsonl:2: not a JSON line"},
@@ -190,6 +194,12 @@ TEST(Report, MalformedResultsExit3NamingFileAndLine) {
       {good + newer.dump() + "\n", "results.jsonl:2: schema_version 2 is newer"},
       {good + bad_metric.dump() + "\n", "results.jsonl:2: field 'pipelines.plain-rt.validation.metrics.psnr' is \"high\""},
       {good + "\n" + minimal_line("a", 5).dump() + "\n", "results.jsonl:3: cell_id 'a' appears again (first on line 1)"},
+      {good + other_sweep.dump() + "\n",
+       "results.jsonl:2: a cell of sweep 'other' (definition sha256 ?), but line 1 is of sweep 'tiny' (sha256 ?); a "
+       "report covers one sweep"},
+      {good + other_version.dump() + "\n", "results.jsonl:2: a cell of sweep 'tiny' (definition sha256 0123456789ab)"},
+      {good + minimal_line("b", 0).dump() + "\n", "results.jsonl:2: cell_index 0 is also the index of line 1"},
+      {minimal_line("a", -1).dump() + "\n", "results.jsonl:1: cell_index -1 is negative"},
       {"[1, 2]\n", "results.jsonl:1: a results line must be a JSON object"},
       {"", "holds no finished cell"},
       {"{\"kind\": \"stereobench.sweep_ce", "holds no finished cell"},
