@@ -129,15 +129,23 @@ void append_result(const fs::path& file, const json& cell) {
   if (fd.get() < 0) io_fail(file, "open");
   if (::flock(fd.get(), LOCK_EX) != 0) io_fail(file, "lock");
   cut_torn_tail(fd.get(), file);
-  // One write of the whole line; a short write (full disk) is completed or reported.
+  // One write of the whole line; a short write is completed, and a failed one (a full disk) is
+  // undone, so that no part of the line stays behind.
+  const off_t before = ::lseek(fd.get(), 0, SEEK_END);
+  const auto fail = [&](const char* what) {
+    const int saved = errno;
+    if (before >= 0) (void)!::ftruncate(fd.get(), before);
+    errno = saved;
+    io_fail(file, what);
+  };
   size_t done = 0;
   while (done < line.size()) {
     const ssize_t n = ::write(fd.get(), line.data() + done, line.size() - done);
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) io_fail(file, "append to");
+    if (n <= 0) fail("append to");
     done += static_cast<size_t>(n);
   }
-  if (::fsync(fd.get()) != 0) io_fail(file, "flush");
+  if (::fsync(fd.get()) != 0) fail("flush");
   (void)::flock(fd.get(), LOCK_UN);
 }
 

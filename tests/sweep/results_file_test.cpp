@@ -1,7 +1,9 @@
 // The results file: atomic appends, a torn last line tolerated and cut before the next append,
 // duplicates rejected, shards merged, CSV export.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
+#include <csignal>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -83,6 +85,32 @@ TEST(ResultsFile, TornLastLineSkippedThenCut) {
   ASSERT_EQ(after.cells.size(), 2u);
   EXPECT_TRUE(after.warnings.empty());
   EXPECT_EQ(after.cells[1], cell(1, "b"));
+}
+
+TEST(ResultsFile, AnAppendThatFailsLeavesNoPartOfItsLine) {
+  test::ScratchDir dir;
+  const auto file = dir / "results.jsonl";
+  append_result(file, cell(0, "a"));
+  const std::string before = test::read_text(file);
+  // A disk that fills mid-line, made by a file-size limit just past the current end (the signal
+  // the kernel sends at the limit is ignored, so the write fails with EFBIG instead).
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  rlimit old_limit{};
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old_limit), 0);
+  rlimit tight = old_limit;
+  tight.rlim_cur = static_cast<rlim_t>(before.size() + 100);
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &tight), 0);
+  bool failed = false;
+  try {
+    append_result(file, cell(1, "b"));
+  } catch (const IoError& e) {
+    failed = true;
+    EXPECT_NE(std::string(e.what()).find("cannot append to the results file"), std::string::npos) << e.what();
+  }
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &old_limit), 0);
+  std::signal(SIGXFSZ, old_handler);
+  EXPECT_TRUE(failed);
+  EXPECT_EQ(test::read_text(file), before) << "the first 100 bytes of the line were written, then taken back";
 }
 
 TEST(ResultsFile, BadLinesAndDuplicatesRejected) {
