@@ -84,6 +84,14 @@ void put_u32(std::ofstream& out, uint32_t v) {
   out.write(reinterpret_cast<const char*>(b.data()), 4);
 }
 
+/// A scene file's write that failed (a full disk, a lost folder): names the file, not its
+/// temporary, with the cause.
+[[noreturn]] void write_failed(const std::filesystem::path& path, size_t bytes) {
+  throw IoError(fmt::format("cannot write the scene file {} ({} bytes): {}; check free disk space and the folder's "
+                            "permissions",
+                            path.string(), bytes, std::strerror(errno)));
+}
+
 }  // namespace
 
 NodeTransform NodeTransform::trs(const dvec3& t, double yaw, double uniform_scale) {
@@ -416,7 +424,7 @@ size_t GltfBuilder::write(const std::filesystem::path& path) const {
         out.write(reinterpret_cast<const char*>(bin_.data()), static_cast<std::streamsize>(bin_.size()));
       }
       out.close();
-      if (!out) throw IoError(fmt::format("cannot write '{}'", tmp.string()));
+      if (!out) write_failed(path, static_cast<size_t>(total));
     });
     return static_cast<size_t>(total);
   }
@@ -451,7 +459,7 @@ size_t GltfBuilder::write(const std::filesystem::path& path) const {
     out.put('\n');
     ++total;
     out.close();
-    if (!out) throw IoError(fmt::format("cannot write '{}'", tmp.string()));
+    if (!out) write_failed(path, total);
   });
   return total;
 }

@@ -93,6 +93,19 @@ TEST(SceneRegistry, RejectsUnknownAndOutOfRangeParameters) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+TEST(SceneRegistry, AWriteThatFailsNamesTheFileAndLeavesNothing) {
+  // A full disk, made by a file-size limit of 1 KiB (the signal sent at the limit ignored, so the
+  // write fails with EFBIG): exit 4 naming the scene file and the cause, and no file left.
+  const ScratchDir dir;
+  const test::CliRun r = test::run_shell("trap '' XFSZ; ulimit -f 2 && " + std::string(SB_CLI_PATH) +
+                                         " scenes generate box-wall --out " + quoted(dir / "gen"));
+  EXPECT_EQ(r.code, 4) << r.out;
+  EXPECT_NE(r.out.find("cannot write the scene file " + (dir / "gen" / "box-wall.gltf").string()), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("File too large"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::is_empty(dir / "gen")) << "neither the file nor its temporary stays";
+}
+
 TEST(SceneParams, TriangleCountsFollowTheParameter) {
   const ScratchDir dir;
   for (const double n : {250000.0, 1200000.0}) {
