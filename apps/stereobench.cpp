@@ -48,6 +48,24 @@ void refuse_empty_out(CLI::App& app) {
   for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) refuse_empty_out(*sub);
 }
 
+/// Options that name a file to write (--json, --junit, sweep collect's merged file): a folder
+/// there would be found only when the file is written, after all the work; refused at once.
+void refuse_folder_as_file(CLI::App& app) {
+  for (const char* name : {"--json", "--junit", "out"}) {
+    CLI::Option* file = app.get_option_no_throw(name);
+    if (!file || (std::string(name) == "out" && !file->get_positional())) continue;
+    file->check(CLI::Validator(
+        [](const std::string& value) {
+          std::error_code ec;
+          return value != "-" && std::filesystem::is_directory(value, ec)
+                     ? std::string("is a folder; give the name of the file to write")
+                     : std::string();
+        },
+        "", "not a folder"));
+  }
+  for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) refuse_folder_as_file(*sub);
+}
+
 /// When parsing stopped for want of a subcommand: the first word after the commands given that
 /// names none of the next level's, with those names ("" when every word is a command or option).
 std::string unknown_command_message(const CLI::App& app, int argc, char** argv) {
@@ -95,6 +113,7 @@ int main(int argc, char** argv) {
   sb::cli::register_report_command(app);
   sb::cli::register_path_command(app);
   refuse_empty_out(app);
+  refuse_folder_as_file(app);
 
   try {
     app.parse(argc, argv);

@@ -69,6 +69,11 @@ TEST(Cli, BadArgumentsExitWith3AndSayWhy) {
       {"", "subcommand"},
       {"scenes generate spheres --seed -1 --out '" + dir.path().string() + "'",
        "--seed: a seed is a whole number of 0 or more, not -1"},
+      // A folder where a file is to be written: refused before the work, not when writing it.
+      {"bench --scene " + scene + " --resolution 16x9 --pipelines plain-rt --json '" + dir.path().string() + "'",
+       "--json: is a folder; give the name of the file to write"},
+      {"sweep collect '" + dir.path().string() + "' a.jsonl", "out: is a folder; give the name of the file to write"},
+      {"gate --results a.jsonl --junit '" + dir.path().string() + "'", "--junit: is a folder"},
   };
   for (const Case& c : cases) {
     const CliRun r = run(c.args);
