@@ -111,8 +111,9 @@ fs::path choose_run_dir(const fs::path& out, const SweepDefinition& d, bool* res
     // "-N" suffixes order after the plain id of the same second, and numerically among themselves.
     const std::string sa = a.substr(0, 16), sb = b.substr(0, 16);
     if (sa != sb) return sa < sb;
-    const int na = a.size() > 17 ? std::stoi(a.substr(17)) : 1, nb = b.size() > 17 ? std::stoi(b.substr(17)) : 1;
-    return na < nb;
+    // Compared as digit strings (shorter is smaller), so that any length of suffix orders.
+    const std::string na = a.size() > 17 ? a.substr(17) : "1", nb = b.size() > 17 ? b.substr(17) : "1";
+    return na.size() != nb.size() ? na.size() < nb.size() : na < nb;
   });
   *resumed = false;
   if (!ids.empty()) {
@@ -161,6 +162,8 @@ void run_nightly(const NightlyArgs& a) {
   else
     baseline_note = fmt::format("no baseline file {}: time regressions not checked", baseline_file.string());
 
+  const int threads = checked_threads(a.threads);  // before a run folder is made
+
   // 1. The sweep, into the run folder.
   bool resumed = false;
   const fs::path run_dir = choose_run_dir(out, d, &resumed);
@@ -172,7 +175,7 @@ void run_nightly(const NightlyArgs& a) {
   if (!a.cache.empty()) o.truth_cache = fs::path(a.cache);
   o.definition_label = a.definition;
   o.jobs = a.jobs;
-  o.threads = checked_threads(a.threads);
+  o.threads = threads;
   const SweepPlan plan = plan_sweep(d, o.results);
   for (const std::string& w : plan.warnings) fmt::print(stderr, "warning: {}\n", w);
   fmt::print("nightly {} run {} ({}): {} cells × {} pipelines, {} finished already, {} to run\n", d.name, run_id,

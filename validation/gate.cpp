@@ -272,7 +272,8 @@ GateConfig parse_gate_config(const std::string& text, const std::string& source)
 
 GateConfig load_gate_config(const std::filesystem::path& file) {
   if (!std::filesystem::exists(file))
-    throw InputError(fmt::format("gate config {} does not exist; give --config FILE (the shipped one is ci/gate.toml)",
+    throw InputError(fmt::format("gate config {} does not exist; give the thresholds file (gate --config FILE, nightly "
+                                 "--gate-config FILE; the shipped one is ci/gate.toml)",
                                  file.string()));
   return parse_gate_config(io::read_file(file), file.string());
 }

@@ -277,6 +277,28 @@ TEST(NightlyTest, MalformedHistoryIsBadInputNamingFileAndLine) {
                                         " --history " + quoted(history));
   EXPECT_EQ(r2.code, 3) << r2.out;
   EXPECT_NE(r2.out.find(history.string() + ":1:"), std::string::npos) << r2.out;
+
+  // A bad option is refused before a run folder is made (an empty one would be resumed next time).
+  fs::remove(history);
+  const test::CliRun threads = test::run_cli(nightly_args(dir) + " --threads -1");
+  EXPECT_EQ(threads.code, 3) << threads.out;
+  run_folders = 0;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs")) run_folders += e.is_directory() ? 1 : 0;
+  EXPECT_EQ(run_folders, 0u);
+}
+
+TEST(NightlyTest, RunFoldersWithLongSuffixesOrderWithoutOverflow) {
+  // Folders of earlier runs, finished, one with a suffix beyond any int: the new run orders after
+  // them (it said "internal error: stoi", exit 4).
+  test::ScratchDir dir;
+  write_inputs(dir);
+  for (const char* id : {"20200101T000000Z", "20200101T000000Z-99999999999", "20200101T000000Z-7"}) {
+    fs::create_directories(dir / "runs" / id);
+    write_text(dir / "runs" / id / "nightly.json", "{}\n");  // the file a finished run leaves
+  }
+  const test::CliRun r = test::run_cli(nightly_args(dir));
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find(" (new): "), std::string::npos) << "a new run, none resumed: " << r.out;
 }
 
 }  // namespace
