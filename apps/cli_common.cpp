@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <tbb/info.h>
 
 #include "renderer/error.hpp"
 #include "scenes/catalog.hpp"
@@ -88,6 +89,13 @@ std::map<std::string, std::string> parse_key_values(const std::vector<std::strin
 int checked_threads(int threads) {
   if (threads < 0 || threads > 1024)
     throw InputError(fmt::format("--threads {} is out of range; give 0 (all cores) or 1..1024", threads));
+  // The task scheduler runs at most one thread per core; more would be recorded but not run.
+  const int cores = tbb::info::default_concurrency();
+  if (threads > cores) {
+    fmt::print(stderr, "note: --threads {} is more than the {} core{} here; using {}\n", threads, cores,
+               cores == 1 ? "" : "s", cores);
+    return cores;
+  }
   return threads;
 }
 

@@ -39,7 +39,8 @@ CLI::Option* add_lights_option(CLI::App& app, std::optional<int>& lights);
 [[nodiscard]] std::map<std::string, std::string> parse_key_values(const std::vector<std::string>& items,
                                                                   const char* option);
 
-/// Checks a --threads value: 0 (all cores) or 1..1024.
+/// Checks a --threads value: 0 (all cores) or 1..1024; more than the cores is taken as the
+/// cores, with a note (the scheduler would run no more, yet the results would record them).
 [[nodiscard]] int checked_threads(int threads);
 
 }  // namespace sb::cli

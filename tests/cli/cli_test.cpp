@@ -94,6 +94,16 @@ TEST(Cli, SceneInfoPrintsRigAndDisparities) {
   EXPECT_NE(r.out.find("max disparity 20.00 px"), std::string::npos) << r.out;
 }
 
+TEST(Cli, MoreThreadsThanCoresAreTheCoresAndSaySo) {
+  test::ScratchDir dir("threads");
+  const CliRun r = run("render --scene box-wall --pipeline plain-rt --resolution 32x18 --threads 1024 --scenes-dir " +
+                       test::quoted(dir / "scenes") + " --out " + test::quoted(dir / "r"));
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("note: --threads 1024 is more than the"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("TBB Warning"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("1024 threads"), std::string::npos) << "the count run is recorded, not the count asked: " << r.out;
+}
+
 TEST(Cli, AFileLargerThanTheMemoryLimitIsAnIoErrorNotATruncatedFile) {
   // A 4 GiB file (sparse: no disk used) read under a 3 GB address-space limit: the read fails
   // for memory (exit 4) instead of returning the file cut short, which the loader reported as a
