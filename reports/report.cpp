@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
+#include <cstring>
+#include <fstream>
 #include <map>
 #include <set>
 #include <span>
@@ -19,6 +21,16 @@ namespace sb::reports {
 namespace {
 
 namespace fs = std::filesystem;
+
+/// Whether a file starts with the PNG signature.
+bool is_png_file(const fs::path& file) {
+  static constexpr unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  std::ifstream in(file, std::ios::binary);
+  char head[8] = {};
+  if (!in.read(head, sizeof head)) return false;
+  return std::memcmp(head, kSignature, sizeof head) == 0;
+}
+
 using nlohmann::json;
 
 /// Marks an index.html as ours, so that a later report may replace the folder's assets and images.
@@ -375,6 +387,13 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
     if (!fs::is_regular_file(source, ec)) {
       summary.warnings.push_back(fmt::format("{}: image {} is missing (looked for {}); the viewer shows it as "
                                              "unavailable",
+                                             results.path.string(), rel, source.string()));
+      return "";
+    }
+    // Every image of a results line is a PNG the sweep wrote; anything else a path names (a
+    // hand-edited line, a path into the system) is not copied into a report that may be shared.
+    if (!is_png_file(source)) {
+      summary.warnings.push_back(fmt::format("{}: image {} ({}) is not a PNG file; left out of the report",
                                              results.path.string(), rel, source.string()));
       return "";
     }

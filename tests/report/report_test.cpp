@@ -257,6 +257,23 @@ TEST(Report, WarnsOnTornTailAndMissingImagesAndGuardsForeignFolders) {
   EXPECT_EQ(foreign.code, 3) << foreign.out;
   EXPECT_NE(foreign.out.find("is not empty and holds no stereobench report"), std::string::npos) << foreign.out;
   EXPECT_EQ(test::read_text(dir / "mine" / "notes.txt"), "keep");
+
+  // An image path naming a file that is not a PNG (here a text file beside the results) is left
+  // out with a warning, not copied into the report.
+  write_text(dir / "secret.txt", "not an image");
+  json stray = minimal_line("a", 0);
+  stray["images"] = {{"left_png", "secret.txt"}};
+  write_text(dir / "stray.jsonl", stray.dump() + "\n");
+  const test::CliRun leak = test::run_cli("report " + quoted(dir / "stray.jsonl") + " --out " + quoted(dir / "leak"));
+  EXPECT_EQ(leak.code, 0) << leak.out;
+  EXPECT_NE(leak.out.find("image secret.txt (" + (dir / "secret.txt").string() + ") is not a PNG file; left out"),
+            std::string::npos)
+      << leak.out;
+  size_t copied = 0;
+  if (fs::exists(dir / "leak" / "images"))
+    for (const auto& e : fs::recursive_directory_iterator(dir / "leak" / "images")) copied += e.is_regular_file();
+  EXPECT_EQ(copied, 0u) << "nothing copied";
+  EXPECT_TRUE(embedded_data(dir / "leak" / "index.html")["cells"][0]["images"]["left"].is_null());
 }
 
 }  // namespace
