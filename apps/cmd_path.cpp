@@ -122,7 +122,8 @@ void run_path_command(const PathArgs& a) {
   for (const auto& [name, s] : frame_s)
     fmt::print("{:<16} {:>14.2f} {:>14.2f} {:>12}\n", name, 1e3 * median(s), 1e3 * percentile(s, 0.95),
                psnr[name].empty() ? std::string("inf") : fmt::format("{:.2f}", median(psnr[name])));
-  if (!bvh_s.empty()) fmt::print("BVH {} per frame: median {:.2f} ms\n", a.bvh, 1e3 * median(bvh_s));
+  // Only a path that moves geometry updates the BVH; a camera-only path keeps it ("static").
+  if (!bvh_s.empty() && a.spin_deg) fmt::print("BVH {} per frame: median {:.2f} ms\n", a.bvh, 1e3 * median(bvh_s));
   fmt::print("wrote {}\n", lines.string());
 }
 

@@ -35,7 +35,7 @@ const GeneratorEntry& find_entry(const std::string& name) {
 }
 
 std::string format_value(double v) {
-  return v == std::floor(v) && std::fabs(v) < 1e15 ? fmt::format("{:.0f}", v) : fmt::format("{:g}", v);
+  return v == std::floor(v) && std::fabs(v) < 1e15 ? fmt::format("{:.0f}", v) : fmt::format("{}", v);
 }
 
 /// The generator's parameters with defaults filled in and the overrides checked.

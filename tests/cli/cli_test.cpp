@@ -74,6 +74,8 @@ TEST(Cli, BadArgumentsExitWith3AndSayWhy) {
        "--json: is a folder; give the name of the file to write"},
       {"sweep collect '" + dir.path().string() + "' a.jsonl", "out: is a folder; give the name of the file to write"},
       {"gate --results a.jsonl --junit '" + dir.path().string() + "'", "--junit: is a folder"},
+      {"sweep run x.toml --executor slurm --shards -1", "--shards: Value -1 not in range 1 to 1000000"},
+      {"sweep run x.toml --executor slurm --shards 0", "--shards: Value 0 not in range 1 to 1000000"},
   };
   for (const Case& c : cases) {
     const CliRun r = run(c.args);

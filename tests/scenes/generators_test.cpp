@@ -85,6 +85,8 @@ TEST(SceneRegistry, RejectsUnknownAndOutOfRangeParameters) {
   expect_input_error([&] { (void)generate("complexity", o, out); }, {"triangles", "1000000000", "[100000, 100000000]"});
   o.params = {{"segments", 12.5}};
   expect_input_error([&] { (void)generate("spheres", o, out); }, {"segments", "12.5", "whole number"});
+  o.params = {{"triangles", 100000.5}};  // the value as given, not rounded to 6 digits
+  expect_input_error([&] { (void)generate("complexity", o, out); }, {"triangles", "100000.5", "whole number"});
   o.params = {{"count", std::numeric_limits<double>::quiet_NaN()}};
   expect_input_error([&] { (void)generate("spheres", o, out); }, {"count", "nan"});
   o.params = {{"anything", 1.0}};
