@@ -46,7 +46,7 @@ dvec3 parse_axis(const std::string& text) {
   dvec3 v;
   char c1 = 0, c2 = 0;
   std::stringstream in(text);
-  if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',')
+  if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !(in >> std::ws).eof())
     throw InputError(fmt::format("--spin-axis '{}' is not x,y,z", text));
   return v;
 }
@@ -143,9 +143,11 @@ void register_path_command(CLI::App& root) {
   p->add_option("--camera-keys", a->camera_keys,
                 "Camera key poses POSITION>TARGET;... in meters, e.g. '0,1.6,4>0,1,0;2,1.6,3>0,1,0';\n"
                 "the camera moves linearly between them over the frames (default: the scene's camera)");
-  p->add_option("--spin-deg", a->spin_deg, "Turn meshes by this many degrees per frame (rigid animation)");
-  p->add_option("--spin-axis", a->spin_axis, "Axis of the turn, x,y,z")->capture_default_str();
-  p->add_option("--spin-prefix", a->spin_prefix, "Turn only meshes whose name starts with this (default: all)");
+  CLI::Option* spin =
+      p->add_option("--spin-deg", a->spin_deg, "Turn meshes by this many degrees per frame (rigid animation)");
+  p->add_option("--spin-axis", a->spin_axis, "Axis of the turn, x,y,z")->capture_default_str()->needs(spin);
+  p->add_option("--spin-prefix", a->spin_prefix, "Turn only meshes whose name starts with this (default: all)")
+      ->needs(spin);
   p->add_option("--bvh", a->bvh, "Per-frame BVH update of a moving scene: refit or rebuild")->capture_default_str();
   p->add_option("--threads,-t", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
   p->add_option("--out", a->out, "Output folder")->capture_default_str();

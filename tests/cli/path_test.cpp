@@ -49,6 +49,17 @@ TEST(PathCommand, BadInput) {
   EXPECT_EQ(test::run_cli(args(dir) + " --camera-keys '1,2,3'").code, 3);
   EXPECT_EQ(test::run_cli(args(dir) + " --spin-deg 5 --spin-prefix nothing-like-this").code, 3);
   EXPECT_EQ(test::run_cli(args(dir) + " --spin-deg 5 --truth blender").code, 3);
+  // An axis with trailing junk, and spin settings without a spin, are refused, not ignored.
+  const test::CliRun junk = test::run_cli(args(dir) + " --spin-deg 5 --spin-axis 0,1,0junk");
+  EXPECT_EQ(junk.code, 3) << junk.out;
+  EXPECT_NE(junk.out.find("--spin-axis '0,1,0junk' is not x,y,z"), std::string::npos) << junk.out;
+  const test::CliRun alone = test::run_cli(args(dir) + " --spin-axis 1,0,0");
+  EXPECT_EQ(alone.code, 3) << alone.out;
+  EXPECT_NE(alone.out.find("--spin-axis requires --spin-deg"), std::string::npos) << alone.out;
+  // Camera keys that swap position and target: the camera would stand on its target at frame 1.
+  const test::CliRun cross = test::run_cli(args(dir) + " --frames 3 --camera-keys '0,1,4>0,1,3;0,1,3>0,1,4'");
+  EXPECT_EQ(cross.code, 3) << cross.out;
+  EXPECT_NE(cross.out.find("frame 1 of 3: the camera reaches its target"), std::string::npos) << cross.out;
 }
 
 }  // namespace
