@@ -2,6 +2,7 @@
 #include "reports/results_file.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <map>
 #include <string_view>
 
@@ -79,6 +80,19 @@ void require(const json& root, const std::string& where, const std::string& pref
                                  v->dump().substr(0, 80), describe(kind)));
 }
 
+/// Checks that a numeric field, where present, lies in [lo, hi] (a metric or time no measurement
+/// gives marks a damaged or hand-edited line). Strings such as "inf" are left to `require`.
+void require_within(const json& root, const std::string& where, const std::string& prefix, std::string_view dotted,
+                    double lo, double hi) {
+  const json* v = find(root, dotted);
+  if (v == nullptr || !v->is_number()) return;
+  const double x = v->get<double>();
+  if (!(x >= lo && x <= hi))
+    throw InputError(fmt::format("{}: field '{}{}' is {}, outside [{}, {}] where every measurement lies; the line is "
+                                 "damaged or edited by hand",
+                                 where, prefix, dotted, v->dump(), lo, hi));
+}
+
 /// A file name for messages: the path as given.
 std::string shown(const fs::path& p) { return p.string(); }
 
@@ -92,7 +106,7 @@ void check_cell_line(const json& line, const std::string& where) {
     throw InputError(fmt::format("{}: kind is {} but a results file holds \"{}\" records", where,
                                  line["kind"].dump(), kSweepCellKind));
   require(line, where, "", "schema_version", Kind::integer);
-  const int version = line["schema_version"].get<int>();
+  const long long version = line["schema_version"].get<long long>();
   if (version > kSweepCellSchemaVersion)
     throw InputError(fmt::format("{}: schema_version {} is newer than this stereobench reads ({}); use the "
                                  "stereobench that wrote the file",
@@ -141,9 +155,18 @@ void check_cell_line(const json& line, const std::string& where) {
     require(p, where, prefix, "validation.timings_s", Kind::object, true);
     require(p, where, prefix, "validation.scene.triangles", Kind::integer_or_null, true);
     require(p, where, prefix, "timing", Kind::object, true);
+    constexpr double kMax = std::numeric_limits<double>::max();
+    require_within(p, where, prefix, "validation.metrics.ssim", -1.0, 1.0);
+    require_within(p, where, prefix, "validation.metrics.mse", 0.0, kMax);
+    for (const char* f : {"validation.metrics.error_fraction", "validation.holes.hole_fraction",
+                          "validation.holes.not_reprojected.recall", "validation.holes.not_reprojected.precision"})
+      require_within(p, where, prefix, f, 0.0, 1.0);
+    require_within(p, where, prefix, "validation.total_s", 0.0, kMax);
     if (p.contains("timing")) {
-      for (const char* t : {"median_s", "min_s", "max_s", "speedup_median"})
+      for (const char* t : {"median_s", "min_s", "max_s", "speedup_median"}) {
         require(p, where, prefix, std::string("timing.") + t, Kind::number_or_null, true);
+        require_within(p, where, prefix, std::string("timing.") + t, 0.0, kMax);
+      }
       require(p, where, prefix, "timing.repetitions", Kind::integer, true);
       require(p, where, prefix, "timing.stages_median_s", Kind::object, true);
     }

@@ -185,6 +185,12 @@ TEST(Report, MalformedResultsExit3NamingFileAndLine) {
   other_sweep["sweep"] = "other";
   json other_version = minimal_line("b", 1);
   other_version["definition_sha256"] = "0123456789abcdef";
+  json ssim_5 = minimal_line("b", 1);
+  ssim_5["pipelines"]["repro-rt"]["validation"]["metrics"]["ssim"] = 5;
+  json negative_time = minimal_line("b", 1);
+  negative_time["pipelines"]["plain-rt"]["validation"]["total_s"] = -0.5;
+  json wrapped_version = minimal_line("b", 1);
+  wrapped_version["schema_version"] = 4294967297LL;  // 2^32 + 1, which an int reads as 1
   const std::vector<Case> cases = {
       {good + "{\"kind\": \"stereobench.sweep_cell\", oops}\n" + minimal_line("c", 2).dump() + "\n",
        "results.jsonl:2: not a JSON line"},
@@ -200,6 +206,10 @@ TEST(Report, MalformedResultsExit3NamingFileAndLine) {
       {good + other_version.dump() + "\n", "results.jsonl:2: a cell of sweep 'tiny' (definition sha256 0123456789ab)"},
       {good + minimal_line("b", 0).dump() + "\n", "results.jsonl:2: cell_index 0 is also the index of line 1"},
       {minimal_line("a", -1).dump() + "\n", "results.jsonl:1: cell_index -1 is negative"},
+      {good + ssim_5.dump() + "\n",
+       "results.jsonl:2: field 'pipelines.repro-rt.validation.metrics.ssim' is 5, outside [-1, 1]"},
+      {good + negative_time.dump() + "\n", "results.jsonl:2: field 'pipelines.plain-rt.validation.total_s' is -0.5"},
+      {good + wrapped_version.dump() + "\n", "results.jsonl:2: schema_version 4294967297 is newer"},
       {"[1, 2]\n", "results.jsonl:1: a results line must be a JSON object"},
       {"", "holds no finished cell"},
       {"{\"kind\": \"stereobench.sweep_ce", "holds no finished cell"},
