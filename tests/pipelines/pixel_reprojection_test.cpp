@@ -189,14 +189,16 @@ TEST(PixelReprojection, BadOptionsAreRejected) {
   EXPECT_THROW((void)test::render_with("rt-buffer", prepared, rig, 1, {{"margin", "-0.1"}}), InputError);
   EXPECT_THROW((void)test::render_with("rt-buffer", prepared, rig, 1, {{"depth", "-1"}}), InputError);
   EXPECT_THROW((void)test::render_with("rt-buffer", prepared, rig, 1, {{"depth", "5000"}}), InputError);
-  // The default depth 2e for an absurd interaxial: rejected before it is converted to an int
-  // (it overflowed to a depth of 1 before).
+  // The default depth 2e for a disparity the rig accepts (up to 1e6 px) but the buffer cannot
+  // hold: rejected before it is converted to an int.
   try {
-    (void)test::render_with("rt-buffer", prepared, rig_with_disparity(scene, 64, 36, 1.2e10), 1, {});
-    ADD_FAILURE() << "a 2.4e10-entry buffer depth was accepted";
+    (void)test::render_with("rt-buffer", prepared, rig_with_disparity(scene, 64, 36, 1e5), 1, {});
+    ADD_FAILURE() << "a 2e5-entry buffer depth was accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("exceeds 4096"), std::string::npos) << e.what();
   }
+  // An absurd one (it overflowed the int depth to 1 once) is refused by the rig itself.
+  EXPECT_THROW((void)rig_with_disparity(scene, 64, 36, 1.2e10), InputError);
 }
 
 }  // namespace
