@@ -44,7 +44,7 @@ std::map<std::string, double> parse_params(const std::vector<std::string>& items
   std::map<std::string, double> out;
   for (const auto& [name, value] : parse_key_values(items, "--param")) {
     const std::optional<double> v = parse_finite(value);
-    if (!v) throw InputError(fmt::format("--param {}: '{}' is not a finite number", name, value));
+    if (!v) throw InputError(fmt::format("--param {}: '{}' is not a finite decimal number", name, value));
     out[name] = *v;
   }
   return out;

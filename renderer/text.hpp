@@ -11,8 +11,10 @@
 
 namespace sb {
 
-/// The whole of `text` as a finite number, or nothing (partial parses, NaN and infinities fail).
+/// The whole of `text` as a finite decimal number, or nothing (partial parses, NaN, infinities and
+/// hexadecimal such as 0x10, which the C library would accept, fail).
 [[nodiscard]] inline std::optional<double> parse_finite(const std::string& text) {
+  if (text.find_first_of("xX") != std::string::npos) return std::nullopt;
   size_t used = 0;
   double v = 0.0;
   try {
