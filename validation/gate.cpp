@@ -581,24 +581,33 @@ std::optional<GateCheck> completeness_check(const GateResults& results) {
   return check;
 }
 
+/// The scenes, pipelines and cell ids of a results file, for naming why a rule matches nothing.
+struct ResultNames {
+  std::set<std::string> scenes, pipelines, cells;
+};
+
+ResultNames result_names(const GateResults& results) {
+  ResultNames n;
+  for (const GateCell& cell : results.cells) {
+    n.scenes.insert(cell.scene);
+    n.cells.insert(cell.cell_id);
+    for (const auto& item : cell.record["pipelines"].items()) n.pipelines.insert(item.key());
+  }
+  return n;
+}
+
 /// Why a rule applied to no (cell, pipeline) of the results: the first of its globs that matches
 /// nothing there, or the combination.
-std::string why_unused(const GateRule& rule, const GateResults& results) {
-  std::set<std::string> scenes, pipelines;
-  bool scene_hit = false, pipeline_hit = false, cell_hit = false;
-  for (const GateCell& cell : results.cells) {
-    scenes.insert(cell.scene);
-    scene_hit = scene_hit || glob_matches(rule.scene, cell.scene);
-    cell_hit = cell_hit || glob_matches(rule.cell, cell.cell_id);
-    for (const auto& item : cell.record["pipelines"].items()) {
-      pipelines.insert(item.key());
-      pipeline_hit = pipeline_hit || glob_matches(rule.pipeline, item.key());
-    }
-  }
-  if (!scene_hit) return fmt::format("scene '{}' matches none of its scenes ({})", rule.scene, fmt::join(scenes, ", "));
-  if (!pipeline_hit)
-    return fmt::format("pipeline '{}' matches none of its pipelines ({})", rule.pipeline, fmt::join(pipelines, ", "));
-  if (!cell_hit) return fmt::format("cell '{}' matches none of its cell ids", rule.cell);
+std::string why_unused(const GateRule& rule, const ResultNames& names) {
+  const auto any = [](const std::set<std::string>& items, const std::string& glob) {
+    return std::any_of(items.begin(), items.end(), [&](const std::string& s) { return glob_matches(glob, s); });
+  };
+  if (!any(names.scenes, rule.scene))
+    return fmt::format("scene '{}' matches none of its scenes ({})", rule.scene, fmt::join(names.scenes, ", "));
+  if (!any(names.pipelines, rule.pipeline))
+    return fmt::format("pipeline '{}' matches none of its pipelines ({})", rule.pipeline,
+                       fmt::join(names.pipelines, ", "));
+  if (!any(names.cells, rule.cell)) return fmt::format("cell '{}' matches none of its cell ids", rule.cell);
   return fmt::format("pipeline '{}', scene '{}' and cell '{}' each match, but never in the same cell", rule.pipeline,
                      rule.scene, rule.cell);
 }
@@ -607,17 +616,17 @@ std::string why_unused(const GateRule& rule, const GateResults& results) {
 /// pass silently: one note names them, grouped by the reason, with their lines.
 std::optional<std::string> unused_rules_note(const GateConfig& config, const GateResults& results,
                                              const std::vector<bool>& rule_used) {
+  const size_t count = static_cast<size_t>(std::count(rule_used.begin(), rule_used.end(), false));
+  if (count == 0) return std::nullopt;
+  const ResultNames names = result_names(results);
   std::vector<std::pair<std::string, std::vector<int>>> groups;  // reason, lines; in file order
-  size_t count = 0;
   for (size_t i = 0; i < config.rules.size(); ++i) {
     if (rule_used[i]) continue;
-    ++count;
-    const std::string reason = why_unused(config.rules[i], results);
+    const std::string reason = why_unused(config.rules[i], names);
     auto it = std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return g.first == reason; });
     if (it == groups.end()) it = groups.insert(groups.end(), {reason, {}});
     it->second.push_back(config.rules[i].line);
   }
-  if (count == 0) return std::nullopt;
   std::vector<std::string> parts;
   for (const auto& [reason, lines] : groups)
     parts.push_back(fmt::format("{} ({} {})", reason, lines.size() == 1 ? "line" : "lines", fmt::join(lines, ", ")));

@@ -458,7 +458,8 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
     d.lights.clear();
     for (const toml::node* e : axis_entries(where, *n, "sweep.lights")) {
       const int64_t v = integer_at(where, *e, "sweep.lights");
-      if (v < 1 || v > 100000) where.fail(*e, "sweep.lights", fmt::format("{} is outside 1..100000 (a count of the scene's lights)", v));
+      if (v < 1 || v > 100000)
+        where.fail(*e, "sweep.lights", fmt::format("{} is outside 1..100000 (a count of the scene's lights)", v));
       for (const auto& seen : d.lights)
         if (*seen == v) where.fail(*e, "sweep.lights", fmt::format("lists {} twice", v));
       d.lights.emplace_back(static_cast<int>(v));

@@ -7,8 +7,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
-#include <cstring>
 #include <chrono>
+#include <cstring>
 #include <ctime>
 #include <exception>
 #include <map>
@@ -339,10 +339,6 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
           {"versions", io::versions_json()}};
 }
 
-}  // namespace
-
-namespace {
-
 /// The marker that gives an output folder to one sweep definition.
 constexpr const char* kOutMarker = ".stereobench-sweep.json";
 
@@ -370,8 +366,8 @@ void claim_out_folder(const SweepDefinition& d, const SweepRunOptions& options) 
     try {
       theirs = json::parse(io::read_file(marker));
     } catch (const json::exception&) {
-      theirs = json::object();
     }
+    if (!theirs.is_object()) theirs = json::object();  // damaged: it names no definition
     if (theirs.value("sweep", "") == d.name && theirs.value("definition_sha256", "") == d.sha256) return;
     throw InputError(fmt::format(
         "{} holds the cells of sweep '{}' ({}, sha256 {}), not of this definition '{}' ({}, sha256 {}); its images "

@@ -87,17 +87,16 @@ std::string read_file(const fs::path& path) {
   if (!in) throw IoError(fmt::format("cannot read {}: {}", path.string(), std::strerror(errno)));
   // Read in blocks rather than through a stream buffer copy, which would swallow a failed
   // allocation and return the file cut short.
+  const uintmax_t size = fs::file_size(path, ec);  // a stream without a size (a pipe) grows as read
   std::string text;
   try {
-    const uintmax_t size = fs::file_size(path, ec);
     if (!ec) text.reserve(static_cast<size_t>(size));
     std::vector<char> block(size_t{1} << 16);
     while (in.read(block.data(), static_cast<std::streamsize>(block.size())) || in.gcount() > 0)
       text.append(block.data(), static_cast<size_t>(in.gcount()));
   } catch (const std::bad_alloc&) {
-    throw IoError(fmt::format("not enough memory to read {} ({} bytes); free memory or raise the process's memory "
-                              "limit",
-                              path.string(), fs::file_size(path, ec)));
+    throw IoError(fmt::format("not enough memory to read {}{}; free memory or raise the process's memory limit",
+                              path.string(), ec ? std::string() : fmt::format(" ({} bytes)", size)));
   }
   if (in.bad()) throw IoError(fmt::format("error while reading {}", path.string()));
   return text;

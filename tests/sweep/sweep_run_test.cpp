@@ -409,6 +409,14 @@ TEST(SweepRun, BadDefinitionAndShardAreUsageErrors) {
       << unusable.out;
   EXPECT_EQ(unusable.out.find("[1/6]"), std::string::npos) << "no cell may run: " << unusable.out;
   EXPECT_FALSE(fs::exists(dir / "r.jsonl"));
+  // A damaged marker (valid JSON, not an object) names no definition: refused as another's, not
+  // an internal error.
+  fs::create_directories(dir / "marked");
+  std::ofstream(dir / "marked" / ".stereobench-sweep.json") << "[1]\n";
+  const test::CliRun damaged = test::run_cli("sweep run " + quoted(dir / "ok.toml") + " --out " +
+                                             quoted(dir / "marked") + " --scenes-dir " + quoted(dir / "scenes"));
+  EXPECT_EQ(damaged.code, 3) << damaged.out;
+  EXPECT_NE(damaged.out.find("holds the cells of sweep '?'"), std::string::npos) << damaged.out;
 }
 
 }  // namespace
