@@ -10,7 +10,9 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -109,14 +111,139 @@ std::string csv_quote(const std::string& s) {
   return out + "\"";
 }
 
-/// The value at a path of keys, or null when any is missing.
-json at(const json& j, std::initializer_list<const char*> path) {
-  const json* cur = &j;
-  for (const char* key : path) {
-    if (!cur->is_object() || !cur->contains(key)) return nullptr;
-    cur = &(*cur)[key];
+/// What a field may hold.
+enum class Kind {
+  object,
+  object_or_null,
+  string,
+  integer,
+  number,
+  metric,
+  number_or_null,
+  integer_or_null,
+  string_or_null
+};
+
+const char* describe(Kind k) {
+  switch (k) {
+    case Kind::object: return "an object";
+    case Kind::object_or_null: return "an object or null";
+    case Kind::string: return "a string";
+    case Kind::integer: return "an integer";
+    case Kind::number: return "a number";
+    case Kind::metric: return "a number, \"inf\" or null";
+    case Kind::number_or_null: return "a number or null";
+    case Kind::integer_or_null: return "an integer or null";
+    case Kind::string_or_null: return "a string or null";
   }
-  return *cur;
+  return "?";
+}
+
+bool matches(const json& v, Kind k) {
+  switch (k) {
+    case Kind::object: return v.is_object();
+    case Kind::object_or_null: return v.is_object() || v.is_null();
+    case Kind::string: return v.is_string();
+    case Kind::integer: return v.is_number_integer();
+    case Kind::number: return v.is_number();
+    case Kind::metric: return v.is_number() || v.is_null() || (v.is_string() && (v == "inf" || v == "-inf"));
+    case Kind::number_or_null: return v.is_number() || v.is_null();
+    case Kind::integer_or_null: return v.is_number_integer() || v.is_null();
+    case Kind::string_or_null: return v.is_string() || v.is_null();
+  }
+  return false;
+}
+
+/// The value at a dotted path ("cell.scene"), or nullptr when a step is missing.
+const json* find(const json& root, std::string_view dotted) {
+  const json* at = &root;
+  while (!dotted.empty()) {
+    const size_t dot = dotted.find('.');
+    const std::string key(dotted.substr(0, dot));
+    if (!at->is_object()) return nullptr;
+    const auto it = at->find(key);
+    if (it == at->end()) return nullptr;
+    at = &*it;
+    dotted = dot == std::string_view::npos ? std::string_view() : dotted.substr(dot + 1);
+  }
+  return at;
+}
+
+/// Checks a field; `prefix` names the enclosing object for the message ("pipelines.repro-rt.").
+void require(const json& root, const std::string& where, const std::string& prefix, std::string_view dotted,
+             Kind kind, bool optional = false) {
+  const json* v = find(root, dotted);
+  if (v == nullptr) {
+    if (optional) return;
+    throw InputError(fmt::format("{}: field '{}{}' is missing; the line is not a sweep cell record (docs/sweeps.md)",
+                                 where, prefix, dotted));
+  }
+  if (!matches(*v, kind))
+    throw InputError(fmt::format("{}: field '{}{}' is {} but must be {}", where, prefix, dotted,
+                                 v->dump().substr(0, 80), describe(kind)));
+}
+
+/// Checks that a numeric field, where present, lies in [lo, hi] (a metric or time no measurement
+/// gives marks a damaged or hand-edited line). Strings such as "inf" are left to `require`.
+void require_within(const json& root, const std::string& where, const std::string& prefix, std::string_view dotted,
+                    double lo, double hi) {
+  const json* v = find(root, dotted);
+  if (v == nullptr || !v->is_number()) return;
+  const double x = v->get<double>();
+  if (!(x >= lo && x <= hi))
+    throw InputError(fmt::format("{}: field '{}{}' is {}, outside [{}, {}] where every measurement lies; the line is "
+                                 "damaged or edited by hand",
+                                 where, prefix, dotted, v->dump(), lo, hi));
+}
+
+/// A field of a results line: its dotted path, what it may hold, whether it may be absent.
+struct Field {
+  const char* path;
+  Kind kind;
+  bool optional = false;
+};
+
+/// The fields of a cell, in the order they are checked (a container before its members).
+constexpr Field kCellFields[] = {
+    {"sweep", Kind::string},
+    {"cell_id", Kind::string},
+    {"cell_index", Kind::integer},
+    {"cell", Kind::object},
+    {"cell.scene", Kind::string},
+    {"cell.resolution", Kind::string},
+    {"cell.truth", Kind::string},
+    {"cell.lights", Kind::integer_or_null, true},
+    {"rig", Kind::object},
+    {"rig.width", Kind::integer},
+    {"rig.height", Kind::integer},
+    {"rig.interaxial_m", Kind::number},
+    {"rig.convergence_m", Kind::number},
+    {"rig.max_disparity_px", Kind::number},
+    {"scene.triangles", Kind::integer_or_null, true},
+    {"baseline", Kind::string},
+    {"pipelines", Kind::object},
+};
+
+/// The fields of each entry of `pipelines`.
+constexpr Field kPipelineFields[] = {
+    {"validation", Kind::object},
+    {"validation.metrics.psnr", Kind::metric},
+    {"validation.metrics.ssim", Kind::metric},
+    {"validation.metrics.mse", Kind::metric},
+    {"validation.metrics.error_fraction", Kind::metric},
+    {"validation.holes.hole_fraction", Kind::number_or_null, true},
+    {"validation.holes.not_reprojected.recall", Kind::number_or_null, true},
+    {"validation.holes.not_reprojected.precision", Kind::number_or_null, true},
+    {"validation.total_s", Kind::number_or_null, true},
+    {"validation.timings_s", Kind::object, true},
+    {"validation.scene.triangles", Kind::integer_or_null, true},
+    {"timing", Kind::object, true},
+};
+
+/// The value at a dotted path, or null when a step is missing.
+json value_at(const json& root, std::string_view dotted) {
+  const json* v = find(root, dotted);
+  return v ? *v : json(nullptr);
 }
 
 }  // namespace
@@ -177,25 +304,102 @@ void read_json_lines(const fs::path& file, const std::string& torn_note, const s
   }
 }
 
+void check_cell_record(const json& line, const std::string& where) {
+  if (!line.is_object())
+    throw InputError(fmt::format("{}: a results line must be a JSON object, not {}", where, line.type_name()));
+  require(line, where, "", "kind", Kind::string);
+  if (line["kind"] != kSweepCellKind)
+    throw InputError(fmt::format("{}: kind is {} but a results file holds \"{}\" records", where,
+                                 line["kind"].dump(), kSweepCellKind));
+  require(line, where, "", "schema_version", Kind::integer);
+  const long long version = line["schema_version"].get<long long>();
+  if (version > kSweepSchemaVersion)
+    throw InputError(fmt::format("{}: schema_version {} is newer than this stereobench reads ({}); use the "
+                                 "stereobench that wrote the file",
+                                 where, version, kSweepSchemaVersion));
+  if (version != kSweepSchemaVersion)
+    throw InputError(fmt::format("{}: schema_version {} is not a known version (expected {})", where, version,
+                                 kSweepSchemaVersion));
+  for (const Field& f : kCellFields) require(line, where, "", f.path, f.kind, f.optional);
+  if (line["cell_id"].get<std::string>().empty()) throw InputError(fmt::format("{}: cell_id is empty", where));
+  if (line["cell_index"].get<long long>() < 0)
+    throw InputError(fmt::format("{}: cell_index {} is negative; cells are numbered from 0", where,
+                                 line["cell_index"].dump()));
+  if (line["rig"]["width"].get<long long>() <= 0 || line["rig"]["height"].get<long long>() <= 0)
+    throw InputError(fmt::format("{}: rig.width and rig.height must be positive, not {}x{}", where,
+                                 line["rig"]["width"].dump(), line["rig"]["height"].dump()));
+  const json& pipelines = line["pipelines"];
+  if (pipelines.empty())
+    throw InputError(fmt::format("{}: 'pipelines' is empty; a cell validates at least one", where));
+  if (!pipelines.contains(line["baseline"].get<std::string>()))
+    throw InputError(fmt::format("{}: baseline {} is not among the cell's pipelines", where, line["baseline"].dump()));
+  for (const auto& [name, p] : pipelines.items()) {
+    const std::string prefix = "pipelines." + name + ".";
+    if (!p.is_object()) throw InputError(fmt::format("{}: field 'pipelines.{}' must be an object", where, name));
+    for (const Field& f : kPipelineFields) require(p, where, prefix, f.path, f.kind, f.optional);
+    constexpr double kMax = std::numeric_limits<double>::max();
+    require_within(p, where, prefix, "validation.metrics.ssim", -1.0, 1.0);
+    require_within(p, where, prefix, "validation.metrics.mse", 0.0, kMax);
+    for (const char* f : {"validation.metrics.error_fraction", "validation.holes.hole_fraction",
+                          "validation.holes.not_reprojected.recall", "validation.holes.not_reprojected.precision"})
+      require_within(p, where, prefix, f, 0.0, 1.0);
+    require_within(p, where, prefix, "validation.total_s", 0.0, kMax);
+    if (p.contains("timing")) {
+      for (const char* t : {"median_s", "min_s", "max_s", "speedup_median"}) {
+        require(p, where, prefix, std::string("timing.") + t, Kind::number_or_null, true);
+        require_within(p, where, prefix, std::string("timing.") + t, 0.0, kMax);
+      }
+      require(p, where, prefix, "timing.repetitions", Kind::integer, true);
+      require(p, where, prefix, "timing.stages_median_s", Kind::object, true);
+    }
+  }
+  require(line, where, "", "images", Kind::object_or_null, true);  // null: a sweep without images
+  if (line.contains("images") && line["images"].is_object()) {
+    for (const char* key : {"left_png", "truth_png", "disocclusions_png"})
+      require(line, where, "", std::string("images.") + key, Kind::string_or_null, true);
+    require(line, where, "", "images.pipelines", Kind::object, true);
+    if (line["images"].contains("pipelines"))
+      for (const auto& [name, imgs] : line["images"]["pipelines"].items()) {
+        if (!imgs.is_object())
+          throw InputError(fmt::format("{}: field 'images.pipelines.{}' must be an object", where, name));
+        for (const auto& [key, v] : imgs.items())
+          if (!v.is_string() && !v.is_null())
+            throw InputError(fmt::format("{}: field 'images.pipelines.{}.{}' must be a path (string) or null", where,
+                                         name, key));
+      }
+  }
+}
+
 ResultsFile read_results(const fs::path& file) {
   ResultsFile out;
-  std::map<std::string, size_t> seen;  // cell_id -> line
+  std::map<std::string, size_t> seen;        // cell_id -> line
+  std::map<std::string, size_t> seen_index;  // cell_index -> line
   read_json_lines(
       file, "(a sweep killed while writing it) skipped; its cell runs again when the sweep resumes",
       "a results file holds one JSON object per line", out.warnings,
       [&](json&& cell, size_t line_no, const std::string& where) {
-        if (!cell.is_object() || cell.value("kind", "") != kSweepCellKind)
-          throw InputError(fmt::format("{}: not a sweep cell record (\"kind\" must be \"{}\")", where, kSweepCellKind));
-        if (!cell.contains("schema_version") || cell["schema_version"] != kSweepSchemaVersion)
-          throw InputError(fmt::format("{}: schema_version {} is not {}, the version this stereobench reads", where,
-                                       cell.value("schema_version", json(nullptr)).dump(), kSweepSchemaVersion));
-        if (!cell.contains("cell_id") || !cell["cell_id"].is_string() || !cell.contains("cell_index") ||
-            !cell["cell_index"].is_number_unsigned())
-          throw InputError(fmt::format("{}: a sweep cell record needs a string cell_id and a cell_index >= 0", where));
-        const std::string id = cell["cell_id"];
-        require_unique_id(seen, id, line_no, where, "cell_id",
-                          "a results file holds each cell once — remove one of the lines");
+        check_cell_record(cell, where);
+        // One definition per file: resuming, collecting, gating and reporting all speak of one sweep.
+        if (!out.cells.empty()) {
+          const json& first = out.cells.front();
+          if (cell["sweep"] != first["sweep"] ||
+              cell.value("definition_sha256", "") != first.value("definition_sha256", ""))
+            throw InputError(fmt::format(
+                "{}: a cell of sweep '{}' (definition sha256 {}), but line {} is of sweep '{}' (sha256 {}); a "
+                "results file holds the cells of one sweep definition (the shards of one definition merge with "
+                "`stereobench sweep collect`)",
+                where, cell["sweep"].get<std::string>(), cell.value("definition_sha256", "?").substr(0, 12),
+                out.lines.front(), first["sweep"].get<std::string>(),
+                first.value("definition_sha256", "?").substr(0, 12)));
+        }
+        require_unique_id(seen, cell["cell_id"].get<std::string>(), line_no, where, "cell_id",
+                          "a results file holds each cell once — remove one of the lines, or merge shards with "
+                          "`stereobench sweep collect`");
+        require_unique_id(seen_index, cell["cell_index"].dump(), line_no, where, "cell_index",
+                          "two cells cannot share an index: the file is damaged or was joined by hand — rerun the "
+                          "sweep, or merge shards with `stereobench sweep collect`");
         out.cells.push_back(std::move(cell));
+        out.lines.push_back(line_no);
       });
   return out;
 }
@@ -218,7 +422,8 @@ fs::path folder_of(const fs::path& file) { return fs::absolute(file).lexically_n
 void require_unique_id(std::map<std::string, size_t>& seen, const std::string& id, size_t line_no,
                        const std::string& where, const char* key, const std::string& advice) {
   if (auto [it, fresh] = seen.emplace(id, line_no); !fresh)
-    throw InputError(fmt::format("{}: {} '{}' appears twice (also on line {}); {}", where, key, id, it->second, advice));
+    throw InputError(
+        fmt::format("{}: {} '{}' appears twice (also on line {}); {}", where, key, id, it->second, advice));
 }
 
 void rebase_image_paths(json& cell, const fs::path& from, const fs::path& to) {
@@ -289,38 +494,38 @@ std::string results_csv(const std::vector<json>& cells) {
   out += "\r\n";
   for (const json& cell : cells) {
     std::string params;
-    const json scene_params = at(cell, {"cell", "scene_params"});
+    const json scene_params = value_at(cell, "cell.scene_params");
     if (scene_params.is_object())
       for (const auto& [key, value] : scene_params.items())
         params += (params.empty() ? "" : ";") + key + "=" + field(value);
-    const json pipelines = at(cell, {"pipelines"});
+    const json pipelines = value_at(cell, "pipelines");
     if (!pipelines.is_object()) continue;
     for (const auto& [name, p] : pipelines.items()) {
-      const json row[] = {at(cell, {"cell_index"}),
-                          at(cell, {"cell_id"}),
-                          at(cell, {"sweep"}),
-                          at(cell, {"cell", "scene"}),
+      const json row[] = {value_at(cell, "cell_index"),
+                          value_at(cell, "cell_id"),
+                          value_at(cell, "sweep"),
+                          value_at(cell, "cell.scene"),
                           params,
-                          at(cell, {"rig", "width"}),
-                          at(cell, {"rig", "height"}),
-                          at(cell, {"rig", "interaxial_m"}),
-                          at(cell, {"rig", "max_disparity_px"}),
-                          at(cell, {"rig", "convergence_m"}),
-                          at(p, {"validation", "scene", "lights"}),
-                          at(cell, {"animation", "frame"}),
-                          at(cell, {"animation", "bvh_update_s"}),
-                          at(cell, {"cell", "truth"}),
+                          value_at(cell, "rig.width"),
+                          value_at(cell, "rig.height"),
+                          value_at(cell, "rig.interaxial_m"),
+                          value_at(cell, "rig.max_disparity_px"),
+                          value_at(cell, "rig.convergence_m"),
+                          value_at(p, "validation.scene.lights"),
+                          value_at(cell, "animation.frame"),
+                          value_at(cell, "animation.bvh_update_s"),
+                          value_at(cell, "cell.truth"),
                           name,
-                          at(cell, {"baseline"}),
-                          at(p, {"validation", "metrics", "psnr"}),
-                          at(p, {"validation", "metrics", "ssim"}),
-                          at(p, {"validation", "metrics", "mse"}),
-                          at(p, {"validation", "metrics", "error_fraction"}),
-                          at(p, {"validation", "holes", "hole_fraction"}),
-                          at(p, {"validation", "holes", "not_reprojected", "recall"}),
-                          at(p, {"validation", "holes", "not_reprojected", "precision"}),
-                          at(p, {"timing", "median_s"}),
-                          at(p, {"timing", "speedup_median"})};
+                          value_at(cell, "baseline"),
+                          value_at(p, "validation.metrics.psnr"),
+                          value_at(p, "validation.metrics.ssim"),
+                          value_at(p, "validation.metrics.mse"),
+                          value_at(p, "validation.metrics.error_fraction"),
+                          value_at(p, "validation.holes.hole_fraction"),
+                          value_at(p, "validation.holes.not_reprojected.recall"),
+                          value_at(p, "validation.holes.not_reprojected.precision"),
+                          value_at(p, "timing.median_s"),
+                          value_at(p, "timing.speedup_median")};
       static_assert(std::size(row) == std::size(kCsvColumns));
       std::string line;
       for (size_t i = 0; i < std::size(row); ++i) line += (i ? "," : "") + csv_quote(field(row[i]));

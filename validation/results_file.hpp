@@ -1,9 +1,11 @@
 // The results file of a sweep (docs/sweeps.md): JSON Lines, one line per finished cell, appended
-// atomically, read back tolerating a torn last line, merged across shards, exported as CSV.
+// atomically, read back with every line checked (a torn last line tolerated), merged across
+// shards, exported as CSV.
 #pragma once
 
 #include <filesystem>
 #include <functional>
+#include <cstddef>
 #include <map>
 #include <string>
 #include <vector>
@@ -28,14 +30,23 @@ void append_result(const std::filesystem::path& file, const nlohmann::json& cell
 /// What was read from a results file.
 struct ResultsFile {
   std::vector<nlohmann::json> cells;  ///< in file order
+  std::vector<size_t> lines;          ///< the 1-based line of each cell
   std::vector<std::string> warnings;  ///< e.g. a torn last line skipped, naming file and line
 };
 
-/// Reads a results file. A missing file reads as empty. An unterminated last line (a writer
-/// killed mid-write) is skipped with a warning naming the file and line. InputError naming the
-/// file and line for any other line that is not a sweep-cell record of this schema version, and
-/// for a cell_id that appears twice. IoError when it cannot be read.
+/// Reads a results file; every consumer (sweep resume, collect, gate, report) reads it here. A
+/// missing file reads as empty. An unterminated last line (a writer killed mid-write) is skipped
+/// with a warning naming the file and line. An InputError names the file and line for any other
+/// line that is not JSON or not a sweep-cell record of this schema version (check_cell_record), a
+/// cell_id or cell_index that appears twice, and a cell of another sweep definition than the
+/// first line's (a results file holds one definition's cells). IoError when it cannot be read.
 [[nodiscard]] ResultsFile read_results(const std::filesystem::path& file);
+
+/// Checks one parsed results line against the fields its readers use: kind, schema version, the
+/// cell's identity, scene, rig, baseline and, per pipeline, the metrics, hole figures and times
+/// (types, and ranges no measurement leaves: SSIM in [-1, 1], fractions in [0, 1], times >= 0) and
+/// image paths. `where` ("FILE:LINE") prefixes the InputError.
+void check_cell_record(const nlohmann::json& line, const std::string& where);
 
 /// Reads a JSON Lines file written by append_result: a missing file reads as empty; blank lines are
 /// skipped; an unterminated last line (a writer killed while writing it) is skipped with the

@@ -311,6 +311,15 @@ TEST(GateCli, BadInputIsExitThree) {
   run = run_cli("gate" + config + " --results " + (dir / "dup.jsonl").string());
   EXPECT_EQ(run.code, 3) << run.out;
   EXPECT_NE(run.out.find("appears twice"), std::string::npos) << run.out;
+  // A value no measurement gives (a damaged or hand-edited line) is refused, not gated.
+  std::vector<json> damaged = passing_cells();
+  damaged[1]["pipelines"]["repro-rt"]["validation"]["metrics"]["ssim"] = 5;
+  write_results(dir / "damaged.jsonl", damaged);
+  run = run_cli("gate" + config + " --results " + (dir / "damaged.jsonl").string());
+  EXPECT_EQ(run.code, 3) << run.out;
+  EXPECT_NE(run.out.find("damaged.jsonl:2: field 'pipelines.repro-rt.validation.metrics.ssim' is 5"),
+            std::string::npos)
+      << run.out;
 
   // A torn last line (killed writer) is skipped with a warning; the rest is gated, and the sweep
   // it left unfinished fails: one of its two cells has results.

@@ -31,7 +31,8 @@ inline nlohmann::json fake_entry(const FakePipeline& p) {
       {"schema_version", 1},
       {"pipeline", p.name},
       {"options", nlohmann::json::object()},
-      {"metrics", {{"psnr", p.psnr}, {"ssim", p.ssim}, {"error_fraction", p.error_fraction}, {"error_threshold", 2}}},
+      {"metrics",
+       {{"psnr", p.psnr}, {"ssim", p.ssim}, {"mse", 1.0}, {"error_fraction", p.error_fraction}, {"error_threshold", 2}}},
       {"holes", {{"hole_fraction", p.hole_fraction}, {"not_reprojected", {{"recall", p.recall}}}}}};
   std::vector<double> sorted = p.samples_s;
   std::sort(sorted.begin(), sorted.end());
@@ -64,7 +65,8 @@ inline nlohmann::json fake_cell(int index, double e, const std::vector<FakePipel
             {"resolution", "320x180"},
             {"lights", nullptr},
             {"truth", "full"}}},
-          {"rig", {{"width", 320}, {"height", 180}, {"interaxial_m", e}, {"convergence_m", 2.0}}},
+          {"rig",
+           {{"width", 320}, {"height", 180}, {"interaxial_m", e}, {"convergence_m", 2.0}, {"max_disparity_px", 9.5}}},
           {"baseline", "plain-rt"},
           {"pipelines", pipes},
           {"host", "testhost"},

@@ -43,6 +43,7 @@ json validated_cell(const std::vector<std::pair<std::string, std::map<std::strin
   json cell = fake_cell(0, 0.064, {});
   cell["cell_count"] = 1;  // the results files below hold this one cell: a whole sweep
   cell["rig"] = json::object();
+  cell["baseline"] = runs.front().first;  // a cell's baseline is one of its pipelines
   for (const auto& [name, options] : runs) {
     const Pipeline& p = find_pipeline(name);
     const validation::PipelineValidation v =

@@ -89,7 +89,7 @@ TEST(Report, SmokeSweepReportsPassTheBrowserCheck) {
 
   const test::CliRun r = test::run_cli("report " + quoted(sweep / "shuffled.jsonl") + " --out " + quoted(dir / "report"));
   ASSERT_EQ(r.code, 0) << r.out;
-  EXPECT_NE(r.out.find("shuffled.jsonl:3: skipped an incomplete last line"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("shuffled.jsonl:3: unterminated last line"), std::string::npos) << r.out;
   // Per cell: left eye, truth, disocclusions, and four images per pipeline.
   const std::string counts = std::to_string(lines.size()) + " cell(s) x " + std::to_string(pipeline_count) +
                              " pipeline(s), " + std::to_string(lines.size() * (3 + 4 * pipeline_count)) + " image(s) copied";
@@ -199,12 +199,12 @@ TEST(Report, MalformedResultsExit3NamingFileAndLine) {
       {good + other_kind.dump() + "\n", "results.jsonl:2: kind is \"stereobench.validation\""},
       {good + newer.dump() + "\n", "results.jsonl:2: schema_version 2 is newer"},
       {good + bad_metric.dump() + "\n", "results.jsonl:2: field 'pipelines.plain-rt.validation.metrics.psnr' is \"high\""},
-      {good + "\n" + minimal_line("a", 5).dump() + "\n", "results.jsonl:3: cell_id 'a' appears again (first on line 1)"},
+      {good + "\n" + minimal_line("a", 5).dump() + "\n", "results.jsonl:3: cell_id 'a' appears twice (also on line 1)"},
       {good + other_sweep.dump() + "\n",
        "results.jsonl:2: a cell of sweep 'other' (definition sha256 ?), but line 1 is of sweep 'tiny' (sha256 ?); a "
-       "report covers one sweep"},
+       "results file holds the cells of one sweep definition"},
       {good + other_version.dump() + "\n", "results.jsonl:2: a cell of sweep 'tiny' (definition sha256 0123456789ab)"},
-      {good + minimal_line("b", 0).dump() + "\n", "results.jsonl:2: cell_index 0 is also the index of line 1"},
+      {good + minimal_line("b", 0).dump() + "\n", "results.jsonl:2: cell_index '0' appears twice (also on line 1)"},
       {minimal_line("a", -1).dump() + "\n", "results.jsonl:1: cell_index -1 is negative"},
       {good + ssim_5.dump() + "\n",
        "results.jsonl:2: field 'pipelines.repro-rt.validation.metrics.ssim' is 5, outside [-1, 1]"},
@@ -237,7 +237,7 @@ TEST(Report, WarnsOnTornTailAndMissingImagesAndGuardsForeignFolders) {
   write_text(dir / "results.jsonl", minimal_line("a", 0).dump() + "\n" + with_images.dump() + "\n{\"kind\": \"stereob");
   const test::CliRun r = test::run_cli("report " + quoted(dir / "results.jsonl") + " --out " + quoted(dir / "out"));
   ASSERT_EQ(r.code, 0) << r.out;
-  EXPECT_NE(r.out.find("results.jsonl:3: skipped an incomplete last line"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("results.jsonl:3: unterminated last line"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("image cells/0001/left.png is missing"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("2 cell(s) x 2 pipeline(s), 0 image(s)"), std::string::npos) << r.out;
   const json data = embedded_data(dir / "out" / "index.html");

@@ -26,7 +26,8 @@ json cell(size_t index, const std::string& id, double psnr = 40.0) {
           {"definition_sha256", "abc"},
           {"cell_id", id},
           {"cell_index", index},
-          {"cell", {{"scene", "box-wall"}, {"scene_params", {{"size", 0.5}}}, {"truth", "full"}}},
+          {"cell",
+           {{"scene", "box-wall"}, {"scene_params", {{"size", 0.5}}}, {"resolution", "96x54"}, {"truth", "full"}}},
           {"rig", {{"width", 96}, {"height", 54}, {"interaxial_m", 0.064}, {"max_disparity_px", 3.5},
                    {"convergence_m", 2.0}}},
           {"baseline", "plain-rt"},
@@ -136,6 +137,36 @@ TEST(ResultsFile, BadLinesAndDuplicatesRejected) {
   const auto other = dir / "other.jsonl";
   append_text(other, R"({"kind": "something.else", "schema_version": 1})" "\n");
   EXPECT_THROW((void)read_results(other), InputError);
+
+  // Every reader (resume, collect, gate, report) sees the same checks: a field of the wrong type or
+  // outside what any measurement gives, a second cell with the same index, a cell of another
+  // definition in the same file.
+  const auto expect_refused = [&](const json& second, const std::string& expected) {
+    const auto file = dir / "checked.jsonl";
+    std::filesystem::remove(file);
+    append_result(file, cell(0, "a"));
+    append_result(file, second);
+    try {
+      (void)read_results(file);
+      ADD_FAILURE() << "accepted: " << second.dump();
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  json wrong_type = cell(1, "b");
+  wrong_type["rig"]["width"] = "96";
+  expect_refused(wrong_type, "checked.jsonl:2: field 'rig.width' is \"96\" but must be an integer");
+  json ssim_5 = cell(1, "b");
+  ssim_5["pipelines"]["plain-rt"]["validation"]["metrics"]["ssim"] = 5;
+  expect_refused(ssim_5, "checked.jsonl:2: field 'pipelines.plain-rt.validation.metrics.ssim' is 5, outside [-1, 1]");
+  expect_refused(cell(0, "b"), "checked.jsonl:2: cell_index '0' appears twice (also on line 1)");
+  json other_definition = cell(1, "b");
+  other_definition["definition_sha256"] = "def";
+  expect_refused(other_definition, "checked.jsonl:2: a cell of sweep 't' (definition sha256 def), but line 1 is of "
+                                   "sweep 't' (sha256 abc); a results file holds the cells of one sweep definition");
+  json no_baseline = cell(1, "b");
+  no_baseline["baseline"] = "repro-rt";
+  expect_refused(no_baseline, "checked.jsonl:2: baseline \"repro-rt\" is not among the cell's pipelines");
 }
 
 TEST(ResultsFile, CollectMergesShards) {
