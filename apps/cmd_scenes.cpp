@@ -1,4 +1,5 @@
 // `stereobench scenes`: list the built-in scene generators, generate scenes, describe scene files.
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -146,7 +147,12 @@ void register_scenes_command(CLI::App& root) {
   g->add_option("--seed", gen->seed, "Random seed; same seed, same file")
       ->check(CLI::Validator(
           [](const std::string& v) {
-            return !v.empty() && v[0] == '-' ? "a seed is a whole number of 0 or more, not " + v : std::string();
+            // Decimal digits only, and within 64 bits: the parser would saturate 2^64 and above.
+            uint64_t parsed = 0;
+            const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), parsed);
+            return v.empty() || ec != std::errc() || end != v.data() + v.size()
+                       ? "a seed is a whole number from 0 to 18446744073709551615, not " + v
+                       : std::string();
           },
           "", "non-negative"))
       ->capture_default_str();

@@ -122,11 +122,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::Success& e) {
     return app.exit(e);  // --help, --version
   } catch (const CLI::ParseError& e) {
+    // Usage errors read like every other error: one "stereobench: error:" line, then where to look.
     const std::string unknown = unknown_command_message(app, argc, argv);
-    if (!unknown.empty())
-      std::fprintf(stderr, "stereobench: error: %s\n", unknown.c_str());
-    else
-      app.exit(e);
+    std::fprintf(stderr, "stereobench: error: %s\n", unknown.empty() ? e.what() : unknown.c_str());
     std::fprintf(stderr, "Run `stereobench --help` (or `stereobench SUBCOMMAND --help`) for usage.\n");
     return static_cast<int>(sb::ExitCode::bad_input);
   } catch (const sb::Error& e) {
