@@ -117,14 +117,14 @@ struct GateResults {
   std::vector<std::string> warnings;  ///< e.g. a torn last line that was skipped
 };
 
-/// Checks the cells read from `file` for what the gate needs: a scene and at least one pipeline
-/// with a validation record; InputError naming the file and cell otherwise, and for no cell at all
-/// (an empty results file is bad input, never a pass).
+/// Checks the cells read from `file` with check_cell_record (results_file.hpp); InputError naming
+/// the file and cell otherwise, and for no cell at all (an empty results file is bad input, never
+/// a pass).
 [[nodiscard]] GateResults gate_results(const std::vector<nlohmann::json>& cells, std::vector<std::string> warnings,
                                        const std::filesystem::path& file);
-/// Reads a results file (read_results: a torn last line is skipped with a warning, a cell id that
-/// appears twice is an error) and checks it with gate_results; InputError when the file does not
-/// exist.
+/// Reads a results file (read_results: a torn last line is skipped with a warning, every line is
+/// checked, a cell id that appears twice is an error) and takes its cells with gate_results;
+/// InputError when the file does not exist.
 [[nodiscard]] GateResults load_gate_results(const std::filesystem::path& file);
 
 /// The one-sided Mann–Whitney U (Wilcoxon rank-sum) test of H1: values of `x` tend to be larger than
