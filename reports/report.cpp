@@ -4,8 +4,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
-#include <cstring>
-#include <fstream>
 #include <map>
 #include <set>
 #include <span>
@@ -14,6 +12,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/io/image_io.hpp"
 #include "sb_version.hpp"
 
 namespace sb::reports {
@@ -21,16 +20,6 @@ namespace sb::reports {
 namespace {
 
 namespace fs = std::filesystem;
-
-/// Whether a file starts with the PNG signature.
-bool is_png_file(const fs::path& file) {
-  static constexpr unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  std::ifstream in(file, std::ios::binary);
-  char head[8] = {};
-  if (!in.read(head, sizeof head)) return false;
-  return std::memcmp(head, kSignature, sizeof head) == 0;
-}
-
 using nlohmann::json;
 
 /// Marks an index.html as ours, so that a later report may replace the folder's assets and images.
@@ -392,7 +381,7 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
     }
     // Every image of a results line is a PNG the sweep wrote; anything else a path names (a
     // hand-edited line, a path into the system) is not copied into a report that may be shared.
-    if (!is_png_file(source)) {
+    if (io::image_file_format(source) != "png") {
       summary.warnings.push_back(fmt::format("{}: image {} ({}) is not a PNG file; left out of the report",
                                              results.path.string(), rel, source.string()));
       return "";

@@ -295,28 +295,29 @@ ThresholdValues thresholds_for(const GateConfig& config, const std::string& pipe
 // ---------------------------------------------------------------------------------------------
 // Results file
 
-GateResults gate_results(const std::vector<json>& cells, std::vector<std::string> warnings,
-                         const std::filesystem::path& file) {
+namespace {
+
+/// The gate's view of cells that passed check_cell_record.
+GateResults take_cells(const std::vector<json>& cells, std::vector<std::string> warnings,
+                       const std::filesystem::path& file) {
   GateResults results;
   results.file = file;
   results.warnings = std::move(warnings);
-  const std::string name = file.string();
-  for (size_t i = 0; i < cells.size(); ++i) {
-    const json& record = cells[i];
-    // The checks every reader of a results line applies (read_results applies them too).
-    check_cell_record(record, fmt::format("{}: cell {}", name, i + 1));
-    GateCell cell;
-    cell.cell_id = record["cell_id"].get<std::string>();
-    cell.scene = record["cell"]["scene"].get<std::string>();
-    cell.record = record;
-    results.cells.push_back(std::move(cell));
-  }
+  for (const json& record : cells)
+    results.cells.push_back({record["cell_id"].get<std::string>(), record["cell"]["scene"].get<std::string>(), record});
   if (results.cells.empty())
-    throw InputError(
-        fmt::format("{} holds no finished cell; run the sweep first (an empty results file is not "
-                    "a pass)",
-                    name));
+    throw InputError(fmt::format(
+        "{} holds no finished cell; run the sweep first (an empty results file is not a pass)", file.string()));
   return results;
+}
+
+}  // namespace
+
+GateResults gate_results(const std::vector<json>& cells, std::vector<std::string> warnings,
+                         const std::filesystem::path& file) {
+  for (size_t i = 0; i < cells.size(); ++i)
+    check_cell_record(cells[i], fmt::format("{}: cell {}", file.string(), i + 1));
+  return take_cells(cells, std::move(warnings), file);
 }
 
 GateResults load_gate_results(const std::filesystem::path& file) {
@@ -325,8 +326,8 @@ GateResults load_gate_results(const std::filesystem::path& file) {
         fmt::format("results file {} does not exist; give --results with the results.jsonl a "
                     "`stereobench sweep` wrote",
                     file.string()));
-  ResultsFile read = read_results(file);
-  return gate_results(read.cells, std::move(read.warnings), file);
+  ResultsFile read = read_results(file);  // every line checked there
+  return take_cells(read.cells, std::move(read.warnings), file);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -448,19 +448,22 @@ std::vector<json> collect_results(const std::vector<fs::path>& files, const fs::
                                    file.string()));
     ResultsFile r = read_results(file);
     if (warnings) warnings->insert(warnings->end(), r.warnings.begin(), r.warnings.end());
+    if (r.cells.empty()) continue;
+    // read_results holds each file to one definition: its first cell speaks for the file.
+    const std::string file_sweep = r.cells.front()["sweep"], file_sha = r.cells.front().value("definition_sha256", "");
+    if (first.empty()) {
+      sweep = file_sweep;
+      sha = file_sha;
+      first = file;
+    } else if (file_sweep != sweep || file_sha != sha) {
+      throw InputError(fmt::format("{} holds cells of sweep '{}' (definition {}), {} of sweep '{}' (definition {}); "
+                                   "collect only shards of one definition",
+                                   file.string(), file_sweep, file_sha.substr(0, 12), first.string(), sweep,
+                                   sha.substr(0, 12)));
+    }
+    const fs::path from = folder_of(file), to = folder_of(out);
     for (json& cell : r.cells) {
-      rebase_image_paths(cell, folder_of(file), folder_of(out));
-      const std::string cell_sweep = cell.value("sweep", ""), cell_sha = cell.value("definition_sha256", "");
-      if (first.empty()) {
-        sweep = cell_sweep;
-        sha = cell_sha;
-        first = file;
-      } else if (cell_sweep != sweep || cell_sha != sha) {
-        throw InputError(fmt::format("{} holds cells of sweep '{}' (definition {}), {} of sweep '{}' (definition {}); "
-                                     "collect only shards of one definition",
-                                     file.string(), cell_sweep, cell_sha.substr(0, 12), first.string(), sweep,
-                                     sha.substr(0, 12)));
-      }
+      rebase_image_paths(cell, from, to);
       const std::string id = cell["cell_id"];
       const uint64_t index = cell["cell_index"];
       if (auto it = by_id.find(id); it != by_id.end()) {

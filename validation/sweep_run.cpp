@@ -75,15 +75,19 @@ SweepPlan plan_sweep(const SweepDefinition& definition, const fs::path& results,
   plan.warnings = std::move(existing.warnings);
   std::set<std::string> known, done;
   for (const SweepCell& c : plan.cells) known.insert(c.id);
-  for (const json& line : existing.cells) {
-    const std::string sweep = line.value("sweep", ""), sha = line.value("definition_sha256", "");
-    const std::string id = line["cell_id"];
+  // read_results holds a file to one definition, so its first line speaks for all.
+  if (!existing.cells.empty()) {
+    const json& first = existing.cells.front();
+    const std::string sweep = first["sweep"], sha = first.value("definition_sha256", "");
     if (sweep != definition.name || sha != definition.sha256)
       throw InputError(fmt::format(
           "{} holds cells of sweep '{}' (definition sha256 {}), not of this definition '{}' ({}, sha256 {}); "
           "the definition changed since those cells ran: give another --out, or delete the file to start over",
           results.string(), sweep, sha.substr(0, 12), definition.name, definition.file.string(),
           definition.sha256.substr(0, 12)));
+  }
+  for (const json& line : existing.cells) {
+    const std::string id = line["cell_id"];
     if (!known.count(id))
       throw InputError(fmt::format("{}: cell '{}' is not a cell of {}", results.string(), id, definition.file.string()));
     done.insert(id);

@@ -966,6 +966,13 @@ std::vector<unsigned char> encode_png(const uint8_t* pixels, int width, int heig
   return bytes;
 }
 
+std::string image_file_format(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char head[16] = {};
+  in.read(reinterpret_cast<char*>(head), sizeof head);
+  return sniff_format(std::span<const unsigned char>(head, static_cast<size_t>(in.gcount())));
+}
+
 DecodedImage decode_image(std::span<const unsigned char> bytes, const std::string& name_for_errors) {
   const std::string& name = name_for_errors;
   if (bytes.empty()) throw InputError(fmt::format("image {} is empty (0 bytes); {}", name, kCorruptHint));

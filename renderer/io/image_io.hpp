@@ -118,6 +118,10 @@ struct DecodedImage {
 /// Reads an image file as decode_image does. InputError if missing or unreadable.
 [[nodiscard]] DecodedImage read_image(const std::filesystem::path& path);
 
+/// The format of an image file from its first bytes, as decode_image recognises it ("png",
+/// "jpeg", "openexr", ...), or "" when the file is unreadable or holds no known signature.
+[[nodiscard]] std::string image_file_format(const std::filesystem::path& path);
+
 /// The OpenImageIO library version, e.g. "2.4.7", for provenance records.
 [[nodiscard]] std::string oiio_version();
 

@@ -195,7 +195,14 @@ TEST(ResultsFile, CollectMergesShards) {
   json foreign = cell(5, "z");
   foreign["definition_sha256"] = "def";
   append_result(dir / "s3.jsonl", foreign);
-  EXPECT_THROW((void)collect_results({dir / "s0.jsonl", dir / "s3.jsonl"}, dir / "merged.jsonl"), InputError);
+  try {
+    (void)collect_results({dir / "s0.jsonl", dir / "s3.jsonl"}, dir / "merged.jsonl");
+    FAIL() << "shards of two definitions were merged";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("s3.jsonl holds cells of sweep 't' (definition def), "), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("collect only shards of one definition"), std::string::npos) << e.what();
+  }
 }
 
 TEST(ResultsFile, CsvRowsAndQuoting) {
