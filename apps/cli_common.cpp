@@ -2,6 +2,7 @@
 #include "apps/cli_common.hpp"
 
 #include <cmath>
+#include <filesystem>
 
 #include <fmt/format.h>
 #include <tbb/info.h>
@@ -97,6 +98,37 @@ int checked_threads(int threads) {
     return cores;
   }
   return threads;
+}
+
+namespace {
+
+/// The same file twice, by path or (both existing) by identity: a link or another spelling.
+bool same_file(const std::string& x, const std::string& y) {
+  namespace fs = std::filesystem;
+  std::error_code ex, ey;
+  const fs::path cx = fs::weakly_canonical(fs::absolute(x, ex), ex);
+  const fs::path cy = fs::weakly_canonical(fs::absolute(y, ey), ey);
+  if (!ex && !ey && cx == cy) return true;
+  return fs::exists(x, ex) && fs::exists(y, ey) && fs::equivalent(x, y, ex);
+}
+
+bool names_file(const NamedPath& p) { return !p.path->empty() && *p.path != "-"; }
+
+}  // namespace
+
+void refuse_overwriting(std::initializer_list<NamedPath> inputs, std::initializer_list<NamedPath> outputs) {
+  for (auto out = outputs.begin(); out != outputs.end(); ++out) {
+    if (!names_file(*out)) continue;
+    for (const NamedPath& in : inputs)
+      if (names_file(in) && same_file(*out->path, *in.path))
+        throw InputError(fmt::format("{} {} names the same file as {} ({}); it would be overwritten: give the output "
+                                     "another name",
+                                     out->name, *out->path, in.name, *in.path));
+    for (auto earlier = outputs.begin(); earlier != out; ++earlier)
+      if (names_file(*earlier) && same_file(*out->path, *earlier->path))
+        throw InputError(
+            fmt::format("{} and {} both name {}; give each output its own file", earlier->name, out->name, *out->path));
+  }
 }
 
 }  // namespace sb::cli

@@ -1,10 +1,11 @@
 // Options shared by several subcommands (rig, scene folder), declared once with their help.
 #pragma once
 
+#include <initializer_list>
 #include <map>
 #include <optional>
-#include <vector>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -38,6 +39,16 @@ CLI::Option* add_lights_option(CLI::App& app, std::optional<int>& lights);
 /// Parses NAME=VALUE items (--option) into a map; InputError for an item without '='.
 [[nodiscard]] std::map<std::string, std::string> parse_key_values(const std::vector<std::string>& items,
                                                                   const char* option);
+
+/// A file named on the command line: the option or argument that names it, and its path.
+struct NamedPath {
+  const char* name;
+  const std::string* path;
+};
+
+/// Refuses an output that would overwrite an input or another output: the same file by path, by
+/// another spelling of it, or through a link. Empty paths and "-" (standard output) are skipped.
+void refuse_overwriting(std::initializer_list<NamedPath> inputs, std::initializer_list<NamedPath> outputs);
 
 /// Checks a --threads value: 0 (all cores) or 1..1024; more than the cores is taken as the
 /// cores, with a note (the scheduler would run no more, yet the results would record them).

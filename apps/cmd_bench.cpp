@@ -61,6 +61,9 @@ double peak_rss_mib() {
 BenchConfig bench_config(const BenchArgs& a, const std::vector<std::string>& default_pipelines) {
   BenchConfig config;
   config.pipelines = split_names(a.pipelines);
+  if (!a.pipelines.empty() && config.pipelines.empty())
+    throw InputError("--pipelines names no pipeline; give names (see `stereobench pipelines`) or leave the option out "
+                     "for the default set");
   if (config.pipelines.empty()) config.pipelines = default_pipelines;
   config.baseline = a.baseline;
   if (std::find(config.pipelines.begin(), config.pipelines.end(), config.baseline) == config.pipelines.end())

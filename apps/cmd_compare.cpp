@@ -1,15 +1,18 @@
 // `stereobench compare A B`: the metrics of DESIGN §6.2 for any two image files, with idiff-style
 // pass / warn / fail thresholds, a JSON record, and difference and SSIM map pictures.
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
@@ -64,6 +67,21 @@ std::vector<std::string> violations(const ImageMetrics& m, const Limit& psnr, co
   return out;
 }
 
+/// Refuses an output that would overwrite an input or another output, and a picture name that
+/// does not end in .png (the pictures are PNG whatever the name says).
+void check_outputs(const CompareArgs& a) {
+  refuse_overwriting({{"image A", &a.a}, {"image B", &a.b}, {"--mask", &a.mask}},
+                     {{"--json", &a.json}, {"--diff", &a.diff}, {"--ssim-map", &a.ssim_map}});
+  const std::pair<const char*, const std::string*> pictures[] = {{"--diff", &a.diff}, {"--ssim-map", &a.ssim_map}};
+  for (const auto& [option, path] : pictures) {
+    std::string ext = fs::path(*path).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (!path->empty() && ext != ".png")
+      throw InputError(fmt::format("{} {}: the picture is written as PNG; give a file name ending in .png", option,
+                                   *path));
+  }
+}
+
 nlohmann::json file_record(const std::string& path, const validation::Srgb8File& f) {
   nlohmann::json j{{"path", path},
                    {"width", f.image.width},
@@ -88,6 +106,8 @@ int run_compare(const CompareArgs& a) {
     check_limit(*o, o == &a.fail_ssim ? "--fail-ssim" : "--warn-ssim", -1.0, 1.0, "an SSIM");
   for (const auto* o : {&a.fail_percent, &a.warn_percent})
     check_limit(*o, o == &a.fail_percent ? "--fail-percent" : "--warn-percent", 0.0, 100.0, "a percentage");
+
+  check_outputs(a);
 
   // Inputs: both images (and the mask) must have one size and one kind of colour.
   const validation::Srgb8File fa = validation::read_srgb8_file(a.a, a.eye);

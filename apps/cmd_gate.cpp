@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
@@ -65,11 +66,14 @@ void run_update(const GateArgs& a) {
 
 void run_gate(const GateArgs& a) {
   if (a.update_baseline) {
+    refuse_overwriting({{"--results", &a.results}, {"--config", &a.config}}, {{"--baseline", &a.baseline}});
     run_update(a);
     return;
   }
   if (!a.only.empty() || !a.cells.empty())
     throw InputError("--only and --cells select what --update-baseline rewrites; add --update-baseline or drop them");
+  refuse_overwriting({{"--results", &a.results}, {"--config", &a.config}, {"--baseline", &a.baseline}},
+                     {{"--junit", &a.junit}, {"--json", &a.json_out}});
   const validation::GateConfig config = validation::load_gate_config(a.config);
   const validation::GateResults results = validation::load_gate_results(a.results);
 

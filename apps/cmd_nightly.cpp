@@ -176,6 +176,7 @@ void run_nightly(const NightlyArgs& a) {
   o.definition_label = a.definition;
   o.jobs = a.jobs;
   o.threads = threads;
+  const ResultsWriterLock lock(o.results);  // held through the gate, history and report
   const SweepPlan plan = plan_sweep(d, o.results);
   for (const std::string& w : plan.warnings) fmt::print(stderr, "warning: {}\n", w);
   fmt::print("nightly {} run {} ({}): {} cells × {} pipelines, {} finished already, {} to run\n", d.name, run_id,

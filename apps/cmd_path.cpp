@@ -91,7 +91,7 @@ void run_path_command(const PathArgs& a) {
   run.pose = rig.pose();
   run.truth = provider.get();
   const validation::TruthCache cache(a.cache);
-  run.cache = &cache;
+  run.cache = a.cache.empty() ? nullptr : &cache;
   run.work_dir = fs::path(a.out) / "work";
   run.refit = a.bvh == "refit";
 
@@ -151,7 +151,8 @@ void register_path_command(CLI::App& root) {
   p->add_option("--bvh", a->bvh, "Per-frame BVH update of a moving scene: refit or rebuild")->capture_default_str();
   p->add_option("--threads,-t", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
   p->add_option("--out", a->out, "Output folder")->capture_default_str();
-  p->add_option("--cache", a->cache, "Folder of cached external ground-truth renders")->capture_default_str();
+  p->add_option("--cache", a->cache, "Folder of cached external ground-truth renders ('' to disable)")
+      ->capture_default_str();
   add_lights_option(*p, a->lights);
   add_scenes_dir_option(*p, a->scenes_dir);
   a->rig.add_to(*p);

@@ -113,6 +113,7 @@ void run_sweep(const SweepRunArgs& a) {
   o.jobs = a.jobs;
   o.threads = checked_threads(a.threads);
 
+  const ResultsWriterLock lock(o.results);  // held until the last cell is recorded
   const SweepPlan plan = plan_sweep(d, o.results, shard);
   for (const std::string& w : plan.warnings) fmt::print(stderr, "warning: {}\n", w);
   fmt::print("sweep {} ({}): {} cells × {} pipelines (baseline {}), {} warm-up + {} repetitions\n", d.name,
@@ -200,6 +201,7 @@ void register_csv(CLI::App& sweep) {
   csv->add_option("--out,-o", a->out, "CSV file to write (default: standard output)");
   csv->callback([a] {
     if (!fs::exists(a->results)) throw InputError(fmt::format("{}: results file does not exist", a->results));
+    refuse_overwriting({{"results", &a->results}}, {{"--out", &a->out}});
     const ResultsFile r = read_results(a->results);
     for (const std::string& w : r.warnings) fmt::print(stderr, "warning: {}\n", w);
     if (r.cells.empty())
@@ -228,9 +230,7 @@ void register_collect(CLI::App& sweep) {
   collect->add_option("inputs", a->inputs, "Results files of the shards")->required();
   collect->callback([a] {
     std::vector<fs::path> inputs(a->inputs.begin(), a->inputs.end());
-    for (const fs::path& in : inputs)
-      if (fs::exists(a->out) && fs::equivalent(in, a->out))
-        throw InputError(fmt::format("{} is both an input and the output; write the merge to a new file", a->out));
+    for (const std::string& in : a->inputs) refuse_overwriting({{"the input", &in}}, {{"the output", &a->out}});
     std::vector<std::string> warnings;
     const std::vector<nlohmann::json> cells = collect_results(inputs, a->out, &warnings);
     for (const std::string& w : warnings) fmt::print(stderr, "warning: {}\n", w);

@@ -35,17 +35,22 @@ std::string command_line(int argc, char** argv) {
   return out;
 }
 
-/// An empty --out (an unset shell variable, say) would write into the current folder: refused.
-void refuse_empty_out(CLI::App& app) {
-  if (CLI::Option* out = app.get_option_no_throw("--out"))
-    out->check(CLI::Validator(
+/// An empty file or folder option (an unset shell variable, say) would read or write the current
+/// folder, or silently drop the output: refused. --cache is not among them: '' turns the ground-truth
+/// cache off.
+void refuse_empty_paths(CLI::App& app) {
+  for (const char* name : {"--out", "--scenes-dir", "--store", "--results", "--history", "--json",
+                           "--junit", "--diff", "--ssim-map", "--mask", "--gate-config", "--config", "--baseline"}) {
+    CLI::Option* option = app.get_option_no_throw(name);
+    if (!option) continue;
+    option->check(CLI::Validator(
         [](const std::string& value) {
-          return value.empty() ? std::string("is empty; give a file or folder name, or leave the option out for its "
-                                             "default")
+          return value.empty() ? std::string("is empty; give a name, or leave the option out for its default")
                                : std::string();
         },
         "", "non-empty"));
-  for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) refuse_empty_out(*sub);
+  }
+  for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) refuse_empty_paths(*sub);
 }
 
 /// Options that name a file to write (--json, --junit, sweep collect's merged file): a folder
@@ -112,7 +117,7 @@ int main(int argc, char** argv) {
   sb::cli::register_reference_command(app, command_line(argc, argv));
   sb::cli::register_report_command(app);
   sb::cli::register_path_command(app);
-  refuse_empty_out(app);
+  refuse_empty_paths(app);
   refuse_folder_as_file(app);
 
   try {

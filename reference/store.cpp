@@ -12,6 +12,7 @@
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/image_io.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/io/render_output.hpp"
 #include "renderer/render_scene.hpp"
 #include "sb_version.hpp"
@@ -237,8 +238,8 @@ json ReferenceStore::provenance(const std::string& id) const {
                                  known.empty() ? "the store is empty" : fmt::format("it holds {} references", known.size())));
   }
   try {
-    return json::parse(io::read_file(file));
-  } catch (const json::exception& e) {
+    return io::parse_json(io::read_file(file));
+  } catch (const io::JsonTextError& e) {
     throw InputError(fmt::format("{} is not valid JSON ({}); regenerate it with `stereobench reference update`",
                                  file.string(), e.what()));
   }

@@ -13,6 +13,7 @@
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/image_io.hpp"
+#include "renderer/io/json_text.hpp"
 #include "sb_version.hpp"
 
 namespace sb::reports {
@@ -358,8 +359,8 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
                                   (assets / f).string()));
   json papers;
   try {
-    papers = json::parse(io::read_file(assets / kPapers));
-  } catch (const json::parse_error& e) {
+    papers = io::parse_json(io::read_file(assets / kPapers));
+  } catch (const io::JsonTextError& e) {
     throw ToolError(fmt::format("report asset {} is not valid JSON: {}", (assets / kPapers).string(), e.what()));
   }
 

@@ -8,6 +8,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/io/json_text.hpp"
 
 namespace sb::validation {
 
@@ -69,8 +70,8 @@ Baseline load_baseline(const std::filesystem::path& file) {
   const std::string text = io::read_file(file);
   json doc;
   try {
-    doc = json::parse(text);
-  } catch (const json::parse_error& e) {
+    doc = io::parse_json(text);
+  } catch (const io::JsonTextError& e) {
     throw InputError(fmt::format("baseline {} is not valid JSON ({})", file.string(), e.what()));
   }
   return parse_baseline(doc, file.string());

@@ -76,11 +76,24 @@ Srgb8File read_srgb8_file(const fs::path& path, std::string_view eye) {
   Srgb8File file;
   if (open_and_sniff_exr(path)) {
     const Image image = read_exr_image(path, eye, file.eye);
-    if (!image.has_plane(planes::rgb))
-      throw InputError(fmt::format("{} has no R, G, B channels (planes: {}); the metrics compare colour images",
+    if (image.has_plane(planes::rgb)) {
+      file.image = encode_srgb8(image, path.string());
+      file.encoding = "openexr, linear float encoded to sRGB";
+      return file;
+    }
+    // A grey EXR: its one channel (Y, or any single name) counts as R = G = B.
+    const auto& all = image.planes();
+    if (all.size() != 1 || all.front().channels() != 1 || all.front().type() != PlaneType::f32)
+      throw InputError(fmt::format("{} has neither R, G, B channels nor a single grey channel (planes: {}); the "
+                                   "metrics compare colour or grey images",
                                    path.string(), image.plane_list()));
-    file.image = encode_srgb8(image, path.string());
-    file.encoding = "openexr, linear float encoded to sRGB";
+    const std::span<const float> grey = all.front().f32();
+    Image linear(image.width(), image.height());
+    float* rgb = linear.add_plane(planes::rgb).data_f32();
+    for (std::size_t i = 0; i < grey.size(); ++i) rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = grey[i];
+    file.image = encode_srgb8(linear, path.string());
+    file.colour_channels = 1;
+    file.encoding = "openexr, linear float grey encoded to sRGB";
     return file;
   }
 

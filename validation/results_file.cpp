@@ -18,6 +18,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/io/json_text.hpp"
 
 namespace sb::validation {
 
@@ -69,6 +70,11 @@ class Fd {
  private:
   int fd_;
 };
+
+/// The hidden lock file beside a results file.
+fs::path lock_path(const fs::path& results) {
+  return results.parent_path() / ("." + results.filename().string() + ".lock");
+}
 
 /// Cuts an unterminated tail (a line torn by a killed writer) so that the next line starts on a
 /// line of its own. The caller holds the exclusive lock.
@@ -248,6 +254,37 @@ json value_at(const json& root, std::string_view dotted) {
 
 }  // namespace
 
+ResultsWriterLock::ResultsWriterLock(const fs::path& results) {
+  std::error_code ec;
+  if (results.has_parent_path()) fs::create_directories(results.parent_path(), ec);
+  const fs::path path = lock_path(results);
+  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0)
+    throw IoError(fmt::format("{}: cannot open the lock file of {}: {}; check the folder's permissions", path.string(),
+                              results.string(), std::strerror(errno)));
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    char holder[32] = {};
+    const ssize_t n = ::pread(fd_, holder, sizeof holder - 1, 0);
+    ::close(fd_);
+    fd_ = -1;
+    if (err != EWOULDBLOCK)
+      throw IoError(fmt::format("{}: cannot lock it: {}", path.string(), std::strerror(err)));
+    std::string pid(holder, n > 0 ? static_cast<size_t>(n) : 0);
+    pid.erase(pid.find_last_not_of(" \n") + 1);
+    throw InputError(fmt::format("{} is being written by another stereobench run ({}); two runs would record the "
+                                 "same cells twice: wait for it to end, or give another --out",
+                                 results.string(), pid.empty() ? "its lock is held" : "pid " + pid));
+  }
+  // The pid only makes another run's message clearer; the lock is held whether or not it is written.
+  const std::string pid = std::to_string(::getpid()) + "\n";
+  if (::ftruncate(fd_, 0) == 0) (void)!::pwrite(fd_, pid.data(), pid.size(), 0);
+}
+
+ResultsWriterLock::~ResultsWriterLock() {
+  if (fd_ >= 0) ::close(fd_);  // releases the flock
+}
+
 void append_result(const fs::path& file, const json& cell) {
   const std::string line = line_of(cell);
   std::error_code ec;
@@ -296,8 +333,8 @@ void read_json_lines(const fs::path& file, const std::string& torn_note, const s
     const std::string where = fmt::format("{}:{}", file.string(), line_no);
     json parsed;
     try {
-      parsed = json::parse(line);
-    } catch (const json::parse_error& e) {
+      parsed = io::parse_json(line);
+    } catch (const io::JsonTextError& e) {
       throw InputError(fmt::format("{}: not a JSON line ({}); {}", where, e.what(), parse_hint));
     }
     take(std::move(parsed), line_no, where);

@@ -27,6 +27,21 @@ inline constexpr int kSweepSchemaVersion = 1;
 /// never run together. Creates the file and its folder. IoError when it cannot be written.
 void append_result(const std::filesystem::path& file, const nlohmann::json& cell);
 
+/// Holds a results file for one writer while it lives: an exclusive flock on a hidden lock file
+/// beside it (".<name>.lock", holding the writer's pid). A second run planned against the same
+/// results file would find the same cells unfinished and record each twice; it is refused with an
+/// InputError naming the file and the holder. The lock goes when the process ends, however it ends.
+class ResultsWriterLock {
+ public:
+  explicit ResultsWriterLock(const std::filesystem::path& results);
+  ~ResultsWriterLock();
+  ResultsWriterLock(const ResultsWriterLock&) = delete;
+  ResultsWriterLock& operator=(const ResultsWriterLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
 /// What was read from a results file.
 struct ResultsFile {
   std::vector<nlohmann::json> cells;  ///< in file order

@@ -18,6 +18,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/io/json_text.hpp"
 #include "validation/process.hpp"
 #include "validation/results_file.hpp"
 
@@ -261,8 +262,8 @@ SlurmSubmission submit_sweep(const SweepDefinition& d, SlurmSweepOptions o) {
   if (fs::exists(l.submission)) {
     json before;
     try {
-      before = json::parse(std::ifstream(l.submission));
-    } catch (const json::exception& e) {
+      before = io::parse_json(io::read_file(l.submission));
+    } catch (const io::JsonTextError& e) {
       throw InputError(fmt::format("{}: unreadable ({}); remove it to submit again", l.submission.string(), e.what()));
     }
     const std::string job = before.value("job_id", "");

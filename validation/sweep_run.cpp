@@ -23,6 +23,7 @@
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/gltf_loader.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/io/render_output.hpp"
 #include "renderer/parallel.hpp"
 #include "renderer/pipeline.hpp"
@@ -368,8 +369,8 @@ void claim_out_folder(const SweepDefinition& d, const SweepRunOptions& options) 
   if (fs::exists(marker)) {
     json theirs;
     try {
-      theirs = json::parse(io::read_file(marker));
-    } catch (const json::exception&) {
+      theirs = io::parse_json(io::read_file(marker));
+    } catch (const io::JsonTextError&) {
     }
     if (!theirs.is_object()) theirs = json::object();  // damaged: it names no definition
     if (theirs.value("sweep", "") == d.name && theirs.value("definition_sha256", "") == d.sha256) return;

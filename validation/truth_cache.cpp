@@ -6,6 +6,7 @@
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/image_io.hpp"
+#include "renderer/io/json_text.hpp"
 #include "validation/content_hash.hpp"
 
 namespace sb::validation {
@@ -40,7 +41,7 @@ std::optional<TruthRender> TruthCache::load(const std::string& provider, const s
   std::error_code ec;
   if (!std::filesystem::exists(meta, ec) || !std::filesystem::exists(exr, ec)) return std::nullopt;
   try {
-    const json j = json::parse(io::read_file(meta));
+    const json j = io::parse_json(io::read_file(meta));
     TruthRender r;
     r.right = rgb_plane_only(io::read_exr(exr));
     if (hash_image(r.right) != j.at("image_sha256").get<std::string>()) return std::nullopt;
@@ -52,6 +53,8 @@ std::optional<TruthRender> TruthCache::load(const std::string& provider, const s
     return r;
   } catch (const Error&) {
     return std::nullopt;  // unreadable entry: render again and overwrite it
+  } catch (const io::JsonTextError&) {
+    return std::nullopt;
   } catch (const json::exception&) {
     return std::nullopt;
   }

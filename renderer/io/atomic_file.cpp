@@ -37,9 +37,49 @@ void sync_file(const fs::path& path) {
   if (rc != 0) throw IoError(fmt::format("cannot flush {} to disk: {}", path.string(), std::strerror(err)));
 }
 
+/// Where a write to `path` lands. A symbolic link is followed to the file it names, so that the
+/// file is replaced and the link stays a link; a link to a device or pipe (/dev/stdout) is kept as
+/// given, for the kernel to follow when it is opened.
+fs::path write_target(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::is_symlink(fs::symlink_status(path, ec))) return path;
+  const fs::file_status target = fs::status(path, ec);
+  if (fs::exists(target)) {
+    if (!fs::is_regular_file(target)) return path;
+    const fs::path real = fs::canonical(path, ec);
+    return ec ? path : real;
+  }
+  // A dangling link names the file to create.
+  fs::path p = path;
+  for (int hops = 0; hops < 40 && fs::is_symlink(fs::symlink_status(p, ec)); ++hops) {
+    const fs::path next = fs::read_symlink(p, ec);
+    if (ec) break;
+    p = next.is_absolute() ? next : p.parent_path() / next;
+  }
+  return p;
+}
+
+/// A device, pipe or socket cannot be replaced by renaming a file over it: it is written in place.
+bool is_stream(const fs::path& path) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  return fs::exists(st) && !fs::is_regular_file(st) && !fs::is_directory(st);
+}
+
 }  // namespace
 
-void write_atomically(const fs::path& path, const std::function<void(const fs::path&)>& write) {
+void write_atomically(const fs::path& given, const std::function<void(const fs::path&)>& write) {
+  const fs::path path = write_target(given);
+  if (is_stream(path)) {
+    try {
+      write(path);
+    } catch (const Error&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw IoError(fmt::format("writing {} failed: {}", given.string(), e.what()));
+    }
+    return;
+  }
   std::error_code ec;
   const fs::path parent = path.parent_path();
   if (!parent.empty()) {

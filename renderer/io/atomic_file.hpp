@@ -13,7 +13,9 @@ namespace sb::io {
 /// Calls `write(tmp_path)` to produce the file under a temporary name in the same folder, then
 /// flushes it to disk and renames it to `path`. Creates missing parent folders. On any failure
 /// (including an exception from `write`) the temporary file is removed and IoError is thrown
-/// naming `path`; an existing file at `path` is left untouched.
+/// naming `path`; an existing file at `path` is left untouched. A symbolic link at `path` is
+/// followed (the file it names is replaced, the link stays); a device or pipe there (/dev/stdout,
+/// a FIFO) is written in place, since it cannot be replaced, and a write error is still IoError.
 void write_atomically(const std::filesystem::path& path,
                       const std::function<void(const std::filesystem::path& tmp_path)>& write);
 

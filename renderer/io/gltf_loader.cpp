@@ -24,6 +24,7 @@
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/gltf_check.hpp"
 #include "renderer/io/image_io.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/text.hpp"
 
 namespace sb::io {
@@ -764,9 +765,10 @@ Scene load_gltf(const fs::path& path, const GltfLoadOptions& options) {
   const GlbParts parts = split_container(bytes, file, lowercase(path.extension().string()) == ".glb");
   json doc;
   try {
-    doc = json::parse(parts.json_text);
-  } catch (const json::parse_error& e) {
-    throw InputError(fmt::format("{}: not valid JSON at byte {}: {}", file, e.byte, short_parse_error(e.what())));
+    doc = parse_json(parts.json_text);
+  } catch (const JsonTextError& e) {
+    const std::string at = e.byte() > 0 ? fmt::format(" at byte {}", e.byte()) : "";
+    throw InputError(fmt::format("{}: not valid JSON{}: {}", file, at, short_parse_error(e.what())));
   }
   check_gltf_json(doc, file);
   const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();

@@ -195,7 +195,13 @@ TEST(Cli, RenderAndBenchRejectBadArguments) {
        "iterations=2000000000 is beyond the ±1e9"},
       {"render --scene box-wall --pipeline plain-raster --option tile=8 --option tile=16" + common,
        "--option gives tile twice (8 and 16)"},
-      {"render --scene box-wall --pipeline plain-rt --resolution 32x18 --out ''", "--out: is empty; give a file"},
+      {"render --scene box-wall --pipeline plain-rt --resolution 32x18 --out ''", "--out: is empty; give a name"},
+      // An empty --scenes-dir would generate scenes into the current folder.
+      {"render --scene box-wall --pipeline plain-rt --scenes-dir '' --out '" + dir.path().string() + "'",
+       "--scenes-dir: is empty; give a name"},
+      {"bench --scene box-wall --pipelines plain-rt --json ''" + bench_common, "--json: is empty; give a name"},
+      // An empty list used to time every registered pipeline.
+      {"bench --scene box-wall --pipelines ''" + bench_common, "--pipelines names no pipeline"},
       {"bench --scene box-wall -n 20000 --pipelines plain-rt --baseline plain-rt" + bench_common,
        "--repetitions 20000 is outside 1..10000"},
       {"bench --scene box-wall --pipelines plain-rt,plain-rt --baseline plain-rt" + bench_common,

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -217,6 +218,45 @@ TEST_F(Compare, StereoExrNeedsAnEye) {
   EXPECT_NE(r.out.find(path("cut.exr").string()), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("holds a stereo pair"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("read_exr_stereo"), std::string::npos) << "an internal name: " << r.out;
+}
+
+TEST_F(Compare, OutputsNeverOverwriteInputs) {
+  const std::string before = test::read_text(path("a.png"));
+  // Each used to succeed, replacing an input (or one picture the other) without a word.
+  const std::pair<std::string, std::string> cases[] = {
+      {" --diff " + q(path("a.png")), "--diff " + path("a.png").string() + " names the same file as image A"},
+      {" --json " + q(dir_.path() / "." / "b.png"), "names the same file as image B"},
+      {" --diff " + q(path("d.png")) + " --ssim-map " + q(dir_.path() / "." / "d.png"),
+       "--diff and --ssim-map both name"},
+      {" --diff " + q(path("d.exr")), "--diff " + path("d.exr").string() + ": the picture is written as PNG"},
+  };
+  for (const auto& [args, expect] : cases) {
+    const CliRun r = compare(ab() + args);
+    EXPECT_EQ(r.code, 3) << args << "\n" << r.out;
+    EXPECT_NE(r.out.find(expect), std::string::npos) << args << "\nexpected: " << expect << "\ngot: " << r.out;
+  }
+  EXPECT_EQ(test::read_text(path("a.png")), before);
+  EXPECT_FALSE(fs::exists(path("d.png")));
+}
+
+TEST_F(Compare, GreyExrCountsAsGrey) {
+  // A one-channel EXR (here named y) is grey, as a grey PNG is: it used to be refused for lacking R, G, B.
+  std::vector<uint8_t> codes(48 * 32);
+  Image grey(48, 32);
+  float* v = grey.add_plane("y", 1, PlaneType::f32).data_f32();
+  for (size_t i = 0; i < codes.size(); ++i) {
+    codes[i] = uint8_t(i % 251);
+    v[i] = srgb8_to_linear(codes[i]);
+  }
+  io::write_exr(path("grey.exr"), grey);
+  io::write_file_atomically(path("grey.png"), io::encode_png(codes.data(), 48, 32, 1));
+  CliRun r = compare(q(path("grey.exr")) + " " + q(path("grey.png")) + " --fail-psnr 1000");
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("inf dB"), std::string::npos) << r.out;
+  // Grey against colour is still refused, naming the channel counts.
+  r = compare(q(path("grey.exr")) + " " + q(path("a.png")));
+  EXPECT_EQ(r.code, 3) << r.out;
+  EXPECT_NE(r.out.find("has 1 colour channel(s)"), std::string::npos) << r.out;
 }
 
 TEST(CompareHelp, ExplainsMetricsAndExitCodes) {

@@ -258,6 +258,15 @@ TEST(GateCli, ExitCodesAndOutputs) {
   EXPECT_TRUE(found);
   const std::string xml = read_text(dir / "junit.xml");
   EXPECT_NE(xml.find("<failure message=\"PSNR 39.00 dB is below the minimum 40.00 dB\""), std::string::npos) << xml;
+
+  // The reports never replace the gate's inputs (--json over the results file used to succeed).
+  const std::string kept = read_text(dir / "fail.jsonl");
+  for (const std::string& out : {" --json " + (dir / "fail.jsonl").string(), " --junit " + (dir / "." / "fail.jsonl").string()}) {
+    run = run_cli("gate" + config + baseline + " --results " + (dir / "fail.jsonl").string() + out);
+    EXPECT_EQ(run.code, 3) << out << "\n" << run.out;
+    EXPECT_NE(run.out.find("names the same file as --results"), std::string::npos) << run.out;
+  }
+  EXPECT_EQ(read_text(dir / "fail.jsonl"), kept);
   EXPECT_NE(xml.find(repro), std::string::npos);
 
   // The JUnit XML validates against the schema CI systems read (xmllint from libxml2-utils; its

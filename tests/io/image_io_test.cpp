@@ -379,6 +379,32 @@ TEST_F(ImageIoTest, FailureInsideWriteAtomicallyLeavesNoFileAndNoTemporary) {
   EXPECT_EQ(read_bytes(file), std::vector<unsigned char>{42});
 }
 
+TEST_F(ImageIoTest, WritingThroughALinkReplacesItsTargetAndKeepsTheLink) {
+  write_bytes(path("target.json"), {1});
+  fs::create_symlink("target.json", path("link.json"));
+  io::write_text_atomically(path("link.json"), "new");
+  EXPECT_TRUE(fs::is_symlink(path("link.json")));
+  EXPECT_EQ(read_bytes(path("target.json")), (std::vector<unsigned char>{'n', 'e', 'w'}));
+  // A dangling link names the file to create.
+  fs::create_symlink("later.json", path("dangling.json"));
+  io::write_text_atomically(path("dangling.json"), "x");
+  EXPECT_TRUE(fs::is_symlink(path("dangling.json")));
+  EXPECT_EQ(read_bytes(path("later.json")), std::vector<unsigned char>{'x'});
+}
+
+TEST_F(ImageIoTest, ADeviceIsWrittenInPlaceNotReplaced) {
+  // /dev/full accepts the open and fails the write: an IoError, and the device stays a device
+  // (renaming a file over it used to replace it with a regular file and report success).
+  if (!fs::is_character_file("/dev/full")) GTEST_SKIP() << "no /dev/full here";
+  fs::create_symlink("/dev/full", path("full"));
+  EXPECT_THROW(io::write_text_atomically(path("full"), std::string(100000, 'x')), IoError);
+  EXPECT_TRUE(fs::is_symlink(path("full")));
+  EXPECT_TRUE(fs::is_character_file("/dev/full"));
+  fs::create_symlink("/dev/null", path("null"));
+  io::write_text_atomically(path("null"), "discarded");
+  EXPECT_TRUE(fs::is_character_file("/dev/null"));
+}
+
 TEST_F(ImageIoTest, OverwritingAnExistingExrReplacesItCompletely) {
   io::write_exr(path("x.exr"), random_image(8, 8, 11));
   const Image second = random_image(3, 2, 12);

@@ -155,6 +155,10 @@ std::vector<BadCase> corpus() {
   c.push_back({"glb_bad_magic", "a.glb", [](auto& p) { write_text(p, std::string("XglT\x02\0\0\0", 8) + std::string(40, ' ')); }, "not a binary glTF file: it starts with 'XglT'"});
   c.push_back({"syntax_error_in_data_uri", "a.gltf", [](auto& p) { write_text(p, "{\"asset\": {\"version\": \"2.0\"}, \"buffers\": [{\"uri\": \"data:" + std::string(3000, 'A') + "}"); }, "'\"data:AAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAA...' (3007 characters)"});
   c.push_back({"long_token_before_expected", "a.gltf", [](auto& p) { write_text(p, "{\"asset\": {\"version\" \"" + std::string(100, 'A')); }, "...' (101 characters); expected ':'"});
+  // Deep nesting crashed the glTF library's recursive parser (stack overflow), 20000 levels here.
+  c.push_back({"nesting_too_deep", "a.gltf", [](auto& p) { write_text(p, "{\"asset\":{\"version\":\"2.0\"},\"extras\":" + std::string(20000, '[') + std::string(20000, ']') + "}"); }, "nesting deeper than 256 levels"});
+  // A number beyond a double's range was an internal error (exit 4) naming no file.
+  c.push_back({"number_overflows_double", "a.gltf", [](auto& p) { write_text(p, R"({"asset":{"version":"2.0"},"extras":{"count":35e400}})"); }, "not valid JSON: number overflow parsing '35e400'"});
   c.push_back({"missing_image_file", "a.gltf", edited([](MiniGltf& g) { g.doc["images"] = json::array({{{"uri", "nope.png"}}}); }), "/images/0/uri: referenced file"});
   return c;
 }

@@ -114,6 +114,23 @@ TEST(ResultsFile, AnAppendThatFailsLeavesNoPartOfItsLine) {
   EXPECT_EQ(test::read_text(file), before) << "the first 100 bytes of the line were written, then taken back";
 }
 
+TEST(ResultsFile, OneWriterAtATime) {
+  test::ScratchDir dir;
+  const auto file = dir / "r.jsonl";
+  {
+    const ResultsWriterLock first(file);
+    try {
+      const ResultsWriterLock second(file);
+      ADD_FAILURE() << "a second writer took the lock";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(file.string() + " is being written by another stereobench run"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  const ResultsWriterLock after(file);  // released with its holder
+}
+
 TEST(ResultsFile, BadLinesAndDuplicatesRejected) {
   test::ScratchDir dir;
   const auto dup = dir / "dup.jsonl";

@@ -146,6 +146,19 @@ TEST(SweepRun, ResumesAfterKillWithoutLosingOrDuplicatingCells) {
     for (const auto& [kind, path] : files.items())
       EXPECT_TRUE(fs::exists(results.parent_path() / path.get<std::string>())) << name << " " << kind;
 
+  // While another run holds the results file, a second one is refused before it plans anything
+  // (two runs used to find the same cells unfinished and record each twice).
+  {
+    const validation::ResultsWriterLock held(results);
+    const test::CliRun second = test::run_cli("sweep run " + quoted(dir / "tiny.toml") + " --out " +
+                                              quoted(dir / "out") + " --scenes-dir " + quoted(dir / "scenes"));
+    EXPECT_EQ(second.code, 3) << second.out;
+    EXPECT_NE(second.out.find("is being written by another stereobench run (pid " + std::to_string(::getpid()) + ")"),
+              std::string::npos)
+        << second.out;
+  }
+  EXPECT_EQ(lines_of(results), after);
+
   // A changed definition is not mixed into these results.
   std::ofstream(dir / "tiny.toml", std::ios::app) << "\n# edited\n";
   const test::CliRun changed = test::run_cli("sweep run " + quoted(dir / "tiny.toml") + " --out " +
@@ -210,6 +223,14 @@ TEST(SweepRun, ShardsCollectedEqualAnUnshardedRun) {
   const std::string text = test::read_text(dir / "m.csv");
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1 + 6 * 5);
   EXPECT_EQ(text.rfind("cell_index,cell_id,", 0), 0u);
+
+  // The export never replaces its input (it used to turn the results file into CSV).
+  const std::string merged_text = test::read_text(dir / "merged.jsonl");
+  const test::CliRun over = test::run_cli("sweep csv " + quoted(dir / "merged.jsonl") + " --out " +
+                                          quoted(dir / "." / "merged.jsonl"));
+  EXPECT_EQ(over.code, 3) << over.out;
+  EXPECT_NE(over.out.find("names the same file as results"), std::string::npos) << over.out;
+  EXPECT_EQ(test::read_text(dir / "merged.jsonl"), merged_text);
 
   // A results file without a finished cell is nothing to export or merge.
   std::ofstream(dir / "empty.jsonl").flush();
