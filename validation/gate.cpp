@@ -263,9 +263,18 @@ GateConfig parse_gate_config(const std::string& text, const std::string& source)
                    fmt::format("unknown key '{}'; a gate config has [defaults], [regression] and [[rule]] tables", k));
     }
   }
-  if (config.defaults.empty() && config.rules.empty() && !root.contains("regression"))
+  // A limit counts only when some table gives it a value: [[rule]]s without one, or keys all turned
+  // off (= false), would pass anything as surely as an empty file.
+  const auto sets_limit = [](const ThresholdValues& values) {
+    return std::any_of(values.begin(), values.end(),
+                       [](const auto& kv) { return kv.first != kToleranceKey && kv.second.has_value(); });
+  };
+  const bool any_limit = sets_limit(config.defaults) ||
+                         std::any_of(config.rules.begin(), config.rules.end(),
+                                     [&](const GateRule& r) { return sets_limit(r.values); });
+  if (!any_limit && !root.contains("regression"))
     throw InputError(fmt::format("{}: the gate config sets no threshold and no [regression]: it would pass anything; "
-                                 "add a [defaults] table or [[rule]] tables (see docs/gate.md)",
+                                 "give a limit a value in [defaults] or a [[rule]] (see docs/gate.md)",
                                  source));
   return config;
 }
@@ -517,7 +526,12 @@ std::string reproduce_command(const GateCell& cell, const std::string& pipeline,
     add("--interaxial", number_arg(*e));
   if (const auto conv = num(c, "convergence_m") ? num(c, "convergence_m") : num(rig, "convergence_m"))
     add("--convergence", number_arg(*conv));
-  if (const auto lights = num(c, "lights")) add("--lights", fmt::format("{}", static_cast<int>(*lights)));
+  // A cell may ask for more lights than its scene has, and keeps the scene's own; validate refuses
+  // that count, so the command gives the count the cell used.
+  if (const auto lights = num(c, "lights")) {
+    const auto used = num(validation.value("scene", json::object()), "lights");
+    add("--lights", fmt::format("{}", static_cast<int>(used ? std::min(*used, *lights) : *lights)));
+  }
   if (const auto t = num(validation.value("metrics", json::object()), "error_threshold"); t && *t != 2.0)
     add("--error-threshold", fmt::format("{}", static_cast<int>(*t)));
   const json& options = validation.value("options", json::object());
@@ -564,6 +578,8 @@ std::optional<GateCheck> completeness_check(const GateResults& results) {
   check.fail_limit = static_cast<double>(expected);
   check.reproduce = fmt::format("stereobench sweep run {} --out {}", definition.empty() ? "DEFINITION" : shell_quote(definition),
                                 shell_quote(results.file.parent_path().empty() ? "." : results.file.parent_path().string()));
+  // sweep run resumes <out>/results.jsonl unless told otherwise.
+  if (results.file.filename() != "results.jsonl") check.reproduce += " --results " + shell_quote(results.file.string());
   if (indices.size() >= expected) {
     check.message = fmt::format("all {} cells of the sweep have results", expected);
     return check;

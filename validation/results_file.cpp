@@ -121,6 +121,7 @@ std::string csv_quote(const std::string& s) {
 enum class Kind {
   object,
   object_or_null,
+  array,
   string,
   integer,
   number,
@@ -134,6 +135,7 @@ const char* describe(Kind k) {
   switch (k) {
     case Kind::object: return "an object";
     case Kind::object_or_null: return "an object or null";
+    case Kind::array: return "an array";
     case Kind::string: return "a string";
     case Kind::integer: return "an integer";
     case Kind::number: return "a number";
@@ -149,6 +151,7 @@ bool matches(const json& v, Kind k) {
   switch (k) {
     case Kind::object: return v.is_object();
     case Kind::object_or_null: return v.is_object() || v.is_null();
+    case Kind::array: return v.is_array();
     case Kind::string: return v.is_string();
     case Kind::integer: return v.is_number_integer();
     case Kind::number: return v.is_number();
@@ -190,12 +193,14 @@ void require(const json& root, const std::string& where, const std::string& pref
 }
 
 /// Checks that a numeric field, where present, lies in [lo, hi] (a metric or time no measurement
-/// gives marks a damaged or hand-edited line). Strings such as "inf" are left to `require`.
+/// gives marks a damaged or hand-edited line); the metric strings "inf" and "-inf" count as
+/// infinities. Other types are left to `require`.
 void require_within(const json& root, const std::string& where, const std::string& prefix, std::string_view dotted,
                     double lo, double hi) {
   const json* v = find(root, dotted);
-  if (v == nullptr || !v->is_number()) return;
-  const double x = v->get<double>();
+  if (v == nullptr || !(v->is_number() || *v == "inf" || *v == "-inf")) return;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const double x = v->is_number() ? v->get<double>() : *v == "inf" ? kInf : -kInf;
   if (!(x >= lo && x <= hi))
     throw InputError(fmt::format("{}: field '{}{}' is {}, outside [{}, {}] where every measurement lies; the line is "
                                  "damaged or edited by hand",
@@ -214,6 +219,7 @@ constexpr Field kCellFields[] = {
     {"sweep", Kind::string},
     {"cell_id", Kind::string},
     {"cell_index", Kind::integer},
+    {"cell_count", Kind::integer, true},
     {"cell", Kind::object},
     {"cell.scene", Kind::string},
     {"cell.resolution", Kind::string},
@@ -362,6 +368,9 @@ void check_cell_record(const json& line, const std::string& where) {
   if (line["cell_index"].get<long long>() < 0)
     throw InputError(fmt::format("{}: cell_index {} is negative; cells are numbered from 0", where,
                                  line["cell_index"].dump()));
+  if (line.contains("cell_count") && line["cell_index"].get<long long>() >= line["cell_count"].get<long long>())
+    throw InputError(fmt::format("{}: cell_index {} is not below cell_count {}; the line is damaged or edited by hand",
+                                 where, line["cell_index"].dump(), line["cell_count"].dump()));
   if (line["rig"]["width"].get<long long>() <= 0 || line["rig"]["height"].get<long long>() <= 0)
     throw InputError(fmt::format("{}: rig.width and rig.height must be positive, not {}x{}", where,
                                  line["rig"]["width"].dump(), line["rig"]["height"].dump()));
@@ -375,8 +384,10 @@ void check_cell_record(const json& line, const std::string& where) {
     if (!p.is_object()) throw InputError(fmt::format("{}: field 'pipelines.{}' must be an object", where, name));
     for (const Field& f : kPipelineFields) require(p, where, prefix, f.path, f.kind, f.optional);
     constexpr double kMax = std::numeric_limits<double>::max();
+    // On 8-bit codes: MSE at most 255^2, so PSNR = 10 log10(255^2 / MSE) at least 0 (inf when equal).
+    require_within(p, where, prefix, "validation.metrics.psnr", 0.0, std::numeric_limits<double>::infinity());
     require_within(p, where, prefix, "validation.metrics.ssim", -1.0, 1.0);
-    require_within(p, where, prefix, "validation.metrics.mse", 0.0, kMax);
+    require_within(p, where, prefix, "validation.metrics.mse", 0.0, 255.0 * 255.0);
     for (const char* f : {"validation.metrics.error_fraction", "validation.holes.hole_fraction",
                           "validation.holes.not_reprojected.recall", "validation.holes.not_reprojected.precision"})
       require_within(p, where, prefix, f, 0.0, 1.0);
@@ -387,6 +398,13 @@ void check_cell_record(const json& line, const std::string& where) {
         require_within(p, where, prefix, std::string("timing.") + t, 0.0, kMax);
       }
       require(p, where, prefix, "timing.repetitions", Kind::integer, true);
+      require(p, where, prefix, "timing.samples_s", Kind::array, true);
+      if (const json* samples = find(p, "timing.samples_s"))
+        for (const json& t : *samples)
+          if (!t.is_number() || !(t.get<double>() >= 0.0 && t.get<double>() <= kMax))
+            throw InputError(fmt::format("{}: field '{}timing.samples_s' holds {}, not a time in seconds; the line is "
+                                         "damaged or edited by hand",
+                                         where, prefix, t.dump()));
       require(p, where, prefix, "timing.stages_median_s", Kind::object, true);
     }
   }
@@ -428,6 +446,11 @@ ResultsFile read_results(const fs::path& file) {
                 where, cell["sweep"].get<std::string>(), cell.value("definition_sha256", "?").substr(0, 12),
                 out.lines.front(), first["sweep"].get<std::string>(),
                 first.value("definition_sha256", "?").substr(0, 12)));
+          if (cell.value("cell_count", json()) != first.value("cell_count", json()))
+            throw InputError(fmt::format("{}: cell_count {}, but line {} of the same definition says {}; the file is "
+                                         "damaged or edited by hand",
+                                         where, cell.value("cell_count", json()).dump(), out.lines.front(),
+                                         first.value("cell_count", json()).dump()));
         }
         require_unique_id(seen, cell["cell_id"].get<std::string>(), line_no, where, "cell_id",
                           "a results file holds each cell once — remove one of the lines, or merge shards with "

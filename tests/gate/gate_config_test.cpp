@@ -62,6 +62,10 @@ TEST(GateConfig, BadValuesAreRejected) {
   const std::string holes = config_error("[[rule]]\npipeline = \"repro-*\"\nmax_hole_fraction = 1.5\n");
   EXPECT_NE(holes.find("test.toml:3: max_hole_fraction = 1.5 is above 1"), std::string::npos) << holes;
   EXPECT_NE(config_error("[defaults]\nwarn_recall = 1.01\n").find("warn_recall"), std::string::npos);
+  // Tables that give no limit a value pass anything, as an empty file would (both used to be accepted).
+  for (const char* none : {"[[rule]]\npipeline = \"repro-*\"\n", "[defaults]\nmin_psnr = false\n",
+                           "[defaults]\nmin_psnr = false\n[[rule]]\nregression_tolerance = 0.1\n"})
+    EXPECT_NE(config_error(none).find("sets no threshold and no [regression]"), std::string::npos) << none;
 }
 
 TEST(GateConfig, RulesOverrideDefaultsInFileOrder) {

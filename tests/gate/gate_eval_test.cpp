@@ -368,6 +368,28 @@ TEST(GateEval, AnUnfinishedSweepFails) {
   EXPECT_EQ(complete(part)->measured, 1.0);
   EXPECT_EQ(complete(part)->fail_limit, 2.0);
   EXPECT_EQ(part.worst, Verdict::fail);
+  // The command resumes the file that was gated: sweep run reads <out>/results.jsonl unless told.
+  EXPECT_EQ(complete(part)->reproduce.find("--results"), std::string::npos) << complete(part)->reproduce;
+  const validation::GateReport other = validation::evaluate_gate(
+      validation::parse_gate_config(kConfig, "test.toml"),
+      validation::gate_results({passing_cells()[1]}, {}, "runs/partial.jsonl"), {});
+  ASSERT_NE(complete(other), nullptr);
+  EXPECT_NE(complete(other)->reproduce.find("--out runs --results runs/partial.jsonl"), std::string::npos)
+      << complete(other)->reproduce;
+}
+
+TEST(GateEval, ReproduceGivesTheLightCountTheCellUsed) {
+  // A cell asking for 7 lights of a 5-light scene keeps the scene's 5; validate refuses --lights 7.
+  json cell = fake_cell(1, 0.064, {FakePipeline{}});
+  cell["cell"]["lights"] = 7;
+  cell["pipelines"][FakePipeline{}.name]["validation"]["scene"] = {{"lights", 5}};
+  const validation::GateCell gc{cell["cell_id"], "box-wall", cell};
+  const std::string command = validation::reproduce_command(gc, FakePipeline{}.name, {});
+  EXPECT_NE(command.find("--lights 5"), std::string::npos) << command;
+  cell["cell"]["lights"] = 3;
+  cell["pipelines"][FakePipeline{}.name]["validation"]["scene"] = {{"lights", 3}};
+  const validation::GateCell fewer{cell["cell_id"], "box-wall", cell};
+  EXPECT_NE(validation::reproduce_command(fewer, FakePipeline{}.name, {}).find("--lights 3"), std::string::npos);
 }
 
 TEST(GateEval, ARuleThatMatchesNothingIsNoted) {
@@ -391,6 +413,7 @@ TEST(GateEval, ARuleThatMatchesNothingIsNoted) {
   // whose globs each match something, but never together, says so.
   std::vector<json> cells = passing_cells();
   cells.push_back(fake_cell(2, 0.064, {{"plain-rt", 90, 1.0, 0, 0, 1, 1.0}}, "spheres"));
+  for (json& c : cells) c["cell_count"] = 3;
   const validation::GateReport several = evaluate(
       cells, {},
       kConfig + "[[rule]]\nscene = \"atrium\"\nmin_psnr = 99\n[[rule]]\nscene = \"atrium\"\n"

@@ -184,6 +184,50 @@ TEST(ResultsFile, BadLinesAndDuplicatesRejected) {
   json no_baseline = cell(1, "b");
   no_baseline["baseline"] = "repro-rt";
   expect_refused(no_baseline, "checked.jsonl:2: baseline \"repro-rt\" is not among the cell's pipelines");
+  // Values no measurement gives, which the gate used to judge as measured (a PSNR of -5 failed the
+  // check instead of being refused as a damaged file; the report took negative times).
+  for (const json& psnr : {json(-5.0), json("-inf")}) {
+    json broken = cell(1, "b");
+    broken["pipelines"]["plain-rt"]["validation"]["metrics"]["psnr"] = psnr;
+    expect_refused(broken, "checked.jsonl:2: field 'pipelines.plain-rt.validation.metrics.psnr' is " + psnr.dump() +
+                            ", outside [0, inf]");
+  }
+  json ssim_inf = cell(1, "b");
+  ssim_inf["pipelines"]["plain-rt"]["validation"]["metrics"]["ssim"] = "inf";
+  expect_refused(ssim_inf, "field 'pipelines.plain-rt.validation.metrics.ssim' is \"inf\", outside [-1, 1]");
+  for (const json& sample : {json(-1.0), json(nullptr)}) {
+    json broken = cell(1, "b");
+    broken["pipelines"]["plain-rt"]["timing"]["samples_s"] = {0.01, sample};
+    expect_refused(broken, "checked.jsonl:2: field 'pipelines.plain-rt.timing.samples_s' holds " + sample.dump() +
+                            ", not a time in seconds");
+  }
+  // cell_index within cell_count, and one cell_count per file.
+  const auto counted = [](size_t index, const std::string& id, int count) {
+    json c = cell(index, id);
+    c["cell_count"] = count;
+    return c;
+  };
+  const auto file = dir / "counted.jsonl";
+  append_result(file, counted(0, "a", 4));
+  append_result(file, counted(9, "z", 4));
+  EXPECT_THROW((void)read_results(file), InputError);
+  try {
+    (void)read_results(file);
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("counted.jsonl:2: cell_index 9 is not below cell_count 4"), std::string::npos)
+        << e.what();
+  }
+  std::filesystem::remove(file);
+  append_result(file, counted(0, "a", 4));
+  append_result(file, counted(1, "b", 5));
+  try {
+    (void)read_results(file);
+    ADD_FAILURE() << "two cell counts accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("counted.jsonl:2: cell_count 5, but line 1 of the same definition says 4"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(ResultsFile, CollectMergesShards) {
