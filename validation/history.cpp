@@ -2,6 +2,7 @@
 #include "validation/history.hpp"
 
 #include <cmath>
+#include <ctime>
 #include <limits>
 #include <map>
 #include <set>
@@ -37,17 +38,23 @@ json median_json(const std::vector<double>& values) {
   return finite_json(json(median(values)));
 }
 
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
 struct Field {
   const char* key;      ///< in the history line
   const char* pointer;  ///< in a pipeline entry of a results line
+  double lo, hi;        ///< the range every median of measurements lies in
 };
 constexpr Field kFields[] = {
-    {"psnr", "/validation/metrics/psnr"},
-    {"ssim", "/validation/metrics/ssim"},
-    {"hole_fraction", "/validation/holes/hole_fraction"},
-    {"median_s", "/timing/median_s"},
-    {"speedup", "/timing/speedup_median"},
+    {"psnr", "/validation/metrics/psnr", 0.0, kInf},
+    {"ssim", "/validation/metrics/ssim", -1.0, 1.0},
+    {"hole_fraction", "/validation/holes/hole_fraction", 0.0, 1.0},
+    {"median_s", "/timing/median_s", 0.0, kInf},
+    {"speedup", "/timing/speedup_median", 0.0, kInf},
 };
+
+/// A count: an integer >= 0.
+bool is_count(const json& v) { return v.is_number_integer() && v.get<long long>() >= 0; }
 
 constexpr const char* kRunStrings[] = {"run_id", "date", "host", "git_revision", "sweep", "definition",
                                         "definition_sha256", "results"};
@@ -115,14 +122,26 @@ void check_history_line(const json& line, const std::string& where) {
                           line.value("schema_version", json(nullptr)).dump(), kHistorySchemaVersion));
   for (const char* key : kRunStrings)
     if (!line.contains(key) || !line[key].is_string()) throw bad(fmt::format("\"{}\" must be a string", key));
+  // The trend charts place runs by date: the form nightly writes, YYYY-MM-DDTHH:MM:SSZ.
+  std::tm tm{};
+  const std::string date = line["date"].get<std::string>();
+  const char* end = ::strptime(date.c_str(), "%Y-%m-%dT%H:%M:%SZ", &tm);
+  if (end == nullptr || *end != '\0' || date.size() != 20)
+    throw bad(fmt::format("\"date\" {} is not a UTC time of the form 2026-01-31T02:00:00Z", line["date"].dump()));
+  if (!line.contains("cells") || !is_count(line["cells"])) throw bad("\"cells\" must be a count >= 0");
   if (!line.contains("pipelines") || !line["pipelines"].is_object())
     throw bad("\"pipelines\" must be an object of pipeline summaries");
   for (const auto& [name, p] : line["pipelines"].items()) {
     if (!p.is_object()) throw bad(fmt::format("pipelines.{} must be an object", name));
+    if (!p.contains("cells") || !is_count(p["cells"])) throw bad(fmt::format("pipelines.{}.cells must be a count >= 0", name));
     for (const Field& f : kFields) {
       const json v = p.value(f.key, json(nullptr));
       if (!v.is_null() && !v.is_number() && v != "inf" && v != "-inf")
         throw bad(fmt::format("pipelines.{}.{} must be a number, \"inf\" or null, not {}", name, f.key, v.dump()));
+      const double x = v.is_number() ? v.get<double>() : v == "inf" ? kInf : v == "-inf" ? -kInf : 0.0;
+      if (!v.is_null() && !(x >= f.lo && x <= f.hi))
+        throw bad(fmt::format("pipelines.{}.{} is {}, outside [{}, {}] where every measurement lies", name, f.key,
+                              v.dump(), f.lo, f.hi));
     }
   }
   const json gate = line.value("gate", json(nullptr));
@@ -130,7 +149,14 @@ void check_history_line(const json& line, const std::string& where) {
       !gate["counts"].is_object())
     throw bad("\"gate\" must be an object with a string \"verdict\" and \"counts\"");
   for (const auto& [verdict, n] : gate["counts"].items())
-    if (!n.is_number_integer() || n.get<long long>() < 0) throw bad(fmt::format("gate.counts.{} must be a count >= 0", verdict));
+    if (!is_count(n)) throw bad(fmt::format("gate.counts.{} must be a count >= 0", verdict));
+  // The verdict and its exit code, as the gate gives them (0 pass, 1 warn, 2 fail).
+  const std::string verdict = gate["verdict"].get<std::string>();
+  const int expected = verdict == "pass" ? 0 : verdict == "warn" ? 1 : verdict == "fail" ? 2 : -1;
+  if (expected < 0) throw bad(fmt::format("gate.verdict {} is not \"pass\", \"warn\" or \"fail\"", gate["verdict"].dump()));
+  if (!gate.contains("exit_code") || !gate["exit_code"].is_number_integer() || gate["exit_code"].get<long long>() != expected)
+    throw bad(fmt::format("gate.exit_code {} does not go with verdict \"{}\" (exit code {})",
+                          gate.value("exit_code", json(nullptr)).dump(), verdict, expected));
 }
 
 HistoryFile read_history(const fs::path& file) {

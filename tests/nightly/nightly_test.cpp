@@ -9,13 +9,16 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <regex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "renderer/error.hpp"
 #include "support/run_cli.hpp"
 #include "support/report_support.hpp"
 #include "support/scratch_dir.hpp"
@@ -285,6 +288,38 @@ TEST(NightlyTest, MalformedHistoryIsBadInputNamingFileAndLine) {
   run_folders = 0;
   for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs")) run_folders += e.is_directory() ? 1 : 0;
   EXPECT_EQ(run_folders, 0u);
+}
+
+TEST(NightlyTest, HistoryLinesWithImpossibleValuesAreRefused) {
+  const validation::NightlyRun run{"20261121T200000Z", "2026-11-21T20:00:00Z", "host", "abc1234", "smoke",
+                                   "ci/smoke.toml",    "0123",                 "20261121T200000Z/results.jsonl"};
+  const json cell = {{"pipelines",
+                      {{"repro-rt",
+                        {{"validation", {{"metrics", {{"psnr", 41.0}, {"ssim", 0.99}}}, {"holes", {{"hole_fraction", 0.02}}}}},
+                         {"timing", {{"median_s", 0.5}, {"speedup_median", 1.7}}}}}}}};
+  const json good = validation::history_entry(run, {cell}, validation::GateReport{});
+  EXPECT_NO_THROW(validation::check_history_line(good, "h:1"));
+  // Each of these used to be accepted and drawn in the trend charts.
+  const std::pair<std::function<void(json&)>, std::string> cases[] = {
+      {[](json& h) { h["cells"] = "1"; }, "\"cells\" must be a count >= 0"},
+      {[](json& h) { h["gate"]["exit_code"] = "0"; }, "gate.exit_code \"0\" does not go with verdict \"pass\""},
+      {[](json& h) { h["gate"]["exit_code"] = 77; }, "gate.exit_code 77 does not go with verdict"},
+      {[](json& h) { h["gate"]["verdict"] = "great"; }, "gate.verdict \"great\" is not"},
+      {[](json& h) { h["date"] = "not a date"; }, "\"date\" \"not a date\" is not a UTC time"},
+      {[](json& h) { h["pipelines"]["repro-rt"]["ssim"] = 9.96; }, "pipelines.repro-rt.ssim is 9.96, outside [-1, 1]"},
+      {[](json& h) { h["pipelines"]["repro-rt"]["median_s"] = -0.5; }, "pipelines.repro-rt.median_s is -0.5"},
+      {[](json& h) { h["pipelines"]["repro-rt"]["cells"] = -1; }, "pipelines.repro-rt.cells must be a count"},
+  };
+  for (const auto& [edit, expect] : cases) {
+    json h = good;
+    edit(h);
+    try {
+      validation::check_history_line(h, "h:1");
+      ADD_FAILURE() << "accepted: " << h.dump();
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("h:1: " + expect), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(NightlyTest, RunFoldersWithLongSuffixesOrderWithoutOverflow) {
