@@ -125,6 +125,19 @@ fs::path scene_file(const SweepScene& scene, const fs::path& scenes_dir) {
   return scene.builtin ? scenes::resolve_builtin(scene.name, scene.params, scenes_dir) : scene.file;
 }
 
+/// The rig a cell asks of its scene.
+RigOverrides cell_overrides(const SweepCell& cell) {
+  RigOverrides overrides;
+  overrides.interaxial = cell.interaxial_m;
+  overrides.max_disparity_px = cell.max_disparity_px;
+  overrides.convergence = cell.convergence_m;
+  if (cell.resolution) {
+    overrides.width = cell.resolution->width;
+    overrides.height = cell.resolution->height;
+  }
+  return overrides;
+}
+
 /// How a frame cell's scene reached its frame: the animation and BVH update, timed.
 struct FrameUpdate {
   double animate_s = 0.0;
@@ -238,15 +251,7 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
   const fs::path file = scene_file(cell.scene, options.scenes_dir);
   const SceneCache::Entry scene = scenes_cache.get(file, cell.lights, d.path, d.path_refit, cell.frame);
 
-  RigOverrides overrides;
-  overrides.interaxial = cell.interaxial_m;
-  overrides.max_disparity_px = cell.max_disparity_px;
-  overrides.convergence = cell.convergence_m;
-  if (cell.resolution) {
-    overrides.width = cell.resolution->width;
-    overrides.height = cell.resolution->height;
-  }
-  const StereoRig resolved = resolve_rig(scene.prepared.scene(), overrides);
+  const StereoRig resolved = resolve_rig(scene.prepared.scene(), cell_overrides(cell));
   // On a path the centre camera stands where the path puts it at this frame.
   const StereoRig rig = scene.animator ? StereoRig(scene.animator->camera_at(*cell.frame, resolved.pose()), resolved.params())
                                        : resolved;
@@ -383,6 +388,30 @@ void claim_out_folder(const SweepDefinition& d, const SweepRunOptions& options) 
   io::write_text_atomically(marker, mine.dump(2) + "\n");
 }
 
+/// Every cell's rig resolved against its scene, and a path's spin against the scene's meshes, each
+/// scene loaded once: an impossible rig (a convergence so near that the disparity exceeds any image)
+/// or a spin prefix that matches nothing is refused before the first cell runs, naming the
+/// definition and the cell, instead of stopping the sweep when that cell comes.
+void check_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, const std::vector<size_t>& todo,
+                 const fs::path& scenes_dir) {
+  std::map<fs::path, std::vector<size_t>> by_file;
+  for (size_t i : todo) by_file[scene_file(cells[i].scene, scenes_dir)].push_back(i);
+  for (const auto& [file, indices] : by_file) {
+    Scene scene = io::load_gltf(file);
+    size_t at = indices.front();
+    try {
+      for (size_t i : indices) {
+        at = i;
+        (void)resolve_rig(scene, cell_overrides(cells[i]));
+      }
+      if (d.path) (void)SceneAnimator(scene, *d.path);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}: cell {} '{}': {}; fix the definition (no cell has run)", d.file.string(),
+                                   cells[at].index, cells[at].id, e.what()));
+    }
+  }
+}
+
 }  // namespace
 
 void prepare_sweep(const SweepDefinition& d, const std::vector<SweepCell>& cells, const std::vector<size_t>& todo,
@@ -397,6 +426,7 @@ void prepare_sweep(const SweepDefinition& d, const std::vector<SweepCell>& cells
   claim_out_folder(d, options);
   for (size_t i : todo)
     if (scenes_done.insert(cells[i].scene.label).second) (void)scene_file(cells[i].scene, options.scenes_dir);
+  check_cells(d, cells, todo, options.scenes_dir);
 }
 
 void run_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, const std::vector<size_t>& todo,

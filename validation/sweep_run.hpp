@@ -56,7 +56,8 @@ struct SweepPlan {
 /// Checks what the cells need before any runs: every truth provider available (ToolError naming
 /// it and why otherwise), the output folder writable and not another definition's (a marker file
 /// gives it to this definition; InputError if it names another), every scene resolvable
-/// (built-in scenes generated now, once).
+/// (built-in scenes generated now, once), and, each scene loaded once, every cell's rig and a
+/// path's spin possible for it (InputError naming the definition and the cell).
 void prepare_sweep(const SweepDefinition& definition, const std::vector<SweepCell>& cells,
                    const std::vector<size_t>& todo, const SweepRunOptions& options);
 

@@ -438,6 +438,18 @@ TEST(SweepRun, BadDefinitionAndShardAreUsageErrors) {
                                              quoted(dir / "marked") + " --scenes-dir " + quoted(dir / "scenes"));
   EXPECT_EQ(damaged.code, 3) << damaged.out;
   EXPECT_NE(damaged.out.find("holds the cells of sweep '?'"), std::string::npos) << damaged.out;
+  // A cell whose rig cannot be (the last one here: a convergence that puts the disparity at
+  // infinity beyond any image) is refused before the first cell runs; it used to stop the sweep
+  // only when its turn came, after the cells before it.
+  std::ofstream(dir / "near.toml") << "[sweep]\nname = \"near\"\nscenes = [\"box-wall\"]\npipelines = [\"plain-rt\"]\n"
+                                      "convergence_m = [2.0, 1e-300]\nresolutions = [\"96x54\"]\n";
+  const test::CliRun near = test::run_cli("sweep run " + quoted(dir / "near.toml") + " --out " + quoted(dir / "n") +
+                                          " --scenes-dir " + quoted(dir / "scenes"));
+  EXPECT_EQ(near.code, 3) << near.out;
+  EXPECT_NE(near.out.find((dir / "near.toml").string() + ": cell 1 "), std::string::npos) << near.out;
+  EXPECT_NE(near.out.find("fix the definition (no cell has run)"), std::string::npos) << near.out;
+  EXPECT_EQ(near.out.find("[1/2]"), std::string::npos) << "no cell may run: " << near.out;
+  EXPECT_FALSE(fs::exists(dir / "n" / "results.jsonl"));
 }
 
 }  // namespace
