@@ -105,6 +105,9 @@ int run_verify(const ReferenceArgs& a) {
 }
 
 int run_update(const ReferenceArgs& a) {
+  if (a.no_render && !a.only_failing)
+    throw InputError("--no-render only shapes the check of --only-failing (hashes only); update always renders the "
+                     "references it rewrites: add --only-failing, or drop --no-render");
   const reference::ReferenceStore store(a.store);
   const Executor executor(checked_threads(a.threads));
   std::vector<std::string> targets;
@@ -143,15 +146,38 @@ int run_update(const ReferenceArgs& a) {
 
 void run_list(const ReferenceArgs& a) {
   const reference::ReferenceStore store(a.store);
+  std::error_code ec;
+  if (!fs::exists(store.root(), ec))
+    throw InputError(fmt::format("the reference store {} does not exist; give --store the folder `stereobench "
+                                 "reference generate` wrote",
+                                 store.root().string()));
+  if (!fs::is_directory(store.root(), ec))
+    throw InputError(fmt::format("the reference store {} is not a folder; give --store the folder `stereobench "
+                                 "reference generate` wrote",
+                                 store.root().string()));
   const std::vector<std::string> ids = store.ids();
   fmt::print("{} reference(s) in {}\n", ids.size(), store.root().string());
+  size_t damaged = 0;
   for (const std::string& id : ids) {
-    const json p = store.provenance(id);
-    const nlohmann::json& provider = p.value("provider", nlohmann::json::object());
-    fmt::print("  {:<48} {:<22} {}\n", id,
-               provider.is_object() ? provider.value("tool_version", std::string("?")) : std::string("?"),
-               p.value("date", std::string("?")));
+    json p;
+    try {
+      p = store.provenance(id);
+    } catch (const InputError& e) {
+      // Listed with the damage, so that the listing stays whole; verify reports it as corrupt.
+      fmt::print("  {:<48} damaged: {}\n", id, e.what());
+      ++damaged;
+      continue;
+    }
+    // A field of another type reads as unknown: the listing is not where damage is judged.
+    const auto text = [](const json& o, const char* key) {
+      return o.is_object() && o.contains(key) && o[key].is_string() ? o[key].get<std::string>() : std::string("?");
+    };
+    const json provider = p.is_object() && p.contains("provider") ? p["provider"] : json();
+    fmt::print("  {:<48} {:<22} {}\n", id, text(provider, "tool_version"), text(p, "date"));
   }
+  if (damaged > 0)
+    fmt::print(stderr, "{} of {} reference(s) damaged; `stereobench reference verify` checks them all\n", damaged,
+               ids.size());
 }
 
 }  // namespace

@@ -131,11 +131,17 @@ ReferenceSpec spec_from_json(const json& j) {
 
 /// The spec a provenance (read from `file`) records; InputError naming the file when it is malformed.
 ReferenceSpec spec_in(const json& provenance, const fs::path& file) {
+  ReferenceSpec spec;
   try {
-    return spec_from_json(provenance.at("spec"));
+    spec = spec_from_json(provenance.at("spec"));
   } catch (const json::exception& e) {
     throw InputError(fmt::format("{}: field 'spec' is malformed ({})", file.string(), e.what()));
   }
+  const std::vector<std::string> providers = validation::truth_provider_names();
+  if (std::find(providers.begin(), providers.end(), spec.provider) == providers.end())
+    throw InputError(fmt::format("{}: spec.provider '{}' is not a ground-truth provider ({})", file.string(),
+                                 spec.provider, fmt::join(providers, ", ")));
+  return spec;
 }
 
 /// Every occurrence of `from` in `text` replaced by `to`.
@@ -240,8 +246,10 @@ json ReferenceStore::provenance(const std::string& id) const {
   try {
     return io::parse_json(io::read_file(file));
   } catch (const io::JsonTextError& e) {
-    throw InputError(fmt::format("{} is not valid JSON ({}); regenerate it with `stereobench reference update`",
-                                 file.string(), e.what()));
+    // Its spec is lost with it, so `reference update` cannot render it again.
+    throw InputError(fmt::format("{} is not valid JSON ({}); remove {} and make the reference again with "
+                                 "`stereobench reference generate` and its scene and rig",
+                                 file.string(), e.what(), (root_ / id).string()));
   }
 }
 

@@ -48,9 +48,11 @@ void RigParams::validate() const {
   const double disparity = max_disparity_from_interaxial(interaxial, convergence, vfov, height);
   if (!(disparity <= kMaxDisparityPx))
     throw InputError(fmt::format("interaxial {:g} m with convergence {:g} m gives a disparity at infinity of {:g} px "
-                                 "at {} px height, beyond the {:g} px a rig may have; increase the convergence "
-                                 "distance or reduce the interaxial",
-                                 interaxial, convergence, disparity, height, kMaxDisparityPx));
+                                 "at {} px height and a vertical field of view of {:g} degrees, beyond the {:g} px a "
+                                 "rig may have; increase the convergence distance, reduce the interaxial or widen the "
+                                 "field of view",
+                                 interaxial, convergence, disparity, height, radians_to_degrees(vfov),
+                                 kMaxDisparityPx));
   require_positive(znear, "znear", "the near plane must lie in front of the camera");
   if (!std::isfinite(zfar) || zfar <= znear)
     throw InputError(fmt::format("zfar {} must be finite and greater than znear {}", zfar, znear));

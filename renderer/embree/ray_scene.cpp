@@ -62,7 +62,15 @@ RayScene::RayScene(const SceneGeometry& geometry, bool refittable)
   const auto t0 = std::chrono::steady_clock::now();
   impl_->geometry = &geometry;
   impl_->device = rtcNewDevice("verbose=0");
-  if (!impl_->device) throw ToolError(fmt::format("cannot create an Embree device (error {})", static_cast<int>(rtcGetDeviceError(nullptr))));
+  if (!impl_->device) {
+    const RTCError e = rtcGetDeviceError(nullptr);
+    if (e == RTC_ERROR_OUT_OF_MEMORY)
+      throw ToolError("cannot create an Embree device: out of memory; free memory or raise the process's memory "
+                      "limit (ulimit -v)");
+    if (e == RTC_ERROR_UNSUPPORTED_CPU)
+      throw ToolError("cannot create an Embree device: this CPU lacks the instruction set the Embree library needs");
+    throw ToolError(fmt::format("cannot create an Embree device (Embree error {})", static_cast<int>(e)));
+  }
   rtcSetDeviceErrorFunction(impl_->device, on_error, impl_.get());
   rtcSetDeviceMemoryMonitorFunction(impl_->device, on_memory, impl_.get());
   impl_->scene = rtcNewScene(impl_->device);

@@ -165,9 +165,12 @@ void check_external_files(const json& doc, const fs::path& dir, const std::strin
       const fs::path p = dir / percent_decode(u->get<std::string>());
       const std::string where = fmt::format("/{}/{}/uri", top, i);
       std::error_code ec;
-      if (!fs::is_regular_file(p, ec))
+      if (!fs::exists(p, ec))
         throw InputError(fmt::format("{}: {}: referenced file '{}' does not exist; put it beside the "
                                      "scene or fix the uri", file, where, p.string()));
+      if (!fs::is_regular_file(p, ec))
+        throw InputError(fmt::format("{}: {}: '{}' is {}, not a regular file; fix the uri", file, where, p.string(),
+                                     fs::is_directory(p, ec) ? "a folder" : "a device, pipe or socket"));
       if (std::string(top) == "buffers") {
         const uint64_t need = e.at("byteLength").get<uint64_t>();
         const uint64_t have = fs::file_size(p, ec);

@@ -247,7 +247,9 @@ void write_exr_layers(const fs::path& path, const std::vector<std::pair<std::str
     auto out = OIIO::ImageOutput::create("openexr");
     if (!out)
       throw IoError(
-          fmt::format("cannot write {}: OpenImageIO has no EXR writer: {}", path.string(), oiio_global_error()));
+          fmt::format("cannot write {}: OpenImageIO could not create its EXR writer ({}); its OpenEXR plugin is "
+                      "missing, or memory ran out",
+                      path.string(), oiio_global_error()));
     if (!out->open(tmp.string(), spec))
       throw IoError(
           fmt::format("cannot write {}: {}; check that the folder is writable", path.string(), oiio_error(out.get())));

@@ -114,10 +114,20 @@ TEST(ReferenceStore, DamagedProvenanceIsAFindingNotAStop) {
   p["rig"] = "wide";
   std::ofstream(dir / "store" / pole / "provenance.json", std::ios::trunc) << p.dump(2);
 
+  // The listing stays whole, the damaged entry flagged (it used to stop at the first).
+  const test::CliRun list = test::run_cli(ref(dir, "list"));
+  EXPECT_EQ(list.code, 0) << list.out;
+  EXPECT_NE(list.out.find("damaged: " + (dir / "store" / box / "provenance.json").string() + " is not valid JSON"),
+            std::string::npos)
+      << list.out;
+  EXPECT_NE(list.out.find(pole), std::string::npos) << list.out;
+  EXPECT_NE(list.out.find("1 of 2 reference(s) damaged"), std::string::npos) << list.out;
+
   const test::CliRun r = test::run_cli(ref(dir, "verify") + " --no-render");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("corrupt        " + box), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("is not valid JSON"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("reference generate"), std::string::npos) << "update cannot rewrite it: " << r.out;
   EXPECT_NE(r.out.find("corrupt        " + pole), std::string::npos) << "verification went on past the first: " << r.out;
   EXPECT_NE(r.out.find("the recorded rig \"wide\" is not a rig record"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("0 of 2 reference(s) verified"), std::string::npos) << r.out;
@@ -129,6 +139,28 @@ TEST(ReferenceStore, DamagedProvenanceIsAFindingNotAStop) {
   EXPECT_NE(upd.out.find("1 reference(s) could not be rewritten"), std::string::npos) << upd.out;
   EXPECT_NE(upd.out.find(box + " ("), std::string::npos) << upd.out;
   EXPECT_TRUE(json::parse(test::read_text(dir / "store" / pole / "provenance.json"))["rig"].is_object());
+
+  // A provenance naming no provider is corrupt, found by the verification (it used to stop it).
+  json unknown = json::parse(test::read_text(dir / "store" / pole / "provenance.json"));
+  unknown["spec"]["provider"] = "nope";
+  std::ofstream(dir / "store" / pole / "provenance.json", std::ios::trunc) << unknown.dump(2);
+  const test::CliRun nope = test::run_cli(ref(dir, "verify") + " --no-render " + pole);
+  EXPECT_EQ(nope.code, 2) << nope.out;
+  EXPECT_NE(nope.out.find("corrupt        " + pole), std::string::npos) << nope.out;
+  EXPECT_NE(nope.out.find("spec.provider 'nope' is not a ground-truth provider"), std::string::npos) << nope.out;
+
+  // update renders what it rewrites: --no-render belongs with --only-failing.
+  const test::CliRun render_less = test::run_cli(ref(dir, "update") + " --no-render " + pole);
+  EXPECT_EQ(render_less.code, 3) << render_less.out;
+  EXPECT_NE(render_less.out.find("--no-render only shapes the check of --only-failing"), std::string::npos)
+      << render_less.out;
+
+  // A store that is missing or a file is named, not listed as empty.
+  for (const fs::path& store : {dir / "nostore", dir / "store" / pole / "provenance.json"}) {
+    const test::CliRun none = test::run_cli("reference list --store " + quoted(store));
+    EXPECT_EQ(none.code, 3) << none.out;
+    EXPECT_NE(none.out.find("the reference store " + store.string()), std::string::npos) << none.out;
+  }
 
   const test::CliRun negative = test::run_cli(ref(dir, "verify") + " --min-psnr -1");
   EXPECT_EQ(negative.code, 3) << negative.out;

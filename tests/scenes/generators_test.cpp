@@ -17,6 +17,8 @@
 
 #include "gltf_reader_support.hpp"
 #include "renderer/error.hpp"
+#include "renderer/io/gltf_loader.hpp"
+#include "scenes/catalog.hpp"
 #include "support/run_cli.hpp"
 #include "support/scratch_dir.hpp"
 #include "scenes/generators.hpp"
@@ -106,6 +108,17 @@ TEST(SceneRegistry, AWriteThatFailsNamesTheFileAndLeavesNothing) {
       << r.out;
   EXPECT_NE(r.out.find("File too large"), std::string::npos) << r.out;
   EXPECT_TRUE(fs::is_empty(dir / "gen")) << "neither the file nor its temporary stays";
+}
+
+TEST(SceneRegistry, ACachedSceneCutShortIsGeneratedAgain) {
+  // It used to be loaded as it was and refused as broken JSON, its stamp still saying "cached".
+  test::ScratchDir dir;
+  const std::filesystem::path file = scenes::resolve_scene("box-wall", dir.path());
+  const auto size = std::filesystem::file_size(file);
+  std::filesystem::resize_file(file, size / 2);
+  EXPECT_EQ(scenes::resolve_scene("box-wall", dir.path()), file);
+  EXPECT_EQ(std::filesystem::file_size(file), size);
+  EXPECT_NO_THROW((void)io::load_gltf(file));
 }
 
 TEST(SceneParams, TriangleCountsFollowTheParameter) {
