@@ -171,6 +171,9 @@ TEST(SweepDefinition, BadValuesRejected) {
       {"[sweep]\nscenes = [\"complexity:size=5\"]\n", "has no parameter 'size'"},
       {"[sweep]\nscenes = [\"missing/scene.gltf\"]\n", "does not exist"},
       {"[sweep]\nscenes = [\"spheres\", \"spheres\"]\n", "lists 'spheres' twice"},
+      // The default count written out is the same scene (the cells used to run twice).
+      {"[sweep]\nscenes = [\"spheres\", \"spheres:count=1000\"]\n",
+       "lists one scene twice: 'spheres' and 'spheres:count=1000' differ only by parameters at their defaults"},
       {"[sweep]\npipelines = [\"repro-rtx\"]\n", "sweep.pipelines"},
       {"[sweep]\nbaseline = \"nope\"\n", "sweep.baseline"},
       {"[sweep]\ntruths = [\"mitsuba\"]\n", "unknown ground-truth provider 'mitsuba'"},
