@@ -112,7 +112,14 @@ bool same_file(const std::string& x, const std::string& y) {
   return fs::exists(x, ex) && fs::exists(y, ey) && fs::equivalent(x, y, ex);
 }
 
-bool names_file(const NamedPath& p) { return !p.path->empty() && *p.path != "-"; }
+/// Whether an option names a file that one run could overwrite: not empty, not "-" (standard
+/// output), not a device or pipe (/dev/null twice is fine).
+bool names_file(const NamedPath& p) {
+  if (p.path->empty() || *p.path == "-") return false;
+  std::error_code ec;
+  const std::filesystem::file_status st = std::filesystem::status(*p.path, ec);
+  return !std::filesystem::exists(st) || std::filesystem::is_regular_file(st) || std::filesystem::is_directory(st);
+}
 
 }  // namespace
 

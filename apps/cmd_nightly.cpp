@@ -176,7 +176,8 @@ void run_nightly(const NightlyArgs& a) {
   o.definition_label = a.definition;
   o.jobs = a.jobs;
   o.threads = threads;
-  const ResultsWriterLock lock(o.results);  // held through the gate, history and report
+  // Every cell, held through the gate, history and report.
+  const ResultsWriterLock lock(o.results, shard_cells(expand_cells(d).size(), Shard{}));
   const SweepPlan plan = plan_sweep(d, o.results);
   for (const std::string& w : plan.warnings) fmt::print(stderr, "warning: {}\n", w);
   fmt::print("nightly {} run {} ({}): {} cells × {} pipelines, {} finished already, {} to run\n", d.name, run_id,

@@ -113,7 +113,8 @@ void run_sweep(const SweepRunArgs& a) {
   o.jobs = a.jobs;
   o.threads = checked_threads(a.threads);
 
-  const ResultsWriterLock lock(o.results);  // held until the last cell is recorded
+  // Held until the last cell is recorded: no other run may plan this shard's cells meanwhile.
+  const ResultsWriterLock lock(o.results, shard_cells(expand_cells(d).size(), shard));
   const SweepPlan plan = plan_sweep(d, o.results, shard);
   for (const std::string& w : plan.warnings) fmt::print(stderr, "warning: {}\n", w);
   fmt::print("sweep {} ({}): {} cells × {} pipelines (baseline {}), {} warm-up + {} repetitions\n", d.name,

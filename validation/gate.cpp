@@ -530,7 +530,8 @@ std::string reproduce_command(const GateCell& cell, const std::string& pipeline,
   // that count, so the command gives the count the cell used.
   if (const auto lights = num(c, "lights")) {
     const auto used = num(validation.value("scene", json::object()), "lights");
-    add("--lights", fmt::format("{}", static_cast<int>(used ? std::min(*used, *lights) : *lights)));
+    const int count = static_cast<int>(used ? std::min(*used, *lights) : *lights);
+    if (count > 0) add("--lights", fmt::format("{}", count));  // an unlit scene takes no --lights
   }
   if (const auto t = num(validation.value("metrics", json::object()), "error_threshold"); t && *t != 2.0)
     add("--error-threshold", fmt::format("{}", static_cast<int>(*t)));

@@ -260,35 +260,38 @@ json value_at(const json& root, std::string_view dotted) {
 
 }  // namespace
 
-ResultsWriterLock::ResultsWriterLock(const fs::path& results) {
+ResultsWriterLock::ResultsWriterLock(const fs::path& results, const std::vector<size_t>& cells) {
   std::error_code ec;
   if (results.has_parent_path()) fs::create_directories(results.parent_path(), ec);
-  const fs::path path = lock_path(results);
+  // Through links to the file itself, so that two spellings of one results file share the lock.
+  const fs::path real = fs::weakly_canonical(fs::absolute(io::follow_links(results), ec), ec);
+  const fs::path path = lock_path(ec ? results : real);
   fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (fd_ < 0)
-    throw IoError(fmt::format("{}: cannot open the lock file of {}: {}; check the folder's permissions", path.string(),
-                              results.string(), std::strerror(errno)));
-  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    throw IoError(fmt::format("cannot open {}, the lock file of {}: {}; give --out (or --results) a folder you can "
+                              "write",
+                              path.string(), results.string(), std::strerror(errno)));
+  for (const size_t cell : cells) {
+    struct flock lock {};
+    lock.l_type = F_WRLCK;
+    lock.l_whence = SEEK_SET;
+    lock.l_start = static_cast<off_t>(cell);
+    lock.l_len = 1;
+    if (::fcntl(fd_, F_OFD_SETLK, &lock) == 0) continue;
     const int err = errno;
-    char holder[32] = {};
-    const ssize_t n = ::pread(fd_, holder, sizeof holder - 1, 0);
     ::close(fd_);
     fd_ = -1;
-    if (err != EWOULDBLOCK)
+    if (err != EAGAIN && err != EACCES)
       throw IoError(fmt::format("{}: cannot lock it: {}", path.string(), std::strerror(err)));
-    std::string pid(holder, n > 0 ? static_cast<size_t>(n) : 0);
-    pid.erase(pid.find_last_not_of(" \n") + 1);
-    throw InputError(fmt::format("{} is being written by another stereobench run ({}); two runs would record the "
-                                 "same cells twice: wait for it to end, or give another --out",
-                                 results.string(), pid.empty() ? "its lock is held" : "pid " + pid));
+    throw InputError(fmt::format("{} is being written by another stereobench run, which holds cell {} of this run; "
+                                 "two runs would record those cells twice: wait for it to end, or give another --out "
+                                 "(or --results)",
+                                 results.string(), cell));
   }
-  // The pid only makes another run's message clearer; the lock is held whether or not it is written.
-  const std::string pid = std::to_string(::getpid()) + "\n";
-  if (::ftruncate(fd_, 0) == 0) (void)!::pwrite(fd_, pid.data(), pid.size(), 0);
 }
 
 ResultsWriterLock::~ResultsWriterLock() {
-  if (fd_ >= 0) ::close(fd_);  // releases the flock
+  if (fd_ >= 0) ::close(fd_);  // releases the locks
 }
 
 void append_result(const fs::path& file, const json& cell) {

@@ -27,13 +27,15 @@ inline constexpr int kSweepSchemaVersion = 1;
 /// never run together. Creates the file and its folder. IoError when it cannot be written.
 void append_result(const std::filesystem::path& file, const nlohmann::json& cell);
 
-/// Holds a results file for one writer while it lives: an exclusive flock on a hidden lock file
-/// beside it (".<name>.lock", holding the writer's pid). A second run planned against the same
-/// results file would find the same cells unfinished and record each twice; it is refused with an
-/// InputError naming the file and the holder. The lock goes when the process ends, however it ends.
+/// Holds the cells a run may write into a results file while it lives: one byte per cell index,
+/// locked for writing (an open-file-description lock) in a hidden lock file beside the results file
+/// (".<name>.lock", found through links). A second run over any of the same cells would find them
+/// unfinished and record each twice; it is refused with an InputError naming the file and a cell.
+/// Shards of one sweep hold disjoint cells and run side by side. The locks go when the process
+/// ends, however it ends.
 class ResultsWriterLock {
  public:
-  explicit ResultsWriterLock(const std::filesystem::path& results);
+  ResultsWriterLock(const std::filesystem::path& results, const std::vector<size_t>& cells);
   ~ResultsWriterLock();
   ResultsWriterLock(const ResultsWriterLock&) = delete;
   ResultsWriterLock& operator=(const ResultsWriterLock&) = delete;

@@ -69,6 +69,12 @@ int threads_per_cell(const SweepRunOptions& options) {
   return std::max(1, cores / std::max(1, options.jobs));
 }
 
+std::vector<size_t> shard_cells(size_t cell_count, const Shard& shard) {
+  std::vector<size_t> out;
+  for (size_t i = shard.index; i < cell_count; i += shard.count) out.push_back(i);
+  return out;
+}
+
 SweepPlan plan_sweep(const SweepDefinition& definition, const fs::path& results, const Shard& shard) {
   SweepPlan plan;
   plan.cells = expand_cells(definition);
@@ -94,7 +100,7 @@ SweepPlan plan_sweep(const SweepDefinition& definition, const fs::path& results,
     done.insert(id);
   }
   for (const SweepCell& c : plan.cells) {
-    if (c.index % shard.count != shard.index) continue;
+    if (c.index % shard.count != shard.index) continue;  // as shard_cells
     ++plan.in_shard;
     if (done.count(c.id))
       ++plan.finished;
@@ -352,11 +358,9 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
 /// The marker that gives an output folder to one sweep definition.
 constexpr const char* kOutMarker = ".stereobench-sweep.json";
 
-/// Claims the output folder for this definition before any cell runs: a folder made for another
-/// definition (its marker names it) is refused, since the cells' images, whose folders are named by
-/// cell index, would overwrite that sweep's; the shards of one sweep share it. Also shows that the
-/// folder and the results file's folder can be written (IoError otherwise), before any work.
-void claim_out_folder(const SweepDefinition& d, const SweepRunOptions& options) {
+/// Shows that the output folder and the results file's folder can be written (IoError otherwise),
+/// before any work.
+void check_out_folders(const SweepRunOptions& options) {
   for (const fs::path& dir : {options.out_dir, options.results.has_parent_path() ? options.results.parent_path()
                                                                                   : fs::path(".")}) {
     std::error_code ec;
@@ -369,6 +373,14 @@ void claim_out_folder(const SweepDefinition& d, const SweepRunOptions& options) 
       throw IoError(fmt::format("cannot write into {}: {}; give --out (or --results) a folder you can write",
                                 dir.string(), std::strerror(errno)));
   }
+}
+
+/// Claims the output folder for this definition before any cell runs: a folder made for another
+/// definition (its marker names it) is refused, since the cells' images, whose folders are named by
+/// cell index, would overwrite that sweep's; the shards of one sweep share it. Called once every
+/// check of the definition has passed, so that a definition refused and then fixed still finds
+/// the folder its own.
+void claim_out_folder(const SweepDefinition& d, const SweepRunOptions& options) {
   const fs::path marker = options.out_dir / kOutMarker;
   const json mine = {{"sweep", d.name}, {"definition_sha256", d.sha256}, {"definition", d.file.string()}};
   if (fs::exists(marker)) {
@@ -398,16 +410,21 @@ void check_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, 
   for (size_t i : todo) by_file[scene_file(cells[i].scene, scenes_dir)].push_back(i);
   for (const auto& [file, indices] : by_file) {
     Scene scene = io::load_gltf(file);
-    size_t at = indices.front();
-    try {
-      for (size_t i : indices) {
-        at = i;
+    for (size_t i : indices) {
+      try {
         (void)resolve_rig(scene, cell_overrides(cells[i]));
+      } catch (const InputError& e) {
+        throw InputError(fmt::format("{}: cell {} '{}': {}; fix the definition (no cell has run)", d.file.string(),
+                                     cells[i].index, cells[i].id, e.what()));
       }
-      if (d.path) (void)SceneAnimator(scene, *d.path);
-    } catch (const InputError& e) {
-      throw InputError(fmt::format("{}: cell {} '{}': {}; fix the definition (no cell has run)", d.file.string(),
-                                   cells[at].index, cells[at].id, e.what()));
+    }
+    if (d.path) {
+      try {
+        (void)SceneAnimator(scene, *d.path);
+      } catch (const InputError& e) {
+        throw InputError(fmt::format("{}: [path] on scene '{}': {}; fix the definition (no cell has run)",
+                                     d.file.string(), cells[indices.front()].scene.label, e.what()));
+      }
     }
   }
 }
@@ -423,10 +440,11 @@ void prepare_sweep(const SweepDefinition& d, const std::vector<SweepCell>& cells
     if (auto why = provider->unavailable_reason())
       throw ToolError(fmt::format("{}: truth '{}' is unavailable: {}", d.file.string(), name, *why));
   }
-  claim_out_folder(d, options);
+  check_out_folders(options);
   for (size_t i : todo)
     if (scenes_done.insert(cells[i].scene.label).second) (void)scene_file(cells[i].scene, options.scenes_dir);
   check_cells(d, cells, todo, options.scenes_dir);
+  claim_out_folder(d, options);
 }
 
 void run_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, const std::vector<size_t>& todo,

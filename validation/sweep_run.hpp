@@ -23,6 +23,8 @@ struct Shard {
 };
 /// Parses "I/N" (0 <= I < N); InputError otherwise.
 [[nodiscard]] Shard parse_shard(const std::string& text);
+/// The indices of a shard's cells among `cell_count`: those with index % N == I.
+[[nodiscard]] std::vector<size_t> shard_cells(size_t cell_count, const Shard& shard);
 
 /// Where and how a sweep runs.
 struct SweepRunOptions {

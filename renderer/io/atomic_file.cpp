@@ -37,26 +37,23 @@ void sync_file(const fs::path& path) {
   if (rc != 0) throw IoError(fmt::format("cannot flush {} to disk: {}", path.string(), std::strerror(err)));
 }
 
-/// Where a write to `path` lands. A symbolic link is followed to the file it names, so that the
-/// file is replaced and the link stays a link; a link to a device or pipe (/dev/stdout) is kept as
-/// given, for the kernel to follow when it is opened.
-fs::path write_target(const fs::path& path) {
+constexpr int kMaxLinkHops = 40;
+
+/// Whether `path`, or a link on the way to its file, names an open file of a process (/dev/stdout,
+/// /dev/fd/N, /proc/self/fd/N): such a file is the caller's stream, whatever it is (a terminal, a
+/// pipe, or a file the shell redirected into), and is written in place, never replaced.
+bool names_open_file(const fs::path& path) {
   std::error_code ec;
-  if (!fs::is_symlink(fs::symlink_status(path, ec))) return path;
-  const fs::file_status target = fs::status(path, ec);
-  if (fs::exists(target)) {
-    if (!fs::is_regular_file(target)) return path;
-    const fs::path real = fs::canonical(path, ec);
-    return ec ? path : real;
-  }
-  // A dangling link names the file to create.
   fs::path p = path;
-  for (int hops = 0; hops < 40 && fs::is_symlink(fs::symlink_status(p, ec)); ++hops) {
+  for (int hops = 0; hops <= kMaxLinkHops; ++hops) {
+    const std::string s = fs::absolute(p, ec).lexically_normal().string();
+    if (s.rfind("/proc/", 0) == 0 || s.rfind("/dev/fd/", 0) == 0) return true;
+    if (!fs::is_symlink(fs::symlink_status(p, ec))) return false;
     const fs::path next = fs::read_symlink(p, ec);
-    if (ec) break;
+    if (ec) return false;
     p = next.is_absolute() ? next : p.parent_path() / next;
   }
-  return p;
+  return false;
 }
 
 /// A device, pipe or socket cannot be replaced by renaming a file over it: it is written in place.
@@ -66,21 +63,76 @@ bool is_stream(const fs::path& path) {
   return fs::exists(st) && !fs::is_regular_file(st) && !fs::is_directory(st);
 }
 
+/// Closes a descriptor on every way out.
+struct FdCloser {
+  int fd;
+  ~FdCloser() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+/// Writes a stream in place: the file is made whole in the temporary folder first (a writer may
+/// need to seek, as the EXR writer does), then its bytes are appended to the stream, which keeps
+/// what a shell's `>>` put there before.
+void write_through(const fs::path& stream, const std::function<void(const fs::path&)>& write) {
+  std::error_code ec;
+  const fs::path tmp = temporary_name(fs::temp_directory_path(ec) / stream.filename());
+  try {
+    write(tmp);
+    const FdCloser in{::open(tmp.c_str(), O_RDONLY | O_CLOEXEC)};
+    const FdCloser out{::open(stream.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC)};
+    if (in.fd < 0 || out.fd < 0)
+      throw IoError(fmt::format("cannot open {}: {}", in.fd < 0 ? tmp.string() : stream.string(), std::strerror(errno)));
+    std::vector<char> block(size_t{1} << 16);
+    for (;;) {
+      const ssize_t n = ::read(in.fd, block.data(), block.size());
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) throw IoError(fmt::format("cannot read {}: {}", tmp.string(), std::strerror(errno)));
+      if (n == 0) break;
+      for (ssize_t done = 0; done < n;) {
+        const ssize_t w = ::write(out.fd, block.data() + done, static_cast<size_t>(n - done));
+        if (w < 0 && errno == EINTR) continue;
+        if (w < 0) throw IoError(fmt::format("cannot write {}: {}", stream.string(), std::strerror(errno)));
+        done += w;
+      }
+    }
+    fs::remove(tmp, ec);
+  } catch (const Error&) {
+    fs::remove(tmp, ec);
+    throw;
+  } catch (const std::exception& e) {
+    fs::remove(tmp, ec);
+    throw IoError(fmt::format("writing {} failed: {}", stream.string(), e.what()));
+  }
+}
+
 }  // namespace
 
+fs::path follow_links(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::is_symlink(fs::symlink_status(path, ec))) return path;
+  fs::path p = path;
+  for (int hops = 0; fs::is_symlink(fs::symlink_status(p, ec)); ++hops) {
+    if (hops == kMaxLinkHops)
+      throw IoError(fmt::format("cannot write {}: too many levels of symbolic links (a loop?)", path.string()));
+    const fs::path next = fs::read_symlink(p, ec);
+    if (ec) throw IoError(fmt::format("cannot write {}: cannot read the link {}: {}", path.string(), p.string(),
+                                      ec.message()));
+    p = next.is_absolute() ? next : p.parent_path() / next;
+  }
+  return p;
+}
+
 void write_atomically(const fs::path& given, const std::function<void(const fs::path&)>& write) {
-  const fs::path path = write_target(given);
-  if (is_stream(path)) {
-    try {
-      write(path);
-    } catch (const Error&) {
-      throw;
-    } catch (const std::exception& e) {
-      throw IoError(fmt::format("writing {} failed: {}", given.string(), e.what()));
-    }
+  const bool open_file = names_open_file(given);
+  const fs::path path = open_file ? given : follow_links(given);
+  std::error_code ec;
+  if (fs::is_directory(path, ec))
+    throw InputError(fmt::format("{} is a folder; give the name of the file to write", given.string()));
+  if (open_file || is_stream(path)) {
+    write_through(given, write);
     return;
   }
-  std::error_code ec;
   const fs::path parent = path.parent_path();
   if (!parent.empty()) {
     fs::create_directories(parent, ec);

@@ -14,10 +14,16 @@ namespace sb::io {
 /// flushes it to disk and renames it to `path`. Creates missing parent folders. On any failure
 /// (including an exception from `write`) the temporary file is removed and IoError is thrown
 /// naming `path`; an existing file at `path` is left untouched. A symbolic link at `path` is
-/// followed (the file it names is replaced, the link stays); a device or pipe there (/dev/stdout,
-/// a FIFO) is written in place, since it cannot be replaced, and a write error is still IoError.
+/// followed (the file it names is replaced, the link stays). A device or pipe there, and a path
+/// through a process's open files (/dev/stdout, /dev/fd/N, /proc/self/fd/N, also when the shell
+/// redirected them into a file), is not replaced: the file is made in the temporary folder and its
+/// bytes appended there; a write error is still IoError. A folder at `path` is an InputError.
 void write_atomically(const std::filesystem::path& path,
                       const std::function<void(const std::filesystem::path& tmp_path)>& write);
+
+/// The file a path names, its symbolic links followed (a dangling link gives the file it would
+/// create); `path` itself when it is no link. IoError for a loop of links.
+[[nodiscard]] std::filesystem::path follow_links(const std::filesystem::path& path);
 
 /// Writes bytes atomically (see write_atomically).
 void write_file_atomically(const std::filesystem::path& path, std::span<const unsigned char> bytes);

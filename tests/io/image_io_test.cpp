@@ -5,6 +5,8 @@
 
 #include <memory>
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <array>
@@ -16,6 +18,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "renderer/color.hpp"
@@ -403,6 +406,37 @@ TEST_F(ImageIoTest, ADeviceIsWrittenInPlaceNotReplaced) {
   fs::create_symlink("/dev/null", path("null"));
   io::write_text_atomically(path("null"), "discarded");
   EXPECT_TRUE(fs::is_character_file("/dev/null"));
+}
+
+TEST_F(ImageIoTest, AnOpenFileOfTheProcessIsAppendedToNotReplaced) {
+  // `--json /dev/stdout >> log`: /dev/stdout leads to /proc/self/fd/1, here a regular file. It used
+  // to be resolved to that file and replaced by a rename, losing what the log held.
+  write_bytes(path("log"), {'o', 'l', 'd'});
+  const int fd = ::open(path("log").c_str(), O_WRONLY | O_APPEND);
+  ASSERT_GE(fd, 0);
+  struct stat before {}, after {};
+  ASSERT_EQ(::stat(path("log").c_str(), &before), 0);
+  io::write_text_atomically("/proc/self/fd/" + std::to_string(fd), "new");
+  ::close(fd);
+  EXPECT_EQ(read_bytes(path("log")), (std::vector<unsigned char>{'o', 'l', 'd', 'n', 'e', 'w'}));
+  ASSERT_EQ(::stat(path("log").c_str(), &after), 0);
+  EXPECT_EQ(after.st_ino, before.st_ino) << "the file was replaced";
+  EXPECT_EQ(entries(), std::vector<std::string>{"log"});
+  // A stereo EXR (its writer seeks) reaches a pipe whole.
+  int pipe_fds[2];
+  ASSERT_EQ(::pipe(pipe_fds), 0);
+  const Image image = random_image(4, 4, 21);
+  std::vector<unsigned char> received;
+  std::thread reader([&] {
+    unsigned char buf[4096];
+    for (ssize_t n; (n = ::read(pipe_fds[0], buf, sizeof buf)) > 0;) received.insert(received.end(), buf, buf + n);
+  });
+  io::write_exr("/proc/self/fd/" + std::to_string(pipe_fds[1]), image);
+  ::close(pipe_fds[1]);
+  reader.join();
+  ::close(pipe_fds[0]);
+  write_bytes(path("piped.exr"), received);
+  EXPECT_TRUE(io::read_exr(path("piped.exr")) == image);
 }
 
 TEST_F(ImageIoTest, OverwritingAnExistingExrReplacesItCompletely) {

@@ -114,21 +114,26 @@ TEST(ResultsFile, AnAppendThatFailsLeavesNoPartOfItsLine) {
   EXPECT_EQ(test::read_text(file), before) << "the first 100 bytes of the line were written, then taken back";
 }
 
-TEST(ResultsFile, OneWriterAtATime) {
+TEST(ResultsFile, OneWriterPerCell) {
   test::ScratchDir dir;
   const auto file = dir / "r.jsonl";
+  std::filesystem::create_symlink("r.jsonl", dir / "link.jsonl");
   {
-    const ResultsWriterLock first(file);
-    try {
-      const ResultsWriterLock second(file);
-      ADD_FAILURE() << "a second writer took the lock";
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(file.string() + " is being written by another stereobench run"),
-                std::string::npos)
-          << e.what();
+    const ResultsWriterLock shard0(file, {0, 2, 4});
+    const ResultsWriterLock shard1(file, {1, 3});  // disjoint cells: side by side
+    // Any shared cell is refused, under any spelling of the file.
+    for (const auto& other : {file, dir / "link.jsonl", dir / "." / "r.jsonl"}) {
+      try {
+        const ResultsWriterLock all(other, {0, 1, 2, 3, 4});
+        ADD_FAILURE() << "a second writer of cell 0 took the lock through " << other;
+      } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(" is being written by another stereobench run, which holds cell 0"),
+                  std::string::npos)
+            << e.what();
+      }
     }
   }
-  const ResultsWriterLock after(file);  // released with its holder
+  const ResultsWriterLock after(file, {0, 1, 2, 3, 4});  // released with their holders
 }
 
 TEST(ResultsFile, BadLinesAndDuplicatesRejected) {

@@ -149,13 +149,17 @@ TEST(SweepRun, ResumesAfterKillWithoutLosingOrDuplicatingCells) {
   // While another run holds the results file, a second one is refused before it plans anything
   // (two runs used to find the same cells unfinished and record each twice).
   {
-    const validation::ResultsWriterLock held(results);
+    const validation::ResultsWriterLock held(results, {3});
     const test::CliRun second = test::run_cli("sweep run " + quoted(dir / "tiny.toml") + " --out " +
                                               quoted(dir / "out") + " --scenes-dir " + quoted(dir / "scenes"));
     EXPECT_EQ(second.code, 3) << second.out;
-    EXPECT_NE(second.out.find("is being written by another stereobench run (pid " + std::to_string(::getpid()) + ")"),
+    EXPECT_NE(second.out.find("is being written by another stereobench run, which holds cell 3 of this run"),
               std::string::npos)
         << second.out;
+    // A shard without cell 3 (cells 1 and 4) runs beside it; it has nothing left to do here.
+    const test::CliRun shard = test::run_cli("sweep run " + quoted(dir / "tiny.toml") + " --out " +
+                                             quoted(dir / "out") + " --shard 1/3 --scenes-dir " + quoted(dir / "scenes"));
+    EXPECT_EQ(shard.code, 0) << shard.out;
   }
   EXPECT_EQ(lines_of(results), after);
 
@@ -450,6 +454,13 @@ TEST(SweepRun, BadDefinitionAndShardAreUsageErrors) {
   EXPECT_NE(near.out.find("fix the definition (no cell has run)"), std::string::npos) << near.out;
   EXPECT_EQ(near.out.find("[1/2]"), std::string::npos) << "no cell may run: " << near.out;
   EXPECT_FALSE(fs::exists(dir / "n" / "results.jsonl"));
+  // Fixed, it runs into the same folder: the refused run did not claim it for the old definition.
+  std::ofstream(dir / "near.toml", std::ios::trunc)
+      << "[sweep]\nname = \"near\"\nscenes = [\"box-wall\"]\npipelines = [\"plain-rt\"]\n"
+         "convergence_m = [2.0, 3.0]\nresolutions = [\"96x54\"]\n[timing]\nrepetitions = 1\nwarmup = 0\n";
+  const test::CliRun fixed = test::run_cli("sweep run " + quoted(dir / "near.toml") + " --out " + quoted(dir / "n") +
+                                           " --scenes-dir " + quoted(dir / "scenes"));
+  EXPECT_EQ(fixed.code, 0) << fixed.out;
 }
 
 }  // namespace
