@@ -63,6 +63,21 @@ bool is_stream(const fs::path& path) {
   return fs::exists(st) && !fs::is_regular_file(st) && !fs::is_directory(st);
 }
 
+/// Runs `work`, which writes `tmp` on the way to `path`; on any failure `tmp` is removed and the
+/// error passed on, typed errors as they are, others as an IoError naming `path`.
+void with_temporary(const fs::path& tmp, const fs::path& path, const std::function<void()>& work) {
+  std::error_code ec;
+  try {
+    work();
+  } catch (const Error&) {
+    fs::remove(tmp, ec);
+    throw;
+  } catch (const std::exception& e) {
+    fs::remove(tmp, ec);
+    throw IoError(fmt::format("writing {} failed: {}", path.string(), e.what()));
+  }
+}
+
 /// Closes a descriptor on every way out.
 struct FdCloser {
   int fd;
@@ -77,7 +92,7 @@ struct FdCloser {
 void write_through(const fs::path& stream, const std::function<void(const fs::path&)>& write) {
   std::error_code ec;
   const fs::path tmp = temporary_name(fs::temp_directory_path(ec) / stream.filename());
-  try {
+  with_temporary(tmp, stream, [&] {
     write(tmp);
     const FdCloser in{::open(tmp.c_str(), O_RDONLY | O_CLOEXEC)};
     const FdCloser out{::open(stream.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC)};
@@ -97,13 +112,7 @@ void write_through(const fs::path& stream, const std::function<void(const fs::pa
       }
     }
     fs::remove(tmp, ec);
-  } catch (const Error&) {
-    fs::remove(tmp, ec);
-    throw;
-  } catch (const std::exception& e) {
-    fs::remove(tmp, ec);
-    throw IoError(fmt::format("writing {} failed: {}", stream.string(), e.what()));
-  }
+  });
 }
 
 }  // namespace
@@ -141,18 +150,12 @@ void write_atomically(const fs::path& given, const std::function<void(const fs::
                                 path.filename().string(), ec.message()));
   }
   const fs::path tmp = temporary_name(path);
-  try {
+  with_temporary(tmp, path, [&] {
     write(tmp);
     sync_file(tmp);
     fs::rename(tmp, path, ec);
     if (ec) throw IoError(fmt::format("cannot rename {} to {}: {}", tmp.string(), path.string(), ec.message()));
-  } catch (const Error&) {
-    fs::remove(tmp, ec);
-    throw;
-  } catch (const std::exception& e) {
-    fs::remove(tmp, ec);
-    throw IoError(fmt::format("writing {} failed: {}", path.string(), e.what()));
-  }
+  });
 }
 
 void write_file_atomically(const fs::path& path, std::span<const unsigned char> bytes) {
