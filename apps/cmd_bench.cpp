@@ -101,6 +101,8 @@ void run_bench_command(const BenchArgs& a) {
   const BenchConfig config = bench_config(a, all);
   const Executor executor(checked_threads(a.threads));
   const scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
+  const std::string scene_file = loaded.file.string();
+  refuse_overwriting({{"the scene file", &scene_file}}, {{"--json", &a.json_out}});
   const Scene& scene = loaded.scene;
   const size_t lights_in_file = loaded.lights_in_file;
   const StereoRig rig = resolve_rig(scene, overrides);

@@ -87,6 +87,16 @@ int verdict(const std::vector<reference::VerifyResult>& results) {
 
 int run_verify(const ReferenceArgs& a) {
   const reference::ReferenceStore store(a.store);
+  if (!a.json_out.empty()) {
+    // Inside the store the verdicts could replace a reference's own files.
+    std::error_code ec;
+    const fs::path out = fs::weakly_canonical(fs::absolute(a.json_out, ec), ec);
+    const fs::path root = fs::weakly_canonical(fs::absolute(store.root(), ec), ec);
+    const fs::path rel = out.lexically_relative(root);
+    if (!rel.empty() && *rel.begin() != "..")
+      throw InputError(fmt::format("--json {} lies inside the reference store {}; write the verdicts outside it",
+                                   a.json_out, store.root().string()));
+  }
   const std::vector<reference::VerifyResult> results = verify_all(a, store);
   if (!a.json_out.empty()) {
     json j = json::array();

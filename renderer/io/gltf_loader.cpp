@@ -770,8 +770,10 @@ Scene load_gltf(const fs::path& path, const GltfLoadOptions& options) {
   try {
     doc = parse_json(parts.json_text);
   } catch (const JsonTextError& e) {
-    const std::string at = e.byte() > 0 ? fmt::format(" at byte {}", e.byte()) : "";
-    throw InputError(fmt::format("{}: not valid JSON{}: {}", file, at, short_parse_error(e.what())));
+    // A syntax error has a byte; nesting and number range are limits of the reader on valid JSON.
+    if (e.byte() == 0)
+      throw InputError(fmt::format("{}: its JSON exceeds what the reader accepts: {}", file, e.what()));
+    throw InputError(fmt::format("{}: not valid JSON at byte {}: {}", file, e.byte(), short_parse_error(e.what())));
   }
   check_gltf_json(doc, file);
   const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();

@@ -200,6 +200,10 @@ TEST(Cli, RenderAndBenchRejectBadArguments) {
       {"render --scene box-wall --pipeline plain-rt --scenes-dir '' --out '" + dir.path().string() + "'",
        "--scenes-dir: is empty; give a name"},
       {"bench --scene box-wall --pipelines plain-rt --json ''" + bench_common, "--json: is empty; give a name"},
+      // The results used to replace the scene file they were measured on.
+      {"bench --scene box-wall --pipelines plain-rt --json '" + (dir / "scenes" / "box-wall.gltf").string() + "'" +
+           bench_common,
+       "names the same file as the scene file"},
       // An empty list used to time every registered pipeline.
       {"bench --scene box-wall --pipelines ''" + bench_common, "--pipelines names no pipeline"},
       {"bench --scene box-wall -n 20000 --pipelines plain-rt --baseline plain-rt" + bench_common,

@@ -158,7 +158,7 @@ std::vector<BadCase> corpus() {
   // Deep nesting crashed the glTF library's recursive parser (stack overflow), 20000 levels here.
   c.push_back({"nesting_too_deep", "a.gltf", [](auto& p) { write_text(p, "{\"asset\":{\"version\":\"2.0\"},\"extras\":" + std::string(20000, '[') + std::string(20000, ']') + "}"); }, "nesting deeper than 256 levels"});
   // A number beyond a double's range was an internal error (exit 4) naming no file.
-  c.push_back({"number_overflows_double", "a.gltf", [](auto& p) { write_text(p, R"({"asset":{"version":"2.0"},"extras":{"count":35e400}})"); }, "not valid JSON: number overflow parsing '35e400'"});
+  c.push_back({"number_overflows_double", "a.gltf", [](auto& p) { write_text(p, R"({"asset":{"version":"2.0"},"extras":{"count":35e400}})"); }, "its JSON exceeds what the reader accepts: number overflow parsing '35e400'"});
   // A folder or a device named as a file was reported as a file that does not exist.
   c.push_back({"image_uri_is_a_folder", "a.gltf", edited([](MiniGltf& g) { g.doc["images"] = json::array({{{"uri", "."}}}); }), "is a folder, not a regular file"});
   c.push_back({"buffer_uri_is_a_device", "a.gltf", [](auto& p) { write_text(p, R"({"asset":{"version":"2.0"},"buffers":[{"uri":"/dev/zero","byteLength":12}]})"); }, "is a device, pipe or socket, not a regular file"});

@@ -149,6 +149,13 @@ TEST(ReferenceStore, DamagedProvenanceIsAFindingNotAStop) {
   EXPECT_NE(nope.out.find("corrupt        " + pole), std::string::npos) << nope.out;
   EXPECT_NE(nope.out.find("spec.provider 'nope' is not a ground-truth provider"), std::string::npos) << nope.out;
 
+  // The verdicts are not written into the store, where they could replace a reference's files.
+  const test::CliRun inside = test::run_cli(ref(dir, "verify") + " --no-render --json " +
+                                            quoted(dir / "store" / pole / "provenance.json"));
+  EXPECT_EQ(inside.code, 3) << inside.out;
+  EXPECT_NE(inside.out.find("lies inside the reference store"), std::string::npos) << inside.out;
+  EXPECT_EQ(json::parse(test::read_text(dir / "store" / pole / "provenance.json"))["spec"]["provider"], "nope");
+
   // update renders what it rewrites: --no-render belongs with --only-failing.
   const test::CliRun render_less = test::run_cli(ref(dir, "update") + " --no-render " + pole);
   EXPECT_EQ(render_less.code, 3) << render_less.out;
