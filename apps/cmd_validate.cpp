@@ -92,7 +92,8 @@ void run_validate(const ValidateArgs& a) {
 
   const fs::path out = a.out;
   const std::optional<validation::TruthCache> cache =
-      a.no_cache || a.cache.empty() ? std::nullopt : std::optional<validation::TruthCache>(validation::TruthCache(a.cache));
+      a.no_cache || a.cache.empty() ? std::nullopt
+                                    : std::optional<validation::TruthCache>(validation::TruthCache(a.cache));
   const validation::ValidationTarget target = validation::prepare_target(
       prepared, loaded.file, rig, *provider, cache ? &*cache : nullptr, out / "work" / provider->name(), executor);
   fmt::print("truth: {} ({}), {}{:.2f} s; true disocclusions {:.3f} % of the image\n", provider->name(),
@@ -149,7 +150,8 @@ void register_validate_command(CLI::App& root) {
       ->capture_default_str();
   v->add_option("--threads,-t", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
   v->add_option("--out", a->out, "Output folder")->capture_default_str();
-  v->add_option("--cache", a->cache, "Folder of cached external ground-truth renders, keyed by content hash ('' to disable)")
+  v->add_option("--cache", a->cache,
+                "Folder of cached external ground-truth renders, keyed by content hash ('' to disable)")
       ->capture_default_str();
   v->add_flag("--no-cache", a->no_cache, "Render the ground truth again and do not store it");
   v->add_option("--error-threshold", a->error_threshold,

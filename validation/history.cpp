@@ -133,7 +133,8 @@ void check_history_line(const json& line, const std::string& where) {
     throw bad("\"pipelines\" must be an object of pipeline summaries");
   for (const auto& [name, p] : line["pipelines"].items()) {
     if (!p.is_object()) throw bad(fmt::format("pipelines.{} must be an object", name));
-    if (!p.contains("cells") || !is_count(p["cells"])) throw bad(fmt::format("pipelines.{}.cells must be a count >= 0", name));
+    if (!p.contains("cells") || !is_count(p["cells"]))
+      throw bad(fmt::format("pipelines.{}.cells must be a count >= 0", name));
     for (const Field& f : kFields) {
       const json v = p.value(f.key, json(nullptr));
       if (!v.is_null() && !v.is_number() && v != "inf" && v != "-inf")
@@ -153,8 +154,10 @@ void check_history_line(const json& line, const std::string& where) {
   // The verdict and its exit code, as the gate gives them (0 pass, 1 warn, 2 fail).
   const std::string verdict = gate["verdict"].get<std::string>();
   const int expected = verdict == "pass" ? 0 : verdict == "warn" ? 1 : verdict == "fail" ? 2 : -1;
-  if (expected < 0) throw bad(fmt::format("gate.verdict {} is not \"pass\", \"warn\" or \"fail\"", gate["verdict"].dump()));
-  if (!gate.contains("exit_code") || !gate["exit_code"].is_number_integer() || gate["exit_code"].get<long long>() != expected)
+  if (expected < 0)
+    throw bad(fmt::format("gate.verdict {} is not \"pass\", \"warn\" or \"fail\"", gate["verdict"].dump()));
+  if (!gate.contains("exit_code") || !gate["exit_code"].is_number_integer() ||
+      gate["exit_code"].get<long long>() != expected)
     throw bad(fmt::format("gate.exit_code {} does not go with verdict \"{}\" (exit code {})",
                           gate.value("exit_code", json(nullptr)).dump(), verdict, expected));
 }

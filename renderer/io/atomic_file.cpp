@@ -97,7 +97,8 @@ void write_through(const fs::path& stream, const std::function<void(const fs::pa
     const FdCloser in{::open(tmp.c_str(), O_RDONLY | O_CLOEXEC)};
     const FdCloser out{::open(stream.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC)};
     if (in.fd < 0 || out.fd < 0)
-      throw IoError(fmt::format("cannot open {}: {}", in.fd < 0 ? tmp.string() : stream.string(), std::strerror(errno)));
+      throw IoError(
+          fmt::format("cannot open {}: {}", in.fd < 0 ? tmp.string() : stream.string(), std::strerror(errno)));
     std::vector<char> block(size_t{1} << 16);
     for (;;) {
       const ssize_t n = ::read(in.fd, block.data(), block.size());
@@ -125,8 +126,9 @@ fs::path follow_links(const fs::path& path) {
     if (hops == kMaxLinkHops)
       throw IoError(fmt::format("cannot write {}: too many levels of symbolic links (a loop?)", path.string()));
     const fs::path next = fs::read_symlink(p, ec);
-    if (ec) throw IoError(fmt::format("cannot write {}: cannot read the link {}: {}", path.string(), p.string(),
-                                      ec.message()));
+    if (ec)
+      throw IoError(
+          fmt::format("cannot write {}: cannot read the link {}: {}", path.string(), p.string(), ec.message()));
     p = next.is_absolute() ? next : p.parent_path() / next;
   }
   return p;

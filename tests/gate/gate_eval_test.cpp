@@ -261,7 +261,8 @@ TEST(GateCli, ExitCodesAndOutputs) {
 
   // The reports never replace the gate's inputs (--json over the results file used to succeed).
   const std::string kept = read_text(dir / "fail.jsonl");
-  for (const std::string& out : {" --json " + (dir / "fail.jsonl").string(), " --junit " + (dir / "." / "fail.jsonl").string()}) {
+  for (const std::string& out :
+       {" --json " + (dir / "fail.jsonl").string(), " --junit " + (dir / "." / "fail.jsonl").string()}) {
     run = run_cli("gate" + config + baseline + " --results " + (dir / "fail.jsonl").string() + out);
     EXPECT_EQ(run.code, 3) << out << "\n" << run.out;
     EXPECT_NE(run.out.find("names the same file as --results"), std::string::npos) << run.out;
@@ -370,9 +371,9 @@ TEST(GateEval, AnUnfinishedSweepFails) {
   EXPECT_EQ(part.worst, Verdict::fail);
   // The command resumes the file that was gated: sweep run reads <out>/results.jsonl unless told.
   EXPECT_EQ(complete(part)->reproduce.find("--results"), std::string::npos) << complete(part)->reproduce;
-  const validation::GateReport other = validation::evaluate_gate(
-      validation::parse_gate_config(kConfig, "test.toml"),
-      validation::gate_results({passing_cells()[1]}, {}, "runs/partial.jsonl"), {});
+  const validation::GateReport other =
+      validation::evaluate_gate(validation::parse_gate_config(kConfig, "test.toml"),
+                                validation::gate_results({passing_cells()[1]}, {}, "runs/partial.jsonl"), {});
   ASSERT_NE(complete(other), nullptr);
   EXPECT_NE(complete(other)->reproduce.find("--out runs --results runs/partial.jsonl"), std::string::npos)
       << complete(other)->reproduce;

@@ -291,12 +291,19 @@ TEST(NightlyTest, MalformedHistoryIsBadInputNamingFileAndLine) {
 }
 
 TEST(NightlyTest, HistoryLinesWithImpossibleValuesAreRefused) {
-  const validation::NightlyRun run{"20261121T200000Z", "2026-11-21T20:00:00Z", "host", "abc1234", "smoke",
-                                   "ci/smoke.toml",    "0123",                 "20261121T200000Z/results.jsonl"};
-  const json cell = {{"pipelines",
-                      {{"repro-rt",
-                        {{"validation", {{"metrics", {{"psnr", 41.0}, {"ssim", 0.99}}}, {"holes", {{"hole_fraction", 0.02}}}}},
-                         {"timing", {{"median_s", 0.5}, {"speedup_median", 1.7}}}}}}}};
+  const validation::NightlyRun run{"20261121T200000Z",
+                                   "2026-11-21T20:00:00Z",
+                                   "host",
+                                   "abc1234",
+                                   "smoke",
+                                   "ci/smoke.toml",
+                                   "0123",
+                                   "20261121T200000Z/results.jsonl"};
+  const json cell = {
+      {"pipelines",
+       {{"repro-rt",
+         {{"validation", {{"metrics", {{"psnr", 41.0}, {"ssim", 0.99}}}, {"holes", {{"hole_fraction", 0.02}}}}},
+          {"timing", {{"median_s", 0.5}, {"speedup_median", 1.7}}}}}}}};
   const json good = validation::history_entry(run, {cell}, validation::GateReport{});
   EXPECT_NO_THROW(validation::check_history_line(good, "h:1"));
   // Each of these used to be accepted and drawn in the trend charts.

@@ -157,8 +157,9 @@ TEST(SweepRun, ResumesAfterKillWithoutLosingOrDuplicatingCells) {
               std::string::npos)
         << second.out;
     // A shard without cell 3 (cells 1 and 4) runs beside it; it has nothing left to do here.
-    const test::CliRun shard = test::run_cli("sweep run " + quoted(dir / "tiny.toml") + " --out " +
-                                             quoted(dir / "out") + " --shard 1/3 --scenes-dir " + quoted(dir / "scenes"));
+    const test::CliRun shard =
+        test::run_cli("sweep run " + quoted(dir / "tiny.toml") + " --out " + quoted(dir / "out") +
+                      " --shard 1/3 --scenes-dir " + quoted(dir / "scenes"));
     EXPECT_EQ(shard.code, 0) << shard.out;
   }
   EXPECT_EQ(lines_of(results), after);
@@ -230,8 +231,8 @@ TEST(SweepRun, ShardsCollectedEqualAnUnshardedRun) {
 
   // The export never replaces its input (it used to turn the results file into CSV).
   const std::string merged_text = test::read_text(dir / "merged.jsonl");
-  const test::CliRun over = test::run_cli("sweep csv " + quoted(dir / "merged.jsonl") + " --out " +
-                                          quoted(dir / "." / "merged.jsonl"));
+  const test::CliRun over =
+      test::run_cli("sweep csv " + quoted(dir / "merged.jsonl") + " --out " + quoted(dir / "." / "merged.jsonl"));
   EXPECT_EQ(over.code, 3) << over.out;
   EXPECT_NE(over.out.find("names the same file as results"), std::string::npos) << over.out;
   EXPECT_EQ(test::read_text(dir / "merged.jsonl"), merged_text);
