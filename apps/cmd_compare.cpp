@@ -1,6 +1,5 @@
 // `stereobench compare A B`: the metrics of DESIGN §6.2 for any two image files, with idiff-style
 // pass / warn / fail thresholds, a JSON record, and difference and SSIM map pictures.
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -16,6 +15,7 @@
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/text.hpp"
 #include "validation/image_files.hpp"
 #include "validation/metric_images.hpp"
 #include "validation/metrics.hpp"
@@ -74,9 +74,7 @@ void check_outputs(const CompareArgs& a) {
                      {{"--json", &a.json}, {"--diff", &a.diff}, {"--ssim-map", &a.ssim_map}});
   const std::pair<const char*, const std::string*> pictures[] = {{"--diff", &a.diff}, {"--ssim-map", &a.ssim_map}};
   for (const auto& [option, path] : pictures) {
-    std::string ext = fs::path(*path).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (!path->empty() && ext != ".png")
+    if (!path->empty() && lowercase(fs::path(*path).extension().string()) != ".png")
       throw InputError(fmt::format("{} {}: the picture is written as PNG; give a file name ending in .png", option,
                                    *path));
   }

@@ -38,30 +38,6 @@ std::string format_value(double v) {
   return v == std::floor(v) && std::fabs(v) < 1e15 ? fmt::format("{:.0f}", v) : fmt::format("{}", v);
 }
 
-/// The generator's parameters with defaults filled in and the overrides checked.
-std::map<std::string, double> resolve_params(const GeneratorInfo& info, const std::map<std::string, double>& overrides) {
-  std::map<std::string, double> values;
-  for (const GeneratorParam& p : info.params) values[p.name] = p.default_value;
-  for (const auto& [name, value] : overrides) {
-    const GeneratorParam* param = nullptr;
-    for (const GeneratorParam& p : info.params)
-      if (p.name == name) param = &p;
-    if (param == nullptr) {
-      std::string known;
-      for (const GeneratorParam& p : info.params) known += (known.empty() ? "" : ", ") + p.name;
-      throw InputError(fmt::format("scene '{}' has no parameter '{}' (its parameters: {})", info.name, name,
-                                   known.empty() ? "none" : known));
-    }
-    if (!(value >= param->min_value && value <= param->max_value))
-      throw InputError(fmt::format("scene '{}': parameter '{}' = {} is out of range [{}, {}]", info.name, name,
-                                   format_value(value), format_value(param->min_value), format_value(param->max_value)));
-    if (param->integer && value != std::floor(value))
-      throw InputError(fmt::format("scene '{}': parameter '{}' = {} must be a whole number in [{}, {}]", info.name, name,
-                                   format_value(value), format_value(param->min_value), format_value(param->max_value)));
-    values[name] = value;
-  }
-  return values;
-}
 
 }  // namespace
 
@@ -124,6 +100,30 @@ GenerateResult generate(const std::string& name, const GenerateOptions& options,
   result.lights = builder.stats().lights;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
+}
+
+std::map<std::string, double> resolve_params(const GeneratorInfo& info, const std::map<std::string, double>& overrides) {
+  std::map<std::string, double> values;
+  for (const GeneratorParam& p : info.params) values[p.name] = p.default_value;
+  for (const auto& [name, value] : overrides) {
+    const GeneratorParam* param = nullptr;
+    for (const GeneratorParam& p : info.params)
+      if (p.name == name) param = &p;
+    if (param == nullptr) {
+      std::string known;
+      for (const GeneratorParam& p : info.params) known += (known.empty() ? "" : ", ") + p.name;
+      throw InputError(fmt::format("scene '{}' has no parameter '{}' (its parameters: {})", info.name, name,
+                                   known.empty() ? "none" : known));
+    }
+    if (!(value >= param->min_value && value <= param->max_value))
+      throw InputError(fmt::format("scene '{}': parameter '{}' = {} is out of range [{}, {}]", info.name, name,
+                                   format_value(value), format_value(param->min_value), format_value(param->max_value)));
+    if (param->integer && value != std::floor(value))
+      throw InputError(fmt::format("scene '{}': parameter '{}' = {} must be a whole number in [{}, {}]", info.name, name,
+                                   format_value(value), format_value(param->min_value), format_value(param->max_value)));
+    values[name] = value;
+  }
+  return values;
 }
 
 }  // namespace sb::scenes

@@ -29,6 +29,11 @@ struct GeneratorInfo {
   std::vector<GeneratorParam> params;
 };
 
+/// A generator's parameters with the defaults filled in and `overrides` applied: what a generation
+/// with them uses. InputError for an unknown name or a value out of range.
+[[nodiscard]] std::map<std::string, double> resolve_params(const GeneratorInfo& info,
+                                                           const std::map<std::string, double>& overrides);
+
 /// How to generate: the seed and parameter overrides.
 struct GenerateOptions {
   uint64_t seed = 1;

@@ -20,16 +20,19 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-/// A number of a results line: finite numbers as they are, "inf"/"-inf" as infinities; nullopt
-/// for anything else (absent, null, NaN written as null).
-std::optional<double> number_at(const json& entry, const char* pointer) {
-  const json::json_pointer ptr(pointer);
-  if (!entry.contains(ptr)) return std::nullopt;
-  const json& v = entry.at(ptr);
+/// A number as finite_json writes it: finite numbers as they are, "inf"/"-inf" as infinities;
+/// nullopt for anything else (null, NaN written as null, another type).
+std::optional<double> number_of(const json& v) {
   if (v.is_number()) return v.get<double>();
   if (v == "inf") return std::numeric_limits<double>::infinity();
   if (v == "-inf") return -std::numeric_limits<double>::infinity();
   return std::nullopt;
+}
+
+/// The number at `pointer` of a results line (number_of), nullopt when absent.
+std::optional<double> number_at(const json& entry, const char* pointer) {
+  const json::json_pointer ptr(pointer);
+  return entry.contains(ptr) ? number_of(entry.at(ptr)) : std::nullopt;
 }
 
 /// The median as JSON: null for no values, "inf" for an infinite one (finite_json's convention).
@@ -137,10 +140,11 @@ void check_history_line(const json& line, const std::string& where) {
       throw bad(fmt::format("pipelines.{}.cells must be a count >= 0", name));
     for (const Field& f : kFields) {
       const json v = p.value(f.key, json(nullptr));
-      if (!v.is_null() && !v.is_number() && v != "inf" && v != "-inf")
+      if (v.is_null()) continue;
+      const std::optional<double> x = number_of(v);
+      if (!x)
         throw bad(fmt::format("pipelines.{}.{} must be a number, \"inf\" or null, not {}", name, f.key, v.dump()));
-      const double x = v.is_number() ? v.get<double>() : v == "inf" ? kInf : v == "-inf" ? -kInf : 0.0;
-      if (!v.is_null() && !(x >= f.lo && x <= f.hi))
+      if (!(*x >= f.lo && *x <= f.hi))
         throw bad(fmt::format("pipelines.{}.{} is {}, outside [{}, {}] where every measurement lies", name, f.key,
                               v.dump(), f.lo, f.hi));
     }

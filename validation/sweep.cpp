@@ -301,17 +301,11 @@ void parse_path(const Where& where, const toml::node& node, SweepDefinition& d) 
   d.path = path;
 }
 
-/// A built-in scene's parameters with the defaults filled in: what it generates.
-std::map<std::string, double> generated_params(const SweepScene& s) {
-  std::map<std::string, double> out;
-  for (const scenes::GeneratorParam& p : scenes::find_generator(s.name).params) out[p.name] = p.default_value;
-  for (const auto& [key, value] : s.params) out[key] = value;
-  return out;
-}
-
 /// Two entries that generate the same built-in scene ("spheres" and "spheres:count=1000").
 bool same_builtin_scene(const SweepScene& a, const SweepScene& b) {
-  return a.builtin && b.builtin && a.name == b.name && generated_params(a) == generated_params(b);
+  if (!a.builtin || !b.builtin || a.name != b.name) return false;
+  const scenes::GeneratorInfo& info = scenes::find_generator(a.name);
+  return scenes::resolve_params(info, a.params) == scenes::resolve_params(info, b.params);
 }
 
 }  // namespace
@@ -325,7 +319,6 @@ SweepScene parse_builtin_scene(const std::string& text) {
   if (colon != std::string::npos) {
     const std::string list = text.substr(colon + 1);
     if (list.empty()) throw InputError(fmt::format("scene '{}': nothing after ':'; give name:key=value,key=value", text));
-    std::set<std::string> given;
     size_t start = 0;
     while (start <= list.size()) {
       const size_t comma = std::min(list.find(',', start), list.size());
@@ -358,9 +351,8 @@ SweepScene parse_builtin_scene(const std::string& text) {
                                      number_text(param->min_value), number_text(param->max_value)));
       if (param->integer && value != std::floor(value))
         throw InputError(fmt::format("scene '{}': {} must be a whole number, not {}", text, key, value_text));
-      if (!given.insert(key).second)
+      if (!s.params.emplace(key, value).second)
         throw InputError(fmt::format("scene '{}': parameter '{}' given twice", text, key));
-      s.params.emplace(key, value);
       if (comma == list.size()) break;
     }
   }

@@ -99,13 +99,12 @@ SweepPlan plan_sweep(const SweepDefinition& definition, const fs::path& results,
       throw InputError(fmt::format("{}: cell '{}' is not a cell of {}", results.string(), id, definition.file.string()));
     done.insert(id);
   }
-  for (const SweepCell& c : plan.cells) {
-    if (c.index % shard.count != shard.index) continue;  // as shard_cells
+  for (const size_t i : shard_cells(plan.cells.size(), shard)) {
     ++plan.in_shard;
-    if (done.count(c.id))
+    if (done.count(plan.cells[i].id))
       ++plan.finished;
     else
-      plan.todo.push_back(c.index);
+      plan.todo.push_back(plan.cells[i].index);
   }
   return plan;
 }

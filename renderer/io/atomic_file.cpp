@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstring>
@@ -39,21 +40,35 @@ void sync_file(const fs::path& path) {
 
 constexpr int kMaxLinkHops = 40;
 
+/// The paths a symbolic link leads through: `path`, then each link's target in turn, ending at a
+/// path that is no link (a missing one for a dangling link). IoError for a loop or an unreadable
+/// link.
+std::vector<fs::path> link_chain(const fs::path& path) {
+  std::error_code ec;
+  std::vector<fs::path> chain{path};
+  while (fs::is_symlink(fs::symlink_status(chain.back(), ec))) {
+    if (chain.size() > static_cast<size_t>(kMaxLinkHops))
+      throw IoError(fmt::format("cannot write {}: too many levels of symbolic links (a loop?)", path.string()));
+    const fs::path& p = chain.back();
+    const fs::path next = fs::read_symlink(p, ec);
+    if (ec)
+      throw IoError(
+          fmt::format("cannot write {}: cannot read the link {}: {}", path.string(), p.string(), ec.message()));
+    chain.push_back(next.is_absolute() ? next : p.parent_path() / next);
+  }
+  return chain;
+}
+
 /// Whether `path`, or a link on the way to its file, names an open file of a process (/dev/stdout,
 /// /dev/fd/N, /proc/self/fd/N): such a file is the caller's stream, whatever it is (a terminal, a
 /// pipe, or a file the shell redirected into), and is written in place, never replaced.
 bool names_open_file(const fs::path& path) {
-  std::error_code ec;
-  fs::path p = path;
-  for (int hops = 0; hops <= kMaxLinkHops; ++hops) {
+  const std::vector<fs::path> chain = link_chain(path);
+  return std::any_of(chain.begin(), chain.end(), [](const fs::path& p) {
+    std::error_code ec;
     const std::string s = fs::absolute(p, ec).lexically_normal().string();
-    if (s.rfind("/proc/", 0) == 0 || s.rfind("/dev/fd/", 0) == 0) return true;
-    if (!fs::is_symlink(fs::symlink_status(p, ec))) return false;
-    const fs::path next = fs::read_symlink(p, ec);
-    if (ec) return false;
-    p = next.is_absolute() ? next : p.parent_path() / next;
-  }
-  return false;
+    return s.rfind("/proc/", 0) == 0 || s.rfind("/dev/fd/", 0) == 0;
+  });
 }
 
 /// A device, pipe or socket cannot be replaced by renaming a file over it: it is written in place.
@@ -118,21 +133,7 @@ void write_through(const fs::path& stream, const std::function<void(const fs::pa
 
 }  // namespace
 
-fs::path follow_links(const fs::path& path) {
-  std::error_code ec;
-  if (!fs::is_symlink(fs::symlink_status(path, ec))) return path;
-  fs::path p = path;
-  for (int hops = 0; fs::is_symlink(fs::symlink_status(p, ec)); ++hops) {
-    if (hops == kMaxLinkHops)
-      throw IoError(fmt::format("cannot write {}: too many levels of symbolic links (a loop?)", path.string()));
-    const fs::path next = fs::read_symlink(p, ec);
-    if (ec)
-      throw IoError(
-          fmt::format("cannot write {}: cannot read the link {}: {}", path.string(), p.string(), ec.message()));
-    p = next.is_absolute() ? next : p.parent_path() / next;
-  }
-  return p;
-}
+fs::path follow_links(const fs::path& path) { return link_chain(path).back(); }
 
 void write_atomically(const fs::path& given, const std::function<void(const fs::path&)>& write) {
   const bool open_file = names_open_file(given);
