@@ -121,16 +121,17 @@ uint32_t lane_bit(int x, int y, int w) {
   return 1u << ((y - 4 * by) * std::min(4, w - 4 * bx) + (x - 4 * bx));
 }
 
-/// Lists the blocks with a pixel to trace, in the order trace_eye visits them: kTraceTile-square
-/// tiles in row-major order, the blocks inside a tile row-major. Consecutive listed pixels then
-/// lie close together, which keeps the shading batches' shadow rays coherent.
+/// Lists the blocks with a pixel to trace: kTraceTile-square tiles in row-major order, the blocks
+/// inside a tile column by column. The pixels to trace are mostly vertical strips (holes and
+/// missed pixels lie beside silhouettes, across the horizontal baseline), so consecutive listed
+/// pixels then lie on one strip, which keeps the shading batches' shadow rays coherent.
 void list_blocks(PixelBlocks& b) {
   const int blocks_y = static_cast<int>(b.masks.size() / static_cast<size_t>(b.blocks_x));
   constexpr int kTileBlocks = kTraceTile / 4;
   for (int ty = 0; ty < blocks_y; ty += kTileBlocks)
     for (int tx = 0; tx < b.blocks_x; tx += kTileBlocks)
-      for (int by = ty; by < std::min(ty + kTileBlocks, blocks_y); ++by)
-        for (int bx = tx; bx < std::min(tx + kTileBlocks, b.blocks_x); ++bx) {
+      for (int bx = tx; bx < std::min(tx + kTileBlocks, b.blocks_x); ++bx)
+        for (int by = ty; by < std::min(ty + kTileBlocks, blocks_y); ++by) {
           const size_t k = static_cast<size_t>(by) * static_cast<size_t>(b.blocks_x) + static_cast<size_t>(bx);
           if (b.masks[k] != 0) b.listed.push_back(static_cast<uint32_t>(k));
         }
