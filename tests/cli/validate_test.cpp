@@ -16,10 +16,11 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::string base_args(const test::ScratchDir& dir) {
+/// The common arguments; the truth cache in the scratch folder unless `cache` names another.
+std::string base_args(const test::ScratchDir& dir, const std::string& cache = "") {
   return "validate --scene box-wall --resolution 160x90 --threads 2 --scenes-dir '" +
          (fs::path(SB_BINARY_DIR) / "Testing" / "scenes-cache").string() + "' --out '" + (dir / "out").string() +
-         "' --cache '" + (dir / "cache").string() + "'";
+         "' --cache " + (cache.empty() ? test::quoted(dir / "cache") : cache);
 }
 
 TEST(Validate, WritesRecordsImagesAndTable) {
@@ -65,6 +66,22 @@ TEST(Validate, ExternalTruthIsRenderedOnceThenCached) {
   // Our ray tracer against POV-Ray on an untextured scene: the providers agree (three-way test).
   EXPECT_NE(record["metrics"]["psnr"], "inf");
   EXPECT_GE(record["metrics"]["psnr"].get<double>(), 45.0);
+}
+
+TEST(Validate, EmptyCacheFolderTurnsTheCacheOff) {
+  test::ScratchDir dir;
+  // Run from the scratch folder: an empty --cache taken as a folder name would cache there.
+  const std::string args = "cd " + test::quoted(dir.path()) + " && " + SB_CLI_PATH + " " + base_args(dir, "''") +
+                           " --truth povray --pipelines plain-rt";
+  for (int run = 0; run < 2; ++run) {
+    const test::CliRun r = test::run_shell(args);
+    ASSERT_EQ(r.code, 0) << r.out << "\n(POV-Ray is installed by ci/install-deps.sh povray)";
+    EXPECT_EQ(r.out.find("from the cache"), std::string::npos) << "run " << run << ":\n" << r.out;
+  }
+  const json record = json::parse(test::read_text(dir / "out" / "box-wall_povray_plain-rt.json"));
+  EXPECT_FALSE(record["truth"]["cached"].get<bool>());
+  for (const auto& entry : fs::directory_iterator(dir.path()))
+    EXPECT_EQ(entry.path().filename(), "out") << "left behind: " << entry.path();
 }
 
 TEST(Validate, PipelineOptionsApplyAndAreChecked) {
