@@ -8,7 +8,6 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <memory>
 #include <regex>
@@ -21,6 +20,7 @@
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/pipeline.hpp"
+#include "renderer/text.hpp"
 #include "reports/report.hpp"
 #include "validation/gate.hpp"
 #include "validation/history.hpp"
@@ -58,15 +58,6 @@ struct NightlyArgs {
 /// Run folder names: the UTC start "YYYYMMDDTHHMMSSZ", with "-N" appended when a run of the same
 /// second exists.
 const std::regex kRunIdPattern(R"((\d{4})(\d{2})(\d{2})T(\d{2})(\d{2})(\d{2})Z(-\d+)?)");
-
-std::string utc_now_id() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  ::gmtime_r(&now, &tm);
-  std::array<char, 32> buf{};
-  std::strftime(buf.data(), buf.size(), "%Y%m%dT%H%M%SZ", &tm);
-  return buf.data();
-}
 
 /// "2026-11-21T20:00:00Z" from a run id.
 std::string run_date(const std::string& run_id) {
@@ -129,7 +120,7 @@ fs::path choose_run_dir(const fs::path& out, const SweepDefinition& d, bool* res
                  newest.string(), d.file.string());
     }
   }
-  const std::string base = utc_now_id();
+  const std::string base = utc_now("%Y%m%dT%H%M%SZ");
   std::string id = base;
   for (int n = 2; fs::exists(out / id, ec); ++n) id = fmt::format("{}-{}", base, n);
   fs::create_directories(out / id, ec);

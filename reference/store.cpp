@@ -2,11 +2,9 @@
 #include "reference/store.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <unistd.h>
 
-#include <fmt/chrono.h>
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
@@ -15,6 +13,7 @@
 #include "renderer/io/json_text.hpp"
 #include "renderer/io/render_output.hpp"
 #include "renderer/render_scene.hpp"
+#include "renderer/text.hpp"
 #include "sb_version.hpp"
 #include "scenes/catalog.hpp"
 #include "validation/content_hash.hpp"
@@ -175,10 +174,6 @@ std::string reference_id(const Scene& scene, const ReferenceSpec& spec, const St
                                p.interaxial * 1e3, p.convergence);
   if (spec.lights) id += fmt::format("_l{}", *spec.lights);
   return id;
-}
-
-std::string utc_now() {
-  return fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", fmt::gmtime(std::chrono::system_clock::to_time_t(std::chrono::system_clock::now())));
 }
 
 /// Replaces `dir` by `staged` (a complete folder beside it) with renames only.

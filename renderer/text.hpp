@@ -1,9 +1,11 @@
-// Small text helpers: parsing numbers given as text (command-line values, option strings), case.
+// Small text helpers: parsing numbers given as text (command-line values, option strings), case,
+// the current time as text.
 #pragma once
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <ctime>
 #include <exception>
 #include <optional>
 #include <string>
@@ -31,6 +33,17 @@ namespace sb {
   std::string out(s);
   std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return out;
+}
+
+/// The current UTC time formatted by strftime's `format`; the default is ISO 8601,
+/// "2026-11-21T20:00:00Z", as every record, provenance and submission file writes it.
+[[nodiscard]] inline std::string utc_now(const char* format = "%Y-%m-%dT%H:%M:%SZ") {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  ::gmtime_r(&t, &tm);
+  char buf[64] = {};
+  std::strftime(buf, sizeof buf, format, &tm);
+  return buf;
 }
 
 }  // namespace sb

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <ctime>
 #include <fstream>
 #include <map>
 #include <regex>
@@ -19,6 +18,7 @@
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/json_text.hpp"
+#include "renderer/text.hpp"
 #include "validation/process.hpp"
 #include "validation/results_file.hpp"
 
@@ -76,15 +76,6 @@ std::string tail_of(const fs::path& file, size_t n) {
   std::string out;
   for (const std::string& l : lines) out += "    " + l + "\n";
   return out;
-}
-
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
 }
 
 /// Array task ids of the job still in the queue (pending, running, completing, ...), with their

@@ -9,7 +9,6 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
-#include <ctime>
 #include <exception>
 #include <map>
 #include <memory>
@@ -27,6 +26,7 @@
 #include "renderer/io/render_output.hpp"
 #include "renderer/parallel.hpp"
 #include "renderer/pipeline.hpp"
+#include "renderer/text.hpp"
 #include "scenes/catalog.hpp"
 #include "validation/benchmark.hpp"
 #include "validation/results_file.hpp"
@@ -110,15 +110,6 @@ SweepPlan plan_sweep(const SweepDefinition& definition, const fs::path& results,
 }
 
 namespace {
-
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
 
 std::string host_name() {
   char buf[256] = {};
