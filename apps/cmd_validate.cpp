@@ -101,7 +101,7 @@ void run_validate(const ValidateArgs& a) {
              target.truth.render.seconds,
              100.0 * double(target.disocclusions.count()) / double(target.truth_srgb8.pixel_count()));
   const std::string scene_stem = fmt::format("{}_{}", scene.name, provider->name());
-  const json shared_images = validation::write_target_images(out, scene.name, target);
+  const json shared_images = validation::write_target_images(out, scene.name, target, executor);
 
   const validation::MetricOptions metric_options{a.error_threshold};
   json records = json::array();
@@ -111,7 +111,7 @@ void run_validate(const ValidateArgs& a) {
     const validation::PipelineValidation v =
         validation::validate_pipeline(target, *chosen[i], options[i], executor, metric_options);
     const std::string stem = fmt::format("{}_{}", scene_stem, v.pipeline);
-    json images = validation::write_pipeline_images(out, stem, target, v);
+    json images = validation::write_pipeline_images(out, stem, target, v, executor);
     images.update(shared_images);
     const json record = validation::validation_record(target, v, executor.threads(), images);
     io::write_text_atomically(out / (stem + ".json"), record.dump(2) + "\n");

@@ -265,7 +265,8 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
   const ImageFileOptions image_options{d.exr};
   json images = nullptr, target_images = json::object();
   if (d.images) {
-    target_images = relative_images(write_target_images(cell_dir, "scene", target, image_options), results_dir);
+    target_images =
+        relative_images(write_target_images(cell_dir, "scene", target, executor, image_options), results_dir);
     images = {{"dir", relative_to(cell_dir, results_dir)},
               {"truth_png", target_images["truth_png"]},
               {"disocclusions_png", target_images["true_disocclusions_png"]},
@@ -282,7 +283,8 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
     const PipelineValidation v = validate_pipeline(target, pipeline, pipeline_options, executor);
     json record_images = json::object();
     if (d.images) {
-      const json files = relative_images(write_pipeline_images(cell_dir, name, target, v, image_options), results_dir);
+      const json files =
+          relative_images(write_pipeline_images(cell_dir, name, target, v, executor, image_options), results_dir);
       images["pipelines"][name] = files;
       record_images = files;
       record_images.update(target_images);

@@ -1,6 +1,9 @@
 // Images written by a validation.
 #include "validation/validation_images.hpp"
 
+#include <functional>
+#include <vector>
+
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
@@ -30,36 +33,52 @@ Srgb8Image disocclusion_image(const Srgb8Image& truth, const TrueDisocclusions& 
   return out;
 }
 
+namespace {
+
+/// Runs the file writers side by side on the executor's threads; the first failure is rethrown
+/// once every writer has stopped (each writes atomically, so none leaves a partial file).
+void write_side_by_side(const std::vector<std::function<void()>>& writers, const Executor& executor) {
+  executor.for_each(writers.size(), [&](size_t i) { writers[i](); });
+}
+
+}  // namespace
+
 json write_target_images(const std::filesystem::path& dir, const std::string& stem, const ValidationTarget& target,
-                         const ImageFileOptions& options) {
+                         const Executor& executor, const ImageFileOptions& options) {
   const std::string provider = target.truth.render.provider;
   const std::filesystem::path exr = dir / fmt::format("{}_truth-{}.exr", stem, provider);
   const std::filesystem::path png = dir / fmt::format("{}_truth-{}.png", stem, provider);
   const std::filesystem::path dis = dir / fmt::format("{}_disocclusions.png", stem);
   json files = json::object();
+  std::vector<std::function<void()>> writers = {
+      [&] { write_png(png, target.truth_srgb8); },
+      [&] { write_png(dis, disocclusion_image(target.truth_srgb8, target.disocclusions)); }};
   if (options.exr) {
-    io::write_exr(exr, target.truth.render.right);
+    writers.emplace_back([&] { io::write_exr(exr, target.truth.render.right); });
     files["truth_exr"] = exr.string();
   }
-  write_png(png, target.truth_srgb8);
-  write_png(dis, disocclusion_image(target.truth_srgb8, target.disocclusions));
+  write_side_by_side(writers, executor);
   files["truth_png"] = png.string();
   files["true_disocclusions_png"] = dis.string();
   return files;
 }
 
 json write_pipeline_images(const std::filesystem::path& dir, const std::string& stem, const ValidationTarget& target,
-                           const PipelineValidation& v, const ImageFileOptions& options) {
+                           const PipelineValidation& v, const Executor& executor, const ImageFileOptions& options) {
   const auto path = [&](const char* suffix) { return dir / fmt::format("{}_{}", stem, suffix); };
   json files = json::object();
+  std::vector<std::function<void()>> writers = {
+      [&] { write_png(path("right.png"), v.right_srgb8); },
+      [&] { write_png(path("diff.png"), difference_image(v.right_srgb8, target.truth_srgb8)); },
+      [&] { write_png(path("ssim.png"), ssim_image(v.ssim)); },
+      [&] {
+        io::write_png_preview(path("holes.png"), hole_overlay(v.result.right, v.hole_mask, target.disocclusions.mask));
+      }};
   if (options.exr) {
-    io::write_exr(path("right.exr"), v.result.right);
+    writers.emplace_back([&] { io::write_exr(path("right.exr"), v.result.right); });
     files["right_exr"] = path("right.exr").string();
   }
-  write_png(path("right.png"), v.right_srgb8);
-  write_png(path("diff.png"), difference_image(v.right_srgb8, target.truth_srgb8));
-  write_png(path("ssim.png"), ssim_image(v.ssim));
-  io::write_png_preview(path("holes.png"), hole_overlay(v.result.right, v.hole_mask, target.disocclusions.mask));
+  write_side_by_side(writers, executor);
   files["right_png"] = path("right.png").string();
   files["diff_png"] = path("diff.png").string();
   files["ssim_png"] = path("ssim.png").string();

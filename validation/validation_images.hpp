@@ -23,17 +23,20 @@ struct ImageFileOptions {
 };
 
 /// Writes the images shared by every pipeline of a target under `dir`: <stem>_truth-<provider>.exr
-/// (unless options.exr is false) and .png, and <stem>_disocclusions.png. Returns {name: path}.
+/// (unless options.exr is false) and .png, and <stem>_disocclusions.png. The files are encoded
+/// side by side on the executor's threads (each file's bytes do not depend on it). Returns
+/// {name: path}.
 nlohmann::json write_target_images(const std::filesystem::path& dir, const std::string& stem,
-                                   const ValidationTarget& target, const ImageFileOptions& options = {});
+                                   const ValidationTarget& target, const Executor& executor,
+                                   const ImageFileOptions& options = {});
 
 /// Writes a pipeline's images under `dir`: <stem>_right.exr (every AOV; unless options.exr is
 /// false) and _right.png, _diff.png (difference heat map), _ssim.png (SSIM map) and _holes.png
-/// (hole mask against the true disocclusions: green found, red missed, blue flagged needlessly).
-/// Returns {name: path}.
+/// (hole mask against the true disocclusions: green found, red missed, blue flagged needlessly),
+/// side by side on the executor's threads. Returns {name: path}.
 nlohmann::json write_pipeline_images(const std::filesystem::path& dir, const std::string& stem,
                                      const ValidationTarget& target, const PipelineValidation& v,
-                                     const ImageFileOptions& options = {});
+                                     const Executor& executor, const ImageFileOptions& options = {});
 
 /// Writes the pipeline's left eye as <stem>_left.png (sRGB), e.g. for anaglyph and side-by-side
 /// views of a right eye. Returns its path.
