@@ -35,8 +35,9 @@ Srgb8Image disocclusion_image(const Srgb8Image& truth, const TrueDisocclusions& 
 
 namespace {
 
-/// Runs the file writers side by side on the executor's threads; the first failure is rethrown
-/// once every writer has stopped (each writes atomically, so none leaves a partial file).
+/// Runs the file writers side by side on the executor's threads. A failure cancels the writers
+/// not yet started and is rethrown once the running ones have finished; each writes atomically,
+/// so none leaves a partial file.
 void write_side_by_side(const std::vector<std::function<void()>>& writers, const Executor& executor) {
   executor.for_each(writers.size(), [&](size_t i) { writers[i](); });
 }

@@ -122,8 +122,8 @@ uint32_t lane_bit(int x, int y, int w) {
 }
 
 /// Lists the blocks with a pixel to trace: kTraceTile-square tiles in row-major order, the blocks
-/// inside a tile column by column. The pixels to trace are mostly vertical strips (holes and
-/// missed pixels lie beside silhouettes, across the horizontal baseline), so consecutive listed
+/// inside a tile column by column. The pixels to trace are mostly vertical strips (a horizontal
+/// baseline opens holes and misses pixels beside vertical silhouettes), so consecutive listed
 /// pixels then lie on one strip, which keeps the shading batches' shadow rays coherent.
 void list_blocks(PixelBlocks& b) {
   const int blocks_y = static_cast<int>(b.masks.size() / static_cast<size_t>(b.blocks_x));
