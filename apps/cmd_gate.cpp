@@ -46,11 +46,11 @@ std::vector<std::string> split_names(const std::vector<std::string>& items) {
   return out;
 }
 
-void run_update(const GateArgs& a) {
+/// Rewrites the entries of the baseline `file` that the selection names.
+void run_update(const GateArgs& a, const fs::path& file) {
   const validation::BaselineSelection selection{split_names(a.only), a.cells};
   const validation::GateResults results = validation::load_gate_results(a.results);
   for (const std::string& w : results.warnings) fmt::print(stderr, "warning: {}\n", w);
-  const fs::path file = a.baseline.empty() ? fs::path(kDefaultBaseline) : fs::path(a.baseline);
   validation::Baseline baseline = fs::exists(file) ? validation::load_baseline(file) : validation::Baseline{};
   const std::vector<validation::BaselineChange> changes = validation::update_baseline(baseline, results, selection);
   validation::save_baseline(file, baseline);
@@ -65,16 +65,16 @@ void run_update(const GateArgs& a) {
 }
 
 void run_gate(const GateArgs& a) {
+  // The default baseline counts as an input too: a report written over ci/baseline.json would lose
+  // the stored timings.
+  const std::string baseline_path = a.baseline.empty() ? kDefaultBaseline : a.baseline;
   if (a.update_baseline) {
-    const std::string baseline = a.baseline.empty() ? kDefaultBaseline : a.baseline;
-    refuse_overwriting({{"--results", &a.results}, {"--config", &a.config}}, {{"the baseline", &baseline}});
-    run_update(a);
+    refuse_overwriting({{"--results", &a.results}, {"--config", &a.config}}, {{"the baseline", &baseline_path}});
+    run_update(a, baseline_path);
     return;
   }
   if (!a.only.empty() || !a.cells.empty())
     throw InputError("--only and --cells select what --update-baseline rewrites; add --update-baseline or drop them");
-  // The default baseline too: a report written over ci/baseline.json would lose the stored timings.
-  const std::string baseline_path = a.baseline.empty() ? kDefaultBaseline : a.baseline;
   refuse_overwriting({{"--results", &a.results}, {"--config", &a.config}, {"the baseline", &baseline_path}},
                      {{"--junit", &a.junit}, {"--json", &a.json_out}});
   const validation::GateConfig config = validation::load_gate_config(a.config);
@@ -83,7 +83,7 @@ void run_gate(const GateArgs& a) {
   // The baseline: an explicit --baseline must exist; the default one may be absent.
   validation::Baseline baseline;
   std::string baseline_note;
-  const fs::path baseline_file = a.baseline.empty() ? fs::path(kDefaultBaseline) : fs::path(a.baseline);
+  const fs::path baseline_file(baseline_path);
   if (!a.baseline.empty() || fs::exists(baseline_file))
     baseline = validation::load_baseline(baseline_file);
   else

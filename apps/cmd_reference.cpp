@@ -156,15 +156,6 @@ int run_update(const ReferenceArgs& a) {
 
 void run_list(const ReferenceArgs& a) {
   const reference::ReferenceStore store(a.store);
-  std::error_code ec;
-  if (!fs::exists(store.root(), ec))
-    throw InputError(fmt::format("the reference store {} does not exist; give --store the folder `stereobench "
-                                 "reference generate` wrote",
-                                 store.root().string()));
-  if (!fs::is_directory(store.root(), ec))
-    throw InputError(fmt::format("the reference store {} is not a folder; give --store the folder `stereobench "
-                                 "reference generate` wrote",
-                                 store.root().string()));
   const std::vector<std::string> ids = store.ids();
   fmt::print("{} reference(s) in {}\n", ids.size(), store.root().string());
   size_t damaged = 0;

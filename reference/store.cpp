@@ -222,7 +222,11 @@ const char* to_string(Status s) {
 std::vector<std::string> ReferenceStore::ids() const {
   std::vector<std::string> out;
   std::error_code ec;
-  if (!fs::is_directory(root_, ec)) return out;
+  if (!fs::is_directory(root_, ec))
+    throw InputError(
+        fmt::format("the reference store {} {}; give --store the folder that `stereobench reference "
+                    "generate` wrote",
+                    root_.string(), fs::exists(root_, ec) ? "is not a folder" : "does not exist"));
   for (const fs::directory_entry& e : fs::directory_iterator(root_)) {
     const std::string name = e.path().filename().string();
     if (e.is_directory() && name[0] != '.' && fs::exists(e.path() / kProvenance)) out.push_back(name);

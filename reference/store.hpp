@@ -63,7 +63,8 @@ class ReferenceStore {
   explicit ReferenceStore(std::filesystem::path root) : root_(std::move(root)) {}
   [[nodiscard]] const std::filesystem::path& root() const { return root_; }
 
-  /// The ids of complete entries, sorted.
+  /// The ids of complete entries, sorted. InputError when the store does not exist or is not a
+  /// folder.
   [[nodiscard]] std::vector<std::string> ids() const;
   /// An entry's provenance; InputError naming the id and listing the store when it is absent.
   [[nodiscard]] nlohmann::json provenance(const std::string& id) const;

@@ -35,9 +35,12 @@ namespace sb {
   return out;
 }
 
-/// The current UTC time formatted by strftime's `format`; the default is ISO 8601,
-/// "2026-11-21T20:00:00Z", as every record, provenance and submission file writes it.
-[[nodiscard]] inline std::string utc_now(const char* format = "%Y-%m-%dT%H:%M:%SZ") {
+/// The strftime form of a UTC time in every record, provenance and submission file the suite
+/// writes: ISO 8601, "2026-11-21T20:00:00Z".
+inline constexpr const char* kUtcTimeFormat = "%Y-%m-%dT%H:%M:%SZ";
+
+/// The current UTC time formatted by strftime's `format` (kUtcTimeFormat unless given).
+[[nodiscard]] inline std::string utc_now(const char* format = kUtcTimeFormat) {
   const std::time_t t = std::time(nullptr);
   std::tm tm{};
   ::gmtime_r(&t, &tm);

@@ -11,6 +11,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/text.hpp"
 #include "validation/results_file.hpp"
 
 namespace sb::validation {
@@ -128,7 +129,7 @@ void check_history_line(const json& line, const std::string& where) {
   // The trend charts place runs by date: the form nightly writes, YYYY-MM-DDTHH:MM:SSZ.
   std::tm tm{};
   const std::string date = line["date"].get<std::string>();
-  const char* end = ::strptime(date.c_str(), "%Y-%m-%dT%H:%M:%SZ", &tm);
+  const char* end = ::strptime(date.c_str(), kUtcTimeFormat, &tm);
   if (end == nullptr || *end != '\0' || date.size() != 20)
     throw bad(fmt::format("\"date\" {} is not a UTC time of the form 2026-01-31T02:00:00Z", line["date"].dump()));
   if (!line.contains("cells") || !is_count(line["cells"])) throw bad("\"cells\" must be a count >= 0");

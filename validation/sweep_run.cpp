@@ -393,13 +393,19 @@ void claim_out_folder(const SweepDefinition& d, const SweepRunOptions& options) 
 }
 
 /// Every cell's rig resolved against its scene, and a path's spin against the scene's meshes, each
-/// scene loaded once: an impossible rig (a convergence so near that the disparity exceeds any image)
-/// or a spin prefix that matches nothing is refused before the first cell runs, naming the
-/// definition and the cell, instead of stopping the sweep when that cell comes.
+/// scene resolved (a built-in one generated) and loaded once: an impossible rig (a convergence so
+/// near that the disparity exceeds any image) or a spin prefix that matches nothing is refused
+/// before the first cell runs, naming the definition and the cell, instead of stopping the sweep
+/// when that cell comes.
 void check_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, const std::vector<size_t>& todo,
                  const fs::path& scenes_dir) {
+  std::map<std::string, fs::path> file_of;  // by scene label
   std::map<fs::path, std::vector<size_t>> by_file;
-  for (size_t i : todo) by_file[scene_file(cells[i].scene, scenes_dir)].push_back(i);
+  for (size_t i : todo) {
+    const auto [at, first] = file_of.try_emplace(cells[i].scene.label);
+    if (first) at->second = scene_file(cells[i].scene, scenes_dir);
+    by_file[at->second].push_back(i);
+  }
   for (const auto& [file, indices] : by_file) {
     Scene scene = io::load_gltf(file);
     for (size_t i : indices) {
@@ -425,7 +431,7 @@ void check_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, 
 
 void prepare_sweep(const SweepDefinition& d, const std::vector<SweepCell>& cells, const std::vector<size_t>& todo,
                    const SweepRunOptions& options) {
-  std::set<std::string> truths, scenes_done;
+  std::set<std::string> truths;
   for (size_t i : todo) truths.insert(cells[i].truth);
   for (const std::string& name : truths) {
     const std::unique_ptr<TruthProvider> provider = make_truth_provider(name);
@@ -433,8 +439,6 @@ void prepare_sweep(const SweepDefinition& d, const std::vector<SweepCell>& cells
       throw ToolError(fmt::format("{}: truth '{}' is unavailable: {}", d.file.string(), name, *why));
   }
   check_out_folders(options);
-  for (size_t i : todo)
-    if (scenes_done.insert(cells[i].scene.label).second) (void)scene_file(cells[i].scene, options.scenes_dir);
   check_cells(d, cells, todo, options.scenes_dir);
   claim_out_folder(d, options);
 }

@@ -59,11 +59,11 @@ std::vector<fs::path> link_chain(const fs::path& path) {
   return chain;
 }
 
-/// Whether `path`, or a link on the way to its file, names an open file of a process (/dev/stdout,
-/// /dev/fd/N, /proc/self/fd/N): such a file is the caller's stream, whatever it is (a terminal, a
-/// pipe, or a file the shell redirected into), and is written in place, never replaced.
-bool names_open_file(const fs::path& path) {
-  const std::vector<fs::path> chain = link_chain(path);
+/// Whether a path, or a link on the way to its file (its link_chain), names an open file of a
+/// process (/dev/stdout, /dev/fd/N, /proc/self/fd/N): such a file is the caller's stream, whatever
+/// it is (a terminal, a pipe, or a file the shell redirected into), and is written in place, never
+/// replaced.
+bool names_open_file(const std::vector<fs::path>& chain) {
   return std::any_of(chain.begin(), chain.end(), [](const fs::path& p) {
     std::error_code ec;
     const std::string s = fs::absolute(p, ec).lexically_normal().string();
@@ -136,8 +136,9 @@ void write_through(const fs::path& stream, const std::function<void(const fs::pa
 fs::path follow_links(const fs::path& path) { return link_chain(path).back(); }
 
 void write_atomically(const fs::path& given, const std::function<void(const fs::path&)>& write) {
-  const bool open_file = names_open_file(given);
-  const fs::path path = open_file ? given : follow_links(given);
+  const std::vector<fs::path> chain = link_chain(given);
+  const bool open_file = names_open_file(chain);
+  const fs::path path = open_file ? given : chain.back();
   std::error_code ec;
   if (fs::is_directory(path, ec))
     throw InputError(fmt::format("{} is a folder; give the name of the file to write", given.string()));

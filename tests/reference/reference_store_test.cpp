@@ -4,7 +4,9 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <utility>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "reference/store.hpp"
@@ -162,12 +164,16 @@ TEST(ReferenceStore, DamagedProvenanceIsAFindingNotAStop) {
   EXPECT_NE(render_less.out.find("--no-render only shapes the check of --only-failing"), std::string::npos)
       << render_less.out;
 
-  // A store that is missing or a file is named, not listed as empty.
-  for (const fs::path& store : {dir / "nostore", dir / "store" / pole / "provenance.json"}) {
-    const test::CliRun none = test::run_cli("reference list --store " + quoted(store));
-    EXPECT_EQ(none.code, 3) << none.out;
-    EXPECT_NE(none.out.find("the reference store " + store.string()), std::string::npos) << none.out;
-  }
+  // A store that is missing or a file is named as such by every command, not taken as empty.
+  const std::pair<fs::path, const char*> stores[] = {{dir / "nostore", "does not exist"},
+                                                     {dir / "store" / pole / "provenance.json", "is not a folder"}};
+  for (const auto& [store, why] : stores)
+    for (const char* command : {"list", "verify", "update"}) {
+      const test::CliRun none = test::run_cli(fmt::format("reference {} --store {}", command, quoted(store)));
+      EXPECT_EQ(none.code, 3) << none.out;
+      EXPECT_NE(none.out.find("the reference store " + store.string() + " " + why), std::string::npos)
+          << command << ": " << none.out;
+    }
 
   const test::CliRun negative = test::run_cli(ref(dir, "verify") + " --min-psnr -1");
   EXPECT_EQ(negative.code, 3) << negative.out;
