@@ -217,6 +217,7 @@ nlohmann::json preset_json(const PresetRun& run, const Executor& executor) {
           {"baseline", run.config.baseline},
           {"warmup", run.config.warmup},
           {"repetitions", run.config.repetitions},
+          {"options", run.config.options},
           {"threads", executor.threads()},
           {"rows_per_series", run.rows_per_series},
           {"complete", false},
@@ -247,6 +248,7 @@ void run_bench_preset(const PresetRun& run, const Executor& executor) {
   fmt::print("{} series, {} rows; {}; baseline {}; {} threads, {} warm-up + {} repetitions per row\n",
              preset.series.size(), total_rows, pipelines, run.config.baseline, executor.threads(), run.config.warmup,
              run.config.repetitions);
+  if (const std::string given = given_options(run.config); !given.empty()) fmt::print("options: {}\n", given);
   fmt::print("speed-up = median over repetitions of {}'s total / the pipeline's total, paired per repetition\n",
              run.config.baseline);
 

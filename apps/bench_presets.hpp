@@ -9,6 +9,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "renderer/error.hpp"
@@ -109,18 +110,16 @@ void run_kim_complexity(const PresetRun& run, const Executor& executor);
 
 /// How a pipeline stage counts in Kim's Table 3.
 enum class StageGroup {
-  rendering,  ///< rasterization and shading: "redirect", "*_gbuffer", "*_shading", "*_trace"
+  rendering,  ///< rasterization and shading: "redirect", "ztest", "*_gbuffer", "*_shading", "*_trace"
   warping,    ///< reprojection and its repairs: warps, motion, crack and hole filling, background
   other,      ///< a stage of neither kind (listed separately, never folded into either)
 };
-[[nodiscard]] inline StageGroup stage_group(const std::string& stage) {
-  const auto ends_with = [&stage](const std::string& suffix) {
-    return stage.size() >= suffix.size() && stage.compare(stage.size() - suffix.size(), suffix.size(), suffix) == 0;
-  };
-  if (stage == "redirect" || ends_with("_gbuffer") || ends_with("_shading") || ends_with("_trace"))
+[[nodiscard]] inline StageGroup stage_group(std::string_view stage) {
+  if (stage == "redirect" || stage == "ztest" || stage.ends_with("_gbuffer") || stage.ends_with("_shading") ||
+      stage.ends_with("_trace"))
     return StageGroup::rendering;
-  for (const char* w : {"motion", "warp", "warp_depth", "warp_color", "backward_warp", "row_warp", "reproject",
-                        "crack_fill", "hole_fill", "background"})
+  for (std::string_view w : {"motion", "warp", "warp_depth", "warp_color", "backward_warp", "row_warp", "reproject",
+                             "crack_fill", "hole_fill", "background"})
     if (stage == w) return StageGroup::warping;
   return StageGroup::other;
 }

@@ -3,6 +3,7 @@
 // and warping time against the triangle count, with a memory check before every row).
 #include <malloc.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -113,6 +114,7 @@ void print_run_head(const PresetRun& run, const Executor& executor) {
   fmt::print("{}; baseline {}; {} threads, {} warm-up + {} repetitions per row\n",
              fmt::join(run.config.pipelines, ", "), run.config.baseline, executor.threads(), run.config.warmup,
              run.config.repetitions);
+  if (const std::string given = given_options(run.config); !given.empty()) fmt::print("options: {}\n", given);
   fmt::print("times: median over repetitions of each pipeline's total; speed-up = median over repetitions of {}'s "
              "total / the pipeline's total, paired per repetition\n",
              run.config.baseline);
@@ -169,18 +171,20 @@ struct GroupTimes {
 
 GroupTimes group_times(const PipelineBench& b) {
   const size_t reps = b.total_seconds.size();
-  std::vector<double> rendering(reps, 0.0), warping(reps, 0.0), other(reps, 0.0);
+  // Per repetition, the sums of the rendering, warping and other stages (indexed by StageGroup).
+  std::array<std::vector<double>, 3> sums;
+  for (std::vector<double>& v : sums) v.assign(reps, 0.0);
   GroupTimes g;
   for (const std::string& stage : b.stage_order) {
     const StageGroup group = stage_group(stage);
-    std::vector<double>& sums = group == StageGroup::rendering ? rendering : group == StageGroup::warping ? warping : other;
     if (group == StageGroup::other) g.other_stages.push_back(stage);
+    std::vector<double>& into = sums[static_cast<size_t>(group)];
     const std::vector<double>& s = b.stage_seconds.at(stage);
-    for (size_t i = 0; i < reps && i < s.size(); ++i) sums[i] += s[i];
+    for (size_t i = 0; i < reps && i < s.size(); ++i) into[i] += s[i];
   }
-  g.rendering_ms = summarize(rendering).median * 1e3;
-  g.warping_ms = summarize(warping).median * 1e3;
-  g.other_ms = summarize(other).median * 1e3;
+  g.rendering_ms = summarize(sums[static_cast<size_t>(StageGroup::rendering)]).median * 1e3;
+  g.warping_ms = summarize(sums[static_cast<size_t>(StageGroup::warping)]).median * 1e3;
+  g.other_ms = summarize(sums[static_cast<size_t>(StageGroup::other)]).median * 1e3;
   g.total_ms = summarize(b.total_seconds).median * 1e3;
   return g;
 }
@@ -355,8 +359,9 @@ void run_kim_complexity(const PresetRun& run, const Executor& executor) {
                                    kReference, needed));
   const uint64_t base_rss = resident_bytes();
   print_run_head(run, executor);
-  fmt::print("rendering = stages redirect, *_gbuffer, *_shading, *_trace; warping = motion, warps, crack and hole "
-             "filling, background; medians of each repetition's sums\n");
+  fmt::print(
+      "rendering = stages redirect, ztest, *_gbuffer, *_shading, *_trace; warping = motion, warps, crack and hole "
+      "filling, background; medians of each repetition's sums\n");
   fmt::print("memory: a row runs when its estimated peak minus the resident memory before it is at most {:.0f} % of "
              "MemAvailable ({} now); peak = VmHWM of the row\n",
              kMemoryUsableShare * 100.0, gib(mem_available_bytes()));

@@ -110,6 +110,7 @@ void run_bench_command(const BenchArgs& a) {
   fmt::print("scene {} ({} triangles, {}), {}, {} threads, {} warm-up + {} repetitions\n", scene.name,
              scene.triangle_count(), describe_lights(scene.lights.size(), lights_in_file), describe(rig),
              executor.threads(), a.warmup, a.repetitions);
+  if (const std::string given = given_options(config); !given.empty()) fmt::print("options: {}\n", given);
   fmt::print("bvh build {:.1f} ms, {:.1f} MiB\n", prepared.bvh_build_seconds() * 1e3,
              prepared.rays().memory_bytes() / 1048576.0);
   const BenchResult r = run_bench(prepared, rig, config, executor,

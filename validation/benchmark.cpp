@@ -41,6 +41,14 @@ void BenchConfig::validate() const {
   }
 }
 
+std::string given_options(const BenchConfig& config) {
+  std::string text;
+  for (const auto& [pipeline, values] : config.options)
+    for (const auto& [name, value] : values)
+      text += fmt::format("{}{}.{}={}", text.empty() ? "" : ", ", pipeline, name, value);
+  return text;
+}
+
 BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const BenchConfig& config,
                       const Executor& executor, const std::function<void(const std::string&)>& progress) {
   config.validate();
@@ -57,6 +65,7 @@ BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const Benc
   result.repetitions = config.repetitions;
   result.threads = executor.threads();
   result.pipelines.resize(ps.size());
+  for (size_t i = 0; i < ps.size(); ++i) result.pipelines[i].options = opts[i].values();
   const RenderContext ctx{executor};
   for (int w = 0; w < config.warmup; ++w)
     for (size_t i = 0; i < ps.size(); ++i) {
@@ -102,6 +111,7 @@ nlohmann::json bench_to_json(const BenchResult& r) {
                                 {"total_samples_s", b.total_seconds},
                                 {"stages_s", stages},
                                 {"speedup_vs_baseline", summary(b.speedup)},
+                                {"options", b.options},
                                 {"counters", b.counters}});
   }
   return out;

@@ -26,6 +26,9 @@ struct BenchConfig {
   void validate() const;
 };
 
+/// The options given for the pipelines, as "PIPELINE.NAME=VALUE, ..." in order; empty when none.
+[[nodiscard]] std::string given_options(const BenchConfig& config);
+
 /// Median, minimum and maximum of a sample.
 struct Summary {
   double median = 0.0, min = 0.0, max = 0.0;
@@ -39,6 +42,7 @@ struct PipelineBench {
   std::vector<double> total_seconds;
   std::map<std::string, uint64_t> counters;  ///< of the last repetition (counters are deterministic)
   Summary speedup;  ///< baseline total / this total, paired per repetition
+  std::map<std::string, std::string> options;  ///< every option's value, defaults included
 };
 
 struct BenchResult {

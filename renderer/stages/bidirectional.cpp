@@ -1,6 +1,9 @@
 // The stages of Kim's bidirectional warping.
 #include "renderer/stages/bidirectional.hpp"
 
+#include <atomic>
+#include <tuple>
+
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
@@ -43,6 +46,73 @@ Image partial_eye(const RenderScene& scene, const StereoRig& rig, Eye which, con
   return image;
 }
 
+/// The pixels an eye shades under the z-test: those whose nearest triangle is in its share, those
+/// that see the background, and those whose nearest triangle went to the other eye only but did not
+/// win the other eye's depth test where the point lands there (target_column, as the row warp moves
+/// it): the other eye shows another triangle in front of it or beside it, so its partial image
+/// would not bring the point back. Counts the last kind in `hidden`.
+std::vector<uint8_t> ztest_mask(const GBuffer& own, const GBuffer& other, const std::vector<uint8_t>& bits,
+                                uint8_t own_bit, const DisparityMotion& motion, const Executor& executor,
+                                uint64_t& hidden) {
+  const int w = own.width;
+  std::vector<uint8_t> mask(own.prim.size());
+  std::atomic<uint64_t> total{0};
+  executor.for_range(static_cast<size_t>(own.height), 4, [&](size_t begin, size_t end) {
+    uint64_t n = 0;
+    for (size_t y = begin; y < end; ++y)
+      for (int x = 0; x < w; ++x) {
+        const size_t i = y * static_cast<size_t>(w) + x;
+        const uint32_t prim = own.prim[i];
+        if (prim == kNoPrimitiveId || (bits[prim] & own_bit) != 0) {
+          mask[i] = 1;
+          continue;
+        }
+        const int t = target_column(x, motion(own.depth[i]));
+        const bool seen = t >= 0 && t < w && other.prim[y * static_cast<size_t>(w) + t] == prim;
+        mask[i] = seen ? 0 : 1;
+        n += seen ? 0 : 1;
+      }
+    total += n;
+  });
+  hidden = total;
+  return mask;
+}
+
+/// Both partial images under the z-test (BidirSettings::ztest).
+std::pair<Image, Image> ztest_partials(const RenderScene& scene, const StereoRig& rig, const std::vector<uint8_t>& bits,
+                                       const BidirSettings& settings, const Executor& executor, StereoResult& r) {
+  GBuffer g[2];
+  RasterStats rs[2];
+  const Eye eyes[2] = {Eye::left, Eye::right};
+  for (int k = 0; k < 2; ++k) {
+    ScopedStage stage(r.timings, std::string(eye_name(eyes[k])) + "_gbuffer");
+    g[k] = rasterize(scene.geometry(), rig.eye(eyes[k]), executor, settings.raster, &rs[k]);
+  }
+  std::vector<uint8_t> mask[2];
+  uint64_t hidden[2] = {0, 0};
+  {
+    ScopedStage stage(r.timings, "ztest");
+    for (int k = 0; k < 2; ++k)
+      mask[k] = ztest_mask(g[k], g[1 - k], bits, k == 0 ? kRedirectLeft : kRedirectRight, DisparityMotion(rig, eyes[k]),
+                           executor, hidden[k]);
+  }
+  Image image[2];
+  for (int k = 0; k < 2; ++k) {
+    const std::string name = eye_name(eyes[k]);
+    TraceCounts counts;
+    {
+      ScopedStage stage(r.timings, name + "_shading");
+      image[k] = make_hole_image(g[k].width, g[k].height, executor);
+      shade_gbuffer(scene, rig.eye(eyes[k]), g[k], executor, image[k], counts, mask[k].data(), Source::rasterized);
+    }
+    add_counts(r.counters, counts, name.c_str(), false);
+    r.counters.add("triangles_rasterized_" + name, rs[k].triangles_rasterized);
+    r.counters.add("fragments_" + name, rs[k].fragments_tested);
+    r.counters.set("pixels_hidden_in_other_" + name, hidden[k]);
+  }
+  return {std::move(image[0]), std::move(image[1])};
+}
+
 }  // namespace
 
 std::vector<OptionSpec> bidir_option_specs() {
@@ -50,9 +120,16 @@ std::vector<OptionSpec> bidir_option_specs() {
           {"max_crack", "2", "widest run of hole pixels in a row filled by linear interpolation after the composition"},
           {"crack_depth", "1.01",
            "a run of at most max_crack pixels deeper than this factor times the depth on both sides is a crack "
-           "(a farther surface showing through the warped one) and is filled; 0 turns this off"},
+           "(a farther surface showing through the warped one) and is filled; 0 turns this off (off under "
+           "occlusion=ztest, where each eye's own pixels are its nearest surfaces)"},
           {"segment", "256", "target-row segment length of the row warp in pixels (the image does not depend on it)"},
-          {"partials", "false", "also output each eye's partial image (<stem>_left_partial.png, <stem>_right_partial.png)"}};
+          {"occlusion", "none",
+           "none: each eye rasterizes only its share (Kim's method as published); ztest: both eyes rasterize every "
+           "triangle for depth, and each shades its share where it is the nearest surface plus the other eye's share "
+           "where the other eye does not show that triangle at the point's place (the z-test Kim's §5 proposes "
+           "against occlusion artifacts)"},
+          {"partials", "false",
+           "also output each eye's partial image (<stem>_left_partial.png, <stem>_right_partial.png)"}};
 }
 
 BidirSettings BidirSettings::from(const std::string& pipeline, const PipelineOptions& options) {
@@ -63,10 +140,20 @@ BidirSettings BidirSettings::from(const std::string& pipeline, const PipelineOpt
   s.keep_partials = options.get_bool("partials");
   if (s.warp.segment < 1)
     throw InputError(fmt::format("{}: option segment={} must be at least 1 pixel", pipeline, s.warp.segment));
+  const std::string& occlusion = options.get("occlusion");
+  if (occlusion == "ztest")
+    s.ztest = true;
+  else if (occlusion != "none")
+    throw InputError(fmt::format("{}: option occlusion={} is not one of none, ztest", pipeline, occlusion));
+  s.warp.keep_native = s.ztest;
   s.crack_depth_ratio = options.get_double("crack_depth");
   if (!(s.crack_depth_ratio == 0.0 || (s.crack_depth_ratio >= 1.0 && s.crack_depth_ratio <= 100.0)))
     throw InputError(fmt::format("{}: option crack_depth={} must be 0 (off) or lie in [1, 100]", pipeline,
                                  s.crack_depth_ratio));
+  // Under the z-test each eye's own pixels are its nearest surfaces, so a deeper pixel between
+  // nearer ones is what that eye sees, not a crack. Marking only the warped ones was measured too:
+  // atrium 960x540 SSIM 0.9944 / 0.9929 at 6 / 0.3 m against 0.9946 / 0.9931 without marking.
+  if (s.ztest) s.crack_depth_ratio = 0.0;
   return s;
 }
 
@@ -81,8 +168,13 @@ void render_bidirectional(const RenderScene& scene, const StereoRig& rig, const 
   r.counters.set("triangles_to_left", sent.left);
   r.counters.set("triangles_to_right", sent.right);
   r.counters.set("triangles_to_both", sent.both);
-  const Image left = partial_eye(scene, rig, Eye::left, bits, settings, executor, r);
-  const Image right = partial_eye(scene, rig, Eye::right, bits, settings, executor, r);
+  Image left, right;
+  if (settings.ztest) {
+    std::tie(left, right) = ztest_partials(scene, rig, bits, settings, executor, r);
+  } else {
+    left = partial_eye(scene, rig, Eye::left, bits, settings, executor, r);
+    right = partial_eye(scene, rig, Eye::right, bits, settings, executor, r);
+  }
   MotionField to_right, to_left;
   {
     ScopedStage stage(r.timings, "motion");

@@ -19,6 +19,12 @@ struct BidirSettings {
   double crack_depth_ratio = 1.01;  ///< mark_depth_cracks before the fill; 0 = off
   RowWarpOptions warp{256, false};  ///< partial images: only surfaces are warped
   bool keep_partials = false;       ///< add the partial images to the result's extras
+  /// Kim's §5 remedy for occlusion artifacts (his Fig. 14): both eyes rasterize every triangle
+  /// (depth test over the whole scene); each eye shades the pixels whose nearest triangle is in its
+  /// share, the background, and the pixels whose nearest triangle went to the other eye but is not
+  /// the other eye's nearest where the point lands there. Each eye keeps its own pixels in the
+  /// composition (RowWarpOptions::keep_native): they are the nearest surface by construction.
+  bool ztest = false;
 
   /// From the options of bidir_option_specs(); InputError for values out of range.
   static BidirSettings from(const std::string& pipeline, const PipelineOptions& options);

@@ -140,8 +140,11 @@ RowWarpStats row_warp(const Image& source, const MotionField& motion, const RowW
       // The target pixels' own candidates: native pixels, or nothing.
       for (int t = s0; t < s1; ++t) {
         const size_t i = row + t;
-        const bool native = takes_part(native_tag[i], native_depth[i], options.warp_background);
-        best_depth[t - s0] = native ? native_depth[i] : std::numeric_limits<float>::infinity();
+        const bool kept = options.keep_native && native_tag[i] != static_cast<uint32_t>(Source::hole);
+        const bool native = kept || takes_part(native_tag[i], native_depth[i], options.warp_background);
+        best_depth[t - s0] = kept     ? -std::numeric_limits<float>::infinity()
+                             : native ? native_depth[i]
+                                      : std::numeric_limits<float>::infinity();
         best_x[t - s0] = native ? kNative : kNoCandidate;
       }
 

@@ -64,6 +64,9 @@ struct RowWarpOptions {
   /// at infinity; they lose every overlap against a surface. Off, only surfaces are warped (for a
   /// partial image whose empty pixels are not tagged as holes).
   bool warp_background = true;
+  /// Target pixels not tagged hole keep their values whatever lands on them (sources fill holes
+  /// only): for a target whose own pixels are known to be the nearest surface there.
+  bool keep_native = false;
 };
 
 /// The motion texture of a source image (Kim §3.1): per-pixel motion in pixels along the row,

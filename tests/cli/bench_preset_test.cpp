@@ -176,6 +176,32 @@ TEST(BenchLights, TheLightCountUsedIsPrintedAndRecorded) {
   EXPECT_GT(s.at("counters").at("shadow_rays").get<uint64_t>(), 0u);
 }
 
+TEST(BenchOptions, GivenOptionsArePrintedAndRecorded) {
+  test::ScratchDir dir("benchoptions");
+  const CliRun b = test::run_cli(
+      "bench --pipelines plain-raster,bidir-warp -n 1 -w 0 -o bidir-warp.occlusion=ztest "
+      "--scene box-wall --resolution 32x18 --scenes-dir '" +
+      (dir / "scenes").string() + "' --json '" + (dir / "bench.json").string() + "'");
+  ASSERT_EQ(b.code, 0) << b.out;
+  EXPECT_NE(b.out.find("options: bidir-warp.occlusion=ztest\n"), std::string::npos) << b.out;
+  const json j = json::parse(test::read_text(dir / "bench.json"));
+  const json& pipelines = j.at("pipelines");
+  ASSERT_EQ(pipelines.size(), 2u);
+  // Every option's value, defaults included.
+  EXPECT_EQ(pipelines[0].at("options").at("tile"), "64");
+  EXPECT_EQ(pipelines[1].at("options").at("occlusion"), "ztest");
+  EXPECT_EQ(pipelines[1].at("options").at("max_crack"), "2");
+
+  const CliRun preset = test::run_cli(
+      "bench --preset kim-focal --preset-rows 1 --resolution 32x18 -n 1 -w 0 "
+      "--pipelines plain-raster,bidir-warp -o bidir-warp.occlusion=ztest "
+      "--scenes-dir '" +
+      (dir / "scenes").string() + "' --json '" + (dir / "focal.json").string() + "'");
+  ASSERT_EQ(preset.code, 0) << preset.out;
+  EXPECT_NE(preset.out.find("options: bidir-warp.occlusion=ztest\n"), std::string::npos) << preset.out;
+  EXPECT_EQ(json::parse(test::read_text(dir / "focal.json")).at("options").at("bidir-warp").at("occlusion"), "ztest");
+}
+
 // ---- Kim's presets ----
 
 TEST(BenchPresetKim, FocalComparesEveryMethodWithPlainRasterAtThreeDistances) {
@@ -307,7 +333,8 @@ TEST(BenchPresetKim, CrossoverIsWhereTheMethodStaysFaster) {
 TEST(BenchPresetKim, StagesGroupAsRenderingOrWarping) {
   using cli::StageGroup;
   // The stages plain-raster, bidir-warp, bidir-warp-rt, fw-warp and bw-warp report.
-  for (const char* s : {"redirect", "left_gbuffer", "left_shading", "right_gbuffer", "right_shading", "left_trace"})
+  for (const char* s :
+       {"redirect", "ztest", "left_gbuffer", "left_shading", "right_gbuffer", "right_shading", "left_trace"})
     EXPECT_EQ(cli::stage_group(s), StageGroup::rendering) << s;
   for (const char* s : {"motion", "warp", "crack_fill", "background", "hole_fill", "warp_depth", "warp_color",
                         "backward_warp"})

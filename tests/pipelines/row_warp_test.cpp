@@ -202,6 +202,40 @@ TEST(RowWarp, NearestDepthWinsAndTiesAreDeterministic) {
   EXPECT_EQ(s.occluded, 4u);
 }
 
+TEST(RowWarp, KeptNativePixelsOnlyLetSourcesIntoHoles) {
+  const int w = 8, h = 1;
+  Image source = make_eye_image(w, h);
+  for (int x = 0; x < w; ++x) set_pixel(source, x, 0, kInf, Source::hole);
+  MotionField m;
+  m.width = w;
+  m.height = h;
+  m.motion.assign(static_cast<size_t>(w), 2.0f);
+  set_pixel(source, 0, 0, 1.0f);  // to 2: a native surface at 6 m
+  set_pixel(source, 1, 0, 1.0f);  // to 3: the native background
+  set_pixel(source, 2, 0, 1.0f);  // to 4: a hole
+  compute_row_bounds(m, source, false, Executor(1));
+  Image target = make_hole_image(w, h, Executor(1));
+  set_pixel(target, 2, 0, 6.0f, Source::traced);
+  set_pixel(target, 3, 0, kInf, Source::traced);
+  RowWarpOptions options{256, false};
+  // Without keep_native the nearer source wins the surface and takes the background too.
+  Image plain = target;
+  EXPECT_EQ(row_warp(source, m, options, Executor(1), plain).written, 3u);
+  EXPECT_EQ(plain.rgb_at(2, 0)[0], 0.0f);
+  EXPECT_EQ(plain.rgb_at(3, 0)[0], 1.0f);
+  options.keep_native = true;
+  const RowWarpStats s = row_warp(source, m, options, Executor(1), target);
+  const uint32_t* tag = target.data_u32(planes::source);
+  EXPECT_EQ(s.written, 1u);
+  EXPECT_EQ(s.occluded, 2u);
+  EXPECT_EQ(target.rgb_at(2, 0)[0], 2.0f);
+  EXPECT_EQ(target.plane(planes::depth).at_f32(2, 0), 6.0f);
+  EXPECT_EQ(tag[3], static_cast<uint32_t>(Source::traced));
+  EXPECT_TRUE(std::isinf(target.plane(planes::depth).at_f32(3, 0)));
+  EXPECT_EQ(target.rgb_at(4, 0)[0], 2.0f);
+  EXPECT_EQ(tag[4], static_cast<uint32_t>(Source::reprojected));
+}
+
 TEST(RowWarp, ChecksItsInputs) {
   const Image source = random_image(8, 2, 1, 0.0);
   Image target = make_eye_image(8, 2);

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <optional>
 #include <string>
 
 #include "renderer/color.hpp"
@@ -22,11 +23,12 @@ inline Scene load_builtin(const std::string& name) {
   return io::load_gltf(scenes::resolve_scene(name, cache));
 }
 
-/// The scene's default rig at another resolution.
-inline StereoRig rig_at(const Scene& scene, int width, int height) {
+/// The scene's default rig at another resolution, and at another convergence distance when given.
+inline StereoRig rig_at(const Scene& scene, int width, int height, std::optional<double> convergence = std::nullopt) {
   RigOverrides o;
   o.width = width;
   o.height = height;
+  o.convergence = convergence;
   return resolve_rig(scene, o);
 }
 
