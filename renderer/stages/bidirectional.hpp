@@ -34,9 +34,11 @@ struct BidirSettings {
 [[nodiscard]] std::vector<OptionSpec> bidir_option_specs();
 
 /// Renders both eyes of `result` (stages redirect, left_gbuffer, left_shading, right_gbuffer,
-/// right_shading, motion, warp, crack_fill). Pixels no partial image covers stay tagged `hole`
-/// (radiance 0, depth +inf) for the caller to fill. Counts triangles sent left, right and both,
-/// pixels warped into each eye and the crack fill of each eye. With keep_partials, the partial
+/// right_shading, motion, warp, crack_fill; with ztest the G-buffers come first, then stage ztest,
+/// then the shading). Pixels no partial image covers stay tagged `hole` (radiance 0, depth +inf)
+/// for the caller to fill. Counts triangles sent left, right and both, pixels warped into each eye,
+/// the crack fill of each eye and, with ztest, each eye's pixels hidden from the other
+/// (pixels_hidden_in_other_<eye>). With keep_partials, the partial
 /// images go to result.extras as "left_partial" and "right_partial" (the paper's Fig. 3).
 void render_bidirectional(const RenderScene& scene, const StereoRig& rig, const BidirSettings& settings,
                           const Executor& executor, StereoResult& result);
