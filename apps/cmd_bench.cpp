@@ -160,14 +160,17 @@ void register_bench_command(CLI::App& root) {
   CLI::App* b = root.add_subcommand("bench", "Time pipelines side by side: medians per stage, throughput, speed-ups");
   b->add_option("--scene,-s", a->scene, "Scene file (.gltf/.glb) or built-in scene name")->capture_default_str();
   b->add_option("--pipelines,-p", a->pipelines,
-                "Pipelines to time, comma-separated (default: all registered; with --preset, the preset's)");
+                "Pipelines to time, comma-separated (default: all registered; with --preset, the preset's); "
+                "NAME:KEY=VALUE[:KEY=VALUE...] times a variant with those options, beside NAME itself "
+                "(e.g. bidir-warp,bidir-warp:occlusion=ztest)");
   CLI::Option* baseline = b->add_option("--baseline,-b", a->baseline,
                                         "Pipeline the speed-ups are measured against (with --preset: the preset's)")
                               ->capture_default_str();
   b->add_option("--repetitions,-n", a->repetitions, "Timed repetitions per pipeline")->capture_default_str();
   b->add_option("--warmup,-w", a->warmup, "Untimed warm-up runs per pipeline")->capture_default_str();
   b->add_option("--threads,-t", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
-  b->add_option("--option,-o", a->options, "Pipeline option PIPELINE.NAME=VALUE");
+  b->add_option("--option,-o", a->options,
+                "Pipeline option PIPELINE.NAME=VALUE (for PIPELINE and its variants, under a variant's own)");
   b->add_option("--json", a->json_out, "Also write the results (with raw samples) to this JSON file");
   add_scenes_dir_option(*b, a->scenes_dir);
   add_lights_option(*b, a->lights);

@@ -21,13 +21,20 @@ Summary summarize(std::vector<double> v) {
   return s;
 }
 
+namespace {
+
+/// The pipeline an entry of BenchConfig::pipelines runs: its name before the first ':'.
+std::string entry_pipeline(const std::string& entry) { return entry.substr(0, entry.find(':')); }
+
+}  // namespace
+
 void BenchConfig::validate() const {
   // The same bounds as a sweep's [timing].
   if (repetitions < 1 || repetitions > 10000)
     throw InputError(fmt::format("--repetitions {} is outside 1..10000", repetitions));
   if (warmup < 0 || warmup > 10000) throw InputError(fmt::format("--warmup {} is outside 0..10000", warmup));
   for (size_t i = 0; i < pipelines.size(); ++i) {
-    (void)find_pipeline(pipelines[i]);
+    (void)bench_entry(pipelines[i], *this);  // the pipeline and every option it will run with
     if (std::find(pipelines.begin(), pipelines.begin() + static_cast<std::ptrdiff_t>(i), pipelines[i]) !=
         pipelines.begin() + static_cast<std::ptrdiff_t>(i))
       throw InputError(fmt::format("--pipelines names '{}' twice; name each pipeline once", pipelines[i]));
@@ -35,10 +42,41 @@ void BenchConfig::validate() const {
   if (std::find(pipelines.begin(), pipelines.end(), baseline) == pipelines.end())
     throw InputError(fmt::format("baseline '{}' is not among the benchmarked pipelines", baseline));
   for (const auto& [name, o] : options) {
-    if (std::find(pipelines.begin(), pipelines.end(), name) == pipelines.end())
+    if (std::none_of(pipelines.begin(), pipelines.end(),
+                     [&name](const std::string& entry) { return entry_pipeline(entry) == name; }))
       throw InputError(fmt::format("options given for pipeline '{}', which is not benchmarked", name));
     (void)PipelineOptions(find_pipeline(name).info(), o);  // the values, as the pipeline reads them
   }
+}
+
+BenchEntry bench_entry(const std::string& entry, const BenchConfig& config) {
+  const std::string name = entry_pipeline(entry);
+  BenchEntry e;
+  e.pipeline = &find_pipeline(name);
+  std::map<std::string, std::string> values;
+  if (const auto it = config.options.find(name); it != config.options.end()) values = it->second;
+  for (size_t at = name.size(); at < entry.size();) {  // entry[at] is ':'
+    const size_t next = std::min(entry.find(':', at + 1), entry.size());
+    const std::string pair = entry.substr(at + 1, next - at - 1);
+    const size_t eq = pair.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError(
+          fmt::format("pipeline entry '{}': '{}' is not KEY=VALUE; write a variant as "
+                      "NAME:KEY=VALUE[:KEY=VALUE...], e.g. bidir-warp:occlusion=ztest",
+                      entry, pair));
+    values[pair.substr(0, eq)] = pair.substr(eq + 1);
+    at = next;
+  }
+  if (name.size() == entry.size()) {
+    e.options = PipelineOptions(e.pipeline->info(), values);
+    return e;
+  }
+  try {
+    e.options = PipelineOptions(e.pipeline->info(), values);
+  } catch (const InputError& error) {
+    throw InputError(fmt::format("pipeline entry '{}': {}", entry, error.what()));
+  }
+  return e;
 }
 
 std::string given_options(const BenchConfig& config) {
@@ -54,10 +92,10 @@ BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const Benc
   config.validate();
   std::vector<const Pipeline*> ps;
   std::vector<PipelineOptions> opts;
-  for (const std::string& name : config.pipelines) {
-    ps.push_back(&find_pipeline(name));
-    auto it = config.options.find(name);
-    opts.emplace_back(ps.back()->info(), it == config.options.end() ? std::map<std::string, std::string>{} : it->second);
+  for (const std::string& entry : config.pipelines) {
+    BenchEntry e = bench_entry(entry, config);
+    ps.push_back(e.pipeline);
+    opts.push_back(std::move(e.options));
   }
 
   BenchResult result;
@@ -76,7 +114,7 @@ BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const Benc
     for (size_t i = 0; i < ps.size(); ++i) {
       const StereoResult r = ps[i]->render(scene, rig, opts[i], ctx);
       PipelineBench& b = result.pipelines[i];
-      b.name = ps[i]->info().name;
+      b.name = config.pipelines[i];
       for (const auto& [stage, s] : r.timings.stages()) {
         if (!b.stage_seconds.count(stage)) b.stage_order.push_back(stage);
         b.stage_seconds[stage].push_back(s);

@@ -15,16 +15,27 @@
 namespace sb {
 
 struct BenchConfig {
-  std::vector<std::string> pipelines;  ///< names, in report order
-  std::string baseline;                ///< one of `pipelines`
+  /// Entries, in report order: a registered pipeline's name, or a variant of it with options fixed
+  /// in the entry, "NAME:KEY=VALUE[:KEY=VALUE...]" (e.g. "bidir-warp:occlusion=ztest").
+  std::vector<std::string> pipelines;
+  std::string baseline;  ///< one of `pipelines`
   int warmup = 1;
   int repetitions = 5;
-  std::map<std::string, std::map<std::string, std::string>> options;  ///< per pipeline
+  /// Per pipeline name; they apply to its variants too, under the variants' own options.
+  std::map<std::string, std::map<std::string, std::string>> options;
 
-  /// InputError for repetitions < 1, warm-up < 0, unknown pipelines, a baseline not benchmarked,
-  /// or options for a pipeline not benchmarked.
+  /// InputError for repetitions < 1, warm-up < 0, unknown pipelines, malformed variants, an entry
+  /// named twice, a baseline not benchmarked, or options for a pipeline not benchmarked.
   void validate() const;
 };
+
+/// What an entry of BenchConfig::pipelines runs: the pipeline and its checked options.
+struct BenchEntry {
+  const Pipeline* pipeline = nullptr;
+  PipelineOptions options;
+};
+/// InputError naming the entry for an unknown pipeline, a malformed KEY=VALUE or a bad option.
+[[nodiscard]] BenchEntry bench_entry(const std::string& entry, const BenchConfig& config);
 
 /// The options given for the pipelines, as "PIPELINE.NAME=VALUE, ..." in order; empty when none.
 [[nodiscard]] std::string given_options(const BenchConfig& config);
