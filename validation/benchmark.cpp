@@ -67,13 +67,10 @@ BenchEntry bench_entry(const std::string& entry, const BenchConfig& config) {
     values[pair.substr(0, eq)] = pair.substr(eq + 1);
     at = next;
   }
-  if (name.size() == entry.size()) {
-    e.options = PipelineOptions(e.pipeline->info(), values);
-    return e;
-  }
   try {
     e.options = PipelineOptions(e.pipeline->info(), values);
   } catch (const InputError& error) {
+    if (name.size() == entry.size()) throw;  // the pipeline's own message names it
     throw InputError(fmt::format("pipeline entry '{}': {}", entry, error.what()));
   }
   return e;

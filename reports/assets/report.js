@@ -268,7 +268,7 @@
 
   /** Rendering or warping, as `stereobench bench --preset kim-complexity` groups the stages. */
   function stageGroup(stage) {
-    if (stage === 'redirect' || /_(gbuffer|shading|trace)$/.test(stage)) return 'rendering';
+    if (stage === 'redirect' || stage === 'ztest' || /_(gbuffer|shading|trace)$/.test(stage)) return 'rendering';
     const warping = ['motion', 'warp', 'warp_depth', 'warp_color', 'backward_warp', 'row_warp', 'reproject',
       'crack_fill', 'hole_fill', 'background'];
     return warping.includes(stage) ? 'warping' : 'other';
