@@ -16,34 +16,39 @@ namespace sb {
 
 namespace {
 
-/// One eye's share of the scene, rasterized and shaded: pixels without a surface of the share are
-/// holes, not background — the other eye's partial image may fill them.
-Image partial_eye(const RenderScene& scene, const StereoRig& rig, Eye which, const std::vector<uint8_t>& bits,
-                  const BidirSettings& settings, const Executor& executor, StereoResult& r) {
+/// The redirection bit of `which` eye's share.
+uint8_t share_bit(Eye which) { return which == Eye::left ? kRedirectLeft : kRedirectRight; }
+
+/// The lighting pass of a partial image, timed as "<eye>_shading": the pixels `mask` selects (every
+/// pixel with a surface when it is null) shaded into a new image whose other pixels are holes — the
+/// other eye's partial image may fill them.
+Image shade_partial(const RenderScene& scene, const StereoRig& rig, Eye which, const GBuffer& g, const uint8_t* mask,
+                    const Executor& executor, StereoResult& r) {
   const std::string name = eye_name(which);
-  const EyeCamera cam = rig.eye(which);
-  RasterOptions ro = settings.raster;
-  ro.triangle_mask = bits.data();
-  ro.triangle_bit = which == Eye::left ? kRedirectLeft : kRedirectRight;
-  RasterStats rs;
-  GBuffer g;
-  {
-    ScopedStage stage(r.timings, name + "_gbuffer");
-    g = rasterize(scene.geometry(), cam, executor, ro, &rs);
-  }
   Image image;
   TraceCounts counts;
   {
     ScopedStage stage(r.timings, name + "_shading");
-    image = make_hole_image(cam.width, cam.height, executor);
-    std::vector<uint8_t> covered(g.prim.size());
-    for (size_t i = 0; i < covered.size(); ++i) covered[i] = g.prim[i] != kNoPrimitiveId ? 1 : 0;
-    shade_gbuffer(scene, cam, g, executor, image, counts, covered.data(), Source::rasterized);
+    image = make_hole_image(g.width, g.height, executor);
+    std::vector<uint8_t> covered;
+    if (mask == nullptr) {
+      covered.resize(g.prim.size());
+      for (size_t i = 0; i < covered.size(); ++i) covered[i] = g.prim[i] != kNoPrimitiveId ? 1 : 0;
+      mask = covered.data();
+    }
+    shade_gbuffer(scene, rig.eye(which), g, executor, image, counts, mask, Source::rasterized);
   }
   add_counts(r.counters, counts, name.c_str(), false);
-  r.counters.add("triangles_rasterized_" + name, rs.triangles_rasterized);
-  r.counters.add("fragments_" + name, rs.fragments_tested);
   return image;
+}
+
+/// One eye's share of the scene, rasterized and shaded into its partial image.
+Image partial_eye(const RenderScene& scene, const StereoRig& rig, Eye which, const std::vector<uint8_t>& bits,
+                  const BidirSettings& settings, const Executor& executor, StereoResult& r) {
+  RasterOptions ro = settings.raster;
+  ro.triangle_mask = bits.data();
+  ro.triangle_bit = share_bit(which);
+  return shade_partial(scene, rig, which, gbuffer_eye(scene, rig, which, ro, executor, r), nullptr, executor, r);
 }
 
 /// The pixels an eye shades under the z-test: those whose nearest triangle is in its share, those
@@ -81,34 +86,21 @@ std::vector<uint8_t> ztest_mask(const GBuffer& own, const GBuffer& other, const 
 /// Both partial images under the z-test (BidirSettings::ztest).
 std::pair<Image, Image> ztest_partials(const RenderScene& scene, const StereoRig& rig, const std::vector<uint8_t>& bits,
                                        const BidirSettings& settings, const Executor& executor, StereoResult& r) {
-  GBuffer g[2];
-  RasterStats rs[2];
   const Eye eyes[2] = {Eye::left, Eye::right};
-  for (int k = 0; k < 2; ++k) {
-    ScopedStage stage(r.timings, std::string(eye_name(eyes[k])) + "_gbuffer");
-    g[k] = rasterize(scene.geometry(), rig.eye(eyes[k]), executor, settings.raster, &rs[k]);
-  }
+  GBuffer g[2];
+  for (int k = 0; k < 2; ++k) g[k] = gbuffer_eye(scene, rig, eyes[k], settings.raster, executor, r);
   std::vector<uint8_t> mask[2];
   uint64_t hidden[2] = {0, 0};
   {
     ScopedStage stage(r.timings, "ztest");
     for (int k = 0; k < 2; ++k)
-      mask[k] = ztest_mask(g[k], g[1 - k], bits, k == 0 ? kRedirectLeft : kRedirectRight, DisparityMotion(rig, eyes[k]),
-                           executor, hidden[k]);
+      mask[k] =
+          ztest_mask(g[k], g[1 - k], bits, share_bit(eyes[k]), DisparityMotion(rig, eyes[k]), executor, hidden[k]);
   }
   Image image[2];
   for (int k = 0; k < 2; ++k) {
-    const std::string name = eye_name(eyes[k]);
-    TraceCounts counts;
-    {
-      ScopedStage stage(r.timings, name + "_shading");
-      image[k] = make_hole_image(g[k].width, g[k].height, executor);
-      shade_gbuffer(scene, rig.eye(eyes[k]), g[k], executor, image[k], counts, mask[k].data(), Source::rasterized);
-    }
-    add_counts(r.counters, counts, name.c_str(), false);
-    r.counters.add("triangles_rasterized_" + name, rs[k].triangles_rasterized);
-    r.counters.add("fragments_" + name, rs[k].fragments_tested);
-    r.counters.set("pixels_hidden_in_other_" + name, hidden[k]);
+    image[k] = shade_partial(scene, rig, eyes[k], g[k], mask[k].data(), executor, r);
+    r.counters.set(std::string("pixels_hidden_in_other_") + eye_name(eyes[k]), hidden[k]);
   }
   return {std::move(image[0]), std::move(image[1])};
 }

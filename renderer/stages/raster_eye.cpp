@@ -9,17 +9,26 @@
 
 namespace sb {
 
+GBuffer gbuffer_eye(const RenderScene& scene, const StereoRig& rig, Eye which, const RasterOptions& options,
+                    const Executor& executor, StereoResult& result) {
+  const std::string name = eye_name(which);
+  RasterStats rs;
+  GBuffer g;
+  {
+    ScopedStage stage(result.timings, name + "_gbuffer");
+    g = rasterize(scene.geometry(), rig.eye(which), executor, options, &rs);
+  }
+  result.counters.add("triangles_rasterized_" + name, rs.triangles_rasterized);
+  result.counters.add("fragments_" + name, rs.fragments_tested);
+  return g;
+}
+
 Image raster_eye(const RenderScene& scene, const StereoRig& rig, Eye which, const RasterOptions& options,
                  const Executor& executor, StereoResult& result, GBuffer* gbuffer) {
   const std::string name = eye_name(which);
   const EyeCamera cam = rig.eye(which);
-  RasterStats rs;
-  GBuffer g;
+  GBuffer g = gbuffer_eye(scene, rig, which, options, executor, result);
   Image image;
-  {
-    ScopedStage stage(result.timings, name + "_gbuffer");
-    g = rasterize(scene.geometry(), cam, executor, options, &rs);
-  }
   TraceCounts counts;
   {
     ScopedStage stage(result.timings, name + "_shading");
@@ -27,8 +36,6 @@ Image raster_eye(const RenderScene& scene, const StereoRig& rig, Eye which, cons
     shade_gbuffer(scene, cam, g, executor, image, counts);
   }
   add_counts(result.counters, counts, name.c_str(), false);
-  result.counters.add("triangles_rasterized_" + name, rs.triangles_rasterized);
-  result.counters.add("fragments_" + name, rs.fragments_tested);
   if (gbuffer != nullptr) *gbuffer = std::move(g);
   return image;
 }

@@ -7,6 +7,11 @@
 
 namespace sb {
 
+/// Rasterizes the G-buffer of `which` eye of the rig, timing the stage "<eye>_gbuffer" and counting
+/// rasterized triangles and fragments into `result`.
+[[nodiscard]] GBuffer gbuffer_eye(const RenderScene& scene, const StereoRig& rig, Eye which,
+                                  const RasterOptions& options, const Executor& executor, StereoResult& result);
+
 /// Rasterizes and shades `which` eye of the rig into a new eye image, timing the stages
 /// "<eye>_gbuffer" and "<eye>_shading" and counting rays, shaded pixels, rasterized triangles and
 /// fragments into `result`. The G-buffer is handed back through `gbuffer` when asked for.

@@ -224,18 +224,24 @@ TEST(BenchOptions, VariantsRunBesideTheirPipelineWithTheirOwnOptions) {
   EXPECT_TRUE(pipelines[2].at("stages_s").contains("ztest"));
   EXPECT_FALSE(pipelines[1].at("stages_s").contains("ztest"));
 
-  for (const auto& [entry, says] : std::vector<std::pair<std::string, std::string>>{
-           {"bidir-warp:occlusion", "pipeline entry 'bidir-warp:occlusion': 'occlusion' is not KEY=VALUE"},
-           {"bidir-warp:occlusions=ztest",
-            "pipeline entry 'bidir-warp:occlusions=ztest': pipeline 'bidir-warp' has "
-            "no option 'occlusions'"},
-           {"bidir-warp:occlusion=zbuf", "option occlusion=zbuf is not one of none, ztest"},
-           {"bidir-warp:=ztest", "'=ztest' is not KEY=VALUE"},
-           {"bidirr:occlusion=ztest", "unknown pipeline 'bidirr'"},
-           {"bidir-warp:occlusion=ztest,bidir-warp:occlusion=ztest", "names 'bidir-warp:occlusion=ztest' twice"}}) {
-    const CliRun bad = test::run_cli("bench --pipelines plain-raster," + entry + common);
-    EXPECT_EQ(bad.code, 3) << entry << "\n" << bad.out;
-    EXPECT_NE(bad.out.find(says), std::string::npos) << entry << "\n" << bad.out;
+  // Bad entries, and given options (checked with the entries that use them, and needing one).
+  const std::string variant = "--pipelines plain-raster,bidir-warp:max_crack=4 -o ";
+  for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+           {"--pipelines plain-raster,bidir-warp:occlusion",
+            "pipeline entry 'bidir-warp:occlusion': 'occlusion' is not KEY=VALUE"},
+           {"--pipelines plain-raster,bidir-warp:occlusions=ztest",
+            "pipeline entry 'bidir-warp:occlusions=ztest': pipeline 'bidir-warp' has no option 'occlusions'"},
+           {"--pipelines plain-raster,bidir-warp:occlusion=zbuf", "option occlusion=zbuf is not one of none, ztest"},
+           {"--pipelines plain-raster,bidir-warp:=ztest", "'=ztest' is not KEY=VALUE"},
+           {"--pipelines plain-raster,bidirr:occlusion=ztest", "unknown pipeline 'bidirr'"},
+           {"--pipelines plain-raster,bidir-warp:occlusion=ztest,bidir-warp:occlusion=ztest",
+            "names 'bidir-warp:occlusion=ztest' twice"},
+           {variant + "bidir-warp.occlusions=ztest", "has no option 'occlusions'"},
+           {variant + "bidir-warp.occlusion=zbuf", "option occlusion=zbuf is not one of none, ztest"},
+           {variant + "fw-warp.max_crack=3", "options given for pipeline 'fw-warp', which is not benchmarked"}}) {
+    const CliRun bad = test::run_cli("bench " + args + common);
+    EXPECT_EQ(bad.code, 3) << args << "\n" << bad.out;
+    EXPECT_NE(bad.out.find(says), std::string::npos) << args << "\n" << bad.out;
   }
 }
 
