@@ -309,7 +309,7 @@ void run_kim_focal(const PresetRun& run, const Executor& executor) {
       std::vector<std::pair<std::string, validation::Srgb8Image>> right_eyes;
       for (const std::string& name : run.config.pipelines) {
         const BenchEntry e = bench_entry(name, run.config);
-        const StereoResult r = e.pipeline->render(*prepared, rig, e.options, ctx);
+        const StereoResult r = e.entry.pipeline->render(*prepared, rig, e.options, ctx);
         right_eyes.emplace_back(name, validation::encode_srgb8(r.right, name + " right eye"));
       }
       const auto ref = std::find_if(right_eyes.begin(), right_eyes.end(), [](const auto& e) { return e.first == kReference; });

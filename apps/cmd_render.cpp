@@ -46,8 +46,9 @@ void print_holes(const HoleAnalysis& h, size_t pixels) {
 
 void run_render(const RenderArgs& a) {
   const RigOverrides overrides = a.rig.overrides();
-  const Pipeline& pipeline = find_pipeline(a.pipeline);
-  const PipelineOptions options(pipeline.info(), parse_key_values(a.options, "--option"));
+  const PipelineEntry entry = parse_pipeline_entry(a.pipeline);
+  const Pipeline& pipeline = *entry.pipeline;
+  const PipelineOptions options = entry.options(parse_key_values(a.options, "--option"));
   const Executor executor(checked_threads(a.threads));
   const scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
   const Scene& scene = loaded.scene;
@@ -57,16 +58,15 @@ void run_render(const RenderArgs& a) {
   const StereoResult result = pipeline.render(prepared, rig, options, RenderContext{executor});
   // Scored against the true disocclusions outside the pipeline's timings.
   const std::optional<HoleAnalysis> holes = analyze_holes(prepared, rig, result.right, executor);
-  nlohmann::json record = io::result_to_json(pipeline.info().name, prepared, rig, result, executor.threads(), options);
+  nlohmann::json record = io::result_to_json(entry.name, prepared, rig, result, executor.threads(), options);
   if (holes) record["holes"] = io::holes_to_json(*holes);
   record["scene"]["lights"] = scene.lights.size();
   record["scene"]["lights_in_file"] = lights_in_file;
-  const std::string stem = fmt::format("{}_{}", scene.name, pipeline.info().name);
+  const std::string stem = fmt::format("{}_{}", scene.name, entry_file_stem(entry.name));
   const io::RenderFiles files =
       io::write_render_outputs(a.out, stem, result, record, holes ? &holes->overlay : nullptr);
-  fmt::print("{} on {} ({} triangles, {}), {}, {} threads\n", pipeline.info().name, scene.name,
-             scene.triangle_count(), describe_lights(scene.lights.size(), lights_in_file), describe(rig),
-             executor.threads());
+  fmt::print("{} on {} ({} triangles, {}), {}, {} threads\n", entry.name, scene.name, scene.triangle_count(),
+             describe_lights(scene.lights.size(), lights_in_file), describe(rig), executor.threads());
   fmt::print("  {:<22} {:>10.2f} ms ({:.1f} MiB)\n", "bvh build (once)", prepared.bvh_build_seconds() * 1e3,
              prepared.rays().memory_bytes() / 1048576.0);
   print_timings(result);
@@ -90,8 +90,12 @@ void register_render_command(CLI::App& root) {
   auto a = std::make_shared<RenderArgs>();
   CLI::App* r = root.add_subcommand("render", "Render a stereo pair with one pipeline; write EXR, PNGs and stats");
   r->add_option("--scene,-s", a->scene, "Scene file (.gltf/.glb) or built-in scene name")->capture_default_str();
-  r->add_option("--pipeline,-p", a->pipeline, "Pipeline name (see `stereobench pipelines`)")->capture_default_str();
-  r->add_option("--option,-o", a->options, "Pipeline option NAME=VALUE (see `stereobench pipelines`)");
+  r->add_option("--pipeline,-p", a->pipeline,
+                "Pipeline name (see `stereobench pipelines`), or a variant with options fixed in its name,\n"
+                "NAME:KEY=VALUE[:KEY=VALUE...] (files are named NAME@KEY=VALUE...)")
+      ->capture_default_str();
+  r->add_option("--option,-o", a->options,
+                "Pipeline option NAME=VALUE (see `stereobench pipelines`); a variant's own options win");
   r->add_option("--threads,-t", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
   r->add_option("--out", a->out, "Output folder")->capture_default_str();
   add_lights_option(*r, a->lights);

@@ -1,6 +1,7 @@
 // `stereobench validate`: render the right eye with each chosen pipeline and measure it against a
 // ground-truth right eye (full ray tracing, Blender Cycles or POV-Ray): metrics, hole statistics,
 // images and a result record per pipeline, and a table on the terminal.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -41,25 +42,27 @@ struct ValidateArgs {
   RigCli rig;
 };
 
-/// The pipelines named (comma-separated or repeated), "all" for every registered one.
-std::vector<const Pipeline*> chosen_pipelines(const std::vector<std::string>& names) {
-  std::vector<const Pipeline*> out;
+/// The pipelines named (comma-separated or repeated), "all" for every registered one, variants as
+/// NAME:KEY=VALUE[:KEY=VALUE...]; a name given twice runs once.
+std::vector<PipelineEntry> chosen_pipelines(const std::vector<std::string>& names) {
+  std::vector<std::string> chosen;
+  const auto add = [&chosen](const std::string& name) {
+    if (std::find(chosen.begin(), chosen.end(), name) == chosen.end()) chosen.push_back(name);
+  };
   for (const std::string& item : names) {
     std::stringstream list(item);
     std::string name;
     while (std::getline(list, name, ',')) {
       if (name.empty()) continue;
-      if (name == "all") {
-        for (const Pipeline* p : pipelines())
-          if (std::find(out.begin(), out.end(), p) == out.end()) out.push_back(p);
-        continue;
-      }
-      const Pipeline* p = &find_pipeline(name);
-      if (std::find(out.begin(), out.end(), p) == out.end()) out.push_back(p);
+      if (name == "all")
+        for (const Pipeline* p : pipelines()) add(p->info().name);
+      else
+        add(name);
     }
   }
-  if (out.empty()) throw InputError("--pipelines names no pipeline; give names (see `stereobench pipelines`) or 'all'");
-  return out;
+  if (chosen.empty())
+    throw InputError("--pipelines names no pipeline; give names (see `stereobench pipelines`) or 'all'");
+  return parse_pipeline_entries(chosen, "--pipelines");
 }
 
 std::string number(double v, const char* format) {
@@ -70,11 +73,12 @@ std::string number(double v, const char* format) {
 
 void run_validate(const ValidateArgs& a) {
   const RigOverrides overrides = a.rig.overrides();
-  const std::vector<const Pipeline*> chosen = chosen_pipelines(a.pipelines);
+  const std::vector<PipelineEntry> chosen = chosen_pipelines(a.pipelines);
   const std::map<std::string, std::string> given = parse_key_values(a.options, "--option");
-  // Checked before anything renders: an option applies to every chosen pipeline.
+  // Checked before anything renders: an option applies to every chosen pipeline, under the options
+  // a variant fixes.
   std::vector<PipelineOptions> options;
-  for (const Pipeline* p : chosen) options.emplace_back(p->info(), given);
+  for (const PipelineEntry& e : chosen) options.push_back(e.options(given));
   if (a.error_threshold < 0 || a.error_threshold > 255)
     throw InputError(fmt::format("--error-threshold {} is outside 0..255 (8-bit codes)", a.error_threshold));
   const std::unique_ptr<validation::TruthProvider> provider = validation::make_truth_provider(a.truth);
@@ -105,22 +109,26 @@ void run_validate(const ValidateArgs& a) {
 
   const validation::MetricOptions metric_options{a.error_threshold};
   json records = json::array();
-  fmt::print("\n{:<16} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10}\n", "pipeline", "PSNR dB", "SSIM", "MSE",
-             "err %", "holes %", "recall", "prec.", "time ms");
+  const size_t name_w = std::max<size_t>(
+      16, std::max_element(chosen.begin(), chosen.end(), [](const PipelineEntry& x, const PipelineEntry& y) {
+            return x.name.size() < y.name.size();
+          })->name.size());
+  fmt::print("\n{:<{}} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10}\n", "pipeline", name_w, "PSNR dB", "SSIM",
+             "MSE", "err %", "holes %", "recall", "prec.", "time ms");
   for (size_t i = 0; i < chosen.size(); ++i) {
     const validation::PipelineValidation v =
-        validation::validate_pipeline(target, *chosen[i], options[i], executor, metric_options);
-    const std::string stem = fmt::format("{}_{}", scene_stem, v.pipeline);
+        validation::validate_pipeline(target, chosen[i], options[i], executor, metric_options);
+    const std::string stem = fmt::format("{}_{}", scene_stem, entry_file_stem(v.pipeline));
     json images = validation::write_pipeline_images(out, stem, target, v, executor);
     images.update(shared_images);
     const json record = validation::validation_record(target, v, executor.threads(), images);
     io::write_text_atomically(out / (stem + ".json"), record.dump(2) + "\n");
     records.push_back(record);
     const validation::HoleStatistics& h = v.holes;
-    fmt::print("{:<16} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10.1f}\n", v.pipeline, number(v.whole.psnr, "{:.2f}"),
-               number(v.whole.ssim, "{:.4f}"), number(v.whole.mse, "{:.3f}"), number(100.0 * v.whole.error_fraction, "{:.3f}"),
-               number(100.0 * h.hole_fraction, "{:.3f}"), number(h.scores.recall, "{:.4f}"),
-               number(h.scores.precision, "{:.4f}"), v.result.timings.total() * 1e3);
+    fmt::print("{:<{}} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10.1f}\n", v.pipeline, name_w,
+               number(v.whole.psnr, "{:.2f}"), number(v.whole.ssim, "{:.4f}"), number(v.whole.mse, "{:.3f}"),
+               number(100.0 * v.whole.error_fraction, "{:.3f}"), number(100.0 * h.hole_fraction, "{:.3f}"),
+               number(h.scores.recall, "{:.4f}"), number(h.scores.precision, "{:.4f}"), v.result.timings.total() * 1e3);
   }
   const fs::path summary = out / fmt::format("{}_summary.json", scene_stem);
   io::write_text_atomically(summary, json{{"kind", "stereobench.validation_summary"}, {"records", records}}.dump(2) + "\n");
@@ -139,11 +147,13 @@ void register_validate_command(CLI::App& root) {
       "(right eye, difference and SSIM maps, hole mask) and prints a table. Schema: docs/results.md.");
   v->add_option("--scene,-s", a->scene, "Scene file (.gltf/.glb) or built-in scene name")->capture_default_str();
   v->add_option("--pipelines,-p", a->pipelines,
-                "Pipelines to validate: names, comma-separated or repeated, or 'all' (see `stereobench pipelines`)")
+                "Pipelines to validate: names, comma-separated or repeated, or 'all' (see `stereobench pipelines`);\n"
+                "a variant fixes options in its name, NAME:KEY=VALUE[:KEY=VALUE...] (e.g.\n"
+                "bidir-warp:occlusion=ztest), and is measured beside the pipeline under that name")
       ->capture_default_str();
   v->add_option("--option,-o", a->options,
                 "Pipeline option NAME=VALUE, applied to every chosen pipeline (each must declare it; see\n"
-                "`stereobench pipelines`)");
+                "`stereobench pipelines`); a variant's own options win");
   v->add_option("--truth", a->truth,
                 "Ground truth: full (this suite's ray tracer), blender (Cycles) or povray; an unavailable\n"
                 "tool is an error (exit 4)")

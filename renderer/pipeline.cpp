@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -37,6 +38,68 @@ const Pipeline& find_pipeline(const std::string& name) {
   std::string names;
   for (const Pipeline* p : pipelines()) names += (names.empty() ? "" : ", ") + p->info().name;
   throw InputError(fmt::format("unknown pipeline '{}'; registered pipelines: {}", name, names));
+}
+
+std::string entry_pipeline_name(const std::string& entry) { return entry.substr(0, entry.find(':')); }
+
+std::map<std::string, std::string> entry_fixed_options(const std::string& name) {
+  std::map<std::string, std::string> fixed;
+  for (size_t at = name.find(':'); at < name.size();) {  // name[at] is ':'
+    const size_t next = std::min(name.find(':', at + 1), name.size());
+    const std::string pair = name.substr(at + 1, next - at - 1);
+    const size_t eq = pair.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError(
+          fmt::format("pipeline entry '{}': '{}' is not KEY=VALUE; write a variant as "
+                      "NAME:KEY=VALUE[:KEY=VALUE...], e.g. bidir-warp:occlusion=ztest",
+                      name, pair));
+    if (!fixed.emplace(pair.substr(0, eq), pair.substr(eq + 1)).second)
+      throw InputError(
+          fmt::format("pipeline entry '{}' fixes option {} twice; give each option once", name, pair.substr(0, eq)));
+    at = next;
+  }
+  return fixed;
+}
+
+PipelineEntry parse_pipeline_entry(const std::string& name) {
+  return {name, &find_pipeline(entry_pipeline_name(name)), entry_fixed_options(name)};
+}
+
+PipelineOptions PipelineEntry::options(const std::map<std::string, std::string>& given) const {
+  std::map<std::string, std::string> values = given;
+  for (const auto& [key, value] : fixed) values[key] = value;
+  try {
+    return PipelineOptions(pipeline->info(), values);
+  } catch (const InputError& error) {
+    if (fixed.empty()) throw;  // the pipeline's own message names it
+    throw InputError(fmt::format("pipeline entry '{}': {}", name, error.what()));
+  }
+}
+
+std::string entry_file_stem(const std::string& entry) {
+  std::string stem = entry;
+  for (char& c : stem) {
+    const bool kept = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                      std::string_view("._-=+@").find(c) != std::string_view::npos;
+    c = c == ':' ? '@' : kept ? c : '_';
+  }
+  return stem;
+}
+
+std::vector<PipelineEntry> parse_pipeline_entries(const std::vector<std::string>& names, const std::string& what) {
+  std::vector<PipelineEntry> entries;
+  std::map<std::string, std::string> stems;  // stem -> entry
+  for (const std::string& name : names) {
+    entries.push_back(parse_pipeline_entry(name));
+    const auto [it, fresh] = stems.emplace(entry_file_stem(name), name);
+    if (fresh) continue;
+    if (it->second == name) throw InputError(fmt::format("{} names '{}' twice; name each pipeline once", what, name));
+    throw InputError(
+        fmt::format("{}: '{}' and '{}' would write files of the same name ({}); write the variants "
+                    "apart in letters, digits and ._-+",
+                    what, it->second, name, it->first));
+  }
+  return entries;
 }
 
 PipelineOptions::PipelineOptions(const PipelineInfo& info, const std::map<std::string, std::string>& given)

@@ -89,6 +89,39 @@ class Pipeline {
 /// The pipeline of that name; InputError listing the registered names otherwise.
 [[nodiscard]] const Pipeline& find_pipeline(const std::string& name);
 
+/// A pipeline as commands name it (validate, bench, sweeps): a registered name, or a variant that
+/// fixes some of its options in the name, "NAME:KEY=VALUE[:KEY=VALUE...]" (e.g.
+/// "bidir-warp:occlusion=ztest"). A variant is run, timed and reported under its whole name, beside
+/// the pipeline itself.
+struct PipelineEntry {
+  std::string name;  ///< as written
+  const Pipeline* pipeline = nullptr;
+  std::map<std::string, std::string> fixed;  ///< the options the name fixes
+
+  /// The options it runs with: `given` (options given for its pipeline), the fixed ones over them,
+  /// all checked by the pipeline; an InputError about a variant names the entry.
+  [[nodiscard]] PipelineOptions options(const std::map<std::string, std::string>& given = {}) const;
+};
+
+/// Parses an entry: InputError for an unknown pipeline, a part that is not KEY=VALUE, or a key
+/// fixed twice. Option names and values are checked by PipelineEntry::options.
+[[nodiscard]] PipelineEntry parse_pipeline_entry(const std::string& name);
+
+/// The registered pipeline an entry names: its text before the first ':'.
+[[nodiscard]] std::string entry_pipeline_name(const std::string& entry);
+/// The options an entry fixes, read from its text alone; InputError as parse_pipeline_entry.
+[[nodiscard]] std::map<std::string, std::string> entry_fixed_options(const std::string& entry);
+
+/// A file-name stem for an entry's images and records: the name with ':' written '@' and any
+/// character other than letters, digits and "._-=+@" written '_'
+/// ("bidir-warp:occlusion=ztest" -> "bidir-warp@occlusion=ztest"; a pipeline's own name is kept).
+[[nodiscard]] std::string entry_file_stem(const std::string& entry);
+
+/// Parses every entry and refuses one named twice, or two whose file stems coincide (InputError;
+/// `what` names the list, e.g. "--pipelines").
+[[nodiscard]] std::vector<PipelineEntry> parse_pipeline_entries(const std::vector<std::string>& names,
+                                                                const std::string& what);
+
 /// Adds a pipeline to the registry at static-initialisation time.
 struct PipelineRegistration {
   explicit PipelineRegistration(std::unique_ptr<Pipeline> pipeline);

@@ -21,60 +21,34 @@ Summary summarize(std::vector<double> v) {
   return s;
 }
 
-namespace {
-
-/// The pipeline an entry of BenchConfig::pipelines runs: its name before the first ':'.
-std::string entry_pipeline(const std::string& entry) { return entry.substr(0, entry.find(':')); }
-
-}  // namespace
-
 void BenchConfig::validate() const {
   // The same bounds as a sweep's [timing].
   if (repetitions < 1 || repetitions > 10000)
     throw InputError(fmt::format("--repetitions {} is outside 1..10000", repetitions));
   if (warmup < 0 || warmup > 10000) throw InputError(fmt::format("--warmup {} is outside 0..10000", warmup));
-  for (size_t i = 0; i < pipelines.size(); ++i) {
-    (void)bench_entry(pipelines[i], *this);  // the pipeline and every option it will run with
-    if (std::find(pipelines.begin(), pipelines.begin() + static_cast<std::ptrdiff_t>(i), pipelines[i]) !=
-        pipelines.begin() + static_cast<std::ptrdiff_t>(i))
-      throw InputError(fmt::format("--pipelines names '{}' twice; name each pipeline once", pipelines[i]));
-  }
+  for (const PipelineEntry& e : parse_pipeline_entries(pipelines, "--pipelines"))
+    (void)e.options(given_for(e));  // every option it will run with
   if (std::find(pipelines.begin(), pipelines.end(), baseline) == pipelines.end())
     throw InputError(fmt::format("baseline '{}' is not among the benchmarked pipelines", baseline));
   // The options' values were checked with each entry above; options for no entry are a mistake.
   for (const auto& given : options) {
     const std::string& name = given.first;
     if (std::none_of(pipelines.begin(), pipelines.end(),
-                     [&name](const std::string& entry) { return entry_pipeline(entry) == name; }))
+                     [&name](const std::string& entry) { return entry_pipeline_name(entry) == name; }))
       throw InputError(fmt::format("options given for pipeline '{}', which is not benchmarked", name));
   }
 }
 
+const std::map<std::string, std::string>& BenchConfig::given_for(const PipelineEntry& entry) const {
+  static const std::map<std::string, std::string> none;
+  const auto it = options.find(entry.pipeline->info().name);
+  return it == options.end() ? none : it->second;
+}
+
 BenchEntry bench_entry(const std::string& entry, const BenchConfig& config) {
-  const std::string name = entry_pipeline(entry);
-  BenchEntry e;
-  e.pipeline = &find_pipeline(name);
-  std::map<std::string, std::string> values;
-  if (const auto it = config.options.find(name); it != config.options.end()) values = it->second;
-  for (size_t at = name.size(); at < entry.size();) {  // entry[at] is ':'
-    const size_t next = std::min(entry.find(':', at + 1), entry.size());
-    const std::string pair = entry.substr(at + 1, next - at - 1);
-    const size_t eq = pair.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw InputError(
-          fmt::format("pipeline entry '{}': '{}' is not KEY=VALUE; write a variant as "
-                      "NAME:KEY=VALUE[:KEY=VALUE...], e.g. bidir-warp:occlusion=ztest",
-                      entry, pair));
-    values[pair.substr(0, eq)] = pair.substr(eq + 1);
-    at = next;
-  }
-  try {
-    e.options = PipelineOptions(e.pipeline->info(), values);
-  } catch (const InputError& error) {
-    if (name.size() == entry.size()) throw;  // the pipeline's own message names it
-    throw InputError(fmt::format("pipeline entry '{}': {}", entry, error.what()));
-  }
-  return e;
+  PipelineEntry e = parse_pipeline_entry(entry);
+  PipelineOptions options = e.options(config.given_for(e));
+  return {std::move(e), std::move(options)};
 }
 
 std::string given_options(const BenchConfig& config) {
@@ -92,7 +66,7 @@ BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const Benc
   std::vector<PipelineOptions> opts;
   for (const std::string& entry : config.pipelines) {
     BenchEntry e = bench_entry(entry, config);
-    ps.push_back(e.pipeline);
+    ps.push_back(e.entry.pipeline);
     opts.push_back(std::move(e.options));
   }
 

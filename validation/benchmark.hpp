@@ -27,14 +27,17 @@ struct BenchConfig {
   /// InputError for repetitions < 1, warm-up < 0, unknown pipelines, malformed variants, an entry
   /// named twice, a baseline not benchmarked, or options for a pipeline not benchmarked.
   void validate() const;
+  /// The options given for an entry's pipeline (empty when none).
+  [[nodiscard]] const std::map<std::string, std::string>& given_for(const PipelineEntry& entry) const;
 };
 
-/// What an entry of BenchConfig::pipelines runs: the pipeline and its checked options.
+/// What an entry of BenchConfig::pipelines runs: the entry parsed, and its options with those
+/// given for its pipeline merged in. InputError naming the entry for an unknown pipeline, a
+/// malformed KEY=VALUE or a bad option.
 struct BenchEntry {
-  const Pipeline* pipeline = nullptr;
+  PipelineEntry entry;
   PipelineOptions options;
 };
-/// InputError naming the entry for an unknown pipeline, a malformed KEY=VALUE or a bad option.
 [[nodiscard]] BenchEntry bench_entry(const std::string& entry, const BenchConfig& config);
 
 /// The options given for the pipelines, as "PIPELINE.NAME=VALUE, ..." in order; empty when none.

@@ -15,6 +15,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/pipeline.hpp"
 #include "validation/results_file.hpp"
 
 namespace sb::validation {
@@ -529,9 +530,16 @@ std::string reproduce_command(const GateCell& cell, const std::string& pipeline,
     add("--error-threshold", fmt::format("{}", static_cast<int>(*t)));
   const json& options = validation.value("options", json::object());
   if (options.is_object()) {
-    const auto defaults = settings.pipeline_defaults.find(pipeline);
+    // A variant's name already fixes its own options.
+    const auto defaults = settings.pipeline_defaults.find(entry_pipeline_name(pipeline));
+    std::map<std::string, std::string> fixed;
+    try {
+      fixed = entry_fixed_options(pipeline);
+    } catch (const InputError&) {  // not an entry this build reads: every option is written
+    }
     for (const auto& [key, value] : options.items()) {
       const std::string v = value.is_string() ? value.get<std::string>() : value.dump();
+      if (const auto f = fixed.find(key); f != fixed.end() && f->second == v) continue;
       if (defaults != settings.pipeline_defaults.end()) {
         const auto d = defaults->second.find(key);
         if (d != defaults->second.end() && d->second == v) continue;

@@ -32,9 +32,8 @@ void run_path(Scene& scene, const PathRun& run, const Executor& executor,
     const ValidationTarget target =
         prepare_target(prepared, run.scene_file, rig, *run.truth, run.cache, run.work_dir, executor);
     json pipelines = json::object();
-    for (const Pipeline* p : run.pipelines) {
-      const PipelineOptions options(p->info(), {});
-      const PipelineValidation v = validate_pipeline(target, *p, options, executor);
+    for (const PipelineEntry& entry : run.pipelines) {
+      const PipelineValidation v = validate_pipeline(target, entry, entry.options(), executor);
       json timings = json::object();
       for (const auto& [stage, s] : v.result.timings.stages()) timings[stage] = s;
       pipelines[v.pipeline] = {{"total_s", v.result.timings.total()},

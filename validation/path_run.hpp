@@ -21,7 +21,7 @@ struct PathRun {
   RigParams rig;                     ///< resolution, interaxial, convergence, field of view
   CameraPose pose;                   ///< the centre camera when the path has no camera keys
   PathSpec path;
-  std::vector<const Pipeline*> pipelines;
+  std::vector<PipelineEntry> pipelines;  ///< pipelines or variants ("NAME:KEY=VALUE...")
   const TruthProvider* truth = nullptr;
   const TruthCache* cache = nullptr;
   std::filesystem::path work_dir;

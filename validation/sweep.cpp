@@ -184,13 +184,18 @@ void parse_pipelines(const Where& where, const toml::node& node, SweepDefinition
       continue;
     }
     try {
-      (void)find_pipeline(name);
+      (void)parse_pipeline_entry(name).options();  // a variant's fixed options are checked here
     } catch (const InputError& err) {
       where.fail(*e, path, err.what());
     }
     if (std::find(names.begin(), names.end(), name) != names.end())
       where.fail(*e, path, fmt::format("lists '{}' twice", name));
     names.push_back(name);
+    try {
+      (void)parse_pipeline_entries(names, path);  // variants whose files would coincide
+    } catch (const InputError& err) {
+      where.fail(*e, path, err.what());
+    }
   }
   d.pipelines = names;
 }
@@ -419,7 +424,7 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
   if (const toml::node* n = sweep.get("baseline")) {
     d.baseline = string_at(where, *n, "sweep.baseline");
     try {
-      (void)find_pipeline(d.baseline);
+      (void)parse_pipeline_entry(d.baseline).options();
     } catch (const InputError& err) {
       where.fail(*n, "sweep.baseline", err.what());
     }
@@ -427,7 +432,14 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
     (void)find_pipeline(d.baseline);
   }
   d.baseline_listed = std::find(d.pipelines.begin(), d.pipelines.end(), d.baseline) != d.pipelines.end();
-  if (!d.baseline_listed) d.pipelines.push_back(d.baseline);
+  if (!d.baseline_listed) {
+    d.pipelines.push_back(d.baseline);
+    try {
+      (void)parse_pipeline_entries(d.pipelines, "sweep.pipelines");
+    } catch (const InputError& err) {
+      where.fail(*sweep.get("baseline"), "sweep.baseline", err.what());
+    }
+  }
   std::sort(d.pipelines.begin(), d.pipelines.end());
 
   // Rig axes.
@@ -513,7 +525,10 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
     for (auto&& [key, node] : options) {
       const std::string pipeline(key.str());
       const std::string path = "options." + pipeline;
-      if (std::find(d.pipelines.begin(), d.pipelines.end(), pipeline) == d.pipelines.end())
+      std::vector<PipelineEntry> runs;  // the pipeline and its variants
+      for (const std::string& entry : d.pipelines)
+        if (entry_pipeline_name(entry) == pipeline) runs.push_back(parse_pipeline_entry(entry));
+      if (runs.empty())
         where.fail(key.source(), path,
                    fmt::format("options for a pipeline the sweep does not run; its pipelines: {}",
                                fmt::join(d.pipelines, ", ")));
@@ -524,7 +539,8 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
         const std::string option_path = path + "." + std::string(option.str());
         values[std::string(option.str())] = option_text(where, value, option_path);
         try {
-          (void)PipelineOptions(find_pipeline(pipeline).info(), values);
+          (void)PipelineOptions(runs.front().pipeline->info(), values);
+          for (const PipelineEntry& run : runs) (void)run.options(values);  // under a variant's own
         } catch (const InputError& err) {
           where.fail(option.source(), option_path, err.what());
         }

@@ -45,6 +45,7 @@ struct SweepDefinition {
 
   std::vector<SweepScene> scenes;  ///< default: {spheres}
   /// Every pipeline validated and timed in each cell, sorted by name; the baseline is included.
+  /// Entries as PipelineEntry reads them: a variant "NAME:KEY=VALUE..." runs beside its pipeline.
   std::vector<std::string> pipelines;
   std::string baseline = "plain-rt";
   bool baseline_listed = true;  ///< false when only added for the speed-ups
@@ -60,7 +61,8 @@ struct SweepDefinition {
 
   int repetitions = 3;
   int warmup = 1;
-  std::map<std::string, std::map<std::string, std::string>> options;  ///< per pipeline, checked
+  /// Per pipeline name, checked; they apply to its variants too, under the variants' own options.
+  std::map<std::string, std::map<std::string, std::string>> options;
 
   /// The `path` axis ([path]): every other combination runs once per frame, the scene animated
   /// and the camera moved to that frame. Unset: no animation, one cell per combination.

@@ -273,33 +273,31 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
               {"pipelines", json::object()}};
     if (target_images.contains("truth_exr")) images["truth_exr"] = target_images["truth_exr"];
   }
-  json pipelines = json::object();
-  for (const std::string& name : d.pipelines) {
-    const Pipeline& pipeline = find_pipeline(name);
-    const auto given = d.options.find(name);
-    const PipelineOptions pipeline_options(pipeline.info(), given == d.options.end()
-                                                                ? std::map<std::string, std::string>{}
-                                                                : given->second);
-    const PipelineValidation v = validate_pipeline(target, pipeline, pipeline_options, executor);
-    json record_images = json::object();
-    if (d.images) {
-      const json files =
-          relative_images(write_pipeline_images(cell_dir, name, target, v, executor, image_options), results_dir);
-      images["pipelines"][name] = files;
-      record_images = files;
-      record_images.update(target_images);
-      if (name == d.baseline) images["left_png"] = relative_to(write_left_image(cell_dir, name, v), results_dir);
-    }
-    pipelines[name]["validation"] = validation_record(target, v, executor.threads(), record_images);
-  }
-
-  // Time: every pipeline side by side, speed-ups against the baseline paired per repetition.
+  // The timing run's configuration; each pipeline is measured with the options it is timed with.
   BenchConfig bench;
   bench.pipelines = d.pipelines;
   bench.baseline = d.baseline;
   bench.warmup = d.warmup;
   bench.repetitions = d.repetitions;
   bench.options = d.options;
+  json pipelines = json::object();
+  for (const std::string& name : d.pipelines) {
+    const BenchEntry entry = bench_entry(name, bench);  // the options the timed runs use
+    const PipelineValidation v = validate_pipeline(target, entry.entry, entry.options, executor);
+    const std::string stem = entry_file_stem(name);
+    json record_images = json::object();
+    if (d.images) {
+      const json files =
+          relative_images(write_pipeline_images(cell_dir, stem, target, v, executor, image_options), results_dir);
+      images["pipelines"][name] = files;
+      record_images = files;
+      record_images.update(target_images);
+      if (name == d.baseline) images["left_png"] = relative_to(write_left_image(cell_dir, stem, v), results_dir);
+    }
+    pipelines[name]["validation"] = validation_record(target, v, executor.threads(), record_images);
+  }
+
+  // Time: every pipeline side by side, speed-ups against the baseline paired per repetition.
   const BenchResult timed = run_bench(scene.prepared, rig, bench, executor);
   for (const PipelineBench& b : timed.pipelines) pipelines[b.name]["timing"] = timing_json(b, timed, d.warmup);
 

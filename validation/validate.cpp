@@ -48,10 +48,17 @@ ValidationTarget prepare_target(const RenderScene& scene, const std::filesystem:
 PipelineValidation validate_pipeline(const ValidationTarget& target, const Pipeline& pipeline,
                                      const PipelineOptions& options, const Executor& executor,
                                      const MetricOptions& metric_options) {
+  return validate_pipeline(target, PipelineEntry{pipeline.info().name, &pipeline, {}}, options, executor,
+                           metric_options);
+}
+
+PipelineValidation validate_pipeline(const ValidationTarget& target, const PipelineEntry& entry,
+                                     const PipelineOptions& options, const Executor& executor,
+                                     const MetricOptions& metric_options) {
   PipelineValidation v;
-  v.pipeline = pipeline.info().name;
+  v.pipeline = entry.name;
   v.options = options;
-  v.result = pipeline.render(target.scene, target.rig, options, RenderContext{executor});
+  v.result = entry.pipeline->render(target.scene, target.rig, options, RenderContext{executor});
   const auto start = std::chrono::steady_clock::now();
   const Image& right = v.result.right;
   const int w = right.width(), h = right.height();

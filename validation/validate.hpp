@@ -41,7 +41,7 @@ inline constexpr const char* kRegionNames[] = {"reprojected", "filled", "true_di
 
 /// A pipeline measured against the target.
 struct PipelineValidation {
-  std::string pipeline;
+  std::string pipeline;  ///< the entry's name: a pipeline's, or a variant's "NAME:KEY=VALUE..."
   PipelineOptions options;
   StereoResult result;
   Srgb8Image right_srgb8;
@@ -58,6 +58,10 @@ struct PipelineValidation {
 
 /// Renders the pipeline and measures its right eye.
 [[nodiscard]] PipelineValidation validate_pipeline(const ValidationTarget& target, const Pipeline& pipeline,
+                                                   const PipelineOptions& options, const Executor& executor,
+                                                   const MetricOptions& metric_options = {});
+/// The same for an entry (a pipeline or a variant of one), recorded under the entry's name.
+[[nodiscard]] PipelineValidation validate_pipeline(const ValidationTarget& target, const PipelineEntry& entry,
                                                    const PipelineOptions& options, const Executor& executor,
                                                    const MetricOptions& metric_options = {});
 

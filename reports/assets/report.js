@@ -506,8 +506,10 @@
   function kimQuality(paper, node) {
     const dfs = distinct([...paper.rows.map((r) => r.focal_distance_mm), ...cells.map((c) => Math.round(c.convergence_m * 1000))])
       .sort((a, b) => b - a);
+    // A method the paper has no column for (ours_only) gets only our column.
     const header = [{ text: 'DF (mm)' }, ...paper.methods.flatMap((m) => [
-      { text: `Paper: ${m.paper_name}`, cls: 'paper', title: 'SSIM / PSNR dB' }, { text: `Ours: ${m.pipeline}`, title: 'SSIM / PSNR dB (median over cells)' }])];
+      ...(m.ours_only ? [] : [{ text: `Paper: ${m.paper_name}`, cls: 'paper', title: 'SSIM / PSNR dB' }]),
+      { text: `Ours: ${m.pipeline}`, title: (m.ours_only ? `${m.paper_name}, not in the paper's table: ` : '') + 'SSIM / PSNR dB (median over cells)' }])];
     const rows = dfs.map((df) => {
       const p = paper.rows.find((r) => r.focal_distance_mm === df);
       const own = cells.filter((c) => Math.round(c.convergence_m * 1000) === df);
@@ -515,7 +517,7 @@
         const theirs = p && p[m.pipeline] ? `${p[m.pipeline].ssim.toFixed(3)} / ${p[m.pipeline].psnr.toFixed(1)}` : '—';
         const mine = own.filter((c) => rec(c, m.pipeline));
         const ours = mine.length ? `${fmt(median(mine.map((c) => field(c, m.pipeline, 'ssim'))), 3)} / ${fmt(median(mine.map((c) => field(c, m.pipeline, 'psnr'))), 1)}` : '—';
-        return [{ num: true, cls: 'paper', text: theirs }, { num: true, text: ours }];
+        return m.ours_only ? [{ num: true, text: ours }] : [{ num: true, cls: 'paper', text: theirs }, { num: true, text: ours }];
       })] };
     });
     const truths = distinct(cells.map((c) => c.truth)).join(', ');

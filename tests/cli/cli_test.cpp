@@ -139,6 +139,15 @@ TEST(Cli, RenderWritesEveryOutputAndBenchPrintsATable) {
   EXPECT_GT(j.at("counters").at("shadow_rays").get<uint64_t>(), 0u);
   EXPECT_EQ(j.at("rig").at("width").get<int>(), 64);
 
+  // A variant renders under its own name; its files say which options it fixed.
+  const CliRun v =
+      run("render --scene box-wall --pipeline plain-raster:tile=8 --out '" + dir.path().string() + "'" + common);
+  ASSERT_EQ(v.code, 0) << v.out;
+  EXPECT_EQ(v.out.rfind("plain-raster:tile=8 on box-wall", 0), 0u) << v.out;
+  const auto jv = nlohmann::json::parse(test::read_text(dir / "box-wall_plain-raster@tile=8_stats.json"));
+  EXPECT_EQ(jv.at("options").at("tile"), "8");
+  EXPECT_TRUE(std::filesystem::exists(dir / "box-wall_plain-raster@tile=8_right.png"));
+
   const CliRun b = run("bench --scene box-wall --pipelines plain-rt,ideal-copy --baseline plain-rt -n 2 -w 0" + common);
   ASSERT_EQ(b.code, 0) << b.out;
   EXPECT_NE(b.out.find("ideal-copy"), std::string::npos) << b.out;
@@ -185,9 +194,12 @@ TEST(Cli, RenderAndBenchRejectBadArguments) {
       {"render --scene box-wall --pipeline warp-drive" + common, "unknown pipeline 'warp-drive'"},
       {"render --scene box-wall --pipeline plain-raster --option tile=3" + common, "tile=3 is out of range"},
       {"render --scene box-wall --pipeline plain-raster --option tiles=32" + common, "has no option 'tiles'"},
+      {"render --scene box-wall --pipeline plain-raster:tile=3" + common,
+       "pipeline entry 'plain-raster:tile=3': plain-raster: option tile=3 is out of range"},
       {"render --scene box-wall --pipeline plain-rt --threads -1" + common, "--threads -1 is out of range"},
       {"bench --scene box-wall -n 0 --pipelines plain-rt --baseline plain-rt" + bench_common, "--repetitions 0"},
-      {"bench --scene box-wall --pipelines plain-rt --baseline plain-rt --option tile=4" + bench_common, "PIPELINE.OPTION"},
+      {"bench --scene box-wall --pipelines plain-rt --baseline plain-rt --option tile=4" + bench_common,
+       "PIPELINE.OPTION"},
       // Option values are checked as the pipeline reads them, before any scene loads.
       {"bench --scene box-wall --pipelines bw-warp --baseline bw-warp --option bw-warp.iterations=99" + bench_common,
        "option iterations=99 is out of range 0..64"},

@@ -21,8 +21,10 @@ std::string args(const test::ScratchDir& dir) {
 
 TEST(PathCommand, FramesWithSpinAndCameraKeys) {
   test::ScratchDir dir;
-  const test::CliRun r = test::run_cli(args(dir) + " --frames 3 --spin-deg 10 --pipelines plain-rt,repro-rt"
-                                                   " --camera-keys '0,1,6>0,0.5,0;1,1,6>0,0.5,0'");
+  const test::CliRun r =
+      test::run_cli(args(dir) +
+                    " --frames 3 --spin-deg 10 --pipelines plain-rt,repro-rt,repro-rt:discontinuity_px=1e6"
+                    " --camera-keys '0,1,6>0,0.5,0;1,1,6>0,0.5,0'");
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("BVH refit per frame"), std::string::npos) << r.out;
   std::stringstream lines(test::read_text(dir / "out" / "box-wall_path.jsonl"));
@@ -39,6 +41,9 @@ TEST(PathCommand, FramesWithSpinAndCameraKeys) {
     EXPECT_GT(f["pipelines"]["repro-rt"]["total_s"].get<double>(), 0.0);
     // Measured 38.4-43.5 dB over the three frames; below 30 dB the frame's truth or rig is wrong.
     EXPECT_GT(f["pipelines"]["repro-rt"]["metrics"]["psnr"].get<double>(), 30.0);
+    // The variant without disocclusion detection misses most true disocclusions.
+    EXPECT_LT(f["pipelines"]["repro-rt:discontinuity_px=1e6"]["recall"].get<double>(),
+              f["pipelines"]["repro-rt"]["recall"].get<double>());
   }
 }
 
@@ -46,6 +51,11 @@ TEST(PathCommand, BadInput) {
   test::ScratchDir dir;
   EXPECT_EQ(test::run_cli(args(dir) + " --bvh sometimes").code, 3);
   EXPECT_EQ(test::run_cli(args(dir) + " --frames 0").code, 3);
+  const test::CliRun variant = test::run_cli(args(dir) + " --pipelines repro-rt:threshold_arcmin=-1");
+  EXPECT_EQ(variant.code, 3) << variant.out;
+  EXPECT_NE(variant.out.find("pipeline entry 'repro-rt:threshold_arcmin=-1'"), std::string::npos) << variant.out;
+  const test::CliRun twice = test::run_cli(args(dir) + " --pipelines plain-rt,plain-rt");
+  EXPECT_EQ(twice.code, 3) << twice.out;
   EXPECT_EQ(test::run_cli(args(dir) + " --camera-keys '1,2,3'").code, 3);
   EXPECT_EQ(test::run_cli(args(dir) + " --spin-deg 5 --spin-prefix nothing-like-this").code, 3);
   EXPECT_EQ(test::run_cli(args(dir) + " --spin-deg 5 --truth blender").code, 3);

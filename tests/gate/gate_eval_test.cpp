@@ -393,6 +393,22 @@ TEST(GateEval, ReproduceGivesTheLightCountTheCellUsed) {
   EXPECT_NE(validation::reproduce_command(fewer, FakePipeline{}.name, {}).find("--lights 3"), std::string::npos);
 }
 
+TEST(GateEval, ReproduceNamesAVariantWithoutRepeatingItsOwnOptions) {
+  FakePipeline variant;
+  variant.name = "bidir-warp:occlusion=ztest";
+  json cell = fake_cell(1, 0.064, {variant});
+  cell["pipelines"][variant.name]["validation"]["options"] = {
+      {"occlusion", "ztest"}, {"max_crack", "3"}, {"tile", "64"}};
+  const validation::GateCell gc{cell["cell_id"], "box-wall", cell};
+  validation::ReproduceSettings settings;
+  settings.pipeline_defaults["bidir-warp"] = {{"occlusion", "none"}, {"max_crack", "2"}, {"tile", "64"}};
+  const std::string command = validation::reproduce_command(gc, variant.name, settings);
+  EXPECT_NE(command.find("--pipelines bidir-warp:occlusion=ztest "), std::string::npos) << command;
+  EXPECT_NE(command.find("--option max_crack=3"), std::string::npos) << "given for the pipeline: " << command;
+  EXPECT_EQ(command.find("--option occlusion"), std::string::npos) << "fixed by the name: " << command;
+  EXPECT_EQ(command.find("--option tile"), std::string::npos) << "at its default: " << command;
+}
+
 TEST(GateEval, ARuleThatMatchesNothingIsNoted) {
   const auto notes_about_rules = [](const validation::GateReport& r) {
     std::vector<std::string> out;

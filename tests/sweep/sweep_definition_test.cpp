@@ -142,6 +142,30 @@ TEST(SweepDefinition, OptionValuesAreCheckedBeforeAnyCellRuns) {
   EXPECT_NE(depth.find("depth=5000 is out of range"), std::string::npos) << depth;
 }
 
+TEST(SweepDefinition, VariantsRunBesideTheirPipeline) {
+  const SweepDefinition d = parse_sweep(
+      "[sweep]\npipelines = [\"bidir-warp\", \"bidir-warp:occlusion=ztest\", \"fw-warp:max_crack=1\"]\n"
+      "baseline = \"plain-raster\"\n[options.bidir-warp]\nmax_crack = 3\n[options.fw-warp]\nmax_crack = 2\n",
+      "def.toml");
+  EXPECT_EQ(d.pipelines, (std::vector<std::string>{"bidir-warp", "bidir-warp:occlusion=ztest", "fw-warp:max_crack=1",
+                                                   "plain-raster"}));
+  EXPECT_EQ(d.options.at("fw-warp").at("max_crack"), "2") << "options of a pipeline run only as a variant";
+  // A variant's options are checked at its line; the options table under each variant's own.
+  const std::string value = error_of("[sweep]\npipelines = [\"plain-rt\",\n \"bidir-warp:occlusion=zbuf\"]\n");
+  EXPECT_NE(value.find("def.toml:3: sweep.pipelines: pipeline entry 'bidir-warp:occlusion=zbuf'"), std::string::npos)
+      << value;
+  const std::string pair = error_of("[sweep]\npipelines = [\"bidir-warp:ztest\"]\n");
+  EXPECT_NE(pair.find("'ztest' is not KEY=VALUE"), std::string::npos) << pair;
+  const std::string twice = error_of("[sweep]\npipelines = [\"bidir-warp:tile=8\", \"bidir-warp:tile=8\"]\n");
+  EXPECT_NE(twice.find("lists 'bidir-warp:tile=8' twice"), std::string::npos) << twice;
+  const std::string under =
+      error_of("[sweep]\npipelines = [\"bidir-warp:occlusion=ztest\"]\n[options.bidir-warp]\nocclusions = \"none\"\n");
+  EXPECT_NE(under.find("def.toml:4: options.bidir-warp.occlusions"), std::string::npos) << under;
+  const std::string baseline = error_of("[sweep]\nbaseline = \"plain-rt:tile=0\"\n");
+  EXPECT_NE(baseline.find("def.toml:2: sweep.baseline: pipeline entry 'plain-rt:tile=0'"), std::string::npos)
+      << baseline;
+}
+
 TEST(SweepDefinition, BothInteraxialKindsRejected) {
   const std::string e = error_of("[sweep]\ninteraxial_m = [0.064]\nmax_disparity_px = [30]\n");
   EXPECT_NE(e.find("def.toml:3: sweep.max_disparity_px"), std::string::npos) << e;
@@ -356,16 +380,16 @@ TEST(SweepDefinition, ShippedDefinitionsLoad) {
     size_t cells;
     size_t pipelines;  // 0: every registered pipeline
   } shipped[] = {
-      {"smoke.toml", 2, 0},                              // spheres × 2 interaxial
-      {"nightly.toml", 6 * 3 * 2, 0},                    // 6 scenes × 3 disparities × 2 resolutions
-      {"presets/wissmann-table2.toml", 3 * 2, 5},        // 3 scenes × HD, 4K
-      {"presets/kim-table2.toml", 3, 5},                 // 3 focal distances
-      {"presets/kim-table3.toml", 3, 2},                 // 3 triangle counts
-      {"presets/al-hagri-dimensions.toml", 6 * 27, 6},   // 6 scenes × 200..1500 step 50
-      {"presets/al-hagri-interaxial.toml", 10, 6},       // 10..100 px
-      {"presets/al-hagri-lights.toml", 10, 6},           // 1..10 lights
-      {"presets/animated-spheres.toml", 30, 6},          // 30 frames of the turning spheres
-      {"presets/wissmann-path.toml", 60, 4},             // 60 frames along the bistro path
+      {"smoke.toml", 2, n_pipelines + 1},               // spheres × 2 interaxial; every pipeline and a variant
+      {"nightly.toml", 6 * 3 * 2, 0},                   // 6 scenes × 3 disparities × 2 resolutions
+      {"presets/wissmann-table2.toml", 3 * 2, 5},       // 3 scenes × HD, 4K
+      {"presets/kim-table2.toml", 3, 6},                // 3 focal distances
+      {"presets/kim-table3.toml", 3, 2},                // 3 triangle counts
+      {"presets/al-hagri-dimensions.toml", 6 * 27, 6},  // 6 scenes × 200..1500 step 50
+      {"presets/al-hagri-interaxial.toml", 10, 6},      // 10..100 px
+      {"presets/al-hagri-lights.toml", 10, 6},          // 1..10 lights
+      {"presets/animated-spheres.toml", 30, 6},         // 30 frames of the turning spheres
+      {"presets/wissmann-path.toml", 60, 4},            // 60 frames along the bistro path
   };
   size_t checked = 0;
   for (const auto& s : shipped) {

@@ -281,7 +281,8 @@ TEST(SweepRun, SmokeSweepRunsAndEveryLineIsWellFormed) {
     EXPECT_EQ(c["rig"]["width"], 320);
     EXPECT_EQ(c["jobs"], 1);
     EXPECT_GT(c["wall_s"].get<double>(), 0.0);
-    EXPECT_EQ(c["pipelines"].size(), registered);
+    EXPECT_EQ(c["pipelines"].size(), registered + 1) << "every pipeline, and bidir-warp:occlusion=ztest";
+    EXPECT_EQ(c["pipelines"]["bidir-warp:occlusion=ztest"]["validation"]["options"]["occlusion"], "ztest");
     for (const auto& [name, p] : c["pipelines"].items()) {
       SCOPED_TRACE(name);
       const json& v = p["validation"];
@@ -303,6 +304,41 @@ TEST(SweepRun, SmokeSweepRunsAndEveryLineIsWellFormed) {
     }
   }
   EXPECT_NE(cells[0]["rig"]["interaxial_m"], cells[1]["rig"]["interaxial_m"]);
+}
+
+TEST(SweepRun, VariantsAreValidatedAndTimedUnderTheirOwnName) {
+  test::ScratchDir dir;
+  const fs::path def = dir / "variants.toml";
+  std::ofstream(def) << R"([sweep]
+name = "variants"
+scenes = ["box-wall"]
+pipelines = ["plain-raster", "bidir-warp", "bidir-warp:occlusion=ztest"]
+baseline = "plain-raster"
+resolutions = ["96x54"]
+[options.bidir-warp]
+max_crack = 3
+[timing]
+repetitions = 1
+warmup = 0
+)";
+  const test::CliRun r = test::run_cli("sweep run " + quoted(def) + " --out " + quoted(dir / "out") + " --scenes-dir " +
+                                       quoted(dir / "scenes"));
+  ASSERT_EQ(r.code, 0) << r.out;
+  const std::vector<json> cells = validation::read_results(dir / "out" / "results.jsonl").cells;
+  ASSERT_EQ(cells.size(), 1u);
+  const json& c = cells[0];
+  ASSERT_EQ(c["pipelines"].size(), 3u);
+  const json& plain = c["pipelines"]["bidir-warp"];
+  const json& ztest = c["pipelines"]["bidir-warp:occlusion=ztest"];
+  EXPECT_EQ(ztest["validation"]["pipeline"], "bidir-warp:occlusion=ztest");
+  EXPECT_EQ(ztest["validation"]["options"]["occlusion"], "ztest");
+  EXPECT_EQ(ztest["validation"]["options"]["max_crack"], "3");
+  EXPECT_EQ(plain["validation"]["options"]["occlusion"], "none");
+  EXPECT_EQ(ztest["timing"]["samples_s"].size(), 1u);
+  EXPECT_NE(ztest["validation"]["counters"], plain["validation"]["counters"]) << "two different renders";
+  const std::string right = c["images"]["pipelines"]["bidir-warp:occlusion=ztest"]["right_png"];
+  EXPECT_EQ(fs::path(right).filename(), "bidir-warp@occlusion=ztest_right.png");
+  EXPECT_TRUE(fs::exists(dir / "out" / right));
 }
 
 /// Three frames of the box turning about the vertical through its centre, 64x36, two pipelines.
