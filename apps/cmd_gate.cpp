@@ -12,7 +12,6 @@
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
-#include "renderer/pipeline.hpp"
 #include "validation/gate.hpp"
 #include "validation/junit.hpp"
 
@@ -21,8 +20,6 @@ namespace sb::cli {
 namespace {
 
 namespace fs = std::filesystem;
-
-constexpr const char* kDefaultBaseline = "ci/baseline.json";
 
 struct GateArgs {
   std::string config = "ci/gate.toml";
@@ -67,7 +64,7 @@ void run_update(const GateArgs& a, const fs::path& file) {
 void run_gate(const GateArgs& a) {
   // The default baseline counts as an input too: a report written over ci/baseline.json would lose
   // the stored timings.
-  const std::string baseline_path = a.baseline.empty() ? kDefaultBaseline : a.baseline;
+  const std::string baseline_path = a.baseline.empty() ? validation::kDefaultBaselineFile : a.baseline;
   if (a.update_baseline) {
     refuse_overwriting({{"--results", &a.results}, {"--config", &a.config}}, {{"the baseline", &baseline_path}});
     run_update(a, baseline_path);
@@ -92,11 +89,8 @@ void run_gate(const GateArgs& a) {
         "--update-baseline)",
         baseline_file.string());
 
-  validation::ReproduceSettings reproduce;
-  for (const Pipeline* p : pipelines())
-    reproduce.pipeline_defaults[p->info().name] = PipelineOptions(p->info(), {}).values();
-
-  validation::GateReport report = validation::evaluate_gate(config, results, baseline, reproduce);
+  validation::GateReport report =
+      validation::evaluate_gate(config, results, baseline, validation::registered_reproduce_settings());
   if (!baseline_note.empty()) report.notes.push_back(baseline_note);
   fmt::print("{}", validation::format_gate_table(report));
 
@@ -127,7 +121,8 @@ void register_gate_command(CLI::App& root) {
   g->add_option("--config", a->config, "Gate thresholds (TOML)")->capture_default_str();
   g->add_option("--results", a->results, "A sweep's results.jsonl")->required();
   g->add_option("--baseline", a->baseline,
-                fmt::format("Timing baseline (JSON); default {} (if absent, no regression check)", kDefaultBaseline));
+                fmt::format("Timing baseline (JSON); default {} (if absent, no regression check)",
+                            validation::kDefaultBaselineFile));
   g->add_option("--junit", a->junit, "Write JUnit XML here (one testsuite per cell, one testcase per check)");
   g->add_option("--json", a->json_out, "Write every check as JSON here");
   g->add_flag("--update-baseline", a->update_baseline,

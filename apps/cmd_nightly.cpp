@@ -19,7 +19,6 @@
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
-#include "renderer/pipeline.hpp"
 #include "renderer/text.hpp"
 #include "reports/report.hpp"
 #include "validation/gate.hpp"
@@ -38,7 +37,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using namespace sb::validation;
 
-constexpr const char* kDefaultBaseline = "ci/baseline.json";
 constexpr const char* kDefaultGateConfig = "ci/gate.toml";
 /// Written last into a run folder: the run is complete (history line appended, report written).
 constexpr const char* kRunDoneFile = "nightly.json";
@@ -147,7 +145,7 @@ void run_nightly(const NightlyArgs& a) {
 
   Baseline baseline;
   std::string baseline_note;
-  const fs::path baseline_file = a.baseline.empty() ? fs::path(kDefaultBaseline) : fs::path(a.baseline);
+  const fs::path baseline_file = a.baseline.empty() ? fs::path(kDefaultBaselineFile) : fs::path(a.baseline);
   if (!a.baseline.empty() || fs::exists(baseline_file))
     baseline = load_baseline(baseline_file);
   else
@@ -188,9 +186,8 @@ void run_nightly(const NightlyArgs& a) {
 
   // 2. The gate.
   const GateResults results = load_gate_results(o.results);
-  ReproduceSettings reproduce;
-  for (const Pipeline* p : pipelines()) reproduce.pipeline_defaults[p->info().name] = PipelineOptions(p->info(), {}).values();
-  GateReport gate = evaluate_gate(gate_config, results, baseline, reproduce);  // notes the read warnings
+  GateReport gate =
+      evaluate_gate(gate_config, results, baseline, registered_reproduce_settings());  // notes the read warnings
   if (!baseline_note.empty()) gate.notes.push_back(baseline_note);
   fmt::print("{}", format_gate_table(gate));
   io::write_text_atomically(run_dir / "gate-junit.xml", junit_xml(gate, "stereobench nightly " + o.results.string()));
@@ -262,8 +259,9 @@ void register_nightly_command(CLI::App& root) {
   n->add_option("--gate-config", a->gate_config,
                 fmt::format("Gate thresholds (TOML); default the definition's [gate] config, else {}",
                             kDefaultGateConfig));
-  n->add_option("--baseline", a->baseline,
-                fmt::format("Timing baseline (JSON); default {} (if absent, no regression check)", kDefaultBaseline));
+  n->add_option(
+      "--baseline", a->baseline,
+      fmt::format("Timing baseline (JSON); default {} (if absent, no regression check)", kDefaultBaselineFile));
   n->add_option("--jobs,-j", a->jobs, "Cells run at once (1 keeps timings undisturbed)")->capture_default_str();
   n->add_option("--threads,-t", a->threads, "Threads per cell (0 = the machine's cores / jobs)")->capture_default_str();
   n->add_option("--cache", a->cache, "Folder of cached external ground-truth renders ('' to disable)")

@@ -12,6 +12,9 @@
 
 namespace sb::validation {
 
+/// The timing baseline `stereobench gate` and `stereobench nightly` read unless told otherwise.
+inline constexpr const char* kDefaultBaselineFile = "ci/baseline.json";
+
 /// The accepted timing of one pipeline in one cell.
 struct BaselineEntry {
   std::vector<double> samples_s;  ///< per repetition, seconds

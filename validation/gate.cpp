@@ -470,6 +470,13 @@ std::string join_args(const std::vector<std::string>& args) {
 
 }  // namespace
 
+ReproduceSettings registered_reproduce_settings() {
+  ReproduceSettings settings;
+  for (const Pipeline* p : pipelines())
+    settings.pipeline_defaults[p->info().name] = PipelineOptions(p->info(), {}).values();
+  return settings;
+}
+
 std::string reproduce_command(const GateCell& cell, const std::string& pipeline, const ReproduceSettings& settings) {
   const json& rec = cell.record;
   const json& c = rec.value("cell", json::object());

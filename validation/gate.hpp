@@ -176,6 +176,8 @@ struct GateReport {
 struct ReproduceSettings {
   std::map<std::string, std::map<std::string, std::string>> pipeline_defaults;
 };
+/// The settings for the pipelines this build registers.
+[[nodiscard]] ReproduceSettings registered_reproduce_settings();
 
 /// Applies the configuration to every pipeline of every cell. `baseline` may be empty (then every
 /// time-regression check is a skip, "no baseline"). InputError naming the file and line for a
