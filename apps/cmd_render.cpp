@@ -82,6 +82,10 @@ void list_pipelines() {
     fmt::print("{:<16} {}\n{:<16} source: {}, {}\n", i.name, i.summary, "", i.paper, i.section);
     for (const OptionSpec& o : i.options) fmt::print("{:<16}   --option {}={}: {}\n", "", o.name, o.default_value, o.help);
   }
+  fmt::print(
+      "\nA variant fixes options in the pipeline's name, NAME:KEY=VALUE[:KEY=VALUE...] (e.g.\n"
+      "bidir-warp:occlusion=ztest): render, validate, bench, path and sweeps run it under that name,\n"
+      "beside the pipeline itself.\n");
 }
 
 }  // namespace
