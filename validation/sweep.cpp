@@ -437,7 +437,9 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
     try {
       (void)parse_pipeline_entries(d.pipelines, "sweep.pipelines");
     } catch (const InputError& err) {
-      where.fail(*sweep.get("baseline"), "sweep.baseline", err.what());
+      // The baseline is missing from the list, so the baseline or the list (or both) was given.
+      const toml::node* at = sweep.get("baseline") ? sweep.get("baseline") : sweep.get("pipelines");
+      where.fail(*at, at == sweep.get("baseline") ? "sweep.baseline" : "sweep.pipelines", err.what());
     }
   }
   std::sort(d.pipelines.begin(), d.pipelines.end());
