@@ -62,6 +62,12 @@ std::map<std::string, std::string> entry_fixed_options(const std::string& name) 
 }
 
 PipelineEntry parse_pipeline_entry(const std::string& name) {
+  // The name is part of file names (entry_file_stem), beside a scene name, a provider, a suffix and
+  // a temporary file's decoration, within the 255 bytes a file name may have.
+  constexpr size_t kMaxEntry = 160;
+  if (name.size() > kMaxEntry)
+    throw InputError(fmt::format("pipeline entry '{}...' is {} characters long; it names files, so keep it within {}",
+                                 name.substr(0, 40), name.size(), kMaxEntry));
   return {name, &find_pipeline(entry_pipeline_name(name)), entry_fixed_options(name)};
 }
 

@@ -103,8 +103,9 @@ struct PipelineEntry {
   [[nodiscard]] PipelineOptions options(const std::map<std::string, std::string>& given = {}) const;
 };
 
-/// Parses an entry: InputError for an unknown pipeline, a part that is not KEY=VALUE, or a key
-/// fixed twice. Option names and values are checked by PipelineEntry::options.
+/// Parses an entry: InputError for an unknown pipeline, a part that is not KEY=VALUE, a key fixed
+/// twice, or a name longer than 160 characters (it names files). Option names and values are checked by
+/// PipelineEntry::options.
 [[nodiscard]] PipelineEntry parse_pipeline_entry(const std::string& name);
 
 /// The registered pipeline an entry names: its text before the first ':'.

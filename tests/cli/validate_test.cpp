@@ -117,12 +117,14 @@ TEST(Validate, VariantsAreMeasuredBesideTheirPipelineUnderTheirOwnName) {
   // with the z-test; the two records come from two renders.
   EXPECT_GT(ztest["metrics"]["psnr"].get<double>(), plain["metrics"]["psnr"].get<double>() + 10.0);
 
-  const std::pair<const char*, const char*> bad[] = {
+  const std::pair<std::string, const char*> bad[] = {
       {"bidir-warp:occlusion=zbuf", "pipeline entry 'bidir-warp:occlusion=zbuf': bidir-warp: option occlusion=zbuf"},
       {"bidir-warp:occlusion", "'occlusion' is not KEY=VALUE"},
       {"bidir-warp:max_crack=2:max_crack=4", "fixes option max_crack twice"},
       {"bidir-warp:occlusions=ztest", "has no option 'occlusions'"},
       {"no-such:tile=8", "unknown pipeline 'no-such'"},
+      // A value of 300 zeros and an 8 reads as 8; the name would pass a file name's 255 bytes.
+      {"plain-raster:tile=" + std::string(300, '0') + "8", "is 319 characters long; it names files"},
       {"bidir-warp:max_crack=3/1,bidir-warp:max_crack=3 1", "would write files of the same name"},
   };
   for (const auto& [entry, message] : bad) {
