@@ -1,6 +1,7 @@
 // Shared command-line options.
 #include "apps/cli_common.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -53,6 +54,12 @@ RigOverrides RigCli::overrides() const {
     o.vfov = degrees_to_radians(*vfov_deg);
   }
   return o;
+}
+
+size_t pipeline_column(const std::vector<std::string>& names) {
+  size_t width = 16;
+  for (const std::string& n : names) width = std::max(width, n.size());
+  return width;
 }
 
 void add_scenes_dir_option(CLI::App& app, std::string& dir) {

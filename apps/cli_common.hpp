@@ -27,6 +27,10 @@ struct RigCli {
   [[nodiscard]] RigOverrides overrides() const;
 };
 
+/// The width of a terminal table's pipeline column: 16, or the longest name (a variant's,
+/// "NAME:KEY=VALUE...", may be longer).
+[[nodiscard]] size_t pipeline_column(const std::vector<std::string>& names);
+
 /// --scenes-dir: where built-in scenes are generated and cached.
 void add_scenes_dir_option(CLI::App& app, std::string& dir);
 

@@ -116,13 +116,16 @@ void run_bench_command(const BenchArgs& a) {
   const BenchResult r = run_bench(prepared, rig, config, executor,
                                   [](const std::string& line) { fmt::print(stderr, "  {}\n", line); });
 
-  fmt::print("\n{:<16} {:>11} {:>11} {:>11} {:>9} {:>13} {:>13}\n", "pipeline", "median ms", "min ms", "max ms",
+  std::vector<std::string> names;
+  for (const PipelineBench& b : r.pipelines) names.push_back(b.name);
+  const size_t name_w = pipeline_column(names);
+  fmt::print("\n{:<{}} {:>11} {:>11} {:>11} {:>9} {:>13} {:>13}\n", "pipeline", name_w, "median ms", "min ms", "max ms",
              "speed-up", "Mrays/s", "Mprimary/s");
   for (const PipelineBench& b : r.pipelines) {
     const Summary t = summarize(b.total_seconds);
     auto counter = [&](const char* n) { auto it = b.counters.find(n); return it == b.counters.end() ? 0.0 : double(it->second); };
     const double primary = counter("primary_rays"), shadow = counter("shadow_rays");
-    fmt::print("{:<16} {:>11.2f} {:>11.2f} {:>11.2f} {:>8.2f}x {:>13.2f} {:>13.2f}\n", b.name, t.median * 1e3,
+    fmt::print("{:<{}} {:>11.2f} {:>11.2f} {:>11.2f} {:>8.2f}x {:>13.2f} {:>13.2f}\n", b.name, name_w, t.median * 1e3,
                t.min * 1e3, t.max * 1e3, b.speedup.median, (primary + shadow) / t.median * 1e-6,
                primary / t.median * 1e-6);
   }

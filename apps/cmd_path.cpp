@@ -120,9 +120,12 @@ void run_path_command(const PathArgs& a) {
     fmt::print(stderr, "{}\n", line);
   });
   io::write_text_atomically(lines, text);
-  fmt::print("\n{:<16} {:>14} {:>14} {:>12}\n", "pipeline", "median ms", "95th pct ms", "median PSNR");
+  std::vector<std::string> names;
+  for (const auto& entry : frame_s) names.push_back(entry.first);
+  const size_t name_w = pipeline_column(names);
+  fmt::print("\n{:<{}} {:>14} {:>14} {:>12}\n", "pipeline", name_w, "median ms", "95th pct ms", "median PSNR");
   for (const auto& [name, s] : frame_s)
-    fmt::print("{:<16} {:>14.2f} {:>14.2f} {:>12}\n", name, 1e3 * median(s), 1e3 * percentile(s, 0.95),
+    fmt::print("{:<{}} {:>14.2f} {:>14.2f} {:>12}\n", name, name_w, 1e3 * median(s), 1e3 * percentile(s, 0.95),
                psnr[name].empty() ? std::string("inf") : fmt::format("{:.2f}", median(psnr[name])));
   if (!bvh_s.empty()) fmt::print("BVH {} per frame: median {:.2f} ms\n", a.bvh, 1e3 * median(bvh_s));
   fmt::print("wrote {}\n", lines.string());

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
 #include "reports/report.hpp"
@@ -47,12 +48,14 @@ void print_summary_table(const reports::ReportSummary& s) {
     if (std::isinf(v)) return std::string("inf");
     return fmt::format("{:.{}f}", v * scale, precision);
   };
-  fmt::print("\n{:<16} {:>8} {:>8} {:>8} {:>11} {:>9}   (medians over {} cell(s))\n", "pipeline", "PSNR dB", "SSIM",
-             "holes %", "time ms", "speed-up", s.cells.size());
-  for (const nlohmann::json& name : s.pipeline_names) {
-    const std::string p = name.get<std::string>();
+  std::vector<std::string> names;
+  for (const nlohmann::json& name : s.pipeline_names) names.push_back(name.get<std::string>());
+  const size_t name_w = pipeline_column(names);
+  fmt::print("\n{:<{}} {:>8} {:>8} {:>8} {:>11} {:>9}   (medians over {} cell(s))\n", "pipeline", name_w, "PSNR dB",
+             "SSIM", "holes %", "time ms", "speed-up", s.cells.size());
+  for (const std::string& p : names) {
     const double speedup = cell_median(s.cells, p, "speedup");
-    fmt::print("{:<16} {:>8} {:>8} {:>8} {:>11} {:>9}\n", p, number(cell_median(s.cells, p, "psnr"), 2),
+    fmt::print("{:<{}} {:>8} {:>8} {:>8} {:>11} {:>9}\n", p, name_w, number(cell_median(s.cells, p, "psnr"), 2),
                number(cell_median(s.cells, p, "ssim"), 4), number(cell_median(s.cells, p, "hole_fraction"), 3, 100.0),
                number(cell_median(s.cells, p, "time_s"), 2, 1000.0),
                std::isnan(speedup) ? std::string("-") : number(speedup, 2) + "x");

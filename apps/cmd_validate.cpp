@@ -109,10 +109,9 @@ void run_validate(const ValidateArgs& a) {
 
   const validation::MetricOptions metric_options{a.error_threshold};
   json records = json::array();
-  const size_t name_w = std::max<size_t>(
-      16, std::max_element(chosen.begin(), chosen.end(), [](const PipelineEntry& x, const PipelineEntry& y) {
-            return x.name.size() < y.name.size();
-          })->name.size());
+  std::vector<std::string> names;
+  for (const PipelineEntry& e : chosen) names.push_back(e.name);
+  const size_t name_w = pipeline_column(names);
   fmt::print("\n{:<{}} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10}\n", "pipeline", name_w, "PSNR dB", "SSIM",
              "MSE", "err %", "holes %", "recall", "prec.", "time ms");
   for (size_t i = 0; i < chosen.size(); ++i) {
