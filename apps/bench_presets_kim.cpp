@@ -264,7 +264,7 @@ BenchPreset kim_complexity_preset() {
 
 void run_kim_focal(const PresetRun& run, const Executor& executor) {
   const BenchPreset& preset = *run.preset;
-  run.config.validate();
+  const std::vector<BenchEntry> entries = run.config.entries();
   if (!contains(run.config.pipelines, kReference))
     throw InputError(fmt::format("--preset {} compares every right eye with {}'s; add {} to --pipelines", preset.name,
                                  kReference, kReference));
@@ -307,10 +307,9 @@ void run_kim_focal(const PresetRun& run, const Executor& executor) {
       // Quality: one untimed render per pipeline; rendering is deterministic, so these are the
       // images the timed repetitions produce.
       std::vector<std::pair<std::string, validation::Srgb8Image>> right_eyes;
-      for (const std::string& name : run.config.pipelines) {
-        const BenchEntry e = bench_entry(name, run.config);
+      for (const BenchEntry& e : entries) {
         const StereoResult r = e.entry.pipeline->render(*prepared, rig, e.options, ctx);
-        right_eyes.emplace_back(name, validation::encode_srgb8(r.right, name + " right eye"));
+        right_eyes.emplace_back(e.entry.name, validation::encode_srgb8(r.right, e.entry.name + " right eye"));
       }
       const auto ref = std::find_if(right_eyes.begin(), right_eyes.end(), [](const auto& e) { return e.first == kReference; });
       FocalRow result;

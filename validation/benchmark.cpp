@@ -21,13 +21,17 @@ Summary summarize(std::vector<double> v) {
   return s;
 }
 
-void BenchConfig::validate() const {
+std::vector<BenchEntry> BenchConfig::entries() const {
   // The same bounds as a sweep's [timing].
   if (repetitions < 1 || repetitions > 10000)
     throw InputError(fmt::format("--repetitions {} is outside 1..10000", repetitions));
   if (warmup < 0 || warmup > 10000) throw InputError(fmt::format("--warmup {} is outside 0..10000", warmup));
-  for (const PipelineEntry& e : parse_pipeline_entries(pipelines, "--pipelines"))
-    (void)e.options(given_for(e));  // every option it will run with
+  std::vector<BenchEntry> out;
+  for (PipelineEntry& e : parse_pipeline_entries(pipelines, "--pipelines")) {
+    const auto given = options.find(e.pipeline->info().name);
+    PipelineOptions o = e.options(given == options.end() ? std::map<std::string, std::string>{} : given->second);
+    out.push_back({std::move(e), std::move(o)});
+  }
   if (std::find(pipelines.begin(), pipelines.end(), baseline) == pipelines.end())
     throw InputError(fmt::format("baseline '{}' is not among the benchmarked pipelines", baseline));
   // The options' values were checked with each entry above; options for no entry are a mistake.
@@ -37,18 +41,7 @@ void BenchConfig::validate() const {
                      [&name](const std::string& entry) { return entry_pipeline_name(entry) == name; }))
       throw InputError(fmt::format("options given for pipeline '{}', which is not benchmarked", name));
   }
-}
-
-const std::map<std::string, std::string>& BenchConfig::given_for(const PipelineEntry& entry) const {
-  static const std::map<std::string, std::string> none;
-  const auto it = options.find(entry.pipeline->info().name);
-  return it == options.end() ? none : it->second;
-}
-
-BenchEntry bench_entry(const std::string& entry, const BenchConfig& config) {
-  PipelineEntry e = parse_pipeline_entry(entry);
-  PipelineOptions options = e.options(config.given_for(e));
-  return {std::move(e), std::move(options)};
+  return out;
 }
 
 std::string given_options(const BenchConfig& config) {
@@ -61,32 +54,28 @@ std::string given_options(const BenchConfig& config) {
 
 BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const BenchConfig& config,
                       const Executor& executor, const std::function<void(const std::string&)>& progress) {
-  config.validate();
-  std::vector<const Pipeline*> ps;
-  std::vector<PipelineOptions> opts;
-  for (const std::string& entry : config.pipelines) {
-    BenchEntry e = bench_entry(entry, config);
-    ps.push_back(e.entry.pipeline);
-    opts.push_back(std::move(e.options));
-  }
+  const std::vector<BenchEntry> entries = config.entries();
 
   BenchResult result;
   result.baseline = config.baseline;
   result.repetitions = config.repetitions;
   result.threads = executor.threads();
-  result.pipelines.resize(ps.size());
-  for (size_t i = 0; i < ps.size(); ++i) result.pipelines[i].options = opts[i].values();
+  result.pipelines.resize(entries.size());
+  for (size_t i = 0; i < entries.size(); ++i) {
+    result.pipelines[i].name = entries[i].entry.name;
+    result.pipelines[i].options = entries[i].options.values();
+  }
   const RenderContext ctx{executor};
+  const auto render = [&](size_t i) { return entries[i].entry.pipeline->render(scene, rig, entries[i].options, ctx); };
   for (int w = 0; w < config.warmup; ++w)
-    for (size_t i = 0; i < ps.size(); ++i) {
-      (void)ps[i]->render(scene, rig, opts[i], ctx);
-      if (progress) progress(fmt::format("warm-up {}/{} {}", w + 1, config.warmup, ps[i]->info().name));
+    for (size_t i = 0; i < entries.size(); ++i) {
+      (void)render(i);
+      if (progress) progress(fmt::format("warm-up {}/{} {}", w + 1, config.warmup, entries[i].entry.name));
     }
   for (int rep = 0; rep < config.repetitions; ++rep)
-    for (size_t i = 0; i < ps.size(); ++i) {
-      const StereoResult r = ps[i]->render(scene, rig, opts[i], ctx);
+    for (size_t i = 0; i < entries.size(); ++i) {
+      const StereoResult r = render(i);
       PipelineBench& b = result.pipelines[i];
-      b.name = config.pipelines[i];
       for (const auto& [stage, s] : r.timings.stages()) {
         if (!b.stage_seconds.count(stage)) b.stage_order.push_back(stage);
         b.stage_seconds[stage].push_back(s);

@@ -14,6 +14,12 @@
 
 namespace sb {
 
+/// What an entry of BenchConfig::pipelines runs.
+struct BenchEntry {
+  PipelineEntry entry;
+  PipelineOptions options;
+};
+
 struct BenchConfig {
   /// Entries, in report order: a registered pipeline's name, or a variant of it with options fixed
   /// in the entry, "NAME:KEY=VALUE[:KEY=VALUE...]" (e.g. "bidir-warp:occlusion=ztest").
@@ -24,21 +30,14 @@ struct BenchConfig {
   /// Per pipeline name; they apply to its variants too, under the variants' own options.
   std::map<std::string, std::map<std::string, std::string>> options;
 
-  /// InputError for repetitions < 1, warm-up < 0, unknown pipelines, malformed variants, an entry
-  /// named twice, a baseline not benchmarked, or options for a pipeline not benchmarked.
-  void validate() const;
-  /// The options given for an entry's pipeline (empty when none).
-  [[nodiscard]] const std::map<std::string, std::string>& given_for(const PipelineEntry& entry) const;
+  /// What each entry runs, in order: the entry parsed, and its options with those given for its
+  /// pipeline merged in under its own. InputError for repetitions < 1, warm-up < 0, unknown
+  /// pipelines, malformed variants or option values (naming the entry), an entry named twice, a
+  /// baseline not benchmarked, or options for a pipeline not benchmarked.
+  [[nodiscard]] std::vector<BenchEntry> entries() const;
+  /// The checks of entries(), when only they are wanted.
+  void validate() const { (void)entries(); }
 };
-
-/// What an entry of BenchConfig::pipelines runs: the entry parsed, and its options with those
-/// given for its pipeline merged in. InputError naming the entry for an unknown pipeline, a
-/// malformed KEY=VALUE or a bad option.
-struct BenchEntry {
-  PipelineEntry entry;
-  PipelineOptions options;
-};
-[[nodiscard]] BenchEntry bench_entry(const std::string& entry, const BenchConfig& config);
 
 /// The options given for the pipelines, as "PIPELINE.NAME=VALUE, ..." in order; empty when none.
 [[nodiscard]] std::string given_options(const BenchConfig& config);

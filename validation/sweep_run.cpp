@@ -281,8 +281,8 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
   bench.repetitions = d.repetitions;
   bench.options = d.options;
   json pipelines = json::object();
-  for (const std::string& name : d.pipelines) {
-    const BenchEntry entry = bench_entry(name, bench);  // the options the timed runs use
+  for (const BenchEntry& entry : bench.entries()) {
+    const std::string& name = entry.entry.name;
     const PipelineValidation v = validate_pipeline(target, entry.entry, entry.options, executor);
     const std::string stem = entry_file_stem(name);
     json record_images = json::object();

@@ -45,13 +45,6 @@ ValidationTarget prepare_target(const RenderScene& scene, const std::filesystem:
   return t;
 }
 
-PipelineValidation validate_pipeline(const ValidationTarget& target, const Pipeline& pipeline,
-                                     const PipelineOptions& options, const Executor& executor,
-                                     const MetricOptions& metric_options) {
-  return validate_pipeline(target, PipelineEntry{pipeline.info().name, &pipeline, {}}, options, executor,
-                           metric_options);
-}
-
 PipelineValidation validate_pipeline(const ValidationTarget& target, const PipelineEntry& entry,
                                      const PipelineOptions& options, const Executor& executor,
                                      const MetricOptions& metric_options) {

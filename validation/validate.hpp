@@ -56,11 +56,8 @@ struct PipelineValidation {
   double seconds_metrics = 0.0;  ///< time to measure (not part of the pipeline's timings)
 };
 
-/// Renders the pipeline and measures its right eye.
-[[nodiscard]] PipelineValidation validate_pipeline(const ValidationTarget& target, const Pipeline& pipeline,
-                                                   const PipelineOptions& options, const Executor& executor,
-                                                   const MetricOptions& metric_options = {});
-/// The same for an entry (a pipeline or a variant of one), recorded under the entry's name.
+/// Renders an entry (a pipeline or a variant of one) and measures its right eye, recorded under
+/// the entry's name.
 [[nodiscard]] PipelineValidation validate_pipeline(const ValidationTarget& target, const PipelineEntry& entry,
                                                    const PipelineOptions& options, const Executor& executor,
                                                    const MetricOptions& metric_options = {});

@@ -45,9 +45,9 @@ json validated_cell(const std::vector<std::pair<std::string, std::map<std::strin
   cell["rig"] = json::object();
   cell["baseline"] = runs.front().first;  // a cell's baseline is one of its pipelines
   for (const auto& [name, options] : runs) {
-    const Pipeline& p = find_pipeline(name);
+    const PipelineEntry entry = parse_pipeline_entry(name);
     const validation::PipelineValidation v =
-        validation::validate_pipeline(target, p, PipelineOptions(p.info(), options), executor);
+        validation::validate_pipeline(target, entry, entry.options(options), executor);
     const double total = v.result.timings.total();
     cell["pipelines"][name] = {
         {"validation", validation::validation_record(target, v, executor.threads(), json::object())},
