@@ -204,14 +204,17 @@ TEST(BenchOptions, GivenOptionsArePrintedAndRecorded) {
 
 TEST(BenchOptions, VariantsRunBesideTheirPipelineWithTheirOwnOptions) {
   test::ScratchDir dir("benchvariants");
-  const std::string common =
-      " --scene box-wall --resolution 32x18 -n 1 -w 0 --scenes-dir '" + (dir / "scenes").string() + "'";
+  const std::string scene =
+      " --scene box-wall --resolution 32x18 -n 1 --scenes-dir '" + (dir / "scenes").string() + "'";
+  const std::string common = scene + " -w 0";
   const CliRun b = test::run_cli(
       "bench --pipelines plain-raster,bidir-warp,bidir-warp:occlusion=ztest:max_crack=4 "
       "-o bidir-warp.max_crack=3 -o bidir-warp.segment=16 --json '" +
-      (dir / "bench.json").string() + "'" + common);
+      (dir / "bench.json").string() + "' -w 1" + scene);
   ASSERT_EQ(b.code, 0) << b.out;
-  EXPECT_NE(b.out.find("bidir-warp:occlusion=ztest:max_crack=4"), std::string::npos) << b.out;
+  EXPECT_NE(b.out.find("\nbidir-warp:occlusion=ztest:max_crack=4 "), std::string::npos) << b.out;
+  // Every progress line names the variant, the warm-up's too.
+  EXPECT_NE(b.out.find("warm-up 1/1 bidir-warp:occlusion=ztest:max_crack=4\n"), std::string::npos) << b.out;
   const json pipelines = json::parse(test::read_text(dir / "bench.json")).at("pipelines");
   ASSERT_EQ(pipelines.size(), 3u);
   EXPECT_EQ(pipelines[1].at("name"), "bidir-warp");
