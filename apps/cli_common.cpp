@@ -1,8 +1,13 @@
 // Shared command-line options.
 #include "apps/cli_common.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 
 #include <fmt/format.h>
@@ -129,6 +134,24 @@ bool names_file(const NamedPath& p) {
 }
 
 }  // namespace
+
+void prepare_output_folder(const std::string& folder, const char* option) {
+  namespace fs = std::filesystem;
+  const auto refuse = [&](const std::string& why) {
+    throw IoError(fmt::format("{} {}: {}; give a folder you can write", option, folder, why));
+  };
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (ec) refuse(fmt::format("cannot create the folder ({})", ec.message()));
+  if (!fs::is_directory(folder, ec)) refuse("it is not a folder");
+  // A probe file, made and removed: permissions, a read-only mount or a pseudo file system show
+  // here rather than when the first result is written.
+  const fs::path probe = fs::path(folder) / fmt::format(".stereobench-probe-{}", ::getpid());
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) refuse(fmt::format("cannot create a file in it ({})", std::strerror(errno)));
+  ::close(fd);
+  fs::remove(probe, ec);
+}
 
 void refuse_overwriting(std::initializer_list<NamedPath> inputs, std::initializer_list<NamedPath> outputs) {
   for (auto out = outputs.begin(); out != outputs.end(); ++out) {

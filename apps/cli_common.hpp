@@ -54,6 +54,11 @@ struct NamedPath {
 /// another spelling of it, or through a link. Empty paths and "-" (standard output) are skipped.
 void refuse_overwriting(std::initializer_list<NamedPath> inputs, std::initializer_list<NamedPath> outputs);
 
+/// Makes an output folder named by `option` (and its parents) and checks that files can be
+/// created in it, before any rendering: a folder that cannot be written fails at once, not after
+/// the work. IoError naming the option, the folder and the reason.
+void prepare_output_folder(const std::string& folder, const char* option);
+
 /// Checks a --threads value: 0 (all cores) or 1..1024; more than the cores is taken as the
 /// cores, with a note (the scheduler would run no more, yet the results would record them).
 [[nodiscard]] int checked_threads(int threads);

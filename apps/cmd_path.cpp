@@ -85,6 +85,7 @@ void run_path_command(const PathArgs& a) {
   if (auto why = provider->unavailable_reason())
     throw ToolError(fmt::format("--truth {}: the provider is unavailable: {}", a.truth, *why));
   const Executor executor(checked_threads(a.threads));
+  prepare_output_folder(a.out, "--out");
   scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
   const StereoRig rig = resolve_rig(loaded.scene, overrides);
   run.scene_file = loaded.file;

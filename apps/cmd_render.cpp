@@ -50,6 +50,7 @@ void run_render(const RenderArgs& a) {
   const Pipeline& pipeline = *entry.pipeline;
   const PipelineOptions options = entry.options(parse_key_values(a.options, "--option"));
   const Executor executor(checked_threads(a.threads));
+  prepare_output_folder(a.out, "--out");
   const scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
   const Scene& scene = loaded.scene;
   const size_t lights_in_file = loaded.lights_in_file;

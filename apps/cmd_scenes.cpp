@@ -65,6 +65,7 @@ void generate_scenes(const GenerateArgs& args) {
   if (!opt.params.empty() && names.size() != 1)
     throw InputError("--param applies to one scene; generate the scenes one at a time");
   for (const std::string& n : names) (void)scenes::find_generator(n);  // fail before writing anything
+  prepare_output_folder(args.out_dir, "--out");
   fmt::print("{:<15} {:>12} {:>10} {:>7} {:>12} {:>9}  {}\n", "scene", "triangles", "vertices", "lights", "bytes",
              "seconds", "file");
   for (const std::string& n : names) {

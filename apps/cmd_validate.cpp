@@ -85,6 +85,7 @@ void run_validate(const ValidateArgs& a) {
   if (auto why = provider->unavailable_reason())
     throw ToolError(fmt::format("--truth {}: the provider is unavailable: {}", a.truth, *why));
   const Executor executor(checked_threads(a.threads));
+  prepare_output_folder(a.out, "--out");
   const scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
   const Scene& scene = loaded.scene;
   const size_t lights_in_file = loaded.lights_in_file;

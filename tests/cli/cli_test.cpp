@@ -185,6 +185,28 @@ TEST(Cli, RenderScoresHolesOnlyWhenPixelsAreReprojected) {
   EXPECT_FALSE(nlohmann::json::parse(test::read_text(dir / "box-wall_plain-rt_stats.json")).contains("holes"));
 }
 
+TEST(Cli, AnOutputFolderThatCannotBeMadeFailsBeforeAnyWork) {
+  test::ScratchDir dir("outbad");
+  const std::filesystem::path file = dir / "a-file";
+  std::ofstream(file) << "not a folder\n";
+  const std::string out = (file / "results").string();
+  const std::string scenes = " --scenes-dir '" + (dir / "scenes").string() + "'";
+  for (const std::string& command : {"render --scene box-wall --pipeline plain-rt --resolution 32x18" + scenes,
+                                     "validate --scene box-wall --pipelines plain-rt --resolution 32x18" + scenes,
+                                     "path --scene box-wall --pipelines plain-rt --resolution 32x18" + scenes,
+                                     std::string("scenes generate box-wall")}) {
+    const std::string args = command + " --out '" + out + "'";
+    const CliRun r = run(args);
+    EXPECT_EQ(r.code, 4) << args << "\n" << r.out;
+    EXPECT_NE(r.out.find("--out " + out + ": cannot create the folder (Not a directory); give a folder you can write"),
+              std::string::npos)
+        << args << "\n"
+        << r.out;
+    // Refused before the scene was generated, let alone rendered.
+    EXPECT_FALSE(std::filesystem::exists(dir / "scenes")) << args;
+  }
+}
+
 TEST(Cli, RenderAndBenchRejectBadArguments) {
   test::ScratchDir dir("renderbad");
   const std::string bench_common = " --scenes-dir '" + (dir / "scenes").string() + "' --resolution 32x18";
