@@ -118,8 +118,9 @@ struct PipelineEntry {
 /// ("bidir-warp:occlusion=ztest" -> "bidir-warp@occlusion=ztest"; a pipeline's own name is kept).
 [[nodiscard]] std::string entry_file_stem(const std::string& entry);
 
-/// Parses every entry and refuses one named twice, or two whose file stems coincide (InputError;
-/// `what` names the list, e.g. "--pipelines").
+/// Parses every entry and refuses one named twice (also as the same variant with its options in
+/// another order), or two whose file stems coincide (InputError; `what` names the list, e.g.
+/// "--pipelines", at the head of the message; "" for none).
 [[nodiscard]] std::vector<PipelineEntry> parse_pipeline_entries(const std::vector<std::string>& names,
                                                                 const std::string& what);
 

@@ -192,7 +192,7 @@ void parse_pipelines(const Where& where, const toml::node& node, SweepDefinition
       where.fail(*e, path, fmt::format("lists '{}' twice", name));
     names.push_back(name);
     try {
-      (void)parse_pipeline_entries(names, path);  // variants whose files would coincide
+      (void)parse_pipeline_entries(names, "");  // variants whose files would coincide
     } catch (const InputError& err) {
       where.fail(*e, path, err.what());
     }
@@ -435,7 +435,7 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
   if (!d.baseline_listed) {
     d.pipelines.push_back(d.baseline);
     try {
-      (void)parse_pipeline_entries(d.pipelines, "sweep.pipelines");
+      (void)parse_pipeline_entries(d.pipelines, "");
     } catch (const InputError& err) {
       // The baseline is missing from the list, so the baseline or the list (or both) was given.
       const toml::node* at = sweep.get("baseline") ? sweep.get("baseline") : sweep.get("pipelines");

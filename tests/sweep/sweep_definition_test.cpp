@@ -199,6 +199,13 @@ TEST(SweepDefinition, BadValuesRejected) {
       {"[sweep]\nscenes = [\"spheres\", \"spheres:count=1000\"]\n",
        "lists one scene twice: 'spheres' and 'spheres:count=1000' differ only by parameters at their defaults"},
       {"[sweep]\npipelines = [\"repro-rtx\"]\n", "sweep.pipelines"},
+      // One configuration under two names used to be rendered and measured twice.
+      {"[sweep]\npipelines = [\"bidir-warp\",\n \"bidir-warp:occlusion=none\"]\n",
+       "def.toml:3: sweep.pipelines: 'bidir-warp' and 'bidir-warp:occlusion=none' differ only by options at their "
+       "defaults: the same bidir-warp; name it once"},
+      {"[sweep]\npipelines = [\"fw-warp:max_crack=1:warp=rows\", \"fw-warp:warp=rows:max_crack=1\"]\n",
+       "def.toml:2: sweep.pipelines: 'fw-warp:max_crack=1:warp=rows' and 'fw-warp:warp=rows:max_crack=1' "
+       "name the same variant of fw-warp; name it once"},
       {"[sweep]\nbaseline = \"nope\"\n", "sweep.baseline"},
       {"[sweep]\ntruths = [\"mitsuba\"]\n", "unknown ground-truth provider 'mitsuba'"},
       {"[sweep]\nname = 3\n", "sweep.name: must be a string, not an integer"},
