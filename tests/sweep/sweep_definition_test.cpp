@@ -2,8 +2,10 @@
 // expanded in a fixed order with stable ids, and every shipped definition loads.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "renderer/error.hpp"
 #include "renderer/pipeline.hpp"
@@ -388,7 +390,7 @@ TEST(SweepDefinition, ShippedDefinitionsLoad) {
     size_t pipelines;  // 0: every registered pipeline
   } shipped[] = {
       {"smoke.toml", 2, n_pipelines + 1},               // spheres × 2 interaxial; every pipeline and a variant
-      {"nightly.toml", 6 * 3 * 2, 0},                   // 6 scenes × 3 disparities × 2 resolutions
+      {"nightly.toml", 6 * 3 * 2, n_pipelines + 1},     // 6 scenes × 3 disparities × 2 resolutions; and a variant
       {"presets/wissmann-table2.toml", 3 * 2, 5},       // 3 scenes × HD, 4K
       {"presets/kim-table2.toml", 3, 6},                // 3 focal distances
       {"presets/kim-table3.toml", 3, 2},                // 3 triangle counts
@@ -417,7 +419,14 @@ TEST(SweepDefinition, ShippedDefinitionsLoad) {
   ASSERT_TRUE(nightly.gate_config.has_value());
   EXPECT_EQ(*nightly.gate_config, ci / "gate-nightly.toml");
   const validation::GateConfig gate = validation::load_gate_config(*nightly.gate_config);
-  EXPECT_GE(gate.rules.size(), 6u * 3u * n_pipelines) << "a rule per scene, max disparity and pipeline";
+  EXPECT_GE(gate.rules.size(), 6u * 3u * nightly.pipelines.size()) << "a rule per scene, max disparity and pipeline";
+  // Every pipeline (the variant too) has measured thresholds in every cell, not just the defaults.
+  for (const validation::SweepCell& cell : validation::expand_cells(nightly))
+    for (const std::string& pipeline : nightly.pipelines) {
+      std::vector<bool> used(gate.rules.size(), false);
+      (void)validation::thresholds_for(gate, pipeline, cell.scene.label, cell.id, &used);
+      EXPECT_NE(std::find(used.begin(), used.end(), true), used.end()) << pipeline << " in " << cell.id;
+    }
 }
 
 }  // namespace
