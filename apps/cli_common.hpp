@@ -59,6 +59,10 @@ void refuse_overwriting(std::initializer_list<NamedPath> inputs, std::initialize
 /// the work. IoError naming the option, the folder and the reason.
 void prepare_output_folder(const std::string& folder, const char* option);
 
+/// The same for the folder of an output file (a --json written after a long benchmark); nothing
+/// for "" (no file), "-" (standard output) or a bare file name (the current folder).
+void prepare_output_file_folder(const std::string& file, const char* option);
+
 /// Checks a --threads value: 0 (all cores) or 1..1024; more than the cores is taken as the
 /// cores, with a note (the scheduler would run no more, yet the results would record them).
 [[nodiscard]] int checked_threads(int threads);

@@ -91,6 +91,7 @@ void run_preset_command(const BenchArgs& a) {
   run.scenes_dir = a.scenes_dir;
   run.json_out = a.json_out;
   const Executor executor(checked_threads(a.threads));
+  prepare_output_file_folder(a.json_out, "--json");
   run_bench_preset(run, executor);
 }
 
@@ -100,6 +101,7 @@ void run_bench_command(const BenchArgs& a) {
   for (const Pipeline* p : pipelines()) all.push_back(p->info().name);
   const BenchConfig config = bench_config(a, all);
   const Executor executor(checked_threads(a.threads));
+  prepare_output_file_folder(a.json_out, "--json");
   const scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
   const std::string scene_file = loaded.file.string();
   refuse_overwriting({{"the scene file", &scene_file}}, {{"--json", &a.json_out}});

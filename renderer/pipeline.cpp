@@ -92,21 +92,6 @@ std::string entry_file_stem(const std::string& entry) {
   return stem;
 }
 
-namespace {
-
-/// The options an entry fixes to values other than its pipeline's defaults (as written).
-std::map<std::string, std::string> fixed_away_from_defaults(const PipelineEntry& e) {
-  std::map<std::string, std::string> out;
-  const std::vector<OptionSpec>& specs = e.pipeline->info().options;
-  for (const auto& [key, value] : e.fixed) {
-    const auto spec = std::find_if(specs.begin(), specs.end(), [&](const OptionSpec& o) { return o.name == key; });
-    if (spec == specs.end() || spec->default_value != value) out.emplace(key, value);
-  }
-  return out;
-}
-
-}  // namespace
-
 std::vector<PipelineEntry> parse_pipeline_entries(const std::vector<std::string>& names, const std::string& what) {
   // A caller that places the message itself (a sweep file's line and key) passes no list name.
   const std::string prefix = what.empty() ? "" : what + ": ";
@@ -114,19 +99,14 @@ std::vector<PipelineEntry> parse_pipeline_entries(const std::vector<std::string>
   std::map<std::string, std::string> stems;  // stem -> entry
   for (const std::string& name : names) {
     PipelineEntry entry = parse_pipeline_entry(name);
-    // One configuration under two names (options in another order, or fixed to their defaults)
-    // would be rendered and measured twice.
-    for (const PipelineEntry& e : entries) {
-      if (e.pipeline != entry.pipeline || e.name == name) continue;
-      if (e.fixed == entry.fixed)
+    // One variant under two names (its options in another order) would be rendered and measured
+    // twice. Entries that fix different options are not compared further: options given for the
+    // pipeline (--option, [options.NAME]) apply under each entry's own, so a variant that fixes a
+    // default is a configuration of its own.
+    for (const PipelineEntry& e : entries)
+      if (e.pipeline == entry.pipeline && e.fixed == entry.fixed && e.name != name)
         throw InputError(fmt::format("{}'{}' and '{}' name the same variant of {}; name it once", prefix, e.name, name,
                                      entry.pipeline->info().name));
-      if (fixed_away_from_defaults(e) == fixed_away_from_defaults(entry))
-        throw InputError(
-            fmt::format("{}'{}' and '{}' differ only by options at their defaults: the same {}; "
-                        "name it once",
-                        prefix, e.name, name, entry.pipeline->info().name));
-    }
     entries.push_back(std::move(entry));
     const auto [it, fresh] = stems.emplace(entry_file_stem(name), name);
     if (fresh) continue;

@@ -205,6 +205,20 @@ TEST(Cli, AnOutputFolderThatCannotBeMadeFailsBeforeAnyWork) {
     // Refused before the scene was generated, let alone rendered.
     EXPECT_FALSE(std::filesystem::exists(dir / "scenes")) << args;
   }
+  // bench writes --json after every repetition of every pipeline (of every preset row).
+  const std::string json = (file / "bench.json").string();
+  for (const std::string& command : {"bench --scene box-wall --pipelines plain-rt --baseline plain-rt" + scenes,
+                                     "bench --preset kim-focal --preset-rows 1" + scenes}) {
+    const std::string args = command + " --json '" + json + "'";
+    const CliRun r = run(args);
+    EXPECT_EQ(r.code, 4) << args << "\n" << r.out;
+    EXPECT_NE(r.out.find("--json " + json + ": its folder " + file.string() +
+                         ": cannot create the folder (Not a directory); give a path you can write"),
+              std::string::npos)
+        << args << "\n"
+        << r.out;
+    EXPECT_FALSE(std::filesystem::exists(dir / "scenes")) << args;
+  }
 }
 
 TEST(Cli, RenderAndBenchRejectBadArguments) {
