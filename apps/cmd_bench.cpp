@@ -57,7 +57,8 @@ double peak_rss_mib() {
   return u.ru_maxrss / 1024.0;
 }
 
-/// Pipelines, baseline, repetitions and options from the command line.
+/// Pipelines, baseline, repetitions and options from the command line, checked, and --json's
+/// folder made: all before any scene is loaded.
 BenchConfig bench_config(const BenchArgs& a, const std::vector<std::string>& default_pipelines) {
   BenchConfig config;
   config.pipelines = split_names(a.pipelines);
@@ -76,7 +77,8 @@ BenchConfig bench_config(const BenchArgs& a, const std::vector<std::string>& def
       throw InputError(fmt::format("--option {}={}: name it PIPELINE.OPTION=VALUE, e.g. plain-raster.tile=32", key, value));
     config.options[key.substr(0, dot)][key.substr(dot + 1)] = value;
   }
-  config.validate();  // before the scene is loaded
+  config.validate();
+  prepare_output_file_folder(a.json_out, "--json");
   return config;
 }
 
@@ -91,7 +93,6 @@ void run_preset_command(const BenchArgs& a) {
   run.scenes_dir = a.scenes_dir;
   run.json_out = a.json_out;
   const Executor executor(checked_threads(a.threads));
-  prepare_output_file_folder(a.json_out, "--json");
   run_bench_preset(run, executor);
 }
 
@@ -101,7 +102,6 @@ void run_bench_command(const BenchArgs& a) {
   for (const Pipeline* p : pipelines()) all.push_back(p->info().name);
   const BenchConfig config = bench_config(a, all);
   const Executor executor(checked_threads(a.threads));
-  prepare_output_file_folder(a.json_out, "--json");
   const scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
   const std::string scene_file = loaded.file.string();
   refuse_overwriting({{"the scene file", &scene_file}}, {{"--json", &a.json_out}});

@@ -189,34 +189,27 @@ TEST(Cli, AnOutputFolderThatCannotBeMadeFailsBeforeAnyWork) {
   test::ScratchDir dir("outbad");
   const std::filesystem::path file = dir / "a-file";
   std::ofstream(file) << "not a folder\n";
-  const std::string out = (file / "results").string();
   const std::string scenes = " --scenes-dir '" + (dir / "scenes").string() + "'";
-  for (const std::string& command : {"render --scene box-wall --pipeline plain-rt --resolution 32x18" + scenes,
-                                     "validate --scene box-wall --pipelines plain-rt --resolution 32x18" + scenes,
-                                     "path --scene box-wall --pipelines plain-rt --resolution 32x18" + scenes,
-                                     std::string("scenes generate box-wall")}) {
-    const std::string args = command + " --out '" + out + "'";
-    const CliRun r = run(args);
-    EXPECT_EQ(r.code, 4) << args << "\n" << r.out;
-    EXPECT_NE(r.out.find("--out " + out + ": cannot create the folder (Not a directory); give a folder you can write"),
-              std::string::npos)
-        << args << "\n"
-        << r.out;
-    // Refused before the scene was generated, let alone rendered.
-    EXPECT_FALSE(std::filesystem::exists(dir / "scenes")) << args;
-  }
+  const std::string out = (file / "results").string(), json = (file / "bench.json").string();
+  const std::string out_args = " --out '" + out + "'", json_args = " --json '" + json + "'";
+  const std::string out_error =
+      "--out " + out + ": cannot create the folder (Not a directory); give a folder you can write";
   // bench writes --json after every repetition of every pipeline (of every preset row).
-  const std::string json = (file / "bench.json").string();
-  for (const std::string& command : {"bench --scene box-wall --pipelines plain-rt --baseline plain-rt" + scenes,
-                                     "bench --preset kim-focal --preset-rows 1" + scenes}) {
-    const std::string args = command + " --json '" + json + "'";
+  const std::string json_error = "--json " + json + ": its folder " + file.string() +
+                                 ": cannot create the folder (Not a directory); give a path you can write";
+  const std::pair<std::string, std::string> cases[] = {
+      {"render --scene box-wall --pipeline plain-rt --resolution 32x18" + scenes + out_args, out_error},
+      {"validate --scene box-wall --pipelines plain-rt --resolution 32x18" + scenes + out_args, out_error},
+      {"path --scene box-wall --pipelines plain-rt --resolution 32x18" + scenes + out_args, out_error},
+      {"scenes generate box-wall" + out_args, out_error},
+      {"bench --scene box-wall --pipelines plain-rt --baseline plain-rt" + scenes + json_args, json_error},
+      {"bench --preset kim-focal --preset-rows 1" + scenes + json_args, json_error},
+  };
+  for (const auto& [args, error] : cases) {
     const CliRun r = run(args);
     EXPECT_EQ(r.code, 4) << args << "\n" << r.out;
-    EXPECT_NE(r.out.find("--json " + json + ": its folder " + file.string() +
-                         ": cannot create the folder (Not a directory); give a path you can write"),
-              std::string::npos)
-        << args << "\n"
-        << r.out;
+    EXPECT_NE(r.out.find(error), std::string::npos) << args << "\n" << r.out;
+    // Refused before the scene was generated, let alone rendered.
     EXPECT_FALSE(std::filesystem::exists(dir / "scenes")) << args;
   }
 }
