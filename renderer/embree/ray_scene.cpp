@@ -131,14 +131,14 @@ RayScene::~RayScene() {
 
 const char* RayScene::version() { return "Embree " RTC_VERSION_STRING; }
 
-void RayScene::intersect(std::span<const RayQuery> rays, std::span<RayHit> hits) const {
+void RayScene::intersect(std::span<const RayQuery> rays, std::span<RayHit> hits, uint32_t lanes) const {
   if (rays.size() > kRayPacket || hits.size() < rays.size())
     throw std::logic_error("RayScene::intersect takes at most 16 rays and as many hit slots");
   alignas(64) RTCRayHit16 rh;
   alignas(64) int valid[16];
   const int n = static_cast<int>(rays.size());
   for (int i = 0; i < 16; ++i) {
-    valid[i] = i < n ? -1 : 0;
+    valid[i] = i < n && (lanes >> i & 1u) != 0 ? -1 : 0;
     const RayQuery& q = rays[static_cast<size_t>(i < n ? i : 0)];
     rh.ray.org_x[i] = q.origin.x;
     rh.ray.org_y[i] = q.origin.y;
@@ -161,6 +161,7 @@ void RayScene::intersect(std::span<const RayQuery> rays, std::span<RayHit> hits)
   rtcIntersect16(valid, impl_->scene, &ctx, &rh);
   const auto& first = impl_->geometry->first_triangle;
   for (int i = 0; i < n; ++i) {
+    if (valid[i] == 0) continue;
     RayHit& h = hits[static_cast<size_t>(i)];
     if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) {
       h = RayHit{};

@@ -43,7 +43,9 @@ class RayScene {
   RayScene& operator=(const RayScene&) = delete;
 
   /// Closest hits of up to 16 rays. Back faces of single-sided meshes are skipped (front_facing()).
-  void intersect(std::span<const RayQuery> rays, std::span<RayHit> hits) const;
+  /// Only the lanes whose bit is set in `lanes` (bit i for ray i) are traced; the others' hits are
+  /// left as they were.
+  void intersect(std::span<const RayQuery> rays, std::span<RayHit> hits, uint32_t lanes = 0xFFFFu) const;
   /// Occlusion of up to 16 ray segments: blocked[i] = 1 when anything lies within [tnear, tfar].
   void occluded(std::span<const RayQuery> rays, std::span<uint8_t> blocked) const;
 

@@ -2,6 +2,7 @@
 #include "renderer/stages/trace.hpp"
 
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <vector>
 
@@ -29,8 +30,12 @@ class PacketTracer {
   PacketTracer& operator=(const PacketTracer&) = delete;
   ~PacketTracer() { flush(); }
 
-  /// Traces the rays of a block as one packet and queues the lanes whose bit is set in `wanted`
-  /// (bit i for lane i) for shading; background lanes are written at once.
+  /// Traces the lanes of a block whose bit is set in `wanted` (bit i for lane i) as one packet and
+  /// queues their surfaces for shading; background lanes are written at once. The other lanes are
+  /// not traced. A lane's closest hit does not depend on which lanes travel with it (only a tie
+  /// between two triangles at exactly the same distance could be resolved in another traversal
+  /// order), so a pixel traced alone gets the hit trace_eye's full blocks give it; the hole
+  /// fillers' bit-identity tests against plain-rt check exactly that.
   void trace(const PixelBlock& block, uint32_t wanted) {
     RayQuery rays[kRayPacket];
     RayHit hits[kRayPacket];
@@ -38,8 +43,8 @@ class PacketTracer {
     const uint32_t* pixels = block.index;
     for (int i = 0; i < n; ++i) rays[i] = rays_(block.x[i], block.y[i]);
     scene_.rays().intersect(std::span<const RayQuery>(rays, static_cast<size_t>(n)),
-                            std::span<RayHit>(hits, static_cast<size_t>(n)));
-    counts_.primary_rays += static_cast<uint64_t>(n);
+                            std::span<RayHit>(hits, static_cast<size_t>(n)), wanted);
+    counts_.primary_rays += static_cast<uint64_t>(std::popcount(wanted & ((1u << n) - 1u)));
     for (int i = 0; i < n; ++i) {
       if ((wanted >> i & 1u) == 0) continue;
       ++counts_.pixels_traced;
