@@ -18,14 +18,34 @@ namespace sb {
 
 namespace {
 
+/// How a tracer groups the surfaces it queues into shading batches.
+enum class Batching {
+  /// One batch: whole blocks, each shaded on its own (a 4x4 block's surfaces are coherent).
+  single,
+  /// By depth class: scattered pixels (hole strips) mix a near occluder's edge with the far
+  /// surface it uncovers, whose shadow rays towards a light diverge. Surfaces queued in separate
+  /// batches by depth class (classes a factor sqrt(2) wide, taken modulo kDepthClasses) keep each
+  /// packet of shadow rays on one surface: bistro's hole fill at 1920x1080 takes about 6 % less
+  /// time than with one batch (medians 107.0 / 107.7 ms -> 102.4 / 100.3 ms, two alternating runs
+  /// of `bench -n 5`). Every surface is shaded on its own, so images do not change.
+  by_depth,
+};
+
 /// Traces packets of up to 16 pixels; the surfaces they hit are shaded in batches of up to 16.
 class PacketTracer {
  public:
   PacketTracer(const RenderScene& scene, const EyeCamera& eye, const PrimaryRays& rays, Image& image, Source source,
-               TraceCounts& counts)
-      : scene_(scene), eye_(eye), rays_(rays), writer_(image),
-        tan_spread_(static_cast<float>(std::tan(ray_cone_spread(2.0 * std::atan(0.5 * eye.height / eye.f_px), eye.height)))),
-        origin_(eye.origin), source_(source), counts_(counts) {}
+               TraceCounts& counts, Batching batching)
+      : scene_(scene),
+        eye_(eye),
+        rays_(rays),
+        writer_(image),
+        tan_spread_(
+            static_cast<float>(std::tan(ray_cone_spread(2.0 * std::atan(0.5 * eye.height / eye.f_px), eye.height)))),
+        origin_(eye.origin),
+        source_(source),
+        counts_(counts),
+        batches_(batching == Batching::single ? 1 : kDepthClasses) {}
   PacketTracer(const PacketTracer&) = delete;
   PacketTracer& operator=(const PacketTracer&) = delete;
   ~PacketTracer() { flush(); }
@@ -52,32 +72,54 @@ class PacketTracer {
         writer_.background(pixels[i], scene_.scene().background, source_);
         continue;
       }
-      SurfacePoint& p = points_[m_];
+      const float depth = hits[i].t * cos_to_axis(eye_, rays[i].dir);
+      Batch& b = batches_[batches_.size() == 1 ? 0 : depth_class(depth)];
+      SurfacePoint& p = b.points[b.m];
       p = surface_at(scene_, hits[i].prim, hits[i].bary, vec3(origin_));
-      const float cos_axis = cos_to_axis(eye_, rays[i].dir);
       const ConeSection cone = primary_cone(hits[i].t, tan_spread_, rays[i].dir, vec3(-eye_.back));
-      albedo_[m_] = albedo_at(scene_, p, ray_cone_lod(scene_, p, cone, rays[i].dir));
-      depth_[m_] = hits[i].t * cos_axis;
-      where_[m_] = pixels[i];
-      if (++m_ == kRayPacket) flush();
+      b.albedo[b.m] = albedo_at(scene_, p, ray_cone_lod(scene_, p, cone, rays[i].dir));
+      b.depth[b.m] = depth;
+      b.where[b.m] = pixels[i];
+      if (++b.m == kRayPacket) flush(b);
     }
   }
 
-  /// Shades and writes the queued surfaces.
+  /// Shades and writes every queued surface.
   void flush() {
-    if (m_ == 0) return;
-    vec3 radiance[kRayPacket];
-    ShadeCounts sc;
-    const auto m = static_cast<size_t>(m_);
-    shade(scene_, std::span<const SurfacePoint>(points_, m), std::span<const vec3>(albedo_, m),
-          std::span<vec3>(radiance, m), sc);
-    counts_.shadow_rays += sc.shadow_rays;
-    counts_.pixels_shaded += sc.pixels_shaded;
-    for (size_t k = 0; k < m; ++k) writer_.surface(where_[k], points_[k], radiance[k], albedo_[k], depth_[k], source_);
-    m_ = 0;
+    for (Batch& b : batches_) flush(b);
   }
 
  private:
+  /// Surfaces queued for one call of shade().
+  struct Batch {
+    SurfacePoint points[kRayPacket];
+    vec3 albedo[kRayPacket];
+    float depth[kRayPacket] = {};
+    uint32_t where[kRayPacket] = {};
+    int m = 0;
+  };
+  static constexpr size_t kDepthClasses = 4;
+
+  /// floor(2 log2 depth) modulo kDepthClasses: neighbouring classes are a factor sqrt(2) apart.
+  static size_t depth_class(float depth) {
+    return static_cast<size_t>(static_cast<int>(std::floor(2.0f * std::log2(std::max(depth, 1e-6f))))) &
+           (kDepthClasses - 1);
+  }
+
+  void flush(Batch& b) {
+    if (b.m == 0) return;
+    vec3 radiance[kRayPacket];
+    ShadeCounts sc;
+    const auto m = static_cast<size_t>(b.m);
+    shade(scene_, std::span<const SurfacePoint>(b.points, m), std::span<const vec3>(b.albedo, m),
+          std::span<vec3>(radiance, m), sc);
+    counts_.shadow_rays += sc.shadow_rays;
+    counts_.pixels_shaded += sc.pixels_shaded;
+    for (size_t k = 0; k < m; ++k)
+      writer_.surface(b.where[k], b.points[k], radiance[k], b.albedo[k], b.depth[k], source_);
+    b.m = 0;
+  }
+
   const RenderScene& scene_;
   const EyeCamera& eye_;
   const PrimaryRays& rays_;
@@ -86,11 +128,7 @@ class PacketTracer {
   dvec3 origin_;
   Source source_;
   TraceCounts& counts_;
-  SurfacePoint points_[kRayPacket];
-  vec3 albedo_[kRayPacket];
-  float depth_[kRayPacket] = {};
-  uint32_t where_[kRayPacket] = {};
-  int m_ = 0;
+  std::vector<Batch> batches_;
 };
 
 /// Adds a task's counts into shared totals.
@@ -182,7 +220,7 @@ PixelBlocks state_blocks(std::span<const uint8_t> states, uint8_t done, int w, i
 void trace_blocks(const RenderScene& scene, const EyeCamera& eye, const PrimaryRays& rays, const PixelBlocks& b,
                   size_t begin, size_t end, Image& image, Source source, TraceCounts& counts) {
   const int w = image.width(), h = image.height();
-  PacketTracer tracer(scene, eye, rays, image, source, counts);
+  PacketTracer tracer(scene, eye, rays, image, source, counts, Batching::by_depth);
   for (size_t k = begin; k < end; ++k) {
     const uint32_t block = b.listed[k];
     const int bx = static_cast<int>(block % static_cast<uint32_t>(b.blocks_x));
@@ -209,7 +247,7 @@ void trace_listed(const RenderScene& scene, const EyeCamera& eye, const Executor
 
 void trace_rect(const RenderScene& scene, const EyeCamera& eye, const PrimaryRays& rays, const PixelRect& rect,
                 Image& image, TraceCounts& counts) {
-  PacketTracer tracer(scene, eye, rays, image, Source::traced, counts);
+  PacketTracer tracer(scene, eye, rays, image, Source::traced, counts, Batching::single);
   // One shading batch per block: a block's surfaces are shaded together.
   for_pixel_blocks(rect, image.width(), [&](const PixelBlock& block) {
     tracer.trace(block, kAllLanes);
