@@ -61,11 +61,29 @@ void run_update(const GateArgs& a, const fs::path& file) {
              changes.size() == 1 ? "y" : "ies", a.results);
 }
 
+/// Removes what an earlier gate run left at an output path, so that a run stopped by bad input
+/// leaves no verdict that looks like its own (a CI step publishing the JUnit file finds none).
+void remove_earlier_output(const std::string& path, const char* option) {
+  if (path.empty()) return;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return;  // a folder is refused while the arguments are read
+  if (!fs::remove(path, ec) || ec)
+    throw IoError(
+        fmt::format("cannot remove the earlier {} file {} before gating: {}; make it writable or give "
+                    "another path",
+                    option, path, ec ? ec.message() : "not removed"));
+}
+
 void run_gate(const GateArgs& a) {
   // The default baseline counts as an input too: a report written over ci/baseline.json would lose
   // the stored timings.
   const std::string baseline_path = a.baseline.empty() ? validation::kDefaultBaselineFile : a.baseline;
   if (a.update_baseline) {
+    if (!a.junit.empty() || !a.json_out.empty())
+      throw InputError(
+          fmt::format("{} writes a gate run's checks; --update-baseline only rewrites the baseline {}: "
+                      "drop {} or run the gate without --update-baseline",
+                      !a.junit.empty() ? "--junit" : "--json", baseline_path, !a.junit.empty() ? "--junit" : "--json"));
     refuse_overwriting({{"--results", &a.results}, {"--config", &a.config}}, {{"the baseline", &baseline_path}});
     run_update(a, baseline_path);
     return;
@@ -74,6 +92,8 @@ void run_gate(const GateArgs& a) {
     throw InputError("--only and --cells select what --update-baseline rewrites; add --update-baseline or drop them");
   refuse_overwriting({{"--results", &a.results}, {"--config", &a.config}, {"the baseline", &baseline_path}},
                      {{"--junit", &a.junit}, {"--json", &a.json_out}});
+  remove_earlier_output(a.junit, "--junit");
+  remove_earlier_output(a.json_out, "--json");
   const validation::GateConfig config = validation::load_gate_config(a.config);
   const validation::GateResults results = validation::load_gate_results(a.results);
 
@@ -116,8 +136,10 @@ void register_gate_command(CLI::App& root) {
       "The CI quality gate: apply the thresholds of a gate config (min PSNR, SSIM, disocclusion recall,\n"
       "speed-up; max hole and error-pixel fractions; time regression against a stored baseline by\n"
       "median, tolerance and a Mann-Whitney rank test) to every pipeline of every cell of a sweep's\n"
-      "results file. Exit 0 all pass, 1 warnings only, 2 any failure, 3 bad input. Each failure\n"
-      "comes with the `stereobench validate` command that re-measures it. See docs/gate.md.");
+      "results file. Exit 0 all pass, 1 warnings only, 2 any failure, 3 bad input, 4 an output that\n"
+      "cannot be written; on 3 and 4 no --junit or --json file is left (an earlier one is removed).\n"
+      "Each failure comes with the command that re-measures it: `stereobench validate` for quality,\n"
+      "`stereobench bench` for the speed-up and the time regression. See docs/gate.md.");
   g->add_option("--config", a->config, "Gate thresholds (TOML)")->capture_default_str();
   g->add_option("--results", a->results, "A sweep's results.jsonl")->required();
   g->add_option("--baseline", a->baseline,

@@ -139,8 +139,10 @@ void run_nightly(const NightlyArgs& a) {
   const GateConfig gate_config = load_gate_config(gate_file);
   const fs::path out = a.out.empty() ? fs::path("out") / "nightly" / d.name : fs::path(a.out);
   const fs::path history_file = a.history.empty() ? out / "history.jsonl" : fs::path(a.history);
-  // Read before any cell runs: a malformed history stops the run before it costs anything.
+  // Read before any cell runs: a malformed history stops the run before it costs anything, and so
+  // does a missing report asset (the report is written last).
   const HistoryFile history_before = read_history(history_file);
+  reports::check_report_assets(reports::report_assets_dir());
   for (const std::string& w : history_before.warnings) fmt::print(stderr, "warning: {}\n", w);
 
   Baseline baseline;

@@ -198,7 +198,8 @@ void register_reference_command(CLI::App& root, const std::string& command_line)
     add_scenes_dir_option(*c, a->scenes_dir);
   };
 
-  CLI::App* gen = ref->add_subcommand("generate", "Render a reference right eye and store it (replacing one of the same id)");
+  CLI::App* gen = ref->add_subcommand(
+      "generate", "Render a reference right eye and store it (replacing one of the same id made from the same scene)");
   add_common(gen);
   gen->add_option("--scene,-s", a->scene, "Scene file (.gltf/.glb) or built-in scene name")->capture_default_str();
   gen->add_option("--truth", a->truth, "Provider: full, blender or povray")->capture_default_str();

@@ -63,7 +63,7 @@ void refuse_folder_as_file(CLI::App& app) {
         [](const std::string& value) {
           std::error_code ec;
           return value != "-" && std::filesystem::is_directory(value, ec)
-                     ? std::string("is a folder; give the name of the file to write")
+                     ? value + " is a folder; give the name of the file to write"
                      : std::string();
         },
         "", "not a folder"));

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <unistd.h>
 
 #include <fmt/format.h>
@@ -193,6 +194,12 @@ void replace_folder(const fs::path& staged, const fs::path& dir) {
   fs::remove_all(old, ec);
 }
 
+/// The scene argument as the store records and compares it: a glTF path absolute and normal (so
+/// that `verify` and `update` find it from any working folder), a built-in name as given.
+std::string stored_scene(const std::string& scene) {
+  return scenes::is_scene_file_spec(scene) ? fs::absolute(scene).lexically_normal().string() : scene;
+}
+
 struct Prepared {
   scenes::LoadedScene loaded;
   std::optional<StereoRig> rig;
@@ -261,9 +268,26 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
   const std::unique_ptr<validation::TruthProvider> provider = validation::make_truth_provider(spec.provider);
   if (auto why = provider->unavailable_reason())
     throw ToolError(fmt::format("cannot generate a '{}' reference: {}", spec.provider, *why));
-  const Prepared p = prepare(spec, scenes_dir);
+  ReferenceSpec stored = spec;
+  stored.scene = stored_scene(spec.scene);
+  const Prepared p = prepare(stored, scenes_dir);
   const Scene& scene = p.loaded.scene;
-  const std::string id = reference_id(scene, spec, *p.rig);
+  const std::string id = reference_id(scene, stored, *p.rig);
+  // The id names the scene by its name alone: another file (or a built-in) of that name would
+  // silently take the entry's place. Regenerating from the same scene replaces it, as does an
+  // entry whose provenance cannot be read.
+  if (fs::exists(root_ / id / kProvenance)) {
+    std::optional<std::string> before;
+    try {
+      before = stored_scene(spec_of(id).scene);
+    } catch (const InputError&) {
+    }
+    if (before && *before != stored.scene)
+      throw InputError(fmt::format(
+          "reference '{}' in {} was made from scene {}, not {} (the id names only the scene's name, '{}'); give this "
+          "one another --store, or remove {} to replace it",
+          id, root_.string(), *before, stored.scene, scene.name, (root_ / id).string()));
+  }
   const fs::path staged = root_ / fmt::format(".{}.new-{}", id, getpid());
   std::error_code ec;
   fs::remove_all(staged, ec);
@@ -281,9 +305,11 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
         {"kind", "stereobench.reference"},
         {"version", 1},
         {"id", id},
-        {"spec", spec_to_json(spec)},
+        {"spec", spec_to_json(stored)},
         {"provider",
-         {{"name", render.provider}, {"tool_version", render.tool_version}, {"revision", provider->revision()},
+         {{"name", render.provider},
+          {"tool_version", render.tool_version},
+          {"revision", provider->revision()},
           // The provider ran its tool in request.work_dir inside the staging folder, both gone once
           // the entry is stored: the provenance writes that folder as $WORK and says so.
           {"settings", without_scratch_path(render.settings, request.work_dir)},
@@ -295,13 +321,21 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
                        kWorkPlaceholder, render.provider, render.provider)},
           {"seconds", render.seconds}}},
         {"scene",
-         {{"name", scene.name}, {"file", p.loaded.file.string()}, {"file_sha256", validation::hash_file(p.loaded.file)},
-          {"content_sha256", validation::hash_scene(scene)}, {"triangles", scene.triangle_count()},
-          {"lights", scene.lights.size()}, {"lights_in_file", p.loaded.lights_in_file}}},
+         {{"name", scene.name},
+          {"file", p.loaded.file.string()},
+          {"file_sha256", validation::hash_file(p.loaded.file)},
+          {"content_sha256", validation::hash_scene(scene)},
+          {"triangles", scene.triangle_count()},
+          {"lights", scene.lights.size()},
+          {"lights_in_file", p.loaded.lights_in_file}}},
         {"rig", rig_record(*p.rig)},
         {"image",
-         {{"file", kImage}, {"preview", kPreview}, {"width", right.width()}, {"height", right.height()},
-          {"sha256", validation::hash_file(staged / kImage)}, {"content_sha256", validation::hash_image(right)}}},
+         {{"file", kImage},
+          {"preview", kPreview},
+          {"width", right.width()},
+          {"height", right.height()},
+          {"sha256", validation::hash_file(staged / kImage)},
+          {"content_sha256", validation::hash_image(right)}}},
         {"command_line", command_line},
         {"date", utc_now()},
         {"stereobench_version", SB_VERSION_STRING},

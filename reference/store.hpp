@@ -69,7 +69,9 @@ class ReferenceStore {
   /// An entry's provenance; InputError naming the id and listing the store when it is absent.
   [[nodiscard]] nlohmann::json provenance(const std::string& id) const;
 
-  /// Renders the reference and stores it, replacing an entry of the same id. Returns the id.
+  /// Renders the reference and stores it, replacing an entry of the same id made from the same
+  /// scene; InputError when that entry was made from another scene of the same name. A glTF path
+  /// is stored absolute. Returns the id.
   std::string generate(const ReferenceSpec& spec, const std::filesystem::path& scenes_dir,
                        const std::string& command_line, const Executor& executor) const;
 

@@ -345,8 +345,7 @@ json report_data(const ResultsFile& results, const std::string& title, const jso
               {"warnings", results.warnings}};
 }
 
-ReportSummary write_report(const ResultsFile& results, const ReportOptions& options) {
-  const fs::path assets = options.assets_dir.empty() ? report_assets_dir() : options.assets_dir;
+void check_report_assets(const fs::path& assets) {
   for (const char* f : {kTemplate, kPapers})
     if (!fs::exists(assets / f))
       throw ToolError(fmt::format("report asset {} is missing; rebuild stereobench (the build copies reports/assets "
@@ -357,6 +356,11 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
       throw ToolError(fmt::format("report asset {} is missing: Chart.js comes from npm (ci/package.json); run "
                                   "`ci/install-deps.sh chromium` and rebuild stereobench",
                                   (assets / f).string()));
+}
+
+ReportSummary write_report(const ResultsFile& results, const ReportOptions& options) {
+  const fs::path assets = options.assets_dir.empty() ? report_assets_dir() : options.assets_dir;
+  check_report_assets(assets);
   json papers;
   try {
     papers = io::parse_json(io::read_file(assets / kPapers));

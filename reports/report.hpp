@@ -51,6 +51,10 @@ struct ReportSummary {
 /// time (the build tree's report-assets/, where the build copies reports/assets and Chart.js).
 [[nodiscard]] std::filesystem::path report_assets_dir();
 
+/// ToolError naming the first page asset missing from `assets` and how to get it back. write_report
+/// checks this itself; a long run that ends in a report checks it before it starts.
+void check_report_assets(const std::filesystem::path& assets);
+
 /// The paper experiment a sweep reproduces, by its name: "wissmann-table2", "kim-table2",
 /// "kim-table3", "al-hagri" (any "al-hagri-*"), or empty.
 [[nodiscard]] std::string paper_experiment(const std::string& sweep_name);

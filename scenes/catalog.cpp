@@ -71,11 +71,15 @@ fs::path default_scenes_dir() {
   return fs::path("out") / "scenes";
 }
 
+bool is_scene_file_spec(const std::string& spec) {
+  const std::string ext = fs::path(spec).extension().string();
+  return ext == ".gltf" || ext == ".glb" || spec.find('/') != std::string::npos;
+}
+
 fs::path resolve_scene(const std::string& spec, const fs::path& scenes_dir) {
   std::error_code ec;
   const fs::path as_path(spec);
-  const std::string ext = as_path.extension().string();
-  if (ext == ".gltf" || ext == ".glb" || spec.find('/') != std::string::npos) {
+  if (is_scene_file_spec(spec)) {
     if (!fs::exists(as_path, ec))
       throw InputError(fmt::format("{}: scene file does not exist; check the path, or give a built-in scene "
                                    "name (see `stereobench scenes list`)", spec));

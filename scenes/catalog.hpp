@@ -15,6 +15,10 @@ namespace sb::scenes {
 /// The folder built-in scenes are generated into: $STEREOBENCH_SCENES if set, else out/scenes.
 [[nodiscard]] std::filesystem::path default_scenes_dir();
 
+/// Whether a scene argument names a glTF file (a .gltf/.glb extension, or a '/' in it) rather than
+/// a built-in scene.
+[[nodiscard]] bool is_scene_file_spec(const std::string& spec);
+
 /// A path to an existing .gltf/.glb file is returned as is. A built-in scene name returns
 /// `<scenes_dir>/<file>`, generated (with default seed and parameters) when missing or written by
 /// another version of the generator

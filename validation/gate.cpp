@@ -8,6 +8,7 @@
 #include <limits>
 #include <set>
 #include <sstream>
+#include <string_view>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -16,6 +17,7 @@
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/pipeline.hpp"
+#include "scenes/catalog.hpp"
 #include "validation/results_file.hpp"
 
 namespace sb::validation {
@@ -477,7 +479,8 @@ ReproduceSettings registered_reproduce_settings() {
   return settings;
 }
 
-std::string reproduce_command(const GateCell& cell, const std::string& pipeline, const ReproduceSettings& settings) {
+std::string reproduce_command(const GateCell& cell, const std::string& pipeline, const ReproduceSettings& settings,
+                              Remeasure what) {
   const json& rec = cell.record;
   const json& c = rec.value("cell", json::object());
   const json& rig = rec.value("rig", json::object());
@@ -488,7 +491,8 @@ std::string reproduce_command(const GateCell& cell, const std::string& pipeline,
     return obj[key].get<double>();
   };
 
-  std::vector<std::string> args{"stereobench", "validate"};
+  const bool timing = what == Remeasure::timing;
+  std::vector<std::string> args{"stereobench", timing ? "bench" : "validate"};
   auto add = [&](const std::string& flag, const std::string& value) {
     args.push_back(flag);
     args.push_back(shell_quote(value));
@@ -504,17 +508,29 @@ std::string reproduce_command(const GateCell& cell, const std::string& pipeline,
                                static_cast<uint64_t>(*num(rec, "cell_count"))));
     return join_args(args);
   }
-  // A parameterised scene is generated into a file of its own: name that file.
+  // A parameterised scene is generated into a file of its own, and a glTF file is written in the
+  // definition relative to the definition's folder: name the file the sweep loaded.
   std::string scene = cell.scene;
   const json& params = c.value("scene_params", json::object());
-  if (params.is_object() && !params.empty() && validation.contains("scene") && validation["scene"].is_object() &&
+  if (((params.is_object() && !params.empty()) || scenes::is_scene_file_spec(cell.scene)) &&
+      validation.contains("scene") && validation["scene"].is_object() &&
       validation["scene"].value("path", json()).is_string())
     scene = validation["scene"]["path"].get<std::string>();
   add("--scene", scene);
   add("--pipelines", pipeline);
-  std::string truth = "full";
-  if (c.value("truth", json()).is_string()) truth = c["truth"].get<std::string>();
-  add("--truth", truth);
+  if (timing) {
+    add("--baseline", rec.value("baseline", json()).is_string() ? rec["baseline"].get<std::string>() : pipeline);
+    const json& t = entry.value("timing", json::object());
+    if (const auto n = num(t, "repetitions"); n && *n >= 1)
+      add("--repetitions", fmt::format("{}", static_cast<int>(*n)));
+    if (const auto w = num(t, "warmup"); w && *w >= 0) add("--warmup", fmt::format("{}", static_cast<int>(*w)));
+    if (const auto threads = num(rec, "threads"); threads && *threads >= 1)
+      add("--threads", fmt::format("{}", static_cast<int>(*threads)));
+  } else {
+    std::string truth = "full";
+    if (c.value("truth", json()).is_string()) truth = c["truth"].get<std::string>();
+    add("--truth", truth);
+  }
   if (c.value("resolution", json()).is_string())
     add("--resolution", c["resolution"].get<std::string>());
   else if (num(rig, "width") && num(rig, "height"))
@@ -533,7 +549,7 @@ std::string reproduce_command(const GateCell& cell, const std::string& pipeline,
     const int count = static_cast<int>(used ? std::min(*used, *lights) : *lights);
     if (count > 0) add("--lights", fmt::format("{}", count));  // an unlit scene takes no --lights
   }
-  if (const auto t = num(validation.value("metrics", json::object()), "error_threshold"); t && *t != 2.0)
+  if (const auto t = num(validation.value("metrics", json::object()), "error_threshold"); !timing && t && *t != 2.0)
     add("--error-threshold", fmt::format("{}", static_cast<int>(*t)));
   const json& options = validation.value("options", json::object());
   if (options.is_object()) {
@@ -667,7 +683,8 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
     const std::string where = fmt::format("{}: cell '{}'", results.file.string(), cell.cell_id);
     for (const auto& [pipeline, entry] : cell.record["pipelines"].items()) {
       const ThresholdValues limits = thresholds_for(config, pipeline, cell.scene, cell.cell_id, &rule_used);
-      const std::string command = reproduce_command(cell, pipeline, reproduce);
+      const std::string quality_command = reproduce_command(cell, pipeline, reproduce, Remeasure::quality);
+      const std::string timing_command = reproduce_command(cell, pipeline, reproduce, Remeasure::timing);
       auto limit = [&](const char* key) -> std::optional<double> {
         const auto it = limits.find(key);
         return it == limits.end() ? std::nullopt : it->second;
@@ -676,12 +693,16 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
         check.cell_id = cell.cell_id;
         check.scene = cell.scene;
         check.pipeline = pipeline;
-        check.reproduce = command;
+        const bool timed = check.check == kRegressionCheck || check.check == std::string_view("speedup");
+        check.reproduce = timed ? timing_command : quality_command;
         report.checks.push_back(std::move(check));
       };
+      // The baseline's speed-up over itself is 1 by definition: a minimum speed-up is for the others.
+      const bool is_baseline = cell.record.value("baseline", json()) == json(pipeline);
 
       // Thresholds.
       for (const MetricCheck& mc : kMetricChecks) {
+        if (is_baseline && mc.name == std::string_view("speedup")) continue;
         GateCheck check;
         check.check = mc.name;
         check.fail_limit = limit(mc.fail_key);

@@ -159,7 +159,7 @@ struct GateCheck {
   std::optional<double> fail_limit;  ///< the limit in force (regression: the tolerance)
   std::optional<double> warn_limit;
   std::string message;    ///< one line: what was measured against what
-  std::string reproduce;  ///< `stereobench validate ...` re-measuring the cell
+  std::string reproduce;  ///< the command re-measuring the cell (reproduce_command)
 };
 
 /// Everything one gate run decided.
@@ -185,11 +185,19 @@ struct ReproduceSettings {
 [[nodiscard]] GateReport evaluate_gate(const GateConfig& config, const GateResults& results, const Baseline& baseline,
                                        const ReproduceSettings& reproduce = {});
 
-/// The `stereobench validate` command line that re-measures one pipeline of a cell: scene, pipeline,
-/// truth, resolution, interaxial (or max disparity), convergence, light count, error threshold, and
-/// the pipeline options that differ from the defaults.
+/// What a reproduce command measures again.
+enum class Remeasure {
+  quality,  ///< `stereobench validate`: the images, for PSNR, SSIM, errors and holes
+  timing,   ///< `stereobench bench`: the times, for the speed-up and the time regression
+};
+
+/// The command line that re-measures one pipeline of a cell: scene (a glTF file by the path the
+/// sweep loaded it from), pipeline, resolution, interaxial (or max disparity), convergence, light
+/// count and the pipeline options that differ from the defaults; for `quality` also the truth and
+/// the error threshold, for `timing` the cell's baseline, repetitions, warm-up runs and threads.
+/// A frame of a camera path is re-measured by running its sweep cell again.
 [[nodiscard]] std::string reproduce_command(const GateCell& cell, const std::string& pipeline,
-                                            const ReproduceSettings& settings);
+                                            const ReproduceSettings& settings, Remeasure what = Remeasure::quality);
 
 /// The readable table: one row per check that did not pass, then the counts.
 [[nodiscard]] std::string format_gate_table(const GateReport& report);

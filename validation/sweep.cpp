@@ -16,6 +16,7 @@
 #include "renderer/pipeline.hpp"
 #include "renderer/rig.hpp"
 #include "renderer/scene.hpp"
+#include "scenes/catalog.hpp"
 #include "scenes/generators.hpp"
 #include "validation/content_hash.hpp"
 #include "validation/truth.hpp"
@@ -41,10 +42,11 @@ class Where {
     fail(at.source(), key_path, what);
   }
   [[nodiscard]] const fs::path& file() const { return file_; }
-  /// A path written in the definition: absolute as given, otherwise relative to its folder.
+  /// A path written in the definition: absolute as given, otherwise relative to its folder; made
+  /// absolute, so that results name the file wherever they are read (the gate's reproduce commands).
   [[nodiscard]] fs::path beside(const std::string& path) const {
     const fs::path p(path);
-    return p.is_absolute() ? p : file_.parent_path() / p;
+    return (p.is_absolute() ? p : fs::absolute(file_.parent_path() / p)).lexically_normal();
   }
 
  private:
@@ -137,16 +139,11 @@ std::vector<std::optional<double>> positive_axis(const Where& where, const toml:
   return out;
 }
 
-bool is_file_spec(const std::string& text) {
-  const std::string ext = fs::path(text).extension().string();
-  return ext == ".gltf" || ext == ".glb" || text.find('/') != std::string::npos;
-}
-
 SweepScene parse_scene_entry(const Where& where, const toml::node& node, const std::string& path) {
   const std::string text = string_at(where, node, path);
   if (text.find('|') != std::string::npos)
     where.fail(node, path, fmt::format("'{}' contains '|', which separates the parts of a cell id; rename the file", text));
-  if (!is_file_spec(text)) {
+  if (!scenes::is_scene_file_spec(text)) {
     try {
       return parse_builtin_scene(text);
     } catch (const InputError& e) {

@@ -76,9 +76,11 @@ TEST(Cli, BadArgumentsExitWith3AndSayWhy) {
       {"scenes generate spheres --seed 1e3 --out '" + dir.path().string() + "'", "not 1e3"},
       // A folder where a file is to be written: refused before the work, not when writing it.
       {"bench --scene " + scene + " --resolution 16x9 --pipelines plain-rt --json '" + dir.path().string() + "'",
-       "--json: is a folder; give the name of the file to write"},
-      {"sweep collect '" + dir.path().string() + "' a.jsonl", "out: is a folder; give the name of the file to write"},
-      {"gate --results a.jsonl --junit '" + dir.path().string() + "'", "--junit: is a folder"},
+       "--json: " + dir.path().string() + " is a folder; give the name of the file to write"},
+      {"sweep collect '" + dir.path().string() + "' a.jsonl",
+       "out: " + dir.path().string() + " is a folder; give the name of the file to write"},
+      {"gate --results a.jsonl --junit '" + dir.path().string() + "'",
+       "--junit: " + dir.path().string() + " is a folder"},
       {"sweep run x.toml --executor slurm --shards -1", "--shards: Value -1 not in range 1 to 1000000"},
       {"sweep run x.toml --executor slurm --shards 0", "--shards: Value 0 not in range 1 to 1000000"},
   };

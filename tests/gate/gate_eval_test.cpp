@@ -209,6 +209,15 @@ TEST(GateEval, BaselineUpdateTouchesOnlyWhatIsNamed) {
   run = run_cli("gate --update-baseline --cells 'spheres|*' --results " + (dir / "results.jsonl").string() +
                 " --baseline " + (dir / "baseline.json").string());
   EXPECT_EQ(run.code, 3) << run.out;
+  // --junit and --json belong to a gate run: refused beside --update-baseline, not ignored.
+  const std::string kept = read_text(dir / "baseline.json");
+  run = run_cli("gate --update-baseline --only repro-rt --results " + (dir / "results.jsonl").string() +
+                " --baseline " + (dir / "baseline.json").string() + " --junit " + (dir / "j.xml").string());
+  EXPECT_EQ(run.code, 3) << run.out;
+  EXPECT_NE(run.out.find("--junit writes a gate run's checks; --update-baseline only rewrites the baseline"),
+            std::string::npos)
+      << run.out;
+  EXPECT_EQ(read_text(dir / "baseline.json"), kept);
 }
 
 TEST(GateCli, ExitCodesAndOutputs) {
@@ -352,6 +361,24 @@ TEST(GateCli, BadInputIsExitThree) {
   run = run_cli("gate --config " + (dir / "empty.toml").string() + " --results " + (dir / "pass.jsonl").string());
   EXPECT_EQ(run.code, 3) << run.out;
   EXPECT_NE(run.out.find("sets no threshold"), std::string::npos) << run.out;
+
+  // A run stopped by bad input leaves no JUnit or JSON file: an earlier run's passing verdict at
+  // those paths is removed, so a CI step that publishes them cannot show it as this run's.
+  const std::string outputs = " --junit " + (dir / "junit.xml").string() + " --json " + (dir / "gate.json").string();
+  run = run_cli("gate" + config + " --results " + (dir / "pass.jsonl").string() + outputs);
+  ASSERT_EQ(run.code, 0) << run.out;
+  ASSERT_TRUE(std::filesystem::exists(dir / "junit.xml"));
+  ASSERT_TRUE(std::filesystem::exists(dir / "gate.json"));
+  run = run_cli("gate" + config + " --results " + (dir / "damaged.jsonl").string() + outputs);
+  EXPECT_EQ(run.code, 3) << run.out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "junit.xml"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "gate.json"));
+  // A folder given as an output is bad input naming it.
+  run = run_cli("gate" + config + " --results " + (dir / "pass.jsonl").string() + " --junit " + dir.path().string());
+  EXPECT_EQ(run.code, 3) << run.out;
+  EXPECT_NE(run.out.find("--junit: " + dir.path().string() + " is a folder; give the name of the file to write"),
+            std::string::npos)
+      << run.out;
 }
 
 TEST(GateEval, AnUnfinishedSweepFails) {
@@ -407,6 +434,46 @@ TEST(GateEval, ReproduceNamesAVariantWithoutRepeatingItsOwnOptions) {
   EXPECT_NE(command.find("--option max_crack=3"), std::string::npos) << "given for the pipeline: " << command;
   EXPECT_EQ(command.find("--option occlusion"), std::string::npos) << "fixed by the name: " << command;
   EXPECT_EQ(command.find("--option tile"), std::string::npos) << "at its default: " << command;
+}
+
+TEST(GateEval, ReproduceNamesTheSceneFileTheSweepLoaded) {
+  // A definition in defs/ lists "../scenes/bw.gltf": relative to its own folder, which is not where
+  // the gate runs. The command names the file the sweep loaded; a built-in keeps its name.
+  json cell = fake_cell(1, 0.064, {FakePipeline{}}, "../scenes/bw.gltf");
+  cell["pipelines"][FakePipeline{}.name]["validation"]["scene"] = {{"path", "/work/scenes/bw.gltf"}};
+  const validation::GateCell file{cell["cell_id"], "../scenes/bw.gltf", cell};
+  const std::string command = validation::reproduce_command(file, FakePipeline{}.name, {});
+  EXPECT_NE(command.find("--scene /work/scenes/bw.gltf "), std::string::npos) << command;
+  json builtin = fake_cell(1, 0.064, {FakePipeline{}});
+  builtin["pipelines"][FakePipeline{}.name]["validation"]["scene"] = {{"path", "/cache/box-wall.gltf"}};
+  const validation::GateCell named{builtin["cell_id"], "box-wall", builtin};
+  EXPECT_NE(validation::reproduce_command(named, FakePipeline{}.name, {}).find("--scene box-wall "), std::string::npos);
+}
+
+TEST(GateEval, TimesAreReproducedByBenchAndTheBaselineHasNoSpeedupCheck) {
+  json cell =
+      fake_cell(0, 0.064, {{"plain-rt", 90, 1.0, 0, 0, 1, 1.0}, {"repro-rt", 45, 0.998, 0.001, 0.01, 1.0, 1.1}});
+  cell["cell_count"] = 1;
+  cell["threads"] = 2;
+  const std::string config = kConfig + "[[rule]]\nmin_speedup = 1.2\n";  // every pipeline, the baseline too
+  const validation::GateReport r = evaluate({cell}, {}, config);
+  const validation::GateCheck* speedup = find_check(r, "repro-rt", "speedup");
+  ASSERT_NE(speedup, nullptr);
+  EXPECT_EQ(speedup->verdict, Verdict::fail);
+  EXPECT_EQ(speedup->reproduce,
+            "stereobench bench --scene box-wall --pipelines repro-rt --baseline plain-rt --repetitions 3 --warmup 0 "
+            "--threads 2 --resolution 320x180 --interaxial 0.064 --convergence 2")
+      << "a speed-up is measured by timing, not by validate";
+  const validation::GateCheck* regression = find_check(r, "repro-rt", "time_regression");
+  ASSERT_NE(regression, nullptr);
+  EXPECT_EQ(regression->reproduce, speedup->reproduce);
+  const validation::GateCheck* psnr = find_check(r, "repro-rt", "psnr");
+  ASSERT_NE(psnr, nullptr);
+  EXPECT_EQ(psnr->reproduce.rfind("stereobench validate --scene box-wall --pipelines repro-rt --truth full", 0), 0u)
+      << psnr->reproduce;
+  // plain-rt is the cell's baseline: its speed-up over itself is 1, so the rule does not apply.
+  EXPECT_EQ(find_check(r, "plain-rt", "speedup"), nullptr);
+  EXPECT_NE(find_check(r, "plain-rt", "psnr"), nullptr);
 }
 
 TEST(GateEval, ARuleThatMatchesNothingIsNoted) {

@@ -288,6 +288,16 @@ TEST(NightlyTest, MalformedHistoryIsBadInputNamingFileAndLine) {
   run_folders = 0;
   for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs")) run_folders += e.is_directory() ? 1 : 0;
   EXPECT_EQ(run_folders, 0u);
+
+  // The report comes last, but its missing page assets are a missing tool found before the sweep.
+  fs::create_directories(dir / "no-assets");
+  const test::CliRun assets =
+      run_shell("STEREOBENCH_REPORT_ASSETS=" + quoted(dir / "no-assets") + " " + SB_CLI_PATH + " " + nightly_args(dir));
+  EXPECT_EQ(assets.code, 4) << assets.out;
+  EXPECT_NE(assets.out.find("report asset " + (dir / "no-assets").string()), std::string::npos) << assets.out;
+  run_folders = 0;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs")) run_folders += e.is_directory() ? 1 : 0;
+  EXPECT_EQ(run_folders, 0u);
 }
 
 TEST(NightlyTest, HistoryLinesWithImpossibleValuesAreRefused) {

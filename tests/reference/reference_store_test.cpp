@@ -180,6 +180,30 @@ TEST(ReferenceStore, DamagedProvenanceIsAFindingNotAStop) {
   EXPECT_NE(negative.out.find("--min-psnr -1 is not a PSNR in dB"), std::string::npos) << negative.out;
 }
 
+TEST(ReferenceStore, AnotherSceneOfTheSameNameDoesNotReplaceAnEntry) {
+  test::ScratchDir dir;
+  // A copy of box-wall as a file of its own: the same scene name, hence the same id.
+  const fs::path copy = dir / "bw.gltf";
+  fs::copy_file(scenes::resolve_scene("box-wall", kScenes), copy);
+  const std::string args = " --resolution 32x18 --threads 1";
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene " + quoted(copy) + args).code, 0);
+  const ReferenceStore store(dir / "store");
+  ASSERT_EQ(store.ids().size(), 1u);
+  const std::string id = store.ids()[0];
+  EXPECT_EQ(store.spec_of(id).scene, copy.string()) << "a file is recorded by its absolute path";
+  const std::string before = test::read_text(dir / "store" / id / "provenance.json");
+  const test::CliRun other = test::run_cli(ref(dir, "generate") + " --scene box-wall" + args);
+  EXPECT_EQ(other.code, 3) << other.out;
+  EXPECT_NE(other.out.find("reference '" + id + "' in " + (dir / "store").string() + " was made from scene " +
+                           copy.string() + ", not box-wall"),
+            std::string::npos)
+      << other.out;
+  EXPECT_EQ(test::read_text(dir / "store" / id / "provenance.json"), before);
+  // The same scene again replaces its entry, as `reference update` does.
+  EXPECT_EQ(test::run_cli(ref(dir, "generate") + " --scene " + quoted(copy) + args).code, 0);
+  EXPECT_EQ(store.ids().size(), 1u);
+}
+
 TEST(ReferenceStore, ChangedSceneIsReported) {
   test::ScratchDir dir;
   // A scene file of our own, changed after the reference was made.

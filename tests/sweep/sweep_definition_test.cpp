@@ -237,6 +237,11 @@ TEST(SweepDefinition, GltfScenesResolveAgainstTheDefinitionsFolder) {
   EXPECT_FALSE(d.scenes[0].builtin);
   EXPECT_EQ(d.scenes[0].file, dir / "defs" / "scenes" / "a.gltf");
   EXPECT_EQ(d.scenes[0].label, "scenes/a.gltf");  // ids do not depend on where the checkout is
+  // A definition named relative to the working folder still gives an absolute, normal file path.
+  const fs::path relative = fs::relative(dir / "defs" / "x.toml");
+  const SweepDefinition r = parse_sweep("[sweep]\nscenes = [\"../defs/scenes/a.gltf\"]\n", relative);
+  ASSERT_EQ(r.scenes.size(), 1u);
+  EXPECT_EQ(r.scenes[0].file, fs::absolute(dir / "defs" / "scenes" / "a.gltf").lexically_normal());
 }
 
 TEST(SweepDefinition, GateConfigResolvesAgainstTheDefinitionsFolder) {
