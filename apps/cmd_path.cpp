@@ -102,7 +102,7 @@ void run_path_command(const PathArgs& a) {
              run.path.camera_keys.empty() ? "the scene's camera" : fmt::format("{} camera keys", run.path.camera_keys.size()),
              a.spin_deg ? fmt::format(", meshes turning {} deg per frame (BVH {})", *a.spin_deg, a.bvh) : "",
              describe(rig), provider->name());
-  const fs::path lines = fs::path(a.out) / fmt::format("{}_path.jsonl", loaded.scene.name);
+  const fs::path lines = fs::path(a.out) / fmt::format("{}_path.jsonl", loaded.scene.file_stem());
   std::string text;
   std::map<std::string, std::vector<double>> frame_s, psnr;
   std::vector<double> bvh_s;

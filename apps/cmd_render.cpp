@@ -63,7 +63,7 @@ void run_render(const RenderArgs& a) {
   if (holes) record["holes"] = io::holes_to_json(*holes);
   record["scene"]["lights"] = scene.lights.size();
   record["scene"]["lights_in_file"] = lights_in_file;
-  const std::string stem = fmt::format("{}_{}", scene.name, entry_file_stem(entry.name));
+  const std::string stem = fmt::format("{}_{}", scene.file_stem(), entry_file_stem(entry.name));
   const io::RenderFiles files =
       io::write_render_outputs(a.out, stem, result, record, holes ? &holes->overlay : nullptr);
   fmt::print("{} on {} ({} triangles, {}), {}, {} threads\n", entry.name, scene.name, scene.triangle_count(),

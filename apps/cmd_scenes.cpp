@@ -70,10 +70,12 @@ void generate_scenes(const GenerateArgs& args) {
              "seconds", "file");
   for (const std::string& n : names) {
     const scenes::GeneratorInfo& g = scenes::find_generator(n);
-    // Default scenes are stamped so that commands naming them reuse the file.
+    // Default scenes are stamped so that commands naming them reuse the file; another seed or
+    // parameters get a file name of their own, so that they never stand in for the default.
     const bool builtin = opt.seed == 1 && opt.params.empty();
-    const scenes::GenerateResult r = builtin ? scenes::generate_builtin(n, args.out_dir)
-                                             : scenes::generate(n, opt, fs::path(args.out_dir) / g.file_name);
+    const scenes::GenerateResult r =
+        builtin ? scenes::generate_builtin(n, args.out_dir)
+                : scenes::generate(n, opt, fs::path(args.out_dir) / scenes::variant_file_name(g, opt.seed, opt.params));
     fmt::print("{:<15} {:>12} {:>10} {:>7} {:>12} {:>9.2f}  {}\n", n, r.triangles, r.vertices, r.lights, r.bytes,
                r.seconds, r.path.string());
   }
@@ -145,7 +147,9 @@ void register_scenes_command(CLI::App& root) {
   g->add_option("names", gen->names, "Scenes to generate (see `scenes list`)");
   g->add_flag("--all", gen->all, "Generate every built-in scene with default parameters");
   g->add_option("--out,-o", gen->out_dir, "Output folder")->capture_default_str();
-  g->add_option("--seed", gen->seed, "Random seed; same seed, same file")
+  g->add_option("--seed", gen->seed,
+                "Random seed; same seed, same file. With another seed than 1 or a --param the file is named\n"
+                "after them (spheres_seed-35_count-500.glb); commands naming the scene load the default file")
       ->check(CLI::Validator(
           [](const std::string& v) {
             // Decimal digits only, and within 64 bits: the parser would saturate 2^64 and above.

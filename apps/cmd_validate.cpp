@@ -105,8 +105,8 @@ void run_validate(const ValidateArgs& a) {
              target.truth.render.tool_version, target.truth.cached ? "from the cache, rendered in " : "",
              target.truth.render.seconds,
              100.0 * double(target.disocclusions.count()) / double(target.truth_srgb8.pixel_count()));
-  const std::string scene_stem = fmt::format("{}_{}", scene.name, provider->name());
-  const json shared_images = validation::write_target_images(out, scene.name, target, executor);
+  const std::string scene_stem = fmt::format("{}_{}", scene.file_stem(), provider->name());
+  const json shared_images = validation::write_target_images(out, scene.file_stem(), target, executor);
 
   const validation::MetricOptions metric_options{a.error_threshold};
   json records = json::array();

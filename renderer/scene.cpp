@@ -26,6 +26,18 @@ Bounds3 Scene::bounds() const {
   return b;
 }
 
+std::string Scene::file_stem() const {
+  constexpr size_t kMaxStem = 64;
+  std::string stem = name.substr(0, kMaxStem);
+  for (char& c : stem) {
+    const bool kept = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' ||
+                      c == '_' || c == '-' || c == '+';
+    if (!kept) c = '_';
+  }
+  if (!stem.empty() && stem[0] == '.') stem[0] = '_';
+  return stem.empty() ? "scene" : stem;
+}
+
 void keep_first_lights(Scene& scene, int count) {
   const size_t available = scene.lights.size();
   if (available == 0)

@@ -109,6 +109,11 @@ struct Scene {
   [[nodiscard]] size_t triangle_count() const;
   [[nodiscard]] size_t vertex_count() const;
   [[nodiscard]] Bounds3 bounds() const;
+  /// The name as the start of output file names: characters other than ASCII letters, digits and
+  /// ._-+ become '_', a leading '.' too, at most 64 bytes, "scene" when nothing is left. A name is
+  /// the file's own text ("/tmp/x", "../up", a newline): outputs stay in the folder they are
+  /// written to.
+  [[nodiscard]] std::string file_stem() const;
 };
 
 /// Keeps the scene's first `count` lights in file order and drops the rest; call it after loading

@@ -71,6 +71,14 @@ fs::path default_scenes_dir() {
   return fs::path("out") / "scenes";
 }
 
+std::string variant_file_name(const GeneratorInfo& info, uint64_t seed, const std::map<std::string, double>& params) {
+  const fs::path file(info.file_name);
+  std::string stem = file.stem().string();
+  if (seed != 1) stem += fmt::format("_seed-{}", seed);
+  for (const auto& [key, value] : params) stem += fmt::format("_{}-{}", key, format_value(value));
+  return stem + file.extension().string();
+}
+
 bool is_scene_file_spec(const std::string& spec) {
   const std::string ext = fs::path(spec).extension().string();
   return ext == ".gltf" || ext == ".glb" || spec.find('/') != std::string::npos;
@@ -110,10 +118,7 @@ fs::path resolve_builtin(const std::string& name, const std::map<std::string, do
                          const fs::path& scenes_dir) {
   if (params.empty()) return resolve_scene(name, scenes_dir);
   const GeneratorInfo& info = find_generator(name);
-  const fs::path file(info.file_name);
-  std::string stem = file.stem().string();
-  for (const auto& [key, value] : params) stem += fmt::format("_{}-{}", key, format_value(value));
-  const fs::path path = scenes_dir / (stem + file.extension().string());
+  const fs::path path = scenes_dir / variant_file_name(info, 1, params);
   const std::string stamp = stamp_text(info.name, params);
   if (cached(path, stamp)) return path;
   GenerateOptions options;

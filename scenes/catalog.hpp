@@ -30,6 +30,13 @@ namespace sb::scenes {
 /// so that resolve_scene() reuses it until the generator's version changes.
 GenerateResult generate_builtin(const std::string& name, const std::filesystem::path& scenes_dir);
 
+/// The file name of a built-in scene generated with `seed` and these parameter overrides: the
+/// generator's file name for the defaults, otherwise its stem, `_seed-<seed>` when the seed is not
+/// 1, `_<param>-<value>` per override and the extension, e.g. `spheres_seed-35_count-500.glb`. A
+/// variant never takes the default file's name, which commands naming the scene load.
+[[nodiscard]] std::string variant_file_name(const GeneratorInfo& info, uint64_t seed,
+                                            const std::map<std::string, double>& params);
+
 /// A built-in scene with seed 1 and these parameter overrides (checked like `scenes generate
 /// --param`), cached like the default one as `<scenes_dir>/<stem>_<param>-<value>....<ext>`, e.g.
 /// `dragon_lights-10.glb`, beside a stamp of its own. Without overrides it is resolve_scene(name).

@@ -374,16 +374,28 @@ class Checker {
           const std::string& type = string(*member(l, "type", p, true), p + "/type");
           if (type != "point" && type != "directional" && type != "spot")
             fail(p + "/type", fmt::format("'{}' is not a light type (point, directional, spot)", type));
-          opt_number_array(l, "color", p, 3);
+          opt_string(l, "name", p);
+          opt_number_array_in(l, "color", p, 3, 0.0, 1.0, "KHR_lights_punctual colours are linear RGB, 0..1");
+          // Shading is in single precision: an intensity beyond a float's range is infinite there.
           if (const json* i = member(l, "intensity", p))
-            if (number(*i, p + "/intensity") < 0.0) fail(p + "/intensity", "must not be negative");
+            number_in(*i, p + "/intensity", 0.0, 1e30,
+                      "candela for point and spot lights, lux for directional ones; not negative, and within "
+                      "single precision");
           if (const json* r = member(l, "range", p))
             if (number(*r, p + "/range") <= 0.0) fail(p + "/range", "must be positive");
           if (type == "spot") {
             const json* s = member(l, "spot", p, true);
             require_object(*s, p + "/spot");
-            opt_number(*s, "innerConeAngle", p + "/spot");
-            opt_number(*s, "outerConeAngle", p + "/spot");
+            // KHR_lights_punctual: 0 <= inner < outer <= pi/2 (defaults 0 and pi/4).
+            constexpr double kHalfPi = 1.5707963267948966;
+            double inner = 0.0, outer = kHalfPi / 2.0;
+            if (const json* i = member(*s, "innerConeAngle", p + "/spot"))
+              inner = number_in(*i, p + "/spot/innerConeAngle", 0.0, kHalfPi, "radians from the spot's axis");
+            if (const json* o = member(*s, "outerConeAngle", p + "/spot"))
+              outer = number_in(*o, p + "/spot/outerConeAngle", 0.0, kHalfPi, "radians from the spot's axis");
+            if (!(inner < outer))
+              fail(p + "/spot",
+                   fmt::format("innerConeAngle {:g} must be less than outerConeAngle {:g} (radians)", inner, outer));
           }
         });
       }

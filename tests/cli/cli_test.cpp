@@ -160,6 +160,57 @@ TEST(Cli, RenderWritesEveryOutputAndBenchPrintsATable) {
   for (const char* name : {"plain-rt", "plain-raster", "ideal-copy"}) EXPECT_NE(l.out.find(name), std::string::npos);
 }
 
+TEST(Cli, ASceneNameNeverLeadsOutputsOutOfTheOutputFolder) {
+  // The scene's name (glTF scenes[0].name) starts every output file name. A file may name its
+  // scene anything: a path out of the folder, a dot file, a newline.
+  test::ScratchDir dir("names");
+  const std::string common = " --scenes-dir '" + (dir / "scenes").string() + "' --resolution 32x18";
+  ASSERT_EQ(run("scenes generate box-wall --out '" + (dir / "scenes").string() + "'").code, 0);
+  auto doc = nlohmann::json::parse(test::read_text(dir / "scenes" / "box-wall.gltf"));
+  const std::pair<const char*, const char*> cases[] = {
+      {"../escaped", "_._escaped"}, {"/tmp/abs", "_tmp_abs"}, {".hidden\nline", "_hidden_line"}, {"", "box-wall-copy"}};
+  for (const auto& [name, stem] : cases) {
+    doc["scenes"][0]["name"] = name;
+    { std::ofstream(dir / "box-wall-copy.gltf") << doc.dump(); }
+    const std::string out = (dir / "out").string();
+    std::filesystem::remove_all(dir / "out");
+    const std::string scene = " --scene '" + (dir / "box-wall-copy.gltf").string() + "' --out '" + out + "'";
+    const CliRun r = run("render --pipeline plain-rt" + scene + common);
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / (std::string(stem) + "_plain-rt_stats.json"))) << name;
+    const CliRun v = run("validate --pipelines ideal-copy" + scene + common);
+    ASSERT_EQ(v.code, 0) << v.out;
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / (std::string(stem) + "_full_summary.json"))) << name;
+    // Everything written lies in the output folder itself.
+    size_t files = 0;
+    for (const auto& e : std::filesystem::recursive_directory_iterator(dir / "out")) {
+      EXPECT_EQ(e.path().parent_path(), dir / "out") << e.path();
+      ++files;
+    }
+    EXPECT_GT(files, 8u);
+  }
+  for (const auto& e : std::filesystem::directory_iterator(dir.path()))
+    EXPECT_TRUE(e.path().filename() == "scenes" || e.path().filename() == "out" ||
+                e.path().filename() == "box-wall-copy.gltf")
+        << "written beside the output folder: " << e.path();
+}
+
+TEST(Cli, AGeneratedVariantNeverTakesTheDefaultScenesFile) {
+  // Commands naming `spheres` load <scenes>/spheres.glb; another seed or parameter written there
+  // would be rendered and recorded as the default scene.
+  test::ScratchDir dir("variants");
+  const std::string out = " --out '" + dir.path().string() + "'";
+  ASSERT_EQ(run("scenes generate lit-plane" + out).code, 0);
+  const std::string before = test::read_text(dir / "lit-plane.gltf");
+  const CliRun seeded = run("scenes generate lit-plane --seed 35 --param albedo=0.25" + out);
+  ASSERT_EQ(seeded.code, 0) << seeded.out;
+  EXPECT_TRUE(std::filesystem::exists(dir / "lit-plane_seed-35_albedo-0.25.gltf")) << seeded.out;
+  EXPECT_EQ(test::read_text(dir / "lit-plane.gltf"), before);
+  ASSERT_EQ(run("scenes generate lit-plane --param albedo=0.25" + out).code, 0);
+  EXPECT_TRUE(std::filesystem::exists(dir / "lit-plane_albedo-0.25.gltf"));
+  EXPECT_EQ(test::read_text(dir / "lit-plane.gltf"), before);
+}
+
 TEST(Cli, RenderScoresHolesOnlyWhenPixelsAreReprojected) {
   test::ScratchDir dir("holes");
   const std::string common = " --scenes-dir '" + (dir / "scenes").string() + "' --resolution 64x36 --out '" +
