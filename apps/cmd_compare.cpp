@@ -241,7 +241,7 @@ is cyan.
 Thresholds (as in OpenImageIO's idiff): the comparison fails when PSNR < --fail-psnr, SSIM <
 --fail-ssim or the error-pixel percentage > --fail-percent, and warns on the --warn-* limits.
 
-Exit codes: 0 pass, 1 warnings only, 2 failure, 3 bad input or usage (a missing, unreadable or
+Exit codes: 0 pass, 1 warnings only, 2 failure, 3 bad input or usage (a missing, damaged or
 non-image input file, a size or channel mismatch, an empty mask, a stereo EXR without --eye, an
 SSIM limit where SSIM is undefined),
 4 I/O failure (an existing input that cannot be opened, an output that cannot be written).)";
@@ -255,7 +255,9 @@ void register_compare_command(CLI::App& root) {
   c->add_option("A", a->a, "First image (EXR, PNG, ...)")->required();
   c->add_option("B", a->b, "Second image, e.g. the reference (EXR, PNG, ...); the metrics are symmetric")->required();
   c->add_option("--eye", a->eye, "Eye to take from a stereo EXR")->check(CLI::IsMember({"left", "right"}));
-  c->add_option("--mask,-m", a->mask, "Compare only where this image (PNG, EXR, ...) is non-zero");
+  c->add_option("--mask,-m", a->mask,
+                "Compare only where this image (PNG, EXR, ...) is non-zero in a colour channel (alpha is not\n"
+                "looked at; in an EXR, R, G and B, or its one channel)");
   c->add_option("--error-threshold", a->error_threshold,
                 "An error pixel differs by more than this many 8-bit codes in some channel")
       ->capture_default_str();

@@ -98,14 +98,17 @@ Srgb8File read_srgb8_file(const fs::path& path, std::string_view eye) {
   }
 
   const io::DecodedImage d = io::read_image(path);
-  if (d.channels != 1 && d.channels != 3 && d.channels != 4)
-    throw InputError(fmt::format("{} has {} channels; compare reads grey (1), RGB (3) or RGBA (4) images",
-                                 path.string(), d.channels));
-  file.colour_channels = d.channels == 1 ? 1 : 3;
+  if (d.channels < 1 || d.channels > 4)
+    throw InputError(
+        fmt::format("{} has {} channels; compare reads grey (1), grey + alpha (2), RGB (3) or RGBA (4) "
+                    "images",
+                    path.string(), d.channels));
+  const bool grey = d.channels <= 2;
+  file.colour_channels = grey ? 1 : 3;
   const std::size_t n = static_cast<std::size_t>(d.width) * static_cast<std::size_t>(d.height);
   const std::size_t stride = static_cast<std::size_t>(d.channels);
-  // The colour of pixel i, channel c (grey replicated).
-  const auto sample = [&](std::size_t i, std::size_t c) { return d.values[i * stride + (d.channels == 1 ? 0 : c)]; };
+  // The colour of pixel i, channel c (grey replicated; alpha not read).
+  const auto sample = [&](std::size_t i, std::size_t c) { return d.values[i * stride + (grey ? 0 : c)]; };
   if (d.srgb) {
     file.image = {d.width, d.height, std::vector<uint8_t>(n * 3)};
     for (std::size_t i = 0; i < n; ++i)
@@ -124,9 +127,11 @@ Srgb8File read_srgb8_file(const fs::path& path, std::string_view eye) {
 
 RegionMask read_region_mask(const fs::path& path, std::string_view eye) {
   RegionMask mask;
-  // Marks pixel i inside when a sample of it is non-zero; NaN is refused with its place.
-  const auto mark = [&](std::span<const float> values, int channels) {
+  // Marks pixel i inside when one of its first `used` samples (of `channels`) is non-zero; NaN is
+  // refused with its place.
+  const auto mark = [&](std::span<const float> values, int channels, int used) {
     for (std::size_t k = 0; k < values.size(); ++k) {
+      if (static_cast<int>(k % static_cast<std::size_t>(channels)) >= used) continue;
       const std::size_t i = k / static_cast<std::size_t>(channels);
       if (std::isnan(values[k]))
         throw InputError(fmt::format("mask {} has a NaN sample at pixel ({}, {}); a mask needs finite values",
@@ -139,13 +144,18 @@ RegionMask read_region_mask(const fs::path& path, std::string_view eye) {
     std::string taken;
     const Image image = read_exr_image(path, eye, taken);
     mask = RegionMask::filled(image.width(), image.height(), false);
+    if (const Plane* rgb = image.find_plane(planes::rgb)) {
+      mark(rgb->f32(), rgb->channels(), rgb->channels());
+      return mask;
+    }
     for (const Plane& p : image.planes())
-      if (p.type() == PlaneType::f32) mark(p.f32(), p.channels());
+      if (p.type() == PlaneType::f32) mark(p.f32(), p.channels(), p.channels());
     return mask;
   }
   const io::DecodedImage d = io::read_image(path);
   mask = RegionMask::filled(d.width, d.height, false);
-  mark(d.values, d.channels);
+  // Grey, grey + alpha, RGB, RGBA: the colour channels.
+  mark(d.values, d.channels, d.channels == 2 ? 1 : std::min(d.channels, 3));
   return mask;
 }
 

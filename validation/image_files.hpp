@@ -36,9 +36,10 @@ struct Srgb8File {
 /// (permissions, I/O error) is an IoError. NaN samples are an InputError naming the file.
 [[nodiscard]] Srgb8File read_srgb8_file(const std::filesystem::path& path, std::string_view eye = {});
 
-/// Reads a region mask: a pixel is inside when any of its channels (alpha included) is non-zero;
-/// in an EXR, any float channel (id and tag channels such as primid are not looked at). Any image
-/// format; a stereo EXR is read through `eye` as for read_srgb8_file. InputError for a
+/// Reads a region mask: a pixel is inside when one of its colour channels is non-zero (alpha is
+/// not looked at, so an opaque black mask is empty); in an EXR, R, G and B when it has them (a
+/// rendered EXR's depth, normals and albedo are not looked at), otherwise every float channel (a
+/// Y- or A-only mask). Any image format; a stereo EXR is read through `eye` as for read_srgb8_file. InputError for a
 /// missing or unreadable file and for NaN samples.
 [[nodiscard]] RegionMask read_region_mask(const std::filesystem::path& path, std::string_view eye = {});
 

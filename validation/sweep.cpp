@@ -107,7 +107,9 @@ bool bool_at(const Where& where, const toml::node& node, const std::string& path
 std::vector<const toml::node*> axis_entries(const Where& where, const toml::node& node, const std::string& path) {
   std::vector<const toml::node*> out;
   if (const toml::array* a = node.as_array()) {
-    if (a->empty()) where.fail(node, path, "is empty; give at least one value or leave the key out for the scene's default");
+    if (a->empty())
+      where.fail(node, path,
+                 "is empty; give at least one value, or leave the key out for its default (docs/sweeps.md)");
     for (const toml::node& e : *a) out.push_back(&e);
   } else {
     out.push_back(&node);
@@ -173,9 +175,11 @@ std::vector<std::string> all_pipeline_names() {
 void parse_pipelines(const Where& where, const toml::node& node, SweepDefinition& d) {
   const std::string path = "sweep.pipelines";
   std::vector<std::string> names;
+  bool all = false;
   for (const toml::node* e : axis_entries(where, node, path)) {
     const std::string name = string_at(where, *e, path);
     if (name == "all") {
+      all = true;
       for (const std::string& n : all_pipeline_names())
         if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
       continue;
@@ -186,7 +190,9 @@ void parse_pipelines(const Where& where, const toml::node& node, SweepDefinition
       where.fail(*e, path, err.what());
     }
     if (std::find(names.begin(), names.end(), name) != names.end())
-      where.fail(*e, path, fmt::format("lists '{}' twice", name));
+      where.fail(*e, path,
+                 all ? fmt::format("'{}' is one of the pipelines 'all' includes; drop one of them", name)
+                     : fmt::format("lists '{}' twice", name));
     names.push_back(name);
     try {
       (void)parse_pipeline_entries(names, "");  // variants whose files would coincide

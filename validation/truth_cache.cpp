@@ -1,6 +1,11 @@
 // The on-disk cache of ground-truth renders.
 #include "validation/truth_cache.hpp"
 
+#include <unistd.h>
+
+#include <cerrno>
+#include <system_error>
+
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
@@ -60,6 +65,19 @@ std::optional<TruthRender> TruthCache::load(const std::string& provider, const s
   }
 }
 
+void TruthCache::prepare(const std::string& provider) const {
+  const std::filesystem::path folder = dir_ / provider;
+  std::error_code ec;
+  std::filesystem::create_directories(folder, ec);
+  if (!ec && !std::filesystem::is_directory(folder, ec)) ec = std::make_error_code(std::errc::not_a_directory);
+  if (!ec && ::access(folder.c_str(), W_OK) != 0) ec = std::error_code(errno, std::generic_category());
+  if (ec)
+    throw IoError(
+        fmt::format("the ground-truth cache {} cannot hold {} renders: {}: {}; give --cache a folder you can "
+                    "write, or --no-cache",
+                    dir_.string(), provider, folder.string(), ec.message()));
+}
+
 void TruthCache::store(const std::string& key, const TruthRender& render) const {
   const std::filesystem::path exr = image_path(render.provider, key);
   std::filesystem::path meta = exr;
@@ -86,6 +104,7 @@ ResolvedTruth resolve_truth(const TruthProvider& provider, const TruthRequest& r
       return out;
     }
   }
+  if (use_cache) cache->prepare(provider.name());
   out.render = provider.render(request);
   if (use_cache) cache->store(out.key, out.render);
   return out;

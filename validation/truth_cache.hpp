@@ -28,6 +28,9 @@ class TruthCache {
   /// recorded hash (edited, truncated) counts as absent and is overwritten by the next store().
   [[nodiscard]] std::optional<TruthRender> load(const std::string& provider, const std::string& key) const;
   void store(const std::string& key, const TruthRender& render) const;
+  /// Makes the provider's folder and checks that it can be written: called before a render, so
+  /// that an unusable cache fails before the external tool runs, not after. IoError naming it.
+  void prepare(const std::string& provider) const;
 
  private:
   std::filesystem::path dir_;

@@ -207,6 +207,10 @@ TEST(SweepDefinition, BadValuesRejected) {
       {"[sweep]\nscenes = [\"spheres\", \"spheres:count=1000\"]\n",
        "lists one scene twice: 'spheres' and 'spheres:count=1000' differ only by parameters at their defaults"},
       {"[sweep]\npipelines = [\"repro-rtx\"]\n", "sweep.pipelines"},
+      {"[sweep]\npipelines = [\"all\", \"repro-rt\"]\n",
+       "sweep.pipelines: 'repro-rt' is one of the pipelines 'all' includes; drop one of them"},
+      {"[sweep]\npipelines = []\n",
+       "sweep.pipelines: is empty; give at least one value, or leave the key out for its default"},
       // One variant under two names (its options in another order) used to be measured twice.
       {"[sweep]\npipelines = [\"fw-warp:max_crack=1:warp=rows\", \"fw-warp:warp=rows:max_crack=1\"]\n",
        "def.toml:2: sweep.pipelines: 'fw-warp:max_crack=1:warp=rows' and 'fw-warp:warp=rows:max_crack=1' "

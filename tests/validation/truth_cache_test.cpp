@@ -127,6 +127,27 @@ TEST(TruthCache, DamagedEntryIsRenderedAgain) {
   EXPECT_TRUE(resolve_truth(provider, request, &cache).cached);
 }
 
+TEST(TruthCache, AnUnusableCacheFailsBeforeTheProviderRenders) {
+  // A file where the cache folder should be: the external render would be lost when storing it.
+  test::ScratchDir dir;
+  { std::ofstream(dir / "not-a-folder") << "x"; }
+  const Scene scene = test::load_builtin("box-wall");
+  const RenderScene prepared(scene);
+  const TruthCache cache(dir / "not-a-folder");
+  CountingProvider provider;
+  const TruthRequest request{prepared, scene.path, test::rig_at(scene, 64, 36), dir / "work", 1};
+  try {
+    (void)resolve_truth(provider, request, &cache);
+    ADD_FAILURE() << "an unusable cache must fail";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("the ground-truth cache " + (dir / "not-a-folder").string() +
+                                         " cannot hold counting renders"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(provider.renders, 0);
+}
+
 TEST(TruthCache, FullProviderIsNeverCachedAndUnavailableProviderIsAToolError) {
   test::ScratchDir dir;
   const Scene scene = test::load_builtin("box-wall");
