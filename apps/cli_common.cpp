@@ -1,19 +1,15 @@
 // Shared command-line options.
 #include "apps/cli_common.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstring>
 #include <filesystem>
 
 #include <fmt/format.h>
 #include <tbb/info.h>
 
 #include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
 #include "scenes/catalog.hpp"
 
 namespace sb::cli {
@@ -133,27 +129,10 @@ bool names_file(const NamedPath& p) {
   return !std::filesystem::exists(st) || std::filesystem::is_regular_file(st) || std::filesystem::is_directory(st);
 }
 
-/// Makes `folder` (and its parents) and makes and removes a probe file in it, so that
-/// permissions, a read-only mount or a pseudo file system show here rather than when the first
-/// result is written. Why the folder cannot be written, or nothing.
-std::optional<std::string> unwritable_folder(const std::filesystem::path& folder) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  fs::create_directories(folder, ec);
-  if (ec) return fmt::format("cannot create the folder ({})", ec.message());
-  if (!fs::is_directory(folder, ec)) return "it is not a folder";
-  const fs::path probe = folder / fmt::format(".stereobench-probe-{}", ::getpid());
-  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  if (fd < 0) return fmt::format("cannot create a file in it ({})", std::strerror(errno));
-  ::close(fd);
-  fs::remove(probe, ec);
-  return std::nullopt;
-}
-
 }  // namespace
 
 void prepare_output_folder(const std::string& folder, const char* option) {
-  if (const auto why = unwritable_folder(folder))
+  if (const auto why = io::unwritable_folder(folder))
     throw IoError(fmt::format("{} {}: {}; give a folder you can write", option, folder, *why));
 }
 
@@ -161,7 +140,7 @@ void prepare_output_file_folder(const std::string& file, const char* option) {
   if (file.empty() || file == "-") return;
   const std::filesystem::path folder = std::filesystem::path(file).parent_path();
   if (folder.empty()) return;  // the current folder
-  if (const auto why = unwritable_folder(folder))
+  if (const auto why = io::unwritable_folder(folder))
     throw IoError(
         fmt::format("{} {}: its folder {}: {}; give a path you can write", option, file, folder.string(), *why));
 }

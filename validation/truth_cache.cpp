@@ -1,11 +1,6 @@
 // The on-disk cache of ground-truth renders.
 #include "validation/truth_cache.hpp"
 
-#include <unistd.h>
-
-#include <cerrno>
-#include <system_error>
-
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
@@ -67,15 +62,11 @@ std::optional<TruthRender> TruthCache::load(const std::string& provider, const s
 
 void TruthCache::prepare(const std::string& provider) const {
   const std::filesystem::path folder = dir_ / provider;
-  std::error_code ec;
-  std::filesystem::create_directories(folder, ec);
-  if (!ec && !std::filesystem::is_directory(folder, ec)) ec = std::make_error_code(std::errc::not_a_directory);
-  if (!ec && ::access(folder.c_str(), W_OK) != 0) ec = std::error_code(errno, std::generic_category());
-  if (ec)
+  if (const auto why = io::unwritable_folder(folder))
     throw IoError(
-        fmt::format("the ground-truth cache {} cannot hold {} renders: {}: {}; give --cache a folder you can "
-                    "write, or --no-cache",
-                    dir_.string(), provider, folder.string(), ec.message()));
+        fmt::format("the ground-truth cache {} cannot hold {} renders: {}: {}; give --cache a folder you "
+                    "can write, or --no-cache",
+                    dir_.string(), provider, folder.string(), *why));
 }
 
 void TruthCache::store(const std::string& key, const TruthRender& render) const {

@@ -178,6 +178,19 @@ void write_text_atomically(const fs::path& path, const std::string& text) {
   write_file_atomically(path, std::span(reinterpret_cast<const unsigned char*>(text.data()), text.size()));
 }
 
+std::optional<std::string> unwritable_folder(const fs::path& folder) {
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (ec) return fmt::format("cannot create the folder ({})", ec.message());
+  if (!fs::is_directory(folder, ec)) return "it is not a folder";
+  const fs::path probe = folder / fmt::format(".stereobench-probe-{}", ::getpid());
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) return fmt::format("cannot create a file in it ({})", std::strerror(errno));
+  ::close(fd);
+  fs::remove(probe, ec);
+  return std::nullopt;
+}
+
 std::string read_file(const fs::path& path) {
   std::error_code ec;
   if (fs::is_directory(path, ec))

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -29,6 +30,11 @@ void write_atomically(const std::filesystem::path& path,
 void write_file_atomically(const std::filesystem::path& path, std::span<const unsigned char> bytes);
 /// Writes text atomically (see write_atomically).
 void write_text_atomically(const std::filesystem::path& path, const std::string& text);
+
+/// Makes `folder` (and its parents) and makes and removes a probe file in it, so that
+/// permissions, a read-only mount or a pseudo file system show before work whose results go there,
+/// not when the first is written. Why the folder cannot be written, or nothing.
+[[nodiscard]] std::optional<std::string> unwritable_folder(const std::filesystem::path& folder);
 
 /// Reads a whole file; IoError naming the path if it cannot be read.
 [[nodiscard]] std::string read_file(const std::filesystem::path& path);
