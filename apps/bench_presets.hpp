@@ -15,6 +15,7 @@
 #include "renderer/error.hpp"
 #include <nlohmann/json.hpp>
 
+#include "renderer/memory.hpp"
 #include "renderer/parallel.hpp"
 #include "renderer/rig.hpp"
 #include "validation/benchmark.hpp"
@@ -123,9 +124,6 @@ enum class StageGroup {
     if (stage == w) return StageGroup::warping;
   return StageGroup::other;
 }
-
-/// Share of MemAvailable a row may plan to use; the rest is left to the system and other processes.
-inline constexpr double kMemoryUsableShare = 0.9;
 
 /// Whether a row that needs `needed_bytes` more resident memory fits into `available_bytes`
 /// (MemAvailable): needed <= kMemoryUsableShare * available.

@@ -10,7 +10,6 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
-#include <sstream>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -21,6 +20,7 @@
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/gltf_loader.hpp"
 #include "renderer/io/render_output.hpp"
+#include "renderer/memory.hpp"
 #include "scenes/catalog.hpp"
 #include "validation/metrics.hpp"
 
@@ -46,21 +46,6 @@ constexpr double kPriorBytesPerTriangle = 1024.0;
 
 constexpr double kMiB = 1024.0 * 1024.0;
 constexpr double kGiB = 1024.0 * kMiB;
-
-/// A "Key:   123 kB" field of a /proc file, in bytes; nullopt when the file or field is missing.
-std::optional<uint64_t> proc_kib_field(const char* file, const std::string& key) {
-  std::ifstream in(file);
-  for (std::string line; std::getline(in, line);) {
-    if (line.compare(0, key.size() + 1, key + ":") != 0) continue;
-    std::istringstream fields(line.substr(key.size() + 1));
-    uint64_t kib = 0;
-    if (fields >> kib) return kib * 1024;
-  }
-  return std::nullopt;
-}
-
-uint64_t resident_bytes() { return proc_kib_field("/proc/self/status", "VmRSS").value_or(0); }
-uint64_t peak_resident_bytes() { return proc_kib_field("/proc/self/status", "VmHWM").value_or(0); }
 
 /// MemAvailable of /proc/meminfo; IoError when it cannot be read (the memory check needs it).
 uint64_t mem_available_bytes() {

@@ -10,6 +10,7 @@
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "renderer/io/render_output.hpp"
+#include "renderer/memory.hpp"
 #include "renderer/pipeline.hpp"
 #include "renderer/stages/disocclusion.hpp"
 #include "scenes/catalog.hpp"
@@ -56,6 +57,7 @@ void run_render(const RenderArgs& a) {
   const size_t lights_in_file = loaded.lights_in_file;
   const StereoRig rig = resolve_rig(scene, overrides);
   const RenderScene prepared(scene);
+  require_frame_memory(rig.params().width, rig.params().height, fmt::format("render {}", entry.name));
   const StereoResult result = pipeline.render(prepared, rig, options, RenderContext{executor});
   // Scored against the true disocclusions outside the pipeline's timings.
   const std::optional<HoleAnalysis> holes = analyze_holes(prepared, rig, result.right, executor);

@@ -43,4 +43,10 @@ class ToolError : public Error {
   explicit ToolError(const std::string& message) : Error(ExitCode::environment, message) {}
 };
 
+/// The machine cannot hold the work asked for (memory), found before it is allocated.
+class ResourceError : public Error {
+ public:
+  explicit ResourceError(const std::string& message) : Error(ExitCode::environment, message) {}
+};
+
 }  // namespace sb

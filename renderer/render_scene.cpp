@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
+#include "renderer/memory.hpp"
 
 namespace sb {
 
@@ -35,6 +36,33 @@ Bounds3 checked_bounds(const Scene& scene) {
                                b.hi.x, b.hi.y, b.hi.z, kMaxSceneCoordinate));
 }
 
+/// Embree's peak while building, per triangle with its vertex and index buffers: 119-153 B
+/// measured (bvh memory of `stereobench bench` on the built-in scenes and on complexity with 1e6
+/// and 5e6 triangles), taken as 160 B plus 16 B per vertex for meshes with many vertices.
+constexpr uint64_t kBvhBytesPerTriangle = 160;
+constexpr uint64_t kBvhBytesPerVertex = 16;
+
+/// Refuses a scene whose acceleration structure and texture mip chains (16 B per texel, 4/3 for
+/// the chain) would not fit in memory, before any of them is built.
+void require_scene_memory(const Scene& scene) {
+  uint64_t triangles = 0, vertices = 0, texels = 0;
+  for (const Mesh& m : scene.meshes) {
+    triangles += m.triangle_count();
+    vertices += m.positions.size();
+  }
+  for (const Texture& t : scene.textures) texels += static_cast<uint64_t>(t.width) * static_cast<uint64_t>(t.height);
+  require_memory(kBvhBytesPerTriangle * triangles + kBvhBytesPerVertex * vertices + texels * 16 * 4 / 3,
+                 fmt::format("preparing scene '{}' for rendering ({} triangles, {} texels of textures)", scene.name,
+                             triangles, texels),
+                 "use a smaller scene, or run on a machine with more memory");
+}
+
+/// The scene's bounds, once its range and size are checked.
+Bounds3 checked_for_rendering(const Scene& scene) {
+  require_scene_memory(scene);
+  return checked_bounds(scene);
+}
+
 /// Shadow-ray offset: 2^-16 of the largest coordinate magnitude (about 128 float ulps), at least 1e-5 m.
 float shadow_offset(const Bounds3& b) {
   float extent = 1.0f;
@@ -45,9 +73,10 @@ float shadow_offset(const Bounds3& b) {
 
 }  // namespace
 
-// The range check comes first (ray_epsilon_ is the first member), before Embree sees the geometry.
+// The range and memory checks come first (ray_epsilon_ is the first member), before Embree sees the
+// geometry.
 RenderScene::RenderScene(const Scene& scene, bool refittable)
-    : ray_epsilon_(shadow_offset(checked_bounds(scene))), scene_(&scene), geometry_(scene),
+    : ray_epsilon_(shadow_offset(checked_for_rendering(scene))), scene_(&scene), geometry_(scene),
       rays_(geometry_, refittable) {
   const auto t0 = std::chrono::steady_clock::now();
   textures_.reserve(scene.textures.size());

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
+#include "renderer/memory.hpp"
 
 namespace sb {
 
@@ -55,6 +56,7 @@ std::string given_options(const BenchConfig& config) {
 BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const BenchConfig& config,
                       const Executor& executor, const std::function<void(const std::string&)>& progress) {
   const std::vector<BenchEntry> entries = config.entries();
+  require_frame_memory(rig.params().width, rig.params().height, "benchmark");
 
   BenchResult result;
   result.baseline = config.baseline;

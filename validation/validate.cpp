@@ -7,6 +7,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/io/render_output.hpp"
+#include "renderer/memory.hpp"
 
 namespace sb::validation {
 
@@ -31,6 +32,7 @@ RegionMask mask_of(int width, int height, std::vector<uint8_t> inside) {
 ValidationTarget prepare_target(const RenderScene& scene, const std::filesystem::path& scene_file,
                                 const StereoRig& rig, const TruthProvider& provider, const TruthCache* cache,
                                 const std::filesystem::path& work_dir, const Executor& executor) {
+  require_frame_memory(rig.params().width, rig.params().height, "validation");
   const TruthRequest request{scene, scene_file, rig, work_dir, executor.threads()};
   ValidationTarget t{scene, rig, resolve_truth(provider, request, cache), {}, {}, 0.0};
   const RigParams& p = rig.params();

@@ -25,6 +25,7 @@
 #include "renderer/io/gltf_check.hpp"
 #include "renderer/io/image_io.hpp"
 #include "renderer/io/json_text.hpp"
+#include "renderer/memory.hpp"
 #include "renderer/text.hpp"
 
 namespace sb::io {
@@ -272,10 +273,14 @@ class Converter {
     convert_materials(scene);
     traverse(scene);
     read_scene_extras(scene);
-    if (scene.meshes.empty())
+    if (scene.meshes.empty()) {
+      // What was skipped on the way explains an empty scene better than the rule alone.
+      std::string skipped;
+      for (const auto& [key, text] : warning_text_) skipped += "; " + text;
       throw InputError(fmt::format("{}: the scene has no triangles to render (no mesh with TRIANGLES, "
                                    "TRIANGLE_STRIP or TRIANGLE_FAN primitives is reachable from the scene's "
-                                   "nodes); add geometry or pick another scene", file_));
+                                   "nodes){}; add geometry or pick another scene", file_, skipped));
+    }
     if (!m_.animations.empty()) warn("animations", fmt::format("{} animation(s) are not played; the scene is rendered at rest", m_.animations.size()));
     if (!m_.skins.empty()) warn("skins", fmt::format("{} skin(s) ignored: meshes render in their bind pose", m_.skins.size()));
     for (const auto& [key, count] : warning_counts_)
@@ -455,9 +460,15 @@ class Converter {
     DecodedImage img;
     try {
       img = decode_image(gi.image, fmt::format("{} {}", file_, ipath));
+    } catch (const ResourceError&) {
+      throw;  // too large for this machine, not malformed
     } catch (const Error& e) {
       fail(ipath, fmt::format("cannot decode the image: {}", e.what()));
     }
+    // The texture's own RGBA copy (16 B per texel) and, when the scene is prepared, its mip chain.
+    require_memory(uint64_t{16} * static_cast<uint64_t>(img.width) * static_cast<uint64_t>(img.height),
+                   fmt::format("the texture of {} {} ({}x{})", file_, ipath, img.width, img.height),
+                   "use smaller textures, or run on a machine with more memory");
     Texture tex;
     tex.name = gi.name.empty() ? (gi.uri.empty() || is_data_uri(gi.uri) ? fmt::format("image{}", gt.source) : gi.uri) : gi.name;
     tex.width = img.width;
@@ -529,7 +540,7 @@ class Converter {
     std::vector<Item> stack;
     for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, dmat4(1.0)});
     std::vector<Item> order;
-    uint64_t triangles = 0;
+    uint64_t triangles = 0, vertices = 0;
     while (!stack.empty()) {
       Item item = stack.back();
       stack.pop_back();
@@ -543,15 +554,34 @@ class Converter {
       order.push_back(item);
       if (n.mesh >= 0) {
         const auto& prims = m_.meshes[static_cast<size_t>(n.mesh)].primitives;
-        for (size_t pi = 0; pi < prims.size(); ++pi)
-          triangles += estimated_triangles(prims[pi], fmt::format("/meshes/{}/primitives/{}", n.mesh, pi));
+        for (size_t pi = 0; pi < prims.size(); ++pi) {
+          const std::string ppath = fmt::format("/meshes/{}/primitives/{}", n.mesh, pi);
+          if (all_at_origin(prims[pi])) continue;
+          triangles += estimated_triangles(prims[pi], ppath);
+          if (auto it = prims[pi].attributes.find("POSITION"); it != prims[pi].attributes.end())
+            vertices += view_of(it->second, ppath).count;
+        }
       }
       if (triangles > kMaxTriangles)
         fail(fmt::format("/nodes/{}", ni), fmt::format("the scene expands to more than {} triangles; this is "
                                                         "beyond what the renderer holds in memory", kMaxTriangles));
       for (auto c = n.children.rbegin(); c != n.children.rend(); ++c) stack.push_back({*c, item.world});
     }
+    // Before any mesh is read: an accessor's count alone (without a bufferView its elements are
+    // zeros) can ask for more than the machine holds, which under overcommit ends in the OOM killer.
+    require_memory(loaded_mesh_bytes(triangles, vertices),
+                   fmt::format("loading {}: {} triangles, {} vertices", file_, triangles, vertices),
+                   "use a smaller scene, check the accessors' counts, or run on a machine with more memory");
     for (const Item& item : order) visit(scene, item.node, item.world);
+  }
+
+  /// Whether a primitive's POSITION accessor has neither a bufferView nor sparse values: glTF
+  /// makes every such vertex (0, 0, 0), so every triangle is degenerate and nothing of it can be seen.
+  bool all_at_origin(const tinygltf::Primitive& prim) const {
+    const auto it = prim.attributes.find("POSITION");
+    if (it == prim.attributes.end()) return false;
+    const tinygltf::Accessor& a = m_.accessors[static_cast<size_t>(it->second)];
+    return a.bufferView < 0 && !a.sparse.isSparse;
   }
 
   /// Triangles a primitive will produce; checks the byte range of the accessor it counts by.
@@ -563,6 +593,11 @@ class Converter {
     const uint64_t n = view_of(counted, path).count;
     return prim.mode == TINYGLTF_MODE_TRIANGLES ? n / 3 : n;
   }
+
+  /// What the meshes of a scene take while they are read, at most: per vertex its position,
+  /// normal and texture coordinate (32 B) and the decoded accessors of one attribute at a time
+  /// (24 B); per triangle its indices, read and kept (24 B).
+  static uint64_t loaded_mesh_bytes(uint64_t triangles, uint64_t vertices) { return 56 * vertices + 24 * triangles; }
 
   void visit(Scene& scene, int ni, const dmat4& world) {
     const tinygltf::Node& n = m_.nodes[static_cast<size_t>(ni)];
@@ -594,6 +629,13 @@ class Converter {
       if (!prim.targets.empty()) warn("morph", "morph targets are ignored (base shape used)");
       auto pos_it = prim.attributes.find("POSITION");
       if (pos_it == prim.attributes.end()) fail(ppath + "/attributes", "primitive has no POSITION attribute");
+      if (all_at_origin(prim)) {
+        warn("positions-at-origin",
+             fmt::format("{}/attributes/POSITION: accessor {} has no bufferView and no sparse values, so every vertex "
+                         "is at the origin and no triangle can be seen; the primitive is skipped",
+                         ppath, pos_it->second));
+        continue;
+      }
       Mesh mesh;
       mesh.name = gm.name.empty() ? fmt::format("mesh{}", mi) : gm.name;
       if (gm.primitives.size() > 1) mesh.name += fmt::format(".{}", pi);

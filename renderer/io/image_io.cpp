@@ -24,6 +24,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/memory.hpp"
 #include "renderer/text.hpp"
 
 namespace sb::io {
@@ -706,6 +707,15 @@ void copy_channel(const InputFile& file, const OIIO::ImageSpec& spec, const std:
 
 /// Builds one image per plan list (one per eye), reading each needed part of the file once.
 std::vector<Image> build_images(InputFile& file, const std::vector<std::vector<PlanePlan>>& images_plans) {
+  // The planes (4 B per channel and pixel) and the largest part read whole beside them.
+  uint64_t channels = 0, largest_part = 0;
+  for (const auto& plans : images_plans)
+    for (const PlanePlan& plan : plans) channels += plan.sources.size();
+  for (const OIIO::ImageSpec& spec : file.parts) largest_part = std::max<uint64_t>(largest_part, spec.image_bytes());
+  require_memory(uint64_t{4} * channels * static_cast<uint64_t>(file.width) * static_cast<uint64_t>(file.height) +
+                     largest_part,
+                 fmt::format("reading image {} ({}x{})", file.path.string(), file.width, file.height),
+                 "use a smaller image, or run on a machine with more memory");
   std::vector<Image> images;
   for (const auto& plans : images_plans) {
     images.emplace_back(file.width, file.height);
@@ -788,6 +798,11 @@ DecodedImage decode_from(OIIO::ImageInput& in, const std::string& name) {
       spec.nchannels <= 0 || spec.nchannels > 64)
     throw InputError(fmt::format("image {} has an unsupported shape {}x{} with {} channels; {}", name, spec.width,
                                  spec.height, spec.nchannels, kCorruptHint));
+  // Decoded whole, every channel as float: a file of a few kilobytes can declare gigabytes.
+  require_memory(uint64_t{4} * static_cast<uint64_t>(spec.width) * static_cast<uint64_t>(spec.height) *
+                     static_cast<uint64_t>(spec.nchannels),
+                 fmt::format("decoding image {} ({}x{}, {} channels)", name, spec.width, spec.height, spec.nchannels),
+                 "use a smaller image, or run on a machine with more memory");
   DecodedImage image;
   image.width = spec.width;
   image.height = spec.height;

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
+#include "renderer/memory.hpp"
 #include "renderer/pipeline.hpp"
 #include "renderer/stages/eye_image.hpp"
 #include "renderer/stages/pixel_reprojection.hpp"
@@ -46,6 +47,10 @@ class RtBuffer final : public Pipeline {
     const ValidationSettings validation = ValidationSettings::from("rt-buffer", options);
     const int w = rig.params().width, h = rig.params().height;
     const int t = buffer_depth(depth_option(options), rig);
+    // Before the left eye is traced, outside the stages' timings.
+    require_memory(uint64_t{4} * static_cast<uint64_t>(t) * static_cast<uint64_t>(w) * static_cast<uint64_t>(h),
+                   fmt::format("rt-buffer's {}x{}x{} reprojection buffer", w, h, t),
+                   "set the option depth to a smaller t, or lower the resolution");
     StereoResult r;
     trace_left_eye(scene, rig, ctx.executor, r);
     const PixelReprojector reprojector(rig);

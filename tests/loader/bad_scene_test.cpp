@@ -168,6 +168,10 @@ std::vector<BadCase> corpus() {
   // A folder or a device named as a file was reported as a file that does not exist.
   c.push_back({"image_uri_is_a_folder", "a.gltf", edited([](MiniGltf& g) { g.doc["images"] = json::array({{{"uri", "."}}}); }), "is a folder, not a regular file"});
   c.push_back({"buffer_uri_is_a_device", "a.gltf", [](auto& p) { write_text(p, R"({"asset":{"version":"2.0"},"buffers":[{"uri":"/dev/zero","byteLength":12}]})"); }, "is a device, pipe or socket, not a regular file"});
+  // glTF fills an accessor without a bufferView with zeros: every vertex at the origin, nothing to
+  // see. The primitive is skipped (it may declare any count), and the empty scene says why.
+  c.push_back({"positions_without_data", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0].erase("bufferView"); g.doc["accessors"][0]["count"] = 300000000; }),
+               "/meshes/0/primitives/0/attributes/POSITION: accessor 0 has no bufferView and no sparse values, so every vertex is at the origin"});
   c.push_back({"missing_image_file", "a.gltf", edited([](MiniGltf& g) { g.doc["images"] = json::array({{{"uri", "nope.png"}}}); }), "/images/0/uri: referenced file"});
   return c;
 }

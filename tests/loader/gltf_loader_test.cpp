@@ -2,8 +2,12 @@
 // container forms, materials and textures, lights, cameras and the stereo-rig extras.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "renderer/color.hpp"
 #include "renderer/io/gltf_loader.hpp"
@@ -123,6 +127,24 @@ TEST(GltfLoader, SparseAccessorAndAccessorWithoutView) {
   const Scene scene = io::load_gltf(dir / "s.gltf");
   expect_vec3(scene.meshes[0].positions[1], {5, 5, 5});
   expect_vec3(scene.meshes[0].positions[2], {0, 1, 0});
+}
+
+TEST(GltfLoader, APrimitiveWhosePositionsAreAllZeroIsSkippedWithAWarning) {
+  // Without a bufferView or sparse values every vertex is (0, 0, 0): nothing of it can be seen,
+  // whatever count it declares, so it is neither read nor rendered.
+  ScratchDir dir("zeros");
+  MiniGltf g;
+  g.add_triangle();
+  g.doc["accessors"].push_back({{"componentType", 5126}, {"count", 300000000}, {"type", "VEC3"}});
+  g.doc["meshes"][0]["primitives"].push_back({{"attributes", {{"POSITION", 1}}}});
+  g.write_gltf(dir / "z.gltf");
+  const Scene scene = io::load_gltf(dir / "z.gltf");
+  ASSERT_EQ(scene.meshes.size(), 1u);
+  EXPECT_EQ(scene.triangle_count(), 1u);
+  const auto named = std::count_if(scene.warnings.begin(), scene.warnings.end(), [](const std::string& w) {
+    return w.find("/meshes/0/primitives/1/attributes/POSITION: accessor 1 has no bufferView") != std::string::npos;
+  });
+  EXPECT_EQ(named, 1) << fmt::format("{}", fmt::join(scene.warnings, "\n"));
 }
 
 TEST(GltfLoader, StripsAndFansAreTriangulated) {

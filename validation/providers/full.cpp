@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include "renderer/memory.hpp"
 #include "renderer/parallel.hpp"
 #include "renderer/stages/eye_image.hpp"
 #include "renderer/stages/trace.hpp"
@@ -29,6 +30,7 @@ class FullProvider final : public TruthProvider {
     out.provider = name();
     out.tool_version = tool_version();
     const RigParams& p = request.rig.params();
+    require_frame_memory(p.width, p.height, "the 'full' ground truth");
     out.right = make_eye_image(p.width, p.height);
     const Executor executor(request.threads);
     TraceCounts counts;
