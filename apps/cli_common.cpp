@@ -10,6 +10,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/stages/near_plane.hpp"
 #include "scenes/catalog.hpp"
 
 namespace sb::cli {
@@ -158,6 +159,17 @@ void refuse_overwriting(std::initializer_list<NamedPath> inputs, std::initialize
         throw InputError(
             fmt::format("{} and {} both name {}; give each output its own file", earlier->name, out->name, *out->path));
   }
+}
+
+void warn_geometry_before_near_plane(const RenderScene& scene, const StereoRig& rig, const Executor& executor) {
+  const uint64_t left = pixels_before_near_plane(scene, rig.eye(Eye::left), executor);
+  const uint64_t right = pixels_before_near_plane(scene, rig.eye(Eye::right), executor);
+  if (left == 0 && right == 0) return;
+  fmt::print(stderr,
+             "warning: {} pixels of the left eye and {} of the right see geometry nearer than the camera's near plane "
+             "(znear {:g} m): rasterizing pipelines clip it, ray tracing and the ground truths show it, so their "
+             "images differ there for the camera's sake; lower the camera's znear in the scene\n",
+             left, right, rig.params().znear);
 }
 
 }  // namespace sb::cli

@@ -9,6 +9,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "renderer/parallel.hpp"
+#include "renderer/render_scene.hpp"
 #include "renderer/rig.hpp"
 #include "renderer/scene.hpp"
 
@@ -62,6 +64,11 @@ void prepare_output_folder(const std::string& folder, const char* option);
 /// The same for the folder of an output file (a --json written after a long benchmark); nothing
 /// for "" (no file), "-" (standard output) or a bare file name (the current folder).
 void prepare_output_file_folder(const std::string& file, const char* option);
+
+/// Warns on standard error when either eye sees geometry in front of its near plane
+/// (pixels_before_near_plane): the rasterizing pipelines clip it, ray tracing and the ground
+/// truths show it, so their images differ there for the camera's sake, not the pipeline's.
+void warn_geometry_before_near_plane(const RenderScene& scene, const StereoRig& rig, const Executor& executor);
 
 /// Checks a --threads value: 0 (all cores) or 1..1024; more than the cores is taken as the
 /// cores, with a note (the scheduler would run no more, yet the results would record them).

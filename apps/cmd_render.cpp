@@ -58,6 +58,7 @@ void run_render(const RenderArgs& a) {
   const StereoRig rig = resolve_rig(scene, overrides);
   const RenderScene prepared(scene);
   require_frame_memory(rig.params().width, rig.params().height, fmt::format("render {}", entry.name));
+  warn_geometry_before_near_plane(prepared, rig, executor);
   const StereoResult result = pipeline.render(prepared, rig, options, RenderContext{executor});
   // Scored against the true disocclusions outside the pipeline's timings.
   const std::optional<HoleAnalysis> holes = analyze_holes(prepared, rig, result.right, executor);

@@ -105,6 +105,7 @@ void run_validate(const ValidateArgs& a) {
              target.truth.render.tool_version, target.truth.cached ? "from the cache, rendered in " : "",
              target.truth.render.seconds,
              100.0 * double(target.disocclusions.count()) / double(target.truth_srgb8.pixel_count()));
+  warn_geometry_before_near_plane(prepared, rig, executor);
   const std::string scene_stem = fmt::format("{}_{}", scene.file_stem(), provider->name());
   const json shared_images = validation::write_target_images(out, scene.file_stem(), target, executor);
 

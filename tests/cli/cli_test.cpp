@@ -238,6 +238,38 @@ TEST(Cli, RenderScoresHolesOnlyWhenPixelsAreReprojected) {
   EXPECT_FALSE(nlohmann::json::parse(test::read_text(dir / "box-wall_plain-rt_stats.json")).contains("holes"));
 }
 
+TEST(Cli, GeometryBeforeTheNearPlaneIsWarnedAbout) {
+  // A triangle 1 m in front of a camera whose near plane is at 2 m: the rasterizer clips it, rays
+  // see it. The warning counts the pixels, and they are exactly those where the two renders differ.
+  test::ScratchDir dir("near");
+  const auto write_scene = [&](double znear) {
+    test::MiniGltf g;
+    g.add_triangle();
+    g.add_node({{"camera", 0}, {"translation", {0.2, 0.2, 1.0}}});
+    g.doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 1.0}, {"znear", znear}, {"zfar", 100.0}}}}};
+    g.doc["scenes"][0]["extras"] = {{"stereobench", {{"ambient", 1.0}}}};
+    g.write_gltf(dir / "near.gltf");
+  };
+  const std::string args = " --scene " + test::quoted(dir / "near.gltf") + " --resolution 160x90 --out " +
+                           test::quoted(dir / "out");
+  write_scene(2.0);
+  const CliRun raster = run("render --pipeline plain-raster" + args);
+  ASSERT_EQ(raster.code, 0) << raster.out;
+  EXPECT_NE(raster.out.find("warning: 3111 pixels of the left eye and 3172 of the right see geometry nearer than the "
+                            "camera's near plane (znear 2 m)"),
+            std::string::npos)
+      << raster.out;
+  ASSERT_EQ(run("render --pipeline plain-rt" + args).code, 0);
+  const CliRun cmp = run("compare " + test::quoted(dir / "out" / "near_plain-raster_right.png") + " " +
+                         test::quoted(dir / "out" / "near_plain-rt_right.png"));
+  EXPECT_NE(cmp.out.find("(3172 pixels with a channel difference"), std::string::npos) << cmp.out;
+
+  write_scene(0.5);
+  const CliRun near = run("render --pipeline plain-raster" + args);
+  ASSERT_EQ(near.code, 0) << near.out;
+  EXPECT_EQ(near.out.find("near plane"), std::string::npos) << near.out;
+}
+
 TEST(Cli, AnOutputFolderThatCannotBeMadeFailsBeforeAnyWork) {
   test::ScratchDir dir("outbad");
   const std::filesystem::path file = dir / "a-file";
