@@ -122,11 +122,36 @@ RegressionSettings read_regression(const toml::table& table, const std::string& 
   return r;
 }
 
+/// Why `pattern` would not match what it seems to say, or nothing. fnmatch takes a '[' whose set
+/// is never closed as a literal '[' (and a trailing '\\' as itself), so a misspelt '[repro' rule
+/// silently applies nowhere.
+std::optional<std::string> glob_fault(const std::string& pattern) {
+  for (size_t i = 0; i < pattern.size(); ++i) {
+    if (pattern[i] == '\\') {
+      if (i + 1 == pattern.size()) return "it ends in a lone '\\'; write '\\\\' for a literal backslash";
+      ++i;
+    } else if (pattern[i] == '[') {
+      size_t j = i + 1;
+      if (j < pattern.size() && (pattern[j] == '!' || pattern[j] == '^')) ++j;
+      if (j < pattern.size() && pattern[j] == ']') ++j;  // a ']' first in a set is a member
+      const size_t close = pattern.find(']', j);
+      if (close == std::string::npos)
+        return fmt::format("the '[' at character {} opens a set that is never closed; close it, or write '\\[' for "
+                           "a literal '['",
+                           i + 1);
+      i = close;
+    }
+  }
+  return std::nullopt;
+}
+
 std::string glob_value(const toml::node& node, const std::string& key, const std::string& source) {
   const std::optional<std::string> v = node.value<std::string>();
   if (!v || v->empty())
     config_error(source, node.source(),
                  fmt::format("[[rule]] {} must be a non-empty string (a name or a glob such as 'repro-*')", key));
+  if (const std::optional<std::string> fault = glob_fault(*v))
+    config_error(source, node.source(), fmt::format("[[rule]] {} = '{}' is not a valid glob: {}", key, *v, *fault));
   return *v;
 }
 
@@ -418,6 +443,8 @@ std::vector<BaselineChange> update_baseline(Baseline& baseline, const GateResult
     throw InputError(
         "--update-baseline rewrites only what you name: give --only PIPELINE[,PIPELINE...] and/or --cells PATTERN "
         "(a glob over cell ids, e.g. 'spheres|*'); --cells '*' names every cell");
+  if (const std::optional<std::string> fault = glob_fault(selection.cells))
+    throw InputError(fmt::format("--cells '{}' is not a valid glob: {}", selection.cells, *fault));
   std::set<std::string> present;
   for (const GateCell& cell : results.cells)
     for (const auto& [pipeline, entry] : cell.record["pipelines"].items()) present.insert(pipeline);

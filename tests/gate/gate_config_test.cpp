@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include <fmt/format.h>
+
 #include "renderer/error.hpp"
 #include "validation/gate.hpp"
 
@@ -37,6 +39,21 @@ TEST(GateConfig, UnknownKeyIsRejectedWithNameAndLine) {
   const std::string top = config_error("[default]\nmin_psnr = 30\n");
   EXPECT_NE(top.find("test.toml:1"), std::string::npos) << top;
   EXPECT_NE(top.find("'default'"), std::string::npos) << top;
+}
+
+TEST(GateConfig, AGlobThatCannotMeanWhatItSaysIsRejected) {
+  // fnmatch reads an unclosed '[' as a literal '[': the rule would apply nowhere without a word.
+  const std::string unclosed = config_error("[[rule]]\npipeline = \"[repro\"\nmin_psnr = 30\n");
+  EXPECT_NE(unclosed.find("test.toml:2"), std::string::npos) << unclosed;
+  EXPECT_NE(unclosed.find("[[rule]] pipeline = '[repro' is not a valid glob: the '[' at character 1 opens a set that "
+                          "is never closed"),
+            std::string::npos)
+      << unclosed;
+  const std::string lone = config_error("[[rule]]\nscene = 'spheres\\'\nmin_psnr = 30\n");
+  EXPECT_NE(lone.find("ends in a lone '\\'"), std::string::npos) << lone;
+  // Sets that are closed, escapes and a ']' first in a set are globs as meant.
+  for (const char* glob : {"repro-[rt]*", "[!p]*", "[]x]", "a\\[b", "bidir-warp:occlusion=*"})
+    EXPECT_EQ(config_error(fmt::format("[[rule]]\npipeline = '{}'\nmin_psnr = 30\n", glob)), "") << glob;
 }
 
 TEST(GateConfig, BadValuesAreRejected) {

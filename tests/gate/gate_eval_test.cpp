@@ -209,6 +209,12 @@ TEST(GateEval, BaselineUpdateTouchesOnlyWhatIsNamed) {
   run = run_cli("gate --update-baseline --cells 'spheres|*' --results " + (dir / "results.jsonl").string() +
                 " --baseline " + (dir / "baseline.json").string());
   EXPECT_EQ(run.code, 3) << run.out;
+  run = run_cli("gate --update-baseline --cells '[lit-plane|*' --results " + (dir / "results.jsonl").string() +
+                " --baseline " + (dir / "baseline.json").string());
+  EXPECT_EQ(run.code, 3) << run.out;
+  EXPECT_NE(run.out.find("--cells '[lit-plane|*' is not a valid glob: the '[' at character 1 opens a set"),
+            std::string::npos)
+      << run.out;
   // --junit and --json belong to a gate run: refused beside --update-baseline, not ignored.
   const std::string kept = read_text(dir / "baseline.json");
   run = run_cli("gate --update-baseline --only repro-rt --results " + (dir / "results.jsonl").string() +
