@@ -15,6 +15,7 @@
 #include <string_view>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
@@ -409,6 +410,13 @@ void check_cell_record(const json& line, const std::string& where) {
                                          "damaged or edited by hand",
                                          where, prefix, t.dump()));
       require(p, where, prefix, "timing.stages_median_s", Kind::object, true);
+      // Every repetition leaves one sample: the medians and the rank test are taken over them.
+      const json* samples = find(p, "timing.samples_s");
+      const json* repetitions = find(p, "timing.repetitions");
+      if (samples && repetitions && static_cast<long long>(samples->size()) != repetitions->get<long long>())
+        throw InputError(fmt::format("{}: field '{}timing.samples_s' holds {} time(s) but timing.repetitions is {}; "
+                                     "the line is damaged or edited by hand",
+                                     where, prefix, samples->size(), repetitions->dump()));
     }
   }
   require(line, where, "", "images", Kind::object_or_null, true);  // null: a sweep without images
@@ -449,6 +457,19 @@ ResultsFile read_results(const fs::path& file) {
                 where, cell["sweep"].get<std::string>(), cell.value("definition_sha256", "?").substr(0, 12),
                 out.lines.front(), first["sweep"].get<std::string>(),
                 first.value("definition_sha256", "?").substr(0, 12)));
+          // Every cell of a definition validates every pipeline of it: a cell without one would let
+          // the gate pass that pipeline there unchecked.
+          const auto names = [](const json& c) {
+            std::vector<std::string> n;
+            for (const auto& [name, p] : c["pipelines"].items()) n.push_back(name);
+            return n;
+          };
+          if (names(cell) != names(first))
+            throw InputError(fmt::format("{}: the cell validates pipelines {}, but line {} of the same definition "
+                                         "validates {}; every cell of a sweep validates every pipeline — the file is "
+                                         "damaged or edited by hand",
+                                         where, fmt::join(names(cell), ", "), out.lines.front(),
+                                         fmt::join(names(first), ", ")));
           if (cell.value("cell_count", json()) != first.value("cell_count", json()))
             throw InputError(fmt::format("{}: cell_count {}, but line {} of the same definition says {}; the file is "
                                          "damaged or edited by hand",

@@ -125,10 +125,16 @@ TEST(GateEval, TimeRegressionAgainstTheBaseline) {
   validation::Baseline baseline;
   baseline.cells[id]["repro-rt"].samples_s = {0.010, 0.0102, 0.0098, 0.0101, 0.0099};
   baseline.cells[id]["repro-rt"].median_s = 0.010;
+  // A run's samples, one per repetition.
+  const auto run_samples = [&](std::vector<double> samples) {
+    json& timing = cells[0]["pipelines"]["repro-rt"]["timing"];
+    timing["repetitions"] = samples.size();
+    timing["samples_s"] = std::move(samples);
+  };
 
   // 20 % slower in every one of five repetitions: beyond the 10 % tolerance; exact one-sided p =
   // 1/C(10,5) = 0.004 < 0.05: failure.
-  cells[0]["pipelines"]["repro-rt"]["timing"]["samples_s"] = {0.012, 0.0121, 0.0119, 0.0122, 0.0118};
+  run_samples({0.012, 0.0121, 0.0119, 0.0122, 0.0118});
   validation::GateReport r = evaluate(cells, baseline);
   const validation::GateCheck* reg = find_check(r, "repro-rt", "time_regression");
   ASSERT_NE(reg, nullptr);
@@ -138,17 +144,17 @@ TEST(GateEval, TimeRegressionAgainstTheBaseline) {
 
   // Median 20 % slower but samples interleaved with the baseline's (U = 15 of 25, exact p = 0.345):
   // beyond the tolerance, not significant: warning.
-  cells[0]["pipelines"]["repro-rt"]["timing"]["samples_s"] = {0.012, 0.0095, 0.0125, 0.0097, 0.013};
+  run_samples({0.012, 0.0095, 0.0125, 0.0097, 0.013});
   r = evaluate(cells, baseline);
   EXPECT_EQ(find_check(r, "repro-rt", "time_regression")->verdict, Verdict::warn);
 
   // 5 % slower, significant: within the tolerance, a pass.
-  cells[0]["pipelines"]["repro-rt"]["timing"]["samples_s"] = {0.0105, 0.0106, 0.0104, 0.0107, 0.0103};
+  run_samples({0.0105, 0.0106, 0.0104, 0.0107, 0.0103});
   r = evaluate(cells, baseline);
   EXPECT_EQ(find_check(r, "repro-rt", "time_regression")->verdict, Verdict::pass);
 
   // Two repetitions where three are needed: "not enough repetitions", a warning.
-  cells[0]["pipelines"]["repro-rt"]["timing"]["samples_s"] = {0.010, 0.010};
+  run_samples({0.010, 0.010});
   r = evaluate(cells, baseline);
   reg = find_check(r, "repro-rt", "time_regression");
   EXPECT_EQ(reg->verdict, Verdict::warn);

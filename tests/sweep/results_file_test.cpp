@@ -213,6 +213,18 @@ TEST(ResultsFile, BadLinesAndDuplicatesRejected) {
   json recounted = cell(1, "b");
   recounted["cell_count"] = 5;
   expect_refused(recounted, "checked.jsonl:2: cell_count 5, but line 1 of the same definition says 10");
+  // One sample per repetition, and the same pipelines in every cell: a cell without one would let
+  // the gate pass that pipeline there unchecked.
+  json short_of_samples = cell(1, "b");
+  short_of_samples["pipelines"]["plain-rt"]["timing"]["repetitions"] = 3;
+  short_of_samples["pipelines"]["plain-rt"]["timing"]["samples_s"] = json::array();
+  expect_refused(short_of_samples,
+                 "checked.jsonl:2: field 'pipelines.plain-rt.timing.samples_s' holds 0 time(s) but timing.repetitions "
+                 "is 3");
+  json more = cell(1, "b");
+  more["pipelines"]["repro-rt"] = more["pipelines"]["plain-rt"];
+  expect_refused(more, "checked.jsonl:2: the cell validates pipelines plain-rt, repro-rt, but line 1 of the same "
+                       "definition validates plain-rt; every cell of a sweep validates every pipeline");
 }
 
 TEST(ResultsFile, CollectMergesShards) {
