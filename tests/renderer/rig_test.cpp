@@ -149,6 +149,30 @@ TEST(Rig, BadParametersAreInputErrors) {
   EXPECT_NO_THROW((void)resolve_rig(empty, wide));
 }
 
+TEST(Rig, ACameraAspectRatioBeyondAnyImageIsRefusedUnlessTheWidthIsGiven) {
+  // 1080 * 1e30 px overflowed the integer width (reported as "resolution 0x1080").
+  Scene scene;
+  scene.name = "wide";
+  SceneCamera cam;
+  cam.aspect = 1e30;
+  scene.cameras.push_back(cam);
+  try {
+    (void)resolve_rig(scene, RigOverrides{});
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("scene 'wide': its camera's aspectRatio 1e+30 gives a width of 1.08e+33 px at "
+                                         "1080 px height, outside 1..16384"),
+              std::string::npos)
+        << e.what();
+  }
+  RigOverrides given;
+  given.width = 320;
+  given.height = 180;
+  EXPECT_EQ(resolve_rig(scene, given).params().width, 320);
+  scene.cameras[0].aspect = 16.0 / 9.0;
+  EXPECT_EQ(resolve_rig(scene, RigOverrides{}).params().width, 1920);
+}
+
 TEST(Rig, ResolutionNamesAndErrors) {
   EXPECT_EQ(parse_resolution("hd"), ivec2(1920, 1080));
   EXPECT_EQ(parse_resolution("4K"), ivec2(3840, 2160));
