@@ -43,6 +43,7 @@ constexpr uint64_t kMaxTriangles = 1'500'000'000;
 struct GlbParts {
   std::string json_text;
   bool is_glb = false;
+  bool has_bin = false;  ///< a .glb with a BIN chunk
 };
 
 uint32_t read_u32(const std::string& bytes, size_t offset) {
@@ -98,6 +99,7 @@ GlbParts split_container(const std::string& bytes, const std::string& file, bool
     if (bin_at + 8 + bin_len > bytes.size())
       throw InputError(fmt::format("{}: truncated .glb: BIN chunk of {} bytes runs past the end of the "
                                    "{}-byte file", file, bin_len, bytes.size()));
+    parts.has_bin = true;
   }
   parts.json_text = bytes.substr(20, json_len);
   return parts;
@@ -150,21 +152,44 @@ void check_data_uri_length(const json& buffer, const std::string& where, const s
                                  "truncated", file, where, have, need));
 }
 
-/// External buffers and images must exist, and buffers must hold their declared byteLength.
-void check_external_files(const json& doc, const fs::path& dir, const std::string& file) {
+/// A URI with a scheme other than data: ("file:", "https:"); one letter before the colon is a
+/// Windows drive, not a scheme.
+bool has_scheme(const std::string& uri) {
+  const size_t colon = uri.find(':');
+  if (colon == std::string::npos || colon < 2 || !std::isalpha(static_cast<unsigned char>(uri[0]))) return false;
+  return std::all_of(uri.begin(), uri.begin() + static_cast<std::ptrdiff_t>(colon), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '+' || c == '-' || c == '.';
+  });
+}
+
+/// External buffers and images must exist, and buffers must hold their declared byteLength. A
+/// buffer without a uri is a .glb's BIN chunk, which the file must have.
+void check_external_files(const json& doc, const fs::path& dir, const std::string& file, const GlbParts& parts) {
   for (const char* top : {"buffers", "images"}) {
     auto it = doc.find(top);
     if (it == doc.end()) continue;
     for (size_t i = 0; i < it->size(); ++i) {
       const json& e = (*it)[i];
       auto u = e.find("uri");
-      if (u == e.end()) continue;
+      if (u == e.end()) {
+        if (std::string(top) == "buffers" && !(parts.is_glb && i == 0 && parts.has_bin))
+          throw InputError(fmt::format(
+              "{}: /buffers/{}: has no uri, {}; give it the uri of its .bin file or a data URI", file, i,
+              parts.is_glb && i == 0 ? "so it is the .glb's BIN chunk, but the file has none (damaged or truncated)"
+                                     : "which only the first buffer of a .glb may omit (it is the BIN chunk)"));
+        continue;
+      }
       if (is_data_uri(u->get<std::string>())) {
         if (std::string(top) == "buffers") check_data_uri_length(e, fmt::format("/buffers/{}", i), file);
         continue;
       }
-      const fs::path p = dir / percent_decode(u->get<std::string>());
       const std::string where = fmt::format("/{}/{}/uri", top, i);
+      if (has_scheme(u->get<std::string>()))
+        throw InputError(fmt::format("{}: {}: '{}' is a URL; only files beside the scene (relative paths) and "
+                                     "base64 data URIs are read — copy the file beside the scene and give its "
+                                     "relative path",
+                                     file, where, u->get<std::string>()));
+      const fs::path p = dir / percent_decode(u->get<std::string>());
       std::error_code ec;
       if (!fs::exists(p, ec))
         throw InputError(fmt::format("{}: {}: referenced file '{}' does not exist; put it beside the "
@@ -819,7 +844,7 @@ Scene load_gltf(const fs::path& path, const GltfLoadOptions& options) {
   }
   check_gltf_json(doc, file);
   const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
-  check_external_files(doc, dir, file);
+  check_external_files(doc, dir, file, parts);
 
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(keep_image_bytes, nullptr);

@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <functional>
 
+#include <fmt/format.h>
+
 #include "renderer/error.hpp"
 #include "renderer/io/gltf_loader.hpp"
 #include "support/mini_gltf.hpp"
@@ -172,6 +174,20 @@ std::vector<BadCase> corpus() {
   // see. The primitive is skipped (it may declare any count), and the empty scene says why.
   c.push_back({"positions_without_data", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0].erase("bufferView"); g.doc["accessors"][0]["count"] = 300000000; }),
                "/meshes/0/primitives/0/attributes/POSITION: accessor 0 has no bufferView and no sparse values, so every vertex is at the origin"});
+  c.push_back({"buffer_without_uri", "a.gltf", edited([](MiniGltf& g) { g.finish_buffer(""); }),
+               "/buffers/0: has no uri, which only the first buffer of a .glb may omit"});
+  c.push_back({"glb_without_bin_chunk", "a.glb", [](auto& p) {
+                 MiniGltf g;
+                 g.add_triangle();
+                 g.finish_buffer("");
+                 g.bin.clear();  // the buffer stays declared, its chunk goes
+                 g.write_glb(p);
+               },
+               "/buffers/0: has no uri, so it is the .glb's BIN chunk, but the file has none"});
+  for (const char* url : {"file:///etc/passwd", "https://example.com/a.bin"})
+    c.push_back({std::string("buffer_url_") + url[0], "a.gltf",
+                 edited([url](MiniGltf& g) { g.doc["buffers"] = json::array({{{"byteLength", 36}, {"uri", url}}}); }),
+                 fmt::format("/buffers/0/uri: '{}' is a URL; only files beside the scene", url)});
   c.push_back({"missing_image_file", "a.gltf", edited([](MiniGltf& g) { g.doc["images"] = json::array({{{"uri", "nope.png"}}}); }), "/images/0/uri: referenced file"});
   return c;
 }
