@@ -210,9 +210,25 @@ std::string presets_help() {
   return text;
 }
 
+std::string preset_overrides(const PresetRun& run) {
+  const RigOverrides& o = run.overrides;
+  std::vector<std::string> parts;
+  if (o.width && o.height) parts.push_back(fmt::format("image size {}x{}", *o.width, *o.height));
+  if (o.convergence) parts.push_back(fmt::format("convergence {:g} m", *o.convergence));
+  if (o.vfov) parts.push_back(fmt::format("vertical field of view {:g} degrees", radians_to_degrees(*o.vfov)));
+  return fmt::format("{}", fmt::join(parts, ", "));
+}
+
+void print_preset_summary(const PresetRun& run) {
+  fmt::print("preset {}: {}\n", run.preset->name, run.preset->summary);
+  if (const std::string given = preset_overrides(run); !given.empty())
+    fmt::print("as run, replacing the preset's: {}\n", given);
+}
+
 nlohmann::json preset_json(const PresetRun& run, const Executor& executor) {
   return {{"preset", run.preset->name},
           {"summary", run.preset->summary},
+          {"overrides", preset_overrides(run)},
           {"pipelines", run.config.pipelines},
           {"baseline", run.config.baseline},
           {"warmup", run.config.warmup},
@@ -244,7 +260,7 @@ void run_bench_preset(const PresetRun& run, const Executor& executor) {
 
   std::string pipelines;
   for (const std::string& p : run.config.pipelines) pipelines += (pipelines.empty() ? "" : ", ") + p;
-  fmt::print("preset {}: {}\n", preset.name, preset.summary);
+  print_preset_summary(run);
   fmt::print("{} series, {} rows; {}; baseline {}; {} threads, {} warm-up + {} repetitions per row\n",
              preset.series.size(), total_rows, pipelines, run.config.baseline, executor.threads(), run.config.warmup,
              run.config.repetitions);

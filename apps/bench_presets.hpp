@@ -186,4 +186,11 @@ struct MeasuredPeak {
 /// with "complete": false and no rows yet.
 [[nodiscard]] nlohmann::json preset_json(const PresetRun& run, const Executor& executor);
 
+/// What the run's rig options replace in the preset's rows ("image size 480x270, ..."), for the
+/// header under the preset's summary, which speaks of the published setting; "" when nothing.
+[[nodiscard]] std::string preset_overrides(const PresetRun& run);
+
+/// Prints the preset's summary and, when the run replaces part of its setting, what it replaces.
+void print_preset_summary(const PresetRun& run);
+
 }  // namespace sb::cli

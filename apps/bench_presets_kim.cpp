@@ -97,7 +97,7 @@ nlohmann::json scene_json(const Scene& scene, const PresetRow& row) {
 }
 
 void print_run_head(const PresetRun& run, const Executor& executor) {
-  fmt::print("preset {}: {}\n", run.preset->name, run.preset->summary);
+  print_preset_summary(run);
   fmt::print("{}; baseline {}; {} threads, {} warm-up + {} repetitions per row\n",
              fmt::join(run.config.pipelines, ", "), run.config.baseline, executor.threads(), run.config.warmup,
              run.config.repetitions);

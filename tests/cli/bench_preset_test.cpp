@@ -260,8 +260,12 @@ TEST(BenchPresetKim, FocalComparesEveryMethodWithPlainRasterAtThreeDistances) {
         "bidir-warp:occlusion=ztest", "bw-warp", "fw-warp", "bidir-warp-rt", "plain-raster ms", "speed-up", "160x90"})
     EXPECT_NE(r.out.find(part), std::string::npos) << part << "\n" << r.out;
 
+  // The summary speaks of Kim's 960x540; the run says what it replaced.
+  EXPECT_NE(r.out.find("as run, replacing the preset's: image size 160x90\n"), std::string::npos) << r.out;
+
   const json j = json::parse(test::read_text(dir / "focal.json"));
   EXPECT_TRUE(j.at("complete").get<bool>());
+  EXPECT_EQ(j.at("overrides"), "image size 160x90");
   EXPECT_EQ(j.at("reference"), "plain-raster");
   EXPECT_EQ(j.at("baseline"), "plain-raster");
   const json& rows = j.at("rows");
