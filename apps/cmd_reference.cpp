@@ -107,10 +107,20 @@ int run_verify(const ReferenceArgs& a) {
     io::write_text_atomically(a.json_out, j.dump(2) + "\n");
   }
   const int code = verdict(results);
-  size_t failures = 0;
-  for (const auto& r : results) failures += reference::failed(r.status) ? 1 : 0;
-  fmt::print("{} of {} reference(s) verified{}\n", results.size() - failures, results.size(),
-             failures == 0 ? "" : fmt::format("; {} did not (run `stereobench reference update --only-failing`)", failures));
+  // What to do differs: a failed check is rewritten by update, an unchecked one needs its tool.
+  size_t failures = 0, unchecked = 0;
+  for (const auto& r : results) {
+    unchecked += r.status == reference::Status::unavailable ? 1 : 0;
+    failures += reference::failed(r.status) && r.status != reference::Status::unavailable ? 1 : 0;
+  }
+  std::string tail;
+  if (failures > 0)
+    tail += fmt::format("; {} did not (rewrite them with `stereobench reference update --only-failing`)", failures);
+  if (unchecked > 0)
+    tail += fmt::format("; {} could not be checked here (their tool is missing: install it, see above, and verify "
+                        "again)",
+                        unchecked);
+  fmt::print("{} of {} reference(s) verified{}\n", results.size() - failures - unchecked, results.size(), tail);
   return code;
 }
 

@@ -236,7 +236,10 @@ TEST(ReferenceStore, MissingToolIsUnavailableNotAPass) {
   EXPECT_EQ(again.code, 4) << again.out;
   EXPECT_EQ(verify.code, 4) << verify.out;
   EXPECT_NE(verify.out.find("unavailable"), std::string::npos) << verify.out;
-  EXPECT_NE(verify.out.find("0 of 1 reference(s) verified"), std::string::npos) << verify.out;
+  EXPECT_NE(verify.out.find("0 of 1 reference(s) verified; 1 could not be checked here (their tool is missing"),
+            std::string::npos)
+      << verify.out;
+  EXPECT_EQ(verify.out.find("update --only-failing"), std::string::npos) << "update cannot render without the tool";
 }
 
 }  // namespace
