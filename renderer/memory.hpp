@@ -68,7 +68,8 @@ void require_memory(uint64_t need, const std::string& what, const std::string& a
 /// state, the ground truth, metric maps and the encoded outputs. Measured as the slope of the peak
 /// resident size between 1920x1080 and 3840x2160 (lit-plane; render and validate of each pipeline):
 /// 197 (plain-rt) to 297 B (bidir-warp), rt-buffer 545 B with its reprojection buffer, which it
-/// checks itself as it allocates it (t x 4 B per pixel).
+/// checks itself as it allocates it (t x 4 B per pixel; t = 83 there); `validate -p all` 622 B,
+/// that buffer included (one pipeline's images are held at a time).
 inline constexpr uint64_t kFrameBytesPerPixel = 320;
 
 /// Refuses a render of width x height stereo pairs that would not fit (require_memory), naming
