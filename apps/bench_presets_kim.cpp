@@ -45,7 +45,6 @@ constexpr double kPriorFixedBytes = 1024.0 * 1024.0 * 1024.0;
 constexpr double kPriorBytesPerTriangle = 1024.0;
 
 constexpr double kMiB = 1024.0 * 1024.0;
-constexpr double kGiB = 1024.0 * kMiB;
 
 /// MemAvailable of /proc/meminfo; IoError when it cannot be read (the memory check needs it).
 uint64_t mem_available_bytes() {
@@ -181,7 +180,6 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-std::string gib(uint64_t bytes) { return fmt::format("{:.2f} GiB", static_cast<double>(bytes) / kGiB); }
 
 /// "1e7" from 10000000.
 std::string power_of_ten(double n) {

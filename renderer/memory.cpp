@@ -20,10 +20,6 @@ namespace {
 /// Limits at or above this are "no limit" (cgroup v1 writes 2^63 rounded down to a page).
 constexpr uint64_t kUnlimited = uint64_t{1} << 62;
 
-constexpr double kGiB = 1024.0 * 1024.0 * 1024.0;
-
-std::string gib(uint64_t bytes) { return fmt::format("{:.2f} GiB", static_cast<double>(bytes) / kGiB); }
-
 /// The first line of a file, or nothing.
 std::optional<std::string> first_line(const std::string& file) {
   std::ifstream in(file);
@@ -80,6 +76,10 @@ void read_cgroup(MemorySources& s) {
 }
 
 }  // namespace
+
+std::string gib(uint64_t bytes) {
+  return fmt::format("{:.2f} GiB", static_cast<double>(bytes) / (1024.0 * 1024.0 * 1024.0));
+}
 
 void keep_freed_memory() {
   mallopt(M_MMAP_MAX, 0);

@@ -22,6 +22,9 @@ void keep_freed_memory();
 /// nothing when the file or the field is missing.
 [[nodiscard]] std::optional<uint64_t> proc_kib_field(const char* file, const std::string& key);
 
+/// Bytes as GiB with two decimals, "20.54 GiB", as memory messages and tables print them.
+[[nodiscard]] std::string gib(uint64_t bytes);
+
 /// The process's resident size (VmRSS) and its peak (VmHWM), in bytes; 0 when unreadable.
 [[nodiscard]] uint64_t resident_bytes();
 [[nodiscard]] uint64_t peak_resident_bytes();
