@@ -125,12 +125,6 @@ enum class StageGroup {
   return StageGroup::other;
 }
 
-/// Whether a row that needs `needed_bytes` more resident memory fits into `available_bytes`
-/// (MemAvailable): needed <= kMemoryUsableShare * available.
-[[nodiscard]] inline bool memory_fits(uint64_t needed_bytes, uint64_t available_bytes) {
-  return static_cast<double>(needed_bytes) <= kMemoryUsableShare * static_cast<double>(available_bytes);
-}
-
 /// The peak resident memory a measured row reached.
 struct MeasuredPeak {
   double triangles = 0.0;

@@ -46,13 +46,14 @@ constexpr double kPriorBytesPerTriangle = 1024.0;
 
 constexpr double kMiB = 1024.0 * 1024.0;
 
-/// MemAvailable of /proc/meminfo; IoError when it cannot be read (the memory check needs it).
-uint64_t mem_available_bytes() {
-  const std::optional<uint64_t> v = proc_kib_field("/proc/meminfo", "MemAvailable");
-  if (!v)
-    throw IoError("cannot read MemAvailable from /proc/meminfo, which kim-complexity needs to decide whether a "
-                  "row fits in memory; run it on Linux 3.14 or later");
-  return *v;
+/// What the process may allocate now, by the bound require_memory uses: a row that passes the
+/// preset's check is not refused part-way by the loader or the BVH's own checks.
+MemoryBudget budget_now() {
+  const MemoryBudget budget = memory_budget(read_memory_sources());
+  if (budget.bytes == UINT64_MAX)
+    throw IoError("cannot read how much memory is available (/proc/meminfo), which kim-complexity needs to decide "
+                  "whether a row fits; run it on Linux 3.14 or later");
+  return budget;
 }
 
 /// Resets the process's peak resident size (VmHWM) to its current size, so that the next reading
@@ -224,7 +225,7 @@ BenchPreset kim_complexity_preset() {
   p.summary =
       "Kim's Table 3: the complexity scene with 1e5, 1e6, 1e7 and 1e8 triangles at 1920x1080 (FHD), e = 64 mm; median "
       "rendering and warping time per pipeline, peak memory per row, and the crossover where bidir-warp beats "
-      "plain-raster. A row that would not fit in MemAvailable is skipped with the reason.";
+      "plain-raster. A row that would not fit in the memory left is skipped with the reason.";
   p.kind = PresetKind::complexity;
   p.pipelines = {kReference, kBidirectional};
   p.baseline = kReference;
@@ -345,9 +346,10 @@ void run_kim_complexity(const PresetRun& run, const Executor& executor) {
   fmt::print(
       "rendering = stages redirect, ztest, *_gbuffer, *_shading, *_trace; warping = motion, warps, crack and hole "
       "filling, background; medians of each repetition's sums\n");
+  const MemoryBudget start_budget = budget_now();
   fmt::print("memory: a row runs when its estimated peak minus the resident memory before it is at most {:.0f} % of "
-             "MemAvailable ({} now); peak = VmHWM of the row\n",
-             kMemoryUsableShare * 100.0, gib(mem_available_bytes()));
+             "the memory left ({} now, by {}); peak = VmHWM of the row\n",
+             kMemoryUsableShare * 100.0, gib(start_budget.bytes), start_budget.bound);
 
   nlohmann::json out = preset_json(run, executor);
   out["memory_usable_share"] = kMemoryUsableShare;
@@ -377,7 +379,7 @@ void run_kim_complexity(const PresetRun& run, const Executor& executor) {
       // Memory check before anything of the row is generated or loaded.
       malloc_trim(0);
       const uint64_t rss_before = resident_bytes();
-      const uint64_t available = mem_available_bytes();
+      const MemoryBudget budget = budget_now();
       const uint64_t estimate = estimate_peak_bytes(peaks, base_rss, triangles, kPriorFixedBytes, kPriorBytesPerTriangle);
       std::string basis = "prior (1 GiB + 1 KiB per triangle)";
       if (peaks.size() == 1) basis = "proportional to the " + measured_values.back() + " row";
@@ -387,11 +389,12 @@ void run_kim_complexity(const PresetRun& run, const Executor& executor) {
       nlohmann::json memory = {{"estimated_peak_bytes", estimate},
                                {"estimate_basis", basis},
                                {"resident_before_bytes", rss_before},
-                               {"mem_available_bytes", available}};
-      if (!memory_fits(extra, available)) {
+                               {"budget_bytes", budget.bytes},
+                               {"budget_bound", budget.bound}};
+      if (!fits(extra, budget)) {
         const std::string reason =
-            fmt::format("estimated peak {} ({}) needs {} more, over {:.0f} % of MemAvailable {}", gib(estimate), basis,
-                        gib(extra), kMemoryUsableShare * 100.0, gib(available));
+            fmt::format("estimated peak {} ({}) needs {} more, over {:.0f} % of the {} left by {}", gib(estimate), basis,
+                        gib(extra), kMemoryUsableShare * 100.0, gib(budget.bytes), budget.bound);
         print_header();
         fmt::print("{:<14} skipped: {}\n", row.value, reason);
         std::fflush(stdout);

@@ -130,10 +130,14 @@ MemoryBudget memory_budget(const MemorySources& s) {
   return b;
 }
 
+bool fits(uint64_t need, const MemoryBudget& budget) {
+  return budget.bytes == UINT64_MAX ||
+         static_cast<double>(need) <= kMemoryUsableShare * static_cast<double>(budget.bytes);
+}
+
 void require_memory(uint64_t need, const std::string& what, const std::string& advice, const MemoryBudget& budget) {
-  if (budget.bytes == UINT64_MAX) return;
+  if (fits(need, budget)) return;
   const double usable = kMemoryUsableShare * static_cast<double>(budget.bytes);
-  if (static_cast<double>(need) <= usable) return;
   throw ResourceError(fmt::format("{} needs about {} of memory, but only {} may be used: {:.0f} % of the {} left by {}; {}",
                                   what, gib(need), gib(static_cast<uint64_t>(usable)), kMemoryUsableShare * 100.0,
                                   gib(budget.bytes), budget.bound, advice));

@@ -58,9 +58,12 @@ struct MemoryBudget {
 /// The least of the bounds in `sources`, each plus the heap's free memory.
 [[nodiscard]] MemoryBudget memory_budget(const MemorySources& sources);
 
-/// Refuses work that needs about `need` bytes more than the process holds when that exceeds
-/// kMemoryUsableShare of `budget`: throws ResourceError (exit 4) "<what> needs about X GiB of
-/// memory, but <bound> leaves Y GiB for it; <advice>".
+/// Whether work needing about `need` bytes more than the process holds fits: need <=
+/// kMemoryUsableShare * budget (always, when no bound could be read).
+[[nodiscard]] bool fits(uint64_t need, const MemoryBudget& budget);
+
+/// Refuses work that does not fit (see fits): throws ResourceError (exit 4) "<what> needs about
+/// X GiB of memory, but only Y GiB may be used: 90 % of the Z GiB left by <bound>; <advice>".
 void require_memory(uint64_t need, const std::string& what, const std::string& advice, const MemoryBudget& budget);
 
 /// The same against this process's budget now.

@@ -197,11 +197,14 @@ StereoRig resolve_rig(const Scene& scene, const RigOverrides& o) {
     if (cam.aspect > 0.0) {
       // The camera's aspect ratio sets the width unless the scene's extras or an override do.
       const double width = p.height * cam.aspect;
-      if (!(width >= 0.5 && width < kMaxImageSide + 0.5) && !scene.rig.width && !o.width)
+      const bool in_range = width >= 0.5 && width < kMaxImageSide + 0.5;
+      if (in_range) {
+        p.width = static_cast<int>(std::lround(width));
+      } else if (!scene.rig.width && !o.width) {
         throw InputError(fmt::format("scene '{}': its camera's aspectRatio {:g} gives a width of {:g} px at {} px "
                                      "height, outside 1..{}; fix the camera's aspectRatio, or give --resolution",
                                      scene.name, cam.aspect, width, p.height, kMaxImageSide));
-      if (width >= 0.5 && width < kMaxImageSide + 0.5) p.width = static_cast<int>(std::lround(width));
+      }
     }
   } else {
     // Frame the bounding sphere from +Z.

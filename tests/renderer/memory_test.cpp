@@ -42,6 +42,16 @@ TEST(Memory, TheBudgetIsTheTightestBoundPlusTheHeapsFreeMemory) {
   EXPECT_EQ(memory_budget(s).bytes, 2 * kGiB);
 }
 
+TEST(Memory, WorkFitsInNinetyPercentOfTheBudget) {
+  const auto budget = [](uint64_t bytes) { return MemoryBudget{bytes, "MemAvailable"}; };
+  EXPECT_TRUE(fits(0, budget(0)));
+  EXPECT_TRUE(fits(9 * kGiB, budget(10 * kGiB)));  // exactly the usable share
+  EXPECT_FALSE(fits(9 * kGiB + 1, budget(10 * kGiB)));
+  EXPECT_FALSE(fits(1, budget(0)));
+  EXPECT_FALSE(fits(30 * kGiB, budget(22 * kGiB)));  // a 1e8 kim-complexity row as extrapolated on a 24 GiB machine
+  EXPECT_TRUE(fits(30 * kGiB, MemoryBudget{})) << "no bound read: no limit";
+}
+
 TEST(Memory, WorkBeyondTheUsableShareIsRefusedNamingWhatAndWhy) {
   const MemoryBudget budget{10 * kGiB, "the address-space limit of 10.00 GiB (ulimit -v)"};
   EXPECT_NO_THROW(require_memory(9 * kGiB, "a job", "do less", budget)) << "exactly the usable share";
