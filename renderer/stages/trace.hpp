@@ -27,10 +27,10 @@ void trace_eye(const RenderScene& scene, const EyeCamera& eye, const Executor& e
                TraceCounts& counts);
 
 /// Traces and shades the listed pixels (indices y * width + x) only; the others are left as they
-/// are. The rays go in trace_eye's packets — each 4x4 block holding a listed pixel is cast whole —
-/// so that every hit is bit-identical to trace_eye's: Embree's packet traversal treats a packet
-/// with few active rays differently from a full one. Only the listed pixels are shaded and written.
-/// InputError for an index outside the image.
+/// are. The rays go in trace_eye's 4x4 blocks, each cast as one packet with only its listed lanes
+/// active: a lane's closest hit does not depend on the lanes beside it, so every hit is
+/// bit-identical to trace_eye's (the hole fillers' tests against plain-rt check this). Only the
+/// listed pixels are shaded and written. InputError for an index outside the image.
 void trace_pixels(const RenderScene& scene, const EyeCamera& eye, const Executor& executor,
                   std::span<const uint32_t> pixels, Image& image, TraceCounts& counts, Source source = Source::traced);
 
