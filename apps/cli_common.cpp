@@ -96,6 +96,26 @@ std::map<std::string, std::string> parse_key_values(const std::vector<std::strin
   return out;
 }
 
+std::vector<std::string> split_list(const std::vector<std::string>& items, const char* option) {
+  std::vector<std::string> out;
+  for (const std::string& item : items) {
+    if (item.empty()) throw InputError(fmt::format("{} is given an empty value; give one or more names", option));
+    size_t begin = 0;
+    while (true) {
+      const size_t comma = item.find(',', begin);
+      const std::string entry = item.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
+      if (entry.empty())
+        throw InputError(fmt::format("{} '{}' has an empty entry (a doubled, leading or trailing comma); separate "
+                                     "the names with single commas",
+                                     option, item));
+      out.push_back(entry);
+      if (comma == std::string::npos) break;
+      begin = comma + 1;
+    }
+  }
+  return out;
+}
+
 int checked_threads(int threads) {
   if (threads < 0 || threads > 1024)
     throw InputError(fmt::format("--threads {} is out of range; give 0 (all cores) or 1..1024", threads));

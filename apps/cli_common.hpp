@@ -46,6 +46,11 @@ CLI::Option* add_lights_option(CLI::App& app, std::optional<int>& lights);
 [[nodiscard]] std::map<std::string, std::string> parse_key_values(const std::vector<std::string>& items,
                                                                   const char* option);
 
+/// The entries of a list option given comma-separated and/or repeated ("a,b" or "a" "b"), in
+/// order. InputError naming the option and the item for an empty entry (a doubled, leading or
+/// trailing comma, or an empty item), which would otherwise drop a name the user meant to give.
+[[nodiscard]] std::vector<std::string> split_list(const std::vector<std::string>& items, const char* option);
+
 /// A file named on the command line: the option or argument that names it, and its path.
 struct NamedPath {
   const char* name;

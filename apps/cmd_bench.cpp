@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
-#include <sstream>
 
 #include <fmt/format.h>
 
@@ -40,17 +39,6 @@ struct BenchArgs {
   RigCli rig;
 };
 
-std::vector<std::string> split_names(const std::vector<std::string>& items) {
-  std::vector<std::string> out;
-  for (const std::string& item : items) {
-    std::stringstream ss(item);
-    std::string name;
-    while (std::getline(ss, name, ','))
-      if (!name.empty()) out.push_back(name);
-  }
-  return out;
-}
-
 double peak_rss_mib() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
@@ -61,10 +49,7 @@ double peak_rss_mib() {
 /// folder made: all before any scene is loaded.
 BenchConfig bench_config(const BenchArgs& a, const std::vector<std::string>& default_pipelines) {
   BenchConfig config;
-  config.pipelines = split_names(a.pipelines);
-  if (!a.pipelines.empty() && config.pipelines.empty())
-    throw InputError("--pipelines names no pipeline; give names (see `stereobench pipelines`) or leave the option out "
-                     "for the default set");
+  config.pipelines = split_list(a.pipelines, "--pipelines");
   if (config.pipelines.empty()) config.pipelines = default_pipelines;
   config.baseline = a.baseline;
   if (std::find(config.pipelines.begin(), config.pipelines.end(), config.baseline) == config.pipelines.end())

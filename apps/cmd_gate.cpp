@@ -4,7 +4,6 @@
 // `--update-baseline` instead stores the timing samples of the named pipelines and cells.
 #include <filesystem>
 #include <memory>
-#include <sstream>
 
 #include <fmt/format.h>
 
@@ -32,20 +31,17 @@ struct GateArgs {
   std::string cells;
 };
 
-std::vector<std::string> split_names(const std::vector<std::string>& items) {
+/// The pipelines --only names, each once.
+std::vector<std::string> only_names(const std::vector<std::string>& items) {
   std::vector<std::string> out;
-  for (const std::string& item : items) {
-    std::stringstream list(item);
-    std::string name;
-    while (std::getline(list, name, ','))
-      if (!name.empty() && std::find(out.begin(), out.end(), name) == out.end()) out.push_back(name);
-  }
+  for (const std::string& name : split_list(items, "--only"))
+    if (std::find(out.begin(), out.end(), name) == out.end()) out.push_back(name);
   return out;
 }
 
 /// Rewrites the entries of the baseline `file` that the selection names.
 void run_update(const GateArgs& a, const fs::path& file) {
-  const validation::BaselineSelection selection{split_names(a.only), a.cells};
+  const validation::BaselineSelection selection{only_names(a.only), a.cells};
   const validation::GateResults results = validation::load_gate_results(a.results);
   for (const std::string& w : results.warnings) fmt::print(stderr, "warning: {}\n", w);
   validation::Baseline baseline = fs::exists(file) ? validation::load_baseline(file) : validation::Baseline{};

@@ -7,7 +7,6 @@
 #include <map>
 #include <memory>
 #include <optional>
-#include <sstream>
 #include <vector>
 
 #include <fmt/format.h>
@@ -49,16 +48,11 @@ std::vector<PipelineEntry> chosen_pipelines(const std::vector<std::string>& name
   const auto add = [&chosen](const std::string& name) {
     if (std::find(chosen.begin(), chosen.end(), name) == chosen.end()) chosen.push_back(name);
   };
-  for (const std::string& item : names) {
-    std::stringstream list(item);
-    std::string name;
-    while (std::getline(list, name, ',')) {
-      if (name.empty()) continue;
-      if (name == "all")
-        for (const Pipeline* p : pipelines()) add(p->info().name);
-      else
-        add(name);
-    }
+  for (const std::string& name : split_list(names, "--pipelines")) {
+    if (name == "all")
+      for (const Pipeline* p : pipelines()) add(p->info().name);
+    else
+      add(name);
   }
   if (chosen.empty())
     throw InputError("--pipelines names no pipeline; give names (see `stereobench pipelines`) or 'all'");

@@ -91,6 +91,31 @@ TEST(Cli, BadArgumentsExitWith3AndSayWhy) {
   }
 }
 
+TEST(Cli, ListOptionsRefuseEmptyEntries) {
+  // A doubled or stray comma used to drop an entry silently: 'plain-rt,,plain-raster' ran two
+  // pipelines where three may have been meant, and a gate --only list stored fewer baselines.
+  test::ScratchDir dir("emptyentry");
+  const std::string common = " --scenes-dir '" + (dir / "scenes").string() + "' --resolution 32x18 --out '" +
+                             dir.path().string() + "'";
+  const std::string entries[] = {"plain-rt,,plain-raster", "plain-rt,", ",plain-rt"};
+  for (const std::string& list : entries)
+    for (const std::string& command : {std::string("validate"), std::string("path -n 1"), std::string("bench")}) {
+      const std::string args = command + " --scene box-wall --pipelines '" + list + "'" +
+                               (command == "bench" ? " --resolution 32x18 --scenes-dir '" + (dir / "scenes").string() + "'"
+                                                   : common);
+      const CliRun r = run(args);
+      EXPECT_EQ(r.code, 3) << args << "\n" << r.out;
+      EXPECT_NE(r.out.find("--pipelines '" + list + "' has an empty entry"), std::string::npos) << args << "\n" << r.out;
+    }
+  const CliRun gate = run("gate --results '" + (dir / "none.jsonl").string() + "' --update-baseline --only 'plain-rt,,repro-rt'");
+  EXPECT_EQ(gate.code, 3) << gate.out;
+  EXPECT_NE(gate.out.find("--only 'plain-rt,,repro-rt' has an empty entry"), std::string::npos) << gate.out;
+  // Comma-separated and repeated entries still combine.
+  const CliRun ok = run("validate --scene box-wall --pipelines plain-rt --pipelines plain-raster,plain-rt" + common);
+  EXPECT_EQ(ok.code, 0) << ok.out;
+  EXPECT_NE(ok.out.find("validating 2 pipeline(s)"), std::string::npos) << ok.out;
+}
+
 TEST(Cli, SceneInfoPrintsRigAndDisparities) {
   test::ScratchDir dir("cliinfo");
   test::MiniGltf g;
@@ -331,7 +356,7 @@ TEST(Cli, RenderAndBenchRejectBadArguments) {
            bench_common,
        "names the same file as the scene file"},
       // An empty list used to time every registered pipeline.
-      {"bench --scene box-wall --pipelines ''" + bench_common, "--pipelines names no pipeline"},
+      {"bench --scene box-wall --pipelines ''" + bench_common, "--pipelines is given an empty value"},
       {"bench --scene box-wall -n 20000 --pipelines plain-rt --baseline plain-rt" + bench_common,
        "--repetitions 20000 is outside 1..10000"},
       {"bench --scene box-wall --pipelines plain-rt,plain-rt --baseline plain-rt" + bench_common,
