@@ -2,7 +2,9 @@
 // test against a stored baseline to a sweep's results file, prints the checks that did not pass,
 // writes JUnit XML and JSON, and exits 0 (pass), 1 (warnings only) or 2 (any failure); bad input is 3.
 // `--update-baseline` instead stores the timing samples of the named pipelines and cells.
+#include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <memory>
 
 #include <fmt/format.h>
@@ -42,6 +44,11 @@ std::vector<std::string> only_names(const std::vector<std::string>& items) {
 /// Rewrites the entries of the baseline `file` that the selection names.
 void run_update(const GateArgs& a, const fs::path& file) {
   const validation::BaselineSelection selection{only_names(a.only), a.cells};
+  // The rank test's minimum comes from the gate config the baseline will be checked with (the
+  // default's when that file is not here).
+  const bool has_config = fs::exists(a.config);
+  const int min_repetitions = has_config ? validation::load_gate_config(a.config).regression.min_repetitions
+                                         : validation::RegressionSettings{}.min_repetitions;
   const validation::GateResults results = validation::load_gate_results(a.results);
   for (const std::string& w : results.warnings) fmt::print(stderr, "warning: {}\n", w);
   validation::Baseline baseline = fs::exists(file) ? validation::load_baseline(file) : validation::Baseline{};
@@ -55,6 +62,23 @@ void run_update(const GateArgs& a, const fs::path& file) {
   }
   fmt::print("wrote {} ({} entr{} from {}; every other entry unchanged)\n", file.string(), changes.size(),
              changes.size() == 1 ? "y" : "ies", a.results);
+  // Too few samples store a baseline that every later time check can only warn about.
+  size_t short_entries = 0, fewest = std::numeric_limits<size_t>::max();
+  for (const validation::BaselineChange& c : changes)
+    if (c.samples < static_cast<size_t>(min_repetitions)) {
+      ++short_entries;
+      fewest = std::min(fewest, c.samples);
+    }
+  if (short_entries > 0)
+    fmt::print(stderr,
+               "warning: {} of the {} stored entr{} hold{} fewer than the {} timing samples the rank test needs "
+               "({}; the fewest: {}): every time check against {} will warn \"not enough repetitions\" and never "
+               "pass or fail; run the sweep with --repetitions {} or more (5 is better) and update again\n",
+               short_entries, changes.size(), changes.size() == 1 ? "y" : "ies", short_entries == 1 ? "s" : "",
+               min_repetitions,
+               has_config ? fmt::format("[regression] min_repetitions in {}", a.config)
+                          : fmt::format("the default min_repetitions; {} is not here", a.config),
+               fewest, short_entries == 1 ? "it" : "them", min_repetitions);
 }
 
 /// Removes what an earlier gate run left at an output path, so that a run stopped by bad input

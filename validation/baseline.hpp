@@ -58,6 +58,7 @@ struct BaselineChange {
   bool replaced = false;  ///< an entry existed before
   double old_median_s = 0.0;
   double new_median_s = 0.0;
+  size_t samples = 0;  ///< timing samples stored
 };
 
 }  // namespace sb::validation

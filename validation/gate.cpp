@@ -468,7 +468,7 @@ std::vector<BaselineChange> update_baseline(Baseline& baseline, const GateResult
       e.median_s = median(e.samples_s);
       e.recorded = cell.record.value("finished", json("")).is_string() ? cell.record.value("finished", "") : "";
       e.host = cell.record.value("host", json("")).is_string() ? cell.record.value("host", "") : "";
-      BaselineChange change{cell.cell_id, pipeline, false, 0.0, e.median_s};
+      BaselineChange change{cell.cell_id, pipeline, false, 0.0, e.median_s, e.samples_s.size()};
       if (const BaselineEntry* old = baseline.find(cell.cell_id, pipeline)) {
         change.replaced = true;
         change.old_median_s = old->median_s;

@@ -198,6 +198,8 @@ TEST(GateEval, BaselineUpdateTouchesOnlyWhatIsNamed) {
   EXPECT_EQ(now.find(id0, "repro-rt")->recorded, "2026-11-21T19:20:00Z");
   ASSERT_NE(now.find(id1, "repro-rt"), nullptr);
   EXPECT_EQ(now.find(id1, "plain-rt"), nullptr);
+  // Three samples each: as many as the rank test needs, so no warning.
+  EXPECT_EQ(run.out.find("warning:"), std::string::npos) << run.out;
 
   // --cells: only the matching cell, every pipeline in it.
   run = run_cli("gate --update-baseline --cells '*|e=0.12m|*' --results " + (dir / "results.jsonl").string() +
@@ -230,6 +232,28 @@ TEST(GateEval, BaselineUpdateTouchesOnlyWhatIsNamed) {
             std::string::npos)
       << run.out;
   EXPECT_EQ(read_text(dir / "baseline.json"), kept);
+
+  // One timing sample (a smoke sweep's): stored as asked, with a warning that every time check
+  // against it can only warn, and how many samples the config's rank test needs.
+  std::vector<json> single = passing_cells();
+  for (json& cell : single) {
+    for (auto& [name, entry] : cell["pipelines"].items()) {
+      entry["timing"]["samples_s"] = json::array({0.02});
+      entry["timing"]["repetitions"] = 1;
+    }
+  }
+  write_results(dir / "single.jsonl", single);
+  write_file(dir / "gate.toml", "[regression]\nmin_repetitions = 5\n");
+  run = run_cli("gate --update-baseline --only repro-rt --results " + (dir / "single.jsonl").string() +
+                " --baseline " + (dir / "baseline.json").string() + " --config " + (dir / "gate.toml").string());
+  ASSERT_EQ(run.code, 0) << run.out;
+  EXPECT_EQ(validation::load_baseline(dir / "baseline.json").find(id0, "repro-rt")->samples_s,
+            std::vector<double>({0.02}));
+  EXPECT_NE(run.out.find("warning: 2 of the 2 stored entries hold fewer than the 5 timing samples the rank test "
+                         "needs ([regression] min_repetitions in " +
+                         (dir / "gate.toml").string() + "; the fewest: 1)"),
+            std::string::npos)
+      << run.out;
 }
 
 TEST(GateCli, ExitCodesAndOutputs) {
