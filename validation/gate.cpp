@@ -41,6 +41,15 @@ std::vector<std::string> threshold_keys() {
   return keys;
 }
 
+/// The warning level of `c`, both levels set, lies beyond its failure level: a value would fail
+/// before it could warn.
+bool warn_level_looser(const MetricCheck& c, const ThresholdValues& values) {
+  const auto f = values.find(c.fail_key);
+  const auto w = values.find(c.warn_key);
+  if (f == values.end() || w == values.end() || !f->second || !w->second) return false;
+  return c.direction == Direction::at_least ? *w->second < *f->second : *w->second > *f->second;
+}
+
 [[noreturn]] void config_error(const std::string& source, const toml::source_region& where, const std::string& what) {
   throw InputError(fmt::format("{}:{}: {}", source, where.begin.line, what));
 }
@@ -84,17 +93,12 @@ ThresholdValues read_thresholds(const toml::table& table, const std::string& tab
                                                                     : "the limit could never be reached"));
   }
   // A warning level must be reached before the failure level.
-  for (const MetricCheck& c : kMetricChecks) {
-    const auto f = values.find(c.fail_key);
-    const auto w = values.find(c.warn_key);
-    if (f == values.end() || w == values.end() || !f->second || !w->second) continue;
-    const bool looser = c.direction == Direction::at_least ? *w->second < *f->second : *w->second > *f->second;
-    if (looser)
+  for (const MetricCheck& c : kMetricChecks)
+    if (warn_level_looser(c, values))
       config_error(source, table[c.warn_key].node()->source(),
                    fmt::format("{} = {} is looser than {} = {} in {}; the warning level must lie between the "
                                "failure level and the expected value",
-                               c.warn_key, *w->second, c.fail_key, *f->second, table_name));
-  }
+                               c.warn_key, *values[c.warn_key], c.fail_key, *values[c.fail_key], table_name));
   return values;
 }
 
@@ -308,17 +312,47 @@ GateConfig load_gate_config(const std::filesystem::path& file) {
 }
 
 ThresholdValues thresholds_for(const GateConfig& config, const std::string& pipeline, const std::string& scene,
-                               const std::string& cell_id, std::vector<bool>* rule_used) {
+                               const std::string& cell_id, std::vector<bool>* rule_used,
+                               std::map<std::string, std::string>* origins) {
   ThresholdValues values = config.defaults;
   values[kToleranceKey] = config.regression.tolerance;
+  // Per key, the rule that set it last (none: [defaults]).
+  std::map<std::string, size_t> set_by;
   for (size_t i = 0; i < config.rules.size(); ++i) {
     const GateRule& rule = config.rules[i];
     if (!glob_matches(rule.pipeline, pipeline) || !glob_matches(rule.scene, scene) || !glob_matches(rule.cell, cell_id))
       continue;
-    for (const auto& [key, value] : rule.values) values[key] = value;
+    for (const auto& [key, value] : rule.values) {
+      values[key] = value;
+      set_by[key] = i;
+    }
     if (rule_used) (*rule_used)[i] = true;
   }
+  if (origins != nullptr)
+    for (const auto& entry : values) {
+      const auto it = set_by.find(entry.first);
+      (*origins)[entry.first] = it == set_by.end() ? std::string("[defaults]")
+                                                   : fmt::format("the [[rule]] at line {}", config.rules[it->second].line);
+    }
   return values;
+}
+
+std::vector<std::string> unreachable_warning_levels(const ThresholdValues& values,
+                                                    const std::map<std::string, std::string>& origins,
+                                                    const std::string& pipeline, const std::string& scene) {
+  std::vector<std::string> out;
+  const auto origin = [&origins](const char* key) {
+    const auto it = origins.find(key);
+    return it == origins.end() ? std::string("[defaults]") : it->second;
+  };
+  for (const MetricCheck& c : kMetricChecks)
+    if (warn_level_looser(c, values))
+      out.push_back(fmt::format(
+          "for pipeline {} on scene {}, {} = {} ({}) is looser than {} = {} ({}): that warning can never be "
+          "raised there, a value beyond {} fails at once; set {} in the same table as {}",
+          pipeline, scene, c.warn_key, *values.at(c.warn_key), origin(c.warn_key), c.fail_key, *values.at(c.fail_key),
+          origin(c.fail_key), c.fail_key, c.warn_key, c.fail_key));
+  return out;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -706,10 +740,14 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
   report.notes = results.warnings;
   const RegressionSettings& reg = config.regression;
   std::vector<bool> rule_used(config.rules.size(), false);
+  std::set<std::string> level_notes;
   for (const GateCell& cell : results.cells) {
     const std::string where = fmt::format("{}: cell '{}'", results.file.string(), cell.cell_id);
     for (const auto& [pipeline, entry] : cell.record["pipelines"].items()) {
-      const ThresholdValues limits = thresholds_for(config, pipeline, cell.scene, cell.cell_id, &rule_used);
+      std::map<std::string, std::string> origins;
+      const ThresholdValues limits = thresholds_for(config, pipeline, cell.scene, cell.cell_id, &rule_used, &origins);
+      for (std::string& note : unreachable_warning_levels(limits, origins, pipeline, cell.scene))
+        if (level_notes.insert(note).second) report.notes.push_back(fmt::format("{}: {}", config.source, note));
       const std::string quality_command = reproduce_command(cell, pipeline, reproduce, Remeasure::quality);
       const std::string timing_command = reproduce_command(cell, pipeline, reproduce, Remeasure::timing);
       auto limit = [&](const char* key) -> std::optional<double> {

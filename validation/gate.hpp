@@ -98,10 +98,22 @@ struct GateConfig {
 
 /// The thresholds in force for one (pipeline, scene, cell): the defaults with every matching rule
 /// applied in file order; the regression tolerance under the key "regression_tolerance". With
-/// `rule_used` (one flag per rule), the matching rules' flags are set.
+/// `rule_used` (one flag per rule), the matching rules' flags are set; with `origins`, each key
+/// gets the table that set it: "[defaults]" or "the [[rule]] at line N".
 [[nodiscard]] ThresholdValues thresholds_for(const GateConfig& config, const std::string& pipeline,
                                              const std::string& scene, const std::string& cell_id,
-                                             std::vector<bool>* rule_used = nullptr);
+                                             std::vector<bool>* rule_used = nullptr,
+                                             std::map<std::string, std::string>* origins = nullptr);
+
+/// Where the merged thresholds of one (pipeline, scene) put a warning level beyond its failure
+/// level — e.g. warn_psnr = 35 from [defaults] under min_psnr = 40 from a rule — so that the
+/// warning can never be raised there: one sentence per such check, naming both levels and the
+/// tables that set them. parse_gate_config refuses the same within one table; across tables it
+/// depends on which rules match, so the gate reports it as a note.
+[[nodiscard]] std::vector<std::string> unreachable_warning_levels(const ThresholdValues& values,
+                                                                  const std::map<std::string, std::string>& origins,
+                                                                  const std::string& pipeline,
+                                                                  const std::string& scene);
 
 /// One finished cell of a sweep's results file, as the gate reads it.
 struct GateCell {

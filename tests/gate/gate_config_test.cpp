@@ -2,6 +2,7 @@
 // cascading, turning checks off, and the shipped ci/gate.toml.
 #include <gtest/gtest.h>
 
+#include <map>
 #include <string>
 
 #include <fmt/format.h>
@@ -111,6 +112,40 @@ TEST(GateConfig, RulesOverrideDefaultsInFileOrder) {
   t = thresholds_for(c, "plain-rt", "box-wall", "box-wall|e=0.064m|c=default|640x360|lights=all|full");
   EXPECT_EQ(t["min_psnr"], 30.0);
   EXPECT_FALSE(t["regression_tolerance"].has_value());
+}
+
+TEST(GateConfig, AWarningLevelLooserThanAFailureLevelFromAnotherTableIsNamed) {
+  // Each table alone is consistent; merged for repro-rt on spheres, the rule's warn_psnr lies below
+  // the defaults' min_psnr, so a PSNR of 27 fails without ever having warned.
+  const GateConfig c = parse_gate_config(
+      "[defaults]\nmin_psnr = 30\nmax_hole_fraction = 0.2\n"
+      "[[rule]]\npipeline = \"repro-*\"\nwarn_psnr = 25\n"
+      "[[rule]]\npipeline = \"repro-rt\"\nscene = \"box-wall\"\nmin_psnr = 20\n"
+      "[[rule]]\npipeline = \"plain-rt\"\nwarn_hole_fraction = 0.3\nmin_psnr = false\n",
+      "test.toml");
+  const std::string cell = "spheres|e=0.064m|c=default|320x180|lights=all|full";
+  const auto notes = [&](const std::string& pipeline, const std::string& scene) {
+    std::map<std::string, std::string> origins;
+    const ThresholdValues t = thresholds_for(c, pipeline, scene, cell, nullptr, &origins);
+    return unreachable_warning_levels(t, origins, pipeline, scene);
+  };
+  std::vector<std::string> n = notes("repro-rt", "spheres");
+  ASSERT_EQ(n.size(), 1u);
+  EXPECT_EQ(n[0].find("for pipeline repro-rt on scene spheres, warn_psnr = 25 (the [[rule]] at line 4) is looser "
+                      "than min_psnr = 30 ([defaults]): that warning can never be raised there"),
+            0u)
+      << n[0];
+  // Where the later rule lowers the failure level below the warning, the levels are in order.
+  EXPECT_TRUE(notes("repro-rt", "box-wall").empty());
+  // A maximum: the rule's warning level above the defaults' failure level.
+  n = notes("plain-rt", "spheres");
+  ASSERT_EQ(n.size(), 1u);
+  EXPECT_NE(n[0].find("warn_hole_fraction = 0.3 (the [[rule]] at line 11) is looser than max_hole_fraction = 0.2 "
+                      "([defaults])"),
+            std::string::npos)
+      << n[0];
+  // A pipeline no rule matches keeps the defaults alone.
+  EXPECT_TRUE(notes("rt-atomic", "spheres").empty());
 }
 
 TEST(GateConfig, ShippedConfigParses) {

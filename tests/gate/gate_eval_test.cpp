@@ -6,6 +6,9 @@
 #include <cstdlib>
 #include <string>
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
 #include "gate/gate_fixture.hpp"
 #include "renderer/error.hpp"
 #include "support/run_cli.hpp"
@@ -512,11 +515,29 @@ TEST(GateEval, TimesAreReproducedByBenchAndTheBaselineHasNoSpeedupCheck) {
   EXPECT_NE(find_check(r, "plain-rt", "psnr"), nullptr);
 }
 
+TEST(GateEval, AWarningLevelBeyondTheFailureLevelInForceIsNoted) {
+  // kConfig's [defaults] warn at 35 dB, its repro-rt rule fails below 40 dB: for repro-rt a PSNR
+  // of 38 fails without a warning level ever in force. One note, though two cells have repro-rt;
+  // plain-rt (defaults only: fail 30, warn 35) gets none.
+  const validation::GateReport r = evaluate(passing_cells());
+  std::vector<std::string> notes;
+  for (const std::string& n : r.notes)
+    if (n.find("can never be raised") != std::string::npos) notes.push_back(n);
+  ASSERT_EQ(notes.size(), 1u) << fmt::format("{}", fmt::join(r.notes, "\n"));
+  EXPECT_EQ(notes[0],
+            "test.toml: for pipeline repro-rt on scene box-wall, warn_psnr = 35 ([defaults]) is looser than "
+            "min_psnr = 40 (the [[rule]] at line 10): that warning can never be raised there, a value beyond "
+            "min_psnr fails at once; set warn_psnr in the same table as min_psnr");
+  // Setting the warning level in the rule as well resolves it.
+  const validation::GateReport fixed = evaluate(passing_cells(), {}, kConfig + "warn_psnr = 42\n");
+  for (const std::string& n : fixed.notes) EXPECT_EQ(n.find("can never be raised"), std::string::npos) << n;
+}
+
 TEST(GateEval, ARuleThatMatchesNothingIsNoted) {
   const auto notes_about_rules = [](const validation::GateReport& r) {
     std::vector<std::string> out;
     for (const std::string& n : r.notes)
-      if (n.find("[[rule]]") != std::string::npos) out.push_back(n);
+      if (n.find(" to no cell of ") != std::string::npos) out.push_back(n);
     return out;
   };
   EXPECT_TRUE(notes_about_rules(evaluate(passing_cells())).empty()) << "kConfig's rule matches repro-rt";

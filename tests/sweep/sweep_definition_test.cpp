@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -417,6 +418,16 @@ TEST(SweepDefinition, ShippedDefinitionsLoad) {
     const SweepDefinition d = validation::load_sweep(ci / s.file);
     EXPECT_EQ(validation::expand_cells(d).size(), s.cells) << s.file;
     EXPECT_EQ(d.pipelines.size(), s.pipelines ? s.pipelines : n_pipelines) << s.file;
+    // The gate config it is checked with puts no warning level beyond a failure level in force.
+    const validation::GateConfig gate = validation::load_gate_config(d.gate_config.value_or(ci / "gate.toml"));
+    for (const validation::SweepCell& cell : validation::expand_cells(d))
+      for (const std::string& pipeline : d.pipelines) {
+        std::map<std::string, std::string> origins;
+        const validation::ThresholdValues t =
+            validation::thresholds_for(gate, pipeline, cell.scene.label, cell.id, nullptr, &origins);
+        for (const std::string& note : validation::unreachable_warning_levels(t, origins, pipeline, cell.scene.label))
+          ADD_FAILURE() << s.file << ", " << cell.id << ": " << note;
+      }
     ++checked;
   }
   // Every TOML shipped under ci/ (besides the gate's) is in the list above.
