@@ -99,6 +99,10 @@ GlbParts split_container(const std::string& bytes, const std::string& file, bool
     if (bin_at + 8 + bin_len > bytes.size())
       throw InputError(fmt::format("{}: truncated .glb: BIN chunk of {} bytes runs past the end of the "
                                    "{}-byte file", file, bin_len, bytes.size()));
+    if (bin_len == 0)
+      throw InputError(fmt::format("{}: the .glb's BIN chunk (at byte {}) is empty: the file is damaged or was "
+                                   "written without its binary data; export the scene again",
+                                   file, bin_at));
     parts.has_bin = true;
   }
   parts.json_text = bytes.substr(20, json_len);

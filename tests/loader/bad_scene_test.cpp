@@ -184,6 +184,20 @@ std::vector<BadCase> corpus() {
                  g.write_glb(p);
                },
                "/buffers/0: has no uri, so it is the .glb's BIN chunk, but the file has none"});
+  // An empty BIN chunk got the glTF library's own words ("Insufficient storage space for Chunk1").
+  c.push_back({"glb_empty_bin_chunk", "a.glb", [](auto& p) {
+                 MiniGltf g;
+                 g.add_triangle();
+                 g.finish_buffer("");
+                 g.bin.clear();
+                 g.write_glb(p);
+                 std::string bytes = test::read_text(p);
+                 bytes += std::string("\0\0\0\0BIN\0", 8);  // a chunk header of length 0
+                 const auto total = static_cast<uint32_t>(bytes.size());
+                 for (int i = 0; i < 4; ++i) bytes[8 + i] = static_cast<char>(total >> (8 * i));
+                 write_text(p, bytes);
+               },
+               "the .glb's BIN chunk (at byte "});
   for (const char* url : {"file:///etc/passwd", "https://example.com/a.bin"})
     c.push_back({std::string("buffer_url_") + url[0], "a.gltf",
                  edited([url](MiniGltf& g) { g.doc["buffers"] = json::array({{{"byteLength", 36}, {"uri", url}}}); }),
