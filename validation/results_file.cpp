@@ -20,6 +20,7 @@
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/json_text.hpp"
+#include "validation/sweep.hpp"
 
 namespace sb::validation {
 
@@ -369,6 +370,12 @@ void check_cell_record(const json& line, const std::string& where) {
                                  kSweepSchemaVersion));
   for (const Field& f : kCellFields) require(line, where, "", f.path, f.kind, f.optional);
   if (line["cell_id"].get<std::string>().empty()) throw InputError(fmt::format("{}: cell_id is empty", where));
+  // The gate keys baselines and rule globs by the id and reads the scene from the fields: the two
+  // must tell the same cell.
+  if (const std::optional<std::string> id = cell_id_from_json(line["cell"]); id && *id != line["cell_id"])
+    throw InputError(fmt::format("{}: cell_id {} does not match the cell's fields, which give \"{}\"; the line is "
+                                 "damaged or edited by hand",
+                                 where, line["cell_id"].dump(), *id));
   if (line["cell_index"].get<long long>() < 0)
     throw InputError(fmt::format("{}: cell_index {} is negative; cells are numbered from 0", where,
                                  line["cell_index"].dump()));

@@ -28,6 +28,67 @@ using nlohmann::json;
 
 std::string number_text(double value) { return fmt::format("{}", value); }
 
+std::string scene_label(const std::string& name, const std::map<std::string, double>& params) {
+  std::string label = name;
+  std::string sep = ":";
+  for (const auto& [key, value] : params) {
+    label += sep + key + "=" + number_text(value);
+    sep = ",";
+  }
+  return label;
+}
+
+std::string cell_id(const SweepCell& cell) {
+  const std::string e = cell.max_disparity_px ? "e=" + number_text(*cell.max_disparity_px) + "px"
+                        : cell.interaxial_m   ? "e=" + number_text(*cell.interaxial_m) + "m"
+                                              : std::string("e=default");
+  std::string id = fmt::format("{}|{}|{}|{}|{}|{}", cell.scene.label, e,
+                               cell.convergence_m ? "c=" + number_text(*cell.convergence_m) + "m" : "c=default",
+                               cell.resolution ? cell.resolution->label : "res=default",
+                               cell.lights ? fmt::format("lights={}", *cell.lights) : "lights=all", cell.truth);
+  if (cell.frame) id += fmt::format("|frame={}", *cell.frame);
+  return id;
+}
+
+std::optional<std::string> cell_id_from_json(const json& cell) {
+  if (!cell.is_object()) return std::nullopt;
+  const auto number = [&cell](const char* key, std::optional<double>& out) {
+    const auto it = cell.find(key);
+    if (it == cell.end() || !(it->is_null() || it->is_number())) return false;
+    if (it->is_number()) out = it->get<double>();
+    return true;
+  };
+  const auto integer = [&cell](const char* key, std::optional<int>& out, bool required) {
+    const auto it = cell.find(key);
+    if (it == cell.end()) return !required;
+    if (!(it->is_null() || it->is_number_integer())) return false;
+    if (it->is_number_integer()) out = it->get<int>();
+    return true;
+  };
+  SweepCell c;
+  const auto scene = cell.find("scene");
+  const auto params = cell.find("scene_params");
+  const auto resolution = cell.find("resolution");
+  const auto truth = cell.find("truth");
+  if (scene == cell.end() || !scene->is_string() || params == cell.end() || !params->is_object() ||
+      resolution == cell.end() || !(resolution->is_string() || resolution->is_null()) || truth == cell.end() ||
+      !truth->is_string())
+    return std::nullopt;
+  std::map<std::string, double> values;
+  for (const auto& [key, value] : params->items()) {
+    if (!value.is_number()) return std::nullopt;
+    values[key] = value.get<double>();
+  }
+  c.scene.label = scene_label(scene->get<std::string>(), values);
+  if (!number("interaxial_m", c.interaxial_m) || !number("max_disparity_px", c.max_disparity_px) ||
+      !number("convergence_m", c.convergence_m) || !integer("lights", c.lights, true) ||
+      !integer("frame", c.frame, false))
+    return std::nullopt;
+  if (resolution->is_string()) c.resolution = SweepResolution{resolution->get<std::string>(), 0, 0};
+  c.truth = truth->get<std::string>();
+  return cell_id(c);
+}
+
 namespace {
 
 /// Reports problems at a place in the definition: "<file>:<line>: <key path>: <what>".
@@ -364,12 +425,7 @@ SweepScene parse_builtin_scene(const std::string& text) {
       if (comma == list.size()) break;
     }
   }
-  s.label = s.name;
-  std::string sep = ":";
-  for (const auto& [key, value] : s.params) {
-    s.label += sep + key + "=" + number_text(value);
-    sep = ",";
-  }
+  s.label = scene_label(s.name, s.params);
   return s;
 }
 
@@ -591,15 +647,12 @@ std::vector<SweepCell> expand_cells(const SweepDefinition& d) {
   // One interaxial axis: meters, max disparity, or the scene default.
   struct Interaxial {
     std::optional<double> meters, pixels;
-    std::string label;
   };
   std::vector<Interaxial> interaxials;
-  const bool by_pixels = d.max_disparity_px.front().has_value();
-  if (by_pixels) {
-    for (const auto& v : d.max_disparity_px) interaxials.push_back({std::nullopt, v, "e=" + number_text(*v) + "px"});
+  if (d.max_disparity_px.front().has_value()) {
+    for (const auto& v : d.max_disparity_px) interaxials.push_back({std::nullopt, v});
   } else {
-    for (const auto& v : d.interaxial_m)
-      interaxials.push_back({v, std::nullopt, v ? "e=" + number_text(*v) + "m" : "e=default"});
+    for (const auto& v : d.interaxial_m) interaxials.push_back({v, std::nullopt});
   }
 
   std::vector<std::optional<int>> frames{std::nullopt};
@@ -626,10 +679,7 @@ std::vector<SweepCell> expand_cells(const SweepDefinition& d) {
                 cell.lights = l;
                 cell.truth = truth;
                 cell.frame = frame;
-                cell.id = fmt::format("{}|{}|{}|{}|{}|{}", scene.label, e.label,
-                                      c ? "c=" + number_text(*c) + "m" : "c=default", r ? r->label : "res=default",
-                                      l ? fmt::format("lights={}", *l) : "lights=all", truth);
-                if (frame) cell.id += fmt::format("|frame={}", *frame);
+                cell.id = cell_id(cell);
                 cells.push_back(std::move(cell));
               }
   return cells;

@@ -114,4 +114,15 @@ struct SweepCell {
 /// Shortest text that reads back as the same double ("0.064", "1e-05").
 [[nodiscard]] std::string number_text(double value);
 
+/// A built-in scene's canonical text: its name, then ":key=value,..." for its parameters.
+[[nodiscard]] std::string scene_label(const std::string& name, const std::map<std::string, double>& params);
+
+/// The id of a cell from its axes (expand_cells names cells with it):
+/// "scene|e=…|c=…|resolution|lights=…|truth", "|frame=k" with a path.
+[[nodiscard]] std::string cell_id(const SweepCell& cell);
+
+/// The id that the axes of a results line's "cell" object (cell_to_json's fields) give, or
+/// nothing when one of them is missing or of the wrong type.
+[[nodiscard]] std::optional<std::string> cell_id_from_json(const nlohmann::json& cell);
+
 }  // namespace sb::validation

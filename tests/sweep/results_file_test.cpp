@@ -221,6 +221,22 @@ TEST(ResultsFile, BadLinesAndDuplicatesRejected) {
   expect_refused(short_of_samples,
                  "checked.jsonl:2: field 'pipelines.plain-rt.timing.samples_s' holds 0 time(s) but timing.repetitions "
                  "is 3");
+  // A cell_id that tells another cell than the fields do: the gate would look its baseline and
+  // rules up under one cell and read the scene of another.
+  json axes = cell(1, "box-wall:size=0.5|e=0.064m|c=default|96x54|lights=all|full");
+  axes["cell"].update({{"interaxial_m", 0.064}, {"max_disparity_px", nullptr}, {"convergence_m", nullptr},
+                       {"lights", nullptr}});
+  {
+    const auto file = dir / "axes.jsonl";
+    append_result(file, cell(0, "a"));
+    append_result(file, axes);
+    EXPECT_EQ(read_results(file).cells.size(), 2u) << "an id that matches its fields";
+  }
+  json relabelled = axes;
+  relabelled["cell"]["interaxial_m"] = 0.12;
+  expect_refused(relabelled, "checked.jsonl:2: cell_id \"box-wall:size=0.5|e=0.064m|c=default|96x54|lights=all|full\" "
+                             "does not match the cell's fields, which give \"box-wall:size=0.5|e=0.12m|c=default|"
+                             "96x54|lights=all|full\"");
   json more = cell(1, "b");
   more["pipelines"]["repro-rt"] = more["pipelines"]["plain-rt"];
   expect_refused(more, "checked.jsonl:2: the cell validates pipelines plain-rt, repro-rt, but line 1 of the same "

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -418,6 +419,10 @@ TEST(SweepDefinition, ShippedDefinitionsLoad) {
     const SweepDefinition d = validation::load_sweep(ci / s.file);
     EXPECT_EQ(validation::expand_cells(d).size(), s.cells) << s.file;
     EXPECT_EQ(d.pipelines.size(), s.pipelines ? s.pipelines : n_pipelines) << s.file;
+    // A results line's cell fields give back the cell's id (check_cell_record compares them).
+    for (const validation::SweepCell& cell : validation::expand_cells(d))
+      EXPECT_EQ(validation::cell_id_from_json(validation::cell_to_json(cell)), std::optional<std::string>(cell.id))
+          << s.file;
     // The gate config it is checked with puts no warning level beyond a failure level in force.
     const validation::GateConfig gate = validation::load_gate_config(d.gate_config.value_or(ci / "gate.toml"));
     for (const validation::SweepCell& cell : validation::expand_cells(d))
