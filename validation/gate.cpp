@@ -746,7 +746,7 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
     for (const auto& [pipeline, entry] : cell.record["pipelines"].items()) {
       std::map<std::string, std::string> origins;
       const ThresholdValues limits = thresholds_for(config, pipeline, cell.scene, cell.cell_id, &rule_used, &origins);
-      for (std::string& note : unreachable_warning_levels(limits, origins, pipeline, cell.scene))
+      for (const std::string& note : unreachable_warning_levels(limits, origins, pipeline, cell.scene))
         if (level_notes.insert(note).second) report.notes.push_back(fmt::format("{}: {}", config.source, note));
       const std::string quality_command = reproduce_command(cell, pipeline, reproduce, Remeasure::quality);
       const std::string timing_command = reproduce_command(cell, pipeline, reproduce, Remeasure::timing);
