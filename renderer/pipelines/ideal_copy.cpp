@@ -24,7 +24,7 @@ class IdealCopy final : public Pipeline {
     TraceCounts counts;
     {
       ScopedStage stage(r.timings, "left_trace");
-      r.left = make_eye_image(rig.params().width, rig.params().height);
+      r.left = make_eye_image(rig.params().width, rig.params().height, PlaneInit::unset);  // traced whole
       trace_eye(scene, rig.eye(Eye::left), ctx.executor, r.left, counts);
     }
     add_counts(r.counters, counts, "left", true);

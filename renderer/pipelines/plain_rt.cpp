@@ -26,7 +26,7 @@ class PlainRt final : public Pipeline {
       TraceCounts counts;
       {
         ScopedStage stage(r.timings, std::string(name) + "_trace");
-        image = make_eye_image(w, h);
+        image = make_eye_image(w, h, PlaneInit::unset);  // trace_eye writes every pixel
         trace_eye(scene, rig.eye(e), ctx.executor, image, counts);
       }
       add_counts(r.counters, counts, name, true);

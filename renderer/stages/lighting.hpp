@@ -12,7 +12,8 @@
 
 namespace sb {
 
-/// Shades every pixel of `gbuffer` seen from `eye` into `image` (made by make_eye_image);
+/// Shades every pixel of `gbuffer` seen from `eye` into `image` (made by make_eye_image; without a
+/// mask every sample is written, so the image may be made with PlaneInit::unset);
 /// source = rasterized. With `mask`, only pixels whose mask is non-zero are shaded and written
 /// (source = `source`), the others are left untouched.
 void shade_gbuffer(const RenderScene& scene, const EyeCamera& eye, const GBuffer& gbuffer, const Executor& executor,

@@ -120,7 +120,7 @@ void trace_left_eye(const RenderScene& scene, const StereoRig& rig, const Execut
   TraceCounts left;
   {
     ScopedStage stage(r.timings, "left_trace");
-    r.left = make_eye_image(rig.params().width, rig.params().height);
+    r.left = make_eye_image(rig.params().width, rig.params().height, PlaneInit::unset);  // traced whole
     trace_eye(scene, rig.eye(Eye::left), executor, r.left, left);
   }
   add_counts(r.counters, left, "left", true);
@@ -141,7 +141,8 @@ void complete_right_eye(const RenderScene& scene, const StereoRig& rig, const Pi
   Validation v;
   {
     ScopedStage stage(r.timings, "validate");
-    r.right = make_eye_image(sources.width, sources.height);
+    // Every pixel is written: approved ones by the copy below, the others by right_trace.
+    r.right = make_eye_image(sources.width, sources.height, PlaneInit::unset);
     v = validate_and_copy(scene, reprojector, sources, r.left, settings, executor, r.right);
   }
   TraceCounts counts;

@@ -32,7 +32,7 @@ Image raster_eye(const RenderScene& scene, const StereoRig& rig, Eye which, cons
   TraceCounts counts;
   {
     ScopedStage stage(result.timings, name + "_shading");
-    image = make_eye_image(cam.width, cam.height);
+    image = make_eye_image(cam.width, cam.height, PlaneInit::unset);  // shade_gbuffer writes every pixel
     shade_gbuffer(scene, cam, g, executor, image, counts);
   }
   add_counts(result.counters, counts, name.c_str(), false);

@@ -22,7 +22,8 @@ struct TraceCounts {
   uint64_t pixels_traced = 0;  ///< pixels written from a primary ray (surface or background)
 };
 
-/// Traces and shades every pixel of `image` (made by make_eye_image) from `eye`; source = traced.
+/// Traces and shades every pixel of `image` (made by make_eye_image; it writes every sample, so the
+/// image may be made with PlaneInit::unset) from `eye`; source = traced.
 void trace_eye(const RenderScene& scene, const EyeCamera& eye, const Executor& executor, Image& image,
                TraceCounts& counts);
 

@@ -31,7 +31,7 @@ class FullProvider final : public TruthProvider {
     out.tool_version = tool_version();
     const RigParams& p = request.rig.params();
     require_frame_memory(p.width, p.height, "the 'full' ground truth");
-    out.right = make_eye_image(p.width, p.height);
+    out.right = make_eye_image(p.width, p.height, PlaneInit::unset);  // trace_eye writes every pixel
     const Executor executor(request.threads);
     TraceCounts counts;
     trace_eye(request.scene, request.rig.eye(Eye::right), executor, out.right, counts);

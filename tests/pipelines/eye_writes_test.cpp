@@ -1,0 +1,93 @@
+// The stages that fill whole eye images made with PlaneInit::unset (trace_eye, shade_gbuffer
+// without a mask, and the parallel pixel reprojection's validate-copy plus right_trace) write every
+// sample of every plane: an image poisoned with a NaN no stage writes keeps none of it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <string>
+
+#include "renderer/raster/rasterizer.hpp"
+#include "renderer/stages/eye_image.hpp"
+#include "renderer/stages/lighting.hpp"
+#include "renderer/stages/pixel_reprojection.hpp"
+#include "renderer/stages/trace.hpp"
+#include "support/render_support.hpp"
+
+namespace sb {
+namespace {
+
+constexpr uint32_t kSentinel = 0x7fc0dead;  // a NaN no stage writes
+
+/// An eye image whose every sample holds the sentinel's bits.
+Image poisoned_eye(int w, int h) {
+  Image image = make_eye_image(w, h, PlaneInit::unset);
+  for (const Plane& plane : image.planes()) {
+    Plane& p = image.plane(plane.name());
+    if (p.type() == PlaneType::u32) {
+      p.fill(kSentinel);
+    } else {
+      p.fill(std::bit_cast<float>(kSentinel));
+    }
+  }
+  return image;
+}
+
+/// Samples of `image` that still hold the sentinel, per plane ("" when none).
+std::string unwritten(const Image& image) {
+  std::string out;
+  for (const Plane& plane : image.planes()) {
+    size_t n = 0;
+    if (plane.type() == PlaneType::u32) {
+      for (const uint32_t v : plane.u32()) n += v == kSentinel ? 1 : 0;
+    } else {
+      for (const float v : plane.f32()) n += std::bit_cast<uint32_t>(v) == kSentinel ? 1 : 0;
+    }
+    if (n > 0) out += std::string(plane.name()) + ": " + std::to_string(n) + " ";
+  }
+  return out;
+}
+
+class EyeWrites : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(EyeWrites, WholeEyeStagesWriteEverySample) {
+  const Scene scene = test::load_builtin(GetParam());
+  const RenderScene prepared(scene);
+  // 90 x 54: not a multiple of the 4x4 ray packets, so clipped blocks are covered too.
+  const StereoRig rig = test::rig_at(scene, 90, 54);
+  const Executor executor(2);
+  const EyeCamera left = rig.eye(Eye::left), right = rig.eye(Eye::right);
+  const int w = left.width, h = left.height;
+
+  Image traced = poisoned_eye(w, h);
+  TraceCounts counts;
+  trace_eye(prepared, left, executor, traced, counts);
+  EXPECT_EQ(unwritten(traced), "") << "trace_eye on " << GetParam();
+
+  Image shaded = poisoned_eye(w, h);
+  const GBuffer g = rasterize(prepared.geometry(), left, executor);
+  shade_gbuffer(prepared, left, g, executor, shaded, counts);
+  EXPECT_EQ(unwritten(shaded), "") << "shade_gbuffer on " << GetParam();
+
+  // rt-atomic's right eye: the winning source column per right pixel, validated and copied, the
+  // rest traced.
+  const PixelReprojector reprojector(rig);
+  RightSources sources{w, h, std::vector<int32_t>(static_cast<size_t>(w) * h, kNoSource)};
+  const float* depth = traced.data_f32(planes::depth);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const int32_t t = reprojector.target(x, y, depth[static_cast<size_t>(y) * w + x]);
+      if (t != kNoSource) sources.column[sources.index(t, y)] = std::max(sources.column[sources.index(t, y)], x);
+    }
+  Image completed = poisoned_eye(w, h);
+  const Validation v = validate_and_copy(prepared, reprojector, sources, traced, ValidationSettings{}, executor, completed);
+  EXPECT_LT(v.missed + v.blocked, static_cast<uint64_t>(w) * h) << "some pixels are reprojected";
+  trace_unless(prepared, right, executor, v.state, kApproved, completed, counts, Source::reshaded_traced);
+  EXPECT_EQ(unwritten(completed), "") << "validate_and_copy + trace_unless on " << GetParam();
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, EyeWrites, ::testing::Values("spheres", "box-wall"));
+
+}  // namespace
+}  // namespace sb
