@@ -4,8 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <atomic>
-#include <bit>
 #include <string>
 
 #include "renderer/raster/rasterizer.hpp"
@@ -13,39 +11,25 @@
 #include "renderer/stages/lighting.hpp"
 #include "renderer/stages/pixel_reprojection.hpp"
 #include "renderer/stages/trace.hpp"
+#include "support/poisoned_image.hpp"
 #include "support/render_support.hpp"
 
 namespace sb {
 namespace {
 
-constexpr uint32_t kSentinel = 0x7fc0dead;  // a NaN no stage writes
-
-/// An eye image whose every sample holds the sentinel's bits.
+/// An eye image whose every sample holds the sentinel.
 Image poisoned_eye(int w, int h) {
   Image image = make_eye_image(w, h, PlaneInit::unset);
-  for (const Plane& plane : image.planes()) {
-    Plane& p = image.plane(plane.name());
-    if (p.type() == PlaneType::u32) {
-      p.fill(kSentinel);
-    } else {
-      p.fill(std::bit_cast<float>(kSentinel));
-    }
-  }
+  test::poison(image);
   return image;
 }
 
 /// Samples of `image` that still hold the sentinel, per plane ("" when none).
 std::string unwritten(const Image& image) {
   std::string out;
-  for (const Plane& plane : image.planes()) {
-    size_t n = 0;
-    if (plane.type() == PlaneType::u32) {
-      for (const uint32_t v : plane.u32()) n += v == kSentinel ? 1 : 0;
-    } else {
-      for (const float v : plane.f32()) n += std::bit_cast<uint32_t>(v) == kSentinel ? 1 : 0;
-    }
-    if (n > 0) out += std::string(plane.name()) + ": " + std::to_string(n) + " ";
-  }
+  for (const Plane& plane : image.planes())
+    if (const size_t n = test::sentinel_count(plane); n > 0)
+      out += std::string(plane.name()) + ": " + std::to_string(n) + " ";
   return out;
 }
 

@@ -3,7 +3,6 @@
 // plane and on `spheres`, the grid overlay, and option checks.
 #include <gtest/gtest.h>
 
-#include <bit>
 #include <cmath>
 #include <numbers>
 
@@ -12,6 +11,7 @@
 #include "renderer/stages/eye_image.hpp"
 #include "renderer/stages/grid_warp.hpp"
 #include "support/lit_plane.hpp"
+#include "support/poisoned_image.hpp"
 #include "support/render_support.hpp"
 
 namespace sb {
@@ -208,27 +208,11 @@ TEST(GridWarp, WritesEverySampleOfTheTarget) {
   GridSettings gs = settings(1.0);
   gs.focal_px = left.f_px;
   const WarpGrid grid = build_warp_grid(r.left.plane(planes::depth).f32(), left.width, left.height, gs, executor);
-  constexpr uint32_t kSentinel = 0x7fc0dead;  // a NaN no stage writes
-  const auto sentinels = [&](const Plane& plane) {
-    size_t n = 0;
-    if (plane.type() == PlaneType::u32) {
-      for (const uint32_t v : plane.u32()) n += v == kSentinel ? 1 : 0;
-    } else {
-      for (const float v : plane.f32()) n += std::bit_cast<uint32_t>(v) == kSentinel ? 1 : 0;
-    }
-    return n;
-  };
   for (const bool detect : {false, true}) {
     Image target = make_eye_image(right.width, right.height, PlaneInit::unset);
-    for (const Plane& plane : target.planes()) {
-      Plane& p = target.plane(plane.name());
-      if (p.type() == PlaneType::u32) {
-        p.fill(kSentinel);
-      } else {
-        p.fill(std::bit_cast<float>(kSentinel));
-      }
-      ASSERT_EQ(sentinels(p), p.value_count()) << p.name();  // the fill kept the NaN's bits
-    }
+    test::poison(target);
+    for (const Plane& p : target.planes())
+      ASSERT_EQ(test::sentinel_count(p), p.value_count()) << p.name();  // the fill kept the NaN's bits
     WarpOptions options;
     options.detect_disocclusions = detect;
     WarpStats stats;
@@ -236,7 +220,7 @@ TEST(GridWarp, WritesEverySampleOfTheTarget) {
     EXPECT_EQ(states.size(), target.pixel_count());
     EXPECT_GT(stats.pixels_covered, target.pixel_count() / 2);
     for (const Plane& plane : target.planes())
-      EXPECT_EQ(sentinels(plane), 0u) << "plane " << plane.name() << ", detection " << detect;
+      EXPECT_EQ(test::sentinel_count(plane), 0u) << "plane " << plane.name() << ", detection " << detect;
   }
 }
 
