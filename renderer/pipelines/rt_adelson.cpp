@@ -30,8 +30,9 @@ class RtAdelson final : public Pipeline {
     ScanlineCounts counts;
     {
       ScopedStage stage(r.timings, "allocate");
-      r.left = make_eye_image(w, h);
-      r.right = make_eye_image(w, h);
+      // scanline_band writes every sample of both eyes.
+      r.left = make_eye_image(w, h, PlaneInit::unset);
+      r.right = make_eye_image(w, h, PlaneInit::unset);
     }
     // Scan-lines in order, in this thread; the bands are the ray packets' height.
     for (int y0 = 0; y0 < h; y0 += kScanlineBand) scanline_band(scene, reprojector, y0, std::min(y0 + kScanlineBand, h), r.left, r.right, counts);

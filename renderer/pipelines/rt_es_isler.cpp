@@ -29,8 +29,9 @@ class RtEsIsler final : public Pipeline {
     std::vector<ScanlineCounts> per_band(bands);
     {
       ScopedStage stage(r.timings, "allocate");
-      r.left = make_eye_image(w, h);
-      r.right = make_eye_image(w, h);
+      // scanline_band writes every sample of both eyes.
+      r.left = make_eye_image(w, h, PlaneInit::unset);
+      r.right = make_eye_image(w, h, PlaneInit::unset);
     }
     {
       ScopedStage stage(r.timings, "scanlines");

@@ -1,6 +1,7 @@
 // The stages that fill whole eye images made with PlaneInit::unset (trace_eye, shade_gbuffer
-// without a mask, and the parallel pixel reprojection's validate-copy plus right_trace) write every
-// sample of every plane: an image poisoned with a NaN no stage writes keeps none of it.
+// without a mask, the parallel pixel reprojection's validate-copy plus right_trace, and the
+// scan-line bands of rt-adelson and rt-es-isler) write every sample of every plane: an image
+// poisoned with a NaN no stage writes keeps none of it.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include "renderer/stages/eye_image.hpp"
 #include "renderer/stages/lighting.hpp"
 #include "renderer/stages/pixel_reprojection.hpp"
+#include "renderer/stages/scanline_reprojection.hpp"
 #include "renderer/stages/trace.hpp"
 #include "support/poisoned_image.hpp"
 #include "support/render_support.hpp"
@@ -69,6 +71,15 @@ TEST_P(EyeWrites, WholeEyeStagesWriteEverySample) {
   EXPECT_LT(v.missed + v.blocked, static_cast<uint64_t>(w) * h) << "some pixels are reprojected";
   trace_unless(prepared, right, executor, v.state, kApproved, completed, counts, Source::reshaded_traced);
   EXPECT_EQ(unwritten(completed), "") << "validate_and_copy + trace_unless on " << GetParam();
+
+  // rt-adelson's and rt-es-isler's scan-line bands, both eyes.
+  Image band_left = poisoned_eye(w, h), band_right = poisoned_eye(w, h);
+  ScanlineCounts scan;
+  for (int y0 = 0; y0 < h; y0 += kScanlineBand)
+    scanline_band(prepared, reprojector, y0, std::min(y0 + kScanlineBand, h), band_left, band_right, scan);
+  EXPECT_GT(scan.right.pixels_traced, 0u);
+  EXPECT_EQ(unwritten(band_left), "") << "scanline_band's left eye on " << GetParam();
+  EXPECT_EQ(unwritten(band_right), "") << "scanline_band's right eye on " << GetParam();
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, EyeWrites, ::testing::Values("spheres", "box-wall"));
