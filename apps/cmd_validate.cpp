@@ -54,8 +54,6 @@ std::vector<PipelineEntry> chosen_pipelines(const std::vector<std::string>& name
     else
       add(name);
   }
-  if (chosen.empty())
-    throw InputError("--pipelines names no pipeline; give names (see `stereobench pipelines`) or 'all'");
   return parse_pipeline_entries(chosen, "--pipelines");
 }
 
