@@ -1,7 +1,6 @@
 // ideal-copy: the left eye traced, the right eye a copy of it (Al-Hagri's "imaginary ideal" stereo
 // ray tracer): the speed limit of any reprojection scheme and a floor for its quality.
 #include "renderer/pipeline.hpp"
-#include "renderer/stages/eye_image.hpp"
 #include "renderer/stages/trace.hpp"
 
 namespace sb {
@@ -24,8 +23,7 @@ class IdealCopy final : public Pipeline {
     TraceCounts counts;
     {
       ScopedStage stage(r.timings, "left_trace");
-      r.left = make_eye_image(rig.params().width, rig.params().height, PlaneInit::unset);  // traced whole
-      trace_eye(scene, rig.eye(Eye::left), ctx.executor, r.left, counts);
+      r.left = traced_eye(scene, rig.eye(Eye::left), ctx.executor, counts);
     }
     add_counts(r.counters, counts, "left", true);
     {

@@ -1,7 +1,6 @@
 // plain-rt: both eyes fully ray traced (Al-Hagri's naive stereo ray tracer); also the built-in
 // ground truth.
 #include "renderer/pipeline.hpp"
-#include "renderer/stages/eye_image.hpp"
 #include "renderer/stages/trace.hpp"
 
 namespace sb {
@@ -19,18 +18,14 @@ class PlainRt final : public Pipeline {
   StereoResult render(const RenderScene& scene, const StereoRig& rig, const PipelineOptions&,
                       const RenderContext& ctx) const override {
     StereoResult r;
-    const int w = rig.params().width, h = rig.params().height;
     for (Eye e : {Eye::left, Eye::right}) {
       const char* name = eye_name(e);
-      Image image;
       TraceCounts counts;
       {
         ScopedStage stage(r.timings, std::string(name) + "_trace");
-        image = make_eye_image(w, h, PlaneInit::unset);  // trace_eye writes every pixel
-        trace_eye(scene, rig.eye(e), ctx.executor, image, counts);
+        (e == Eye::left ? r.left : r.right) = traced_eye(scene, rig.eye(e), ctx.executor, counts);
       }
       add_counts(r.counters, counts, name, true);
-      (e == Eye::left ? r.left : r.right) = std::move(image);
     }
     r.counters.set("hole_pixels", 0);
     return r;

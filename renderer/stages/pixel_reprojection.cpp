@@ -120,8 +120,7 @@ void trace_left_eye(const RenderScene& scene, const StereoRig& rig, const Execut
   TraceCounts left;
   {
     ScopedStage stage(r.timings, "left_trace");
-    r.left = make_eye_image(rig.params().width, rig.params().height, PlaneInit::unset);  // traced whole
-    trace_eye(scene, rig.eye(Eye::left), executor, r.left, left);
+    r.left = traced_eye(scene, rig.eye(Eye::left), executor, left);
   }
   add_counts(r.counters, left, "left", true);
 }

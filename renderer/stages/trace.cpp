@@ -267,6 +267,12 @@ void trace_eye(const RenderScene& scene, const EyeCamera& eye, const Executor& e
   add_totals(counts, totals);
 }
 
+Image traced_eye(const RenderScene& scene, const EyeCamera& eye, const Executor& executor, TraceCounts& counts) {
+  Image image = make_eye_image(eye.width, eye.height, PlaneInit::unset);
+  trace_eye(scene, eye, executor, image, counts);
+  return image;
+}
+
 void trace_pixels(const RenderScene& scene, const EyeCamera& eye, const Executor& executor,
                   std::span<const uint32_t> pixels, Image& image, TraceCounts& counts, Source source) {
   trace_listed(scene, eye, executor, pixel_blocks(pixels, image.width(), image.height()), image, counts, source);

@@ -22,10 +22,15 @@ struct TraceCounts {
   uint64_t pixels_traced = 0;  ///< pixels written from a primary ray (surface or background)
 };
 
-/// Traces and shades every pixel of `image` (made by make_eye_image; it writes every sample, so the
-/// image may be made with PlaneInit::unset) from `eye`; source = traced.
+/// Traces and shades every pixel of `image` (made by make_eye_image) from `eye`; source = traced.
+/// Every sample of every plane is written.
 void trace_eye(const RenderScene& scene, const EyeCamera& eye, const Executor& executor, Image& image,
                TraceCounts& counts);
+
+/// A new eye image of `eye`'s size traced whole by trace_eye; made without a fill, since
+/// trace_eye writes every sample.
+[[nodiscard]] Image traced_eye(const RenderScene& scene, const EyeCamera& eye, const Executor& executor,
+                               TraceCounts& counts);
 
 /// Traces and shades the listed pixels (indices y * width + x) only; the others are left as they
 /// are. The rays go in trace_eye's 4x4 blocks, each cast as one packet with only its listed lanes

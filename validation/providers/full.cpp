@@ -5,7 +5,6 @@
 
 #include "renderer/memory.hpp"
 #include "renderer/parallel.hpp"
-#include "renderer/stages/eye_image.hpp"
 #include "renderer/stages/trace.hpp"
 #include "sb_version.hpp"
 #include "validation/providers/providers.hpp"
@@ -31,10 +30,9 @@ class FullProvider final : public TruthProvider {
     out.tool_version = tool_version();
     const RigParams& p = request.rig.params();
     require_frame_memory(p.width, p.height, "the 'full' ground truth");
-    out.right = make_eye_image(p.width, p.height, PlaneInit::unset);  // trace_eye writes every pixel
     const Executor executor(request.threads);
     TraceCounts counts;
-    trace_eye(request.scene, request.rig.eye(Eye::right), executor, out.right, counts);
+    out.right = traced_eye(request.scene, request.rig.eye(Eye::right), executor, counts);
     out.settings = {{"pipeline", "plain-rt"}, {"eye", "right"}, {"samples_per_pixel", 1}};
     out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return out;
