@@ -181,7 +181,6 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-
 /// "1e7" from 10000000.
 std::string power_of_ten(double n) {
   const double e = std::log10(n);

@@ -287,9 +287,9 @@ GBuffer rasterize(const SceneGeometry& geometry, const EyeCamera& eye, const Exe
   g.prim.reserve(pixels);
   g.bary.reserve(pixels);
   g.duv.reserve(pixels);
-  for (size_t task = 0; task < chunk_count; ++task)
-    chunks[task].triangles.reserve(uint64_t{triangle_count} * (task + 1) / chunk_count -
-                                   uint64_t{triangle_count} * task / chunk_count);
+  // Chunk k holds triangle ids [first(k), first(k + 1)).
+  const auto first = [&](size_t k) { return static_cast<uint32_t>(uint64_t{triangle_count} * k / chunk_count); };
+  for (size_t k = 0; k < chunk_count; ++k) chunks[k].triangles.reserve(first(k + 1) - first(k));
   executor.for_each(chunk_count + 4, [&](size_t task) {
     if (task >= chunk_count) {
       switch (task - chunk_count) {
@@ -301,9 +301,7 @@ GBuffer rasterize(const SceneGeometry& geometry, const EyeCamera& eye, const Exe
       return;
     }
     Chunk& chunk = chunks[task];
-    const auto begin = static_cast<uint32_t>(uint64_t{triangle_count} * task / chunk_count);
-    const auto end = static_cast<uint32_t>(uint64_t{triangle_count} * (task + 1) / chunk_count);
-    raster::setup_triangles(inputs, begin, end, chunk.triangles, chunk.counts);
+    raster::setup_triangles(inputs, first(task), first(task + 1), chunk.triangles, chunk.counts);
     bin_chunk(chunk, grid);
   });
 
