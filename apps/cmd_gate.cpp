@@ -33,17 +33,9 @@ struct GateArgs {
   std::string cells;
 };
 
-/// The pipelines --only names, each once.
-std::vector<std::string> only_names(const std::vector<std::string>& items) {
-  std::vector<std::string> out;
-  for (const std::string& name : split_list(items, "--only"))
-    if (std::find(out.begin(), out.end(), name) == out.end()) out.push_back(name);
-  return out;
-}
-
 /// Rewrites the entries of the baseline `file` that the selection names.
 void run_update(const GateArgs& a, const fs::path& file) {
-  const validation::BaselineSelection selection{only_names(a.only), a.cells};
+  const validation::BaselineSelection selection{split_list(a.only, "--only"), a.cells};
   // The rank test's minimum comes from the gate config the baseline will be checked with (the
   // default's when that file is not here).
   const bool has_config = fs::exists(a.config);
