@@ -184,14 +184,25 @@ void cell_triangles(const WarpGrid& g, int cx, int cy, Emit&& emit) {
     if (fine_left || j == y0) step_to(x0, j);
 }
 
-/// The target-side buffers of a warp: per pixel the nearest kept fragment's inverse depth and
-/// source position, and its WarpPixel state. Cell rows of the same parity write disjoint rows.
+/// The target-side buffers of a warp for target rows [y0, y1), row-major from row y0: per pixel
+/// the nearest kept fragment's inverse depth (-1 before any) and source position, and its
+/// WarpPixel state. Fragments outside those rows are not drawn.
 struct WarpTarget {
   int width = 0;
-  int height = 0;
-  std::vector<float> q;
-  std::vector<vec2> src;
-  std::vector<uint8_t> state;
+  int y0 = 0;
+  int y1 = 0;
+  float* q = nullptr;
+  vec2* src = nullptr;
+  uint8_t* state = nullptr;
+
+  [[nodiscard]] size_t at(int x, int y) const {
+    return static_cast<size_t>(y - y0) * static_cast<size_t>(width) + static_cast<size_t>(x);
+  }
+  /// The same buffers restricted to rows [r0, r1) (within [y0, y1)).
+  [[nodiscard]] WarpTarget rows(int r0, int r1) const {
+    const size_t skip = at(0, r0);
+    return WarpTarget{width, r0, r1, q + skip, src + skip, state + skip};
+  }
 };
 
 /// Rasterizes warped grid triangles into the target buffers and counts what it did.
@@ -199,7 +210,7 @@ class GridRasterizer {
  public:
   enum class Detect { off, interpolated, flags };
 
-  GridRasterizer(WarpTarget& target, const WarpOptions& options)
+  GridRasterizer(const WarpTarget& target, const WarpOptions& options)
       : t_(target), detect_(options.detect_disocclusions), rule_(options.rule), threshold_(options.discontinuity_px) {}
 
   /// Rasterizes one grid triangle; `detect` enables disocclusion detection for it.
@@ -223,7 +234,7 @@ class GridRasterizer {
     const auto first = [](int32_t lo) { return static_cast<int>((int64_t{lo} - kSubHalf + kSubOne - 1) >> kSubBits); };
     const auto last = [](int32_t hi) { return static_cast<int>((int64_t{hi} - kSubHalf) >> kSubBits); };
     const int px0 = std::max(first(min_x), 0), px1 = std::min(last(max_x), t_.width - 1);
-    const int py0 = std::max(first(min_y), 0), py1 = std::min(last(max_y), t_.height - 1);
+    const int py0 = std::max(first(min_y), t_.y0), py1 = std::min(last(max_y), t_.y1 - 1);
     if (px0 > px1 || py0 > py1) return;
 
     int64_t ex[3], ey[3], e0[3], bias[3];
@@ -265,7 +276,7 @@ class GridRasterizer {
       ++culled;  // turned over: the triangle on this edge is culled
       return true;
     }
-    if (row < 0 || row >= t_.height) return true;
+    if (row < t_.y0 || row >= t_.y1) return true;
     // Pixel centres p * kSubOne + kSubHalf in [a.x, b.x).
     const int p0 = std::max(static_cast<int>((int64_t{a.x} - kSubHalf + kSubOne - 1) >> kSubBits), 0);
     const int p1 = std::min(static_cast<int>((int64_t{b.x} - kSubHalf - 1) >> kSubBits), t_.width - 1);
@@ -304,7 +315,7 @@ class GridRasterizer {
       w1 = p1 * inv;
       w2 = p2 * inv;
     }
-    const size_t o = static_cast<size_t>(y) * t_.width + x;
+    const size_t o = t_.at(x, y);
     // The flags interpolate to exactly 1 where every vertex of non-zero weight is flagged; a
     // weight is zero exactly when the edge function of the opposite edge is.
     const bool discard =
@@ -328,7 +339,7 @@ class GridRasterizer {
     t_.state[o] = static_cast<uint8_t>(WarpPixel::covered);
   }
 
-  WarpTarget& t_;
+  WarpTarget t_;
   bool detect_;
   DiscardRule rule_;
   double threshold_;
@@ -380,14 +391,14 @@ class CellRowVertices {
   std::vector<GridVertex> v_;
 };
 
-/// Marks the occluding-edge band of target rows [y0, y1): a covered pixel whose right-hand
+/// Marks the occluding-edge band of the target's rows: a covered pixel whose right-hand
 /// neighbour is covered by a surface nearer by more than `step` pixels of disparity. The nearer
 /// surface's silhouette lies somewhere between its last source pixel centre and the one before,
 /// so its warped image may reach up to a pixel further left than its first warped vertex: the
 /// pixel there shows either surface and is left for the hole filler.
-void mark_occluding_edges(WarpTarget& t, int y0, int y1, double disparity_per_inverse_depth, double step) {
-  for (int y = y0; y < y1; ++y) {
-    const size_t row = static_cast<size_t>(y) * t.width;
+void mark_occluding_edges(const WarpTarget& t, double disparity_per_inverse_depth, double step) {
+  for (int y = t.y0; y < t.y1; ++y) {
+    const size_t row = t.at(0, y);
     for (int x = 0; x + 1 < t.width; ++x) {
       const size_t o = row + x;
       if (t.state[o] != static_cast<uint8_t>(WarpPixel::covered) ||
@@ -399,16 +410,17 @@ void mark_occluding_edges(WarpTarget& t, int y0, int y1, double disparity_per_in
   }
 }
 
-/// Writes target rows [y0, y1) from the warp buffers and counts their pixels.
-void resolve_rows(const WarpTarget& t, const Image& source, int y0, int y1, Image& target, WarpStats& stats) {
+/// Writes the target's rows of the target eye from the warp buffers and counts their pixels.
+void resolve_rows(const WarpTarget& t, const Image& source, Image& target, WarpStats& stats) {
   const int sw = source.width(), sh = source.height();
   const EyeReader from(source);
   EyeWriter out(target);
-  for (int y = y0; y < y1; ++y)
+  for (int y = t.y0; y < t.y1; ++y)
     for (int x = 0; x < t.width; ++x) {
-      const size_t o = static_cast<size_t>(y) * t.width + x;
-      if (t.state[o] != static_cast<uint8_t>(WarpPixel::covered)) {
-        const auto state = static_cast<WarpPixel>(t.state[o]);
+      const size_t b = t.at(x, y);
+      const size_t o = static_cast<size_t>(y) * static_cast<size_t>(t.width) + static_cast<size_t>(x);
+      if (t.state[b] != static_cast<uint8_t>(WarpPixel::covered)) {
+        const auto state = static_cast<WarpPixel>(t.state[b]);
         (state == WarpPixel::discarded        ? stats.pixels_discarded
          : state == WarpPixel::occluding_edge ? stats.pixels_occluding_edge
                                               : stats.pixels_uncovered)++;
@@ -418,7 +430,7 @@ void resolve_rows(const WarpTarget& t, const Image& source, int y0, int y1, Imag
       ++stats.pixels_covered;
       // Bilinear lookup: texel centres sit at integer + 0.5, so a source position on a pixel
       // centre reads that pixel alone.
-      const vec2 s = t.src[o];
+      const vec2 s = t.src[b];
       const float u = s.x - 0.5f, v = s.y - 0.5f;
       const float fu = std::floor(u), fv = std::floor(v);
       const float ax = u - fu, ay = v - fv;
@@ -434,7 +446,7 @@ void resolve_rows(const WarpTarget& t, const Image& source, int y0, int y1, Imag
       // The other AOVs come from the source pixel the position falls in.
       const size_t n = static_cast<size_t>(std::clamp(static_cast<int>(std::floor(s.y)), 0, sh - 1)) * sw +
                        static_cast<size_t>(std::clamp(static_cast<int>(std::floor(s.x)), 0, sw - 1));
-      const float depth = t.q[o] > 0.0f ? 1.0f / t.q[o] : std::numeric_limits<float>::infinity();
+      const float depth = t.q[b] > 0.0f ? 1.0f / t.q[b] : std::numeric_limits<float>::infinity();
       out.copy(o, rgb, from.normal(n), from.albedo(n), depth, from.prim(n), Source::reprojected);
     }
 }
@@ -565,17 +577,13 @@ std::vector<uint8_t> grid_warp(const WarpGrid& grid, const Image& source, const 
     throw InputError(fmt::format("grid warp: discontinuity threshold {} px must be positive and finite",
                                  options.discontinuity_px));
   const Reprojector reproject(grid, from, to, interaxial);
-  WarpTarget target_buffers{to.width, to.height, std::vector<float>(static_cast<size_t>(to.width) * to.height, -1.0f),
-                            std::vector<vec2>(static_cast<size_t>(to.width) * to.height, vec2(0.0f)),
-                            std::vector<uint8_t>(static_cast<size_t>(to.width) * to.height, 0)};
-  // A cell row of lattice rows [16 cy, 16 cy + 16] writes target rows within 7 px of those when
-  // the reprojection moves nothing further vertically, so rows of one parity never share a pixel
-  // and run in parallel: even rows first, then odd ones — the same order on any thread count.
-  const bool banded = vertical_displacement_bound(reproject, from) < 7.0;
-  std::vector<GridRasterizer> rasterizers(static_cast<size_t>(grid.cells_y), GridRasterizer(target_buffers, options));
-  const auto warp_row = [&](int cy) {
+  const size_t w = static_cast<size_t>(to.width);
+  std::vector<uint8_t> state(w * static_cast<size_t>(to.height), static_cast<uint8_t>(WarpPixel::uncovered));
+  // Per cell row: its grid triangles' counts, and the pixel counts of the target rows it resolves.
+  std::vector<WarpStats> row_stats(static_cast<size_t>(grid.cells_y));
+  const auto warp_row = [&](int cy, const WarpTarget& buffers) {
     CellRowVertices vertices(grid, reproject, cy);
-    GridRasterizer& raster = rasterizers[static_cast<size_t>(cy)];
+    GridRasterizer raster(buffers, options);
     for (int cx = 0; cx < grid.cells_x; ++cx) {
       vertices.prepare(cx, cy);
       // A coarse cell is flat in parallax by construction: nothing in it is discarded.
@@ -595,40 +603,78 @@ std::vector<uint8_t> grid_warp(const WarpGrid& grid, const Image& source, const 
         raster.draw(vertices.at(i0, j0), vertices.at(i1, j1), vertices.at(i2, j2), detect);
       });
     }
+    WarpStats& counts = row_stats[static_cast<size_t>(cy)];
+    counts.triangles = raster.triangles;
+    counts.triangles_culled = raster.culled;
+    counts.fragments = raster.fragments;
+    counts.fragments_discarded = raster.discarded;
   };
-  for (int parity = 0; parity < 2; ++parity) {
-    const size_t count = static_cast<size_t>(grid.cells_y - parity + 1) / 2;
-    if (banded) {
-      executor.for_each(count, [&](size_t k) { warp_row(static_cast<int>(2 * k) + parity); });
-    } else {
-      for (size_t k = 0; k < count; ++k) warp_row(static_cast<int>(2 * k) + parity);
-    }
-  }
-
-  const int bands = (to.height + kGridCell - 1) / kGridCell;
-  std::vector<WarpStats> band_stats(static_cast<size_t>(bands));
-  executor.for_each(static_cast<size_t>(bands), [&](size_t b) {
-    const int y0 = static_cast<int>(b) * kGridCell;
-    const int y1 = std::min(y0 + kGridCell, to.height);
+  // Marks the occluding edges of finished target rows and writes them into the target eye.
+  const auto resolve = [&](const WarpTarget& rows, WarpStats& counts) {
     if (options.detect_disocclusions && options.occluding_edge_px > 0.0)
-      mark_occluding_edges(target_buffers, y0, y1, from.f_px * interaxial, options.occluding_edge_px);
-    resolve_rows(target_buffers, source, y0, y1, target, band_stats[b]);
-  });
+      mark_occluding_edges(rows, from.f_px * interaxial, options.occluding_edge_px);
+    resolve_rows(rows, source, target, counts);
+  };
+  // The target rows [16 cy, 16 cy + 16) of cell row cy, clipped to the image.
+  const auto own_rows = [&](int cy) {
+    return std::pair(cy * kGridCell, std::min(cy * kGridCell + kGridCell, to.height));
+  };
+
+  const double vertical = vertical_displacement_bound(reproject, from);
+  // Where the reprojection moves no vertex off its source row (within half a fixed-point step, so
+  // every vertex snaps back onto it; any rig with a horizontal baseline), cell row cy draws only
+  // into its own rows: its lattice rows' pixel centres, each row on the top edges that the fill
+  // rule includes. Each cell row is then warped and resolved in one task, in buffers of its own
+  // rows that stay in cache, instead of a warp over the whole image and a second pass reading the
+  // whole-image buffers back. Which fragment wins a pixel does not change, nor does the image.
+  if (options.resolve_per_cell_row && vertical < 0.5 / static_cast<double>(kSubOne) && to.height == grid.height) {
+    executor.for_each(static_cast<size_t>(grid.cells_y), [&](size_t k) {
+      const int cy = static_cast<int>(k);
+      const auto [y0, y1] = own_rows(cy);
+      const size_t n = static_cast<size_t>(y1 - y0) * w;
+      std::vector<float> q(n, -1.0f);
+      std::vector<vec2> src(n);
+      const WarpTarget buffers{to.width, y0, y1, q.data(), src.data(), state.data() + static_cast<size_t>(y0) * w};
+      warp_row(cy, buffers);
+      resolve(buffers, row_stats[k]);
+    });
+  } else {
+    std::vector<float> q(state.size(), -1.0f);
+    std::vector<vec2> src(state.size());
+    const WarpTarget whole{to.width, 0, to.height, q.data(), src.data(), state.data()};
+    // A cell row of lattice rows [16 cy, 16 cy + 16] writes target rows within 7 px of those when
+    // the reprojection moves nothing further vertically, so rows of one parity never share a pixel
+    // and run in parallel: even rows first, then odd ones — the same order on any thread count.
+    const bool banded = vertical < 7.0;
+    for (int parity = 0; parity < 2; ++parity) {
+      const size_t count = static_cast<size_t>(grid.cells_y - parity + 1) / 2;
+      if (banded) {
+        executor.for_each(count, [&](size_t k) { warp_row(static_cast<int>(2 * k) + parity, whole); });
+      } else {
+        for (size_t k = 0; k < count; ++k) warp_row(static_cast<int>(2 * k) + parity, whole);
+      }
+    }
+    // Resolved in bands of 16 rows; a band's pixel counts go with the cell row of the same index.
+    const int bands = (to.height + kGridCell - 1) / kGridCell;
+    if (static_cast<size_t>(bands) > row_stats.size()) row_stats.resize(static_cast<size_t>(bands));
+    executor.for_each(static_cast<size_t>(bands), [&](size_t b) {
+      const auto [y0, y1] = own_rows(static_cast<int>(b));
+      resolve(whole.rows(y0, y1), row_stats[b]);
+    });
+  }
 
   stats = WarpStats{};
-  for (const GridRasterizer& r : rasterizers) {
-    stats.triangles += r.triangles;
-    stats.triangles_culled += r.culled;
-    stats.fragments += r.fragments;
-    stats.fragments_discarded += r.discarded;
-  }
-  for (const WarpStats& s : band_stats) {
+  for (const WarpStats& s : row_stats) {
+    stats.triangles += s.triangles;
+    stats.triangles_culled += s.triangles_culled;
+    stats.fragments += s.fragments;
+    stats.fragments_discarded += s.fragments_discarded;
     stats.pixels_covered += s.pixels_covered;
     stats.pixels_discarded += s.pixels_discarded;
     stats.pixels_occluding_edge += s.pixels_occluding_edge;
     stats.pixels_uncovered += s.pixels_uncovered;
   }
-  return std::move(target_buffers.state);
+  return state;
 }
 
 Image grid_overlay(const WarpGrid& grid, const Image& source) {

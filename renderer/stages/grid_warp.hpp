@@ -112,6 +112,10 @@ struct WarpOptions {
   /// Leave the occluding-edge band to the hole filler: the covered pixel just left of a surface
   /// that is nearer by more than this many pixels of disparity (see WarpPixel); 0 = off.
   double occluding_edge_px = 0.5;
+  /// Where the reprojection moves nothing vertically (a horizontal baseline), warp and resolve each
+  /// row of cells in one task while its target rows are in cache. Off, the whole grid is warped
+  /// before any row is resolved, as for any other rig. The image is the same either way.
+  bool resolve_per_cell_row = true;
 };
 
 /// What became of a target pixel.
