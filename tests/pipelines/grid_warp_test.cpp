@@ -196,19 +196,34 @@ TEST(GridWarp, NoCracksOnSpheres) {
   EXPECT_EQ(c.slivers, 0u);
 }
 
+/// plain-raster's eyes of a built-in scene at w x h under its default rig, and the warping grid of
+/// the left eye (1′; with `opening_px`, cells where a gap opens that much are subdivided too).
+struct LeftEyeGrid {
+  StereoRig rig;
+  StereoResult eyes;
+  WarpGrid grid;
+};
+
+LeftEyeGrid left_eye_grid(const std::string& name, int width, int height, double opening_px = 0.0) {
+  const Scene scene = test::load_builtin(name);
+  const RenderScene prepared(scene);
+  LeftEyeGrid g{test::rig_at(scene, width, height), {}, {}};
+  g.eyes = test::render_with("plain-raster", prepared, g.rig, 2);
+  const EyeCamera left = g.rig.eye(Eye::left);
+  GridSettings gs = settings(1.0);
+  gs.focal_px = left.f_px;
+  gs.opening_px = opening_px;
+  g.grid = build_warp_grid(g.eyes.left.plane(planes::depth).f32(), left.width, left.height, gs, Executor(2));
+  return g;
+}
+
 /// repro-rt makes its right eye with unset samples (PlaneInit::unset), so grid_warp must write
 /// every sample of every plane: on a target pre-filled with a sentinel none may remain, with and
 /// without disocclusion detection.
 TEST(GridWarp, WritesEverySampleOfTheTarget) {
-  const Scene scene = test::load_builtin("spheres");
-  const RenderScene prepared(scene);
-  const StereoRig rig = test::rig_at(scene, 240, 135);
-  const StereoResult r = test::render_with("plain-raster", prepared, rig, 2);
-  const EyeCamera left = rig.eye(Eye::left), right = rig.eye(Eye::right);
+  const LeftEyeGrid g = left_eye_grid("spheres", 240, 135);
+  const EyeCamera left = g.rig.eye(Eye::left), right = g.rig.eye(Eye::right);
   const Executor executor(2);
-  GridSettings gs = settings(1.0);
-  gs.focal_px = left.f_px;
-  const WarpGrid grid = build_warp_grid(r.left.plane(planes::depth).f32(), left.width, left.height, gs, executor);
   for (const bool detect : {false, true}) {
     Image target = make_eye_image(right.width, right.height, PlaneInit::unset);
     test::poison(target);
@@ -217,7 +232,8 @@ TEST(GridWarp, WritesEverySampleOfTheTarget) {
     WarpOptions options;
     options.detect_disocclusions = detect;
     WarpStats stats;
-    const std::vector<uint8_t> states = grid_warp(grid, r.left, left, right, kInteraxial, options, executor, target, stats);
+    const std::vector<uint8_t> states =
+        grid_warp(g.grid, g.eyes.left, left, right, kInteraxial, options, executor, target, stats);
     EXPECT_EQ(states.size(), target.pixel_count());
     EXPECT_GT(stats.pixels_covered, target.pixel_count() / 2);
     for (const Plane& plane : target.planes())
@@ -231,18 +247,11 @@ TEST(GridWarp, WritesEverySampleOfTheTarget) {
 /// most cells (native cells and coarse fans alike) and an image height that is not a multiple of 16.
 TEST(GridWarp, PerCellRowResolveGivesTheSameImage) {
   for (const char* name : {"temple", "box-wall"}) {
-    const Scene scene = test::load_builtin(name);
-    const RenderScene prepared(scene);
-    const StereoRig rig = test::rig_at(scene, 248, 141);
-    const StereoResult r = test::render_with("plain-raster", prepared, rig, 2);
-    const EyeCamera left = rig.eye(Eye::left), right = rig.eye(Eye::right);
+    const LeftEyeGrid g = left_eye_grid(name, 248, 141, 0.05);
+    const EyeCamera left = g.rig.eye(Eye::left), right = g.rig.eye(Eye::right);
     const Executor executor(2);
-    GridSettings gs = settings(1.0);
-    gs.focal_px = left.f_px;
-    gs.opening_px = 0.05;
-    const WarpGrid grid = build_warp_grid(r.left.plane(planes::depth).f32(), left.width, left.height, gs, executor);
-    ASSERT_GT(grid.subdivided_count(), 0u);
-    ASSERT_LT(grid.subdivided_count(), grid.subdivided.size());
+    ASSERT_GT(g.grid.subdivided_count(), 0u);
+    ASSERT_LT(g.grid.subdivided_count(), g.grid.subdivided.size());
     for (const bool detect : {false, true}) {
       Image image[2] = {make_eye_image(right.width, right.height), make_eye_image(right.width, right.height)};
       std::vector<uint8_t> states[2];
@@ -251,7 +260,7 @@ TEST(GridWarp, PerCellRowResolveGivesTheSameImage) {
         WarpOptions options;
         options.detect_disocclusions = detect;
         options.resolve_per_cell_row = k == 0;
-        states[k] = grid_warp(grid, r.left, left, right, kInteraxial, options, executor, image[k], stats[k]);
+        states[k] = grid_warp(g.grid, g.eyes.left, left, right, kInteraxial, options, executor, image[k], stats[k]);
       }
       const std::string where = std::string(name) + (detect ? ", detection on" : ", detection off");
       EXPECT_EQ(states[0], states[1]) << where;
