@@ -2,6 +2,8 @@
 #include "renderer/image.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <bit>
 #include <cstring>
 
 #include <fmt/format.h>
@@ -55,6 +57,12 @@ std::optional<Source> source_from_u32(uint32_t value) {
 
 // ---- Plane ----------------------------------------------------------------------------------
 
+namespace {
+std::atomic<bool> g_poison_unset{false};
+}  // namespace
+
+void poison_unset_planes(bool on) { g_poison_unset.store(on); }
+
 Plane::Plane(std::string name, int channels, PlaneType type, int width, int height, PlaneInit init)
     : name_(std::move(name)), channels_(channels), type_(type), width_(width), height_(height) {
   if (channels < 1 || channels > 64)
@@ -62,12 +70,15 @@ Plane::Plane(std::string name, int channels, PlaneType type, int width, int heig
   if (width < 0 || height < 0 || width > kMaxImageDimension || height > kMaxImageDimension)
     throw InputError(
         fmt::format("plane '{}': size {}x{} is out of range 0..{}", name_, width, height, kMaxImageDimension));
+  const bool poison = init == PlaneInit::unset && g_poison_unset.load(std::memory_order_relaxed);
   if (type == PlaneType::f32) {
     f32_.resize(value_count());
     if (init == PlaneInit::filled) fill(0.0f);
+    if (poison) fill(std::bit_cast<float>(kUnsetPoison));
   } else {
     u32_.resize(value_count());
     if (init == PlaneInit::filled) fill(name_ == planes::primid ? kNoPrimitive : 0u);
+    if (poison) fill(kUnsetPoison);
   }
 }
 

@@ -74,6 +74,15 @@ inline constexpr std::size_t kSourceCount = 7;
 /// saves a pass over the memory; an unset sample that is read is undefined).
 enum class PlaneInit : uint8_t { filled, unset };
 
+/// The bits of a NaN that no stage writes: with poison_unset_planes(true), planes made with
+/// PlaneInit::unset hold it in every sample until they are written.
+inline constexpr uint32_t kUnsetPoison = 0x7fc0dead;
+
+/// For tests: while on, planes made with PlaneInit::unset are filled with kUnsetPoison instead of
+/// being left unset, so that a sample no stage wrote can be found in the output. Off by default;
+/// nothing outside the tests turns it on.
+void poison_unset_planes(bool on);
+
 /// Allocator of plane samples: a resize default-initializes new samples, which for float and
 /// uint32 leaves them unset, so that PlaneInit::unset costs nothing and `filled` fills once.
 template <class T>

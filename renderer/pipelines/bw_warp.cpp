@@ -234,7 +234,8 @@ class BwWarp final : public Pipeline {
     BackwardCounts counts;
     {
       ScopedStage stage(r.timings, "backward_warp");
-      r.right = make_eye_image(rig.params().width, rig.params().height);
+      // backward_warp writes every pixel (a copy or a hole), so the eye needs no fill.
+      r.right = make_eye_image(rig.params().width, rig.params().height, PlaneInit::unset);
       counts = backward_warp(r.left, rig, settings, ctx.executor, r.right);
     }
     CrackFillStats cracks;

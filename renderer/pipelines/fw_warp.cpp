@@ -167,7 +167,8 @@ class FwWarp final : public Pipeline {
         keys = splat_depth(r.left, rig, settings.row.warp_background, ctx.executor, counts.landed);
       }
       ScopedStage stage(r.timings, "warp_color");
-      r.right = make_eye_image(w, h);
+      // splat_color writes every pixel (a copy or a hole), so the eye needs no fill.
+      r.right = make_eye_image(w, h, PlaneInit::unset);
       counts.written = splat_color(r.left, keys, ctx.executor, r.right);
     }
     CrackFillStats cracks;

@@ -1,12 +1,17 @@
 // The stages that fill whole eye images made with PlaneInit::unset (trace_eye, shade_gbuffer
 // without a mask, the parallel pixel reprojection's validate-copy plus right_trace, and the
 // scan-line bands of rt-adelson and rt-es-isler) write every sample of every plane: an image
-// poisoned with a NaN no stage writes keeps none of it.
+// poisoned with a NaN no stage writes keeps none of it. And every pipeline's eyes, rendered with
+// every unset plane poisoned, keep none of it either.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 #include <string>
+#include <utility>
+#include <vector>
 
+#include "renderer/pipeline.hpp"
 #include "renderer/raster/rasterizer.hpp"
 #include "renderer/stages/eye_image.hpp"
 #include "renderer/stages/lighting.hpp"
@@ -80,6 +85,34 @@ TEST_P(EyeWrites, WholeEyeStagesWriteEverySample) {
   EXPECT_GT(scan.right.pixels_traced, 0u);
   EXPECT_EQ(unwritten(band_left), "") << "scanline_band's left eye on " << GetParam();
   EXPECT_EQ(unwritten(band_right), "") << "scanline_band's right eye on " << GetParam();
+}
+
+/// Turns poison_unset_planes on for its lifetime.
+struct PoisonUnsetPlanes {
+  PoisonUnsetPlanes() { poison_unset_planes(true); }
+  ~PoisonUnsetPlanes() { poison_unset_planes(false); }
+  PoisonUnsetPlanes(const PoisonUnsetPlanes&) = delete;
+  PoisonUnsetPlanes& operator=(const PoisonUnsetPlanes&) = delete;
+};
+
+/// Every pipeline, on each of its paths, writes every sample of both eyes it returns: with every
+/// plane made unset poisoned, none of the poison is left in its output. This covers the eyes
+/// pipelines allocate unset themselves (bw-warp's backward warp, fw-warp's colour pass, ...).
+TEST_P(EyeWrites, EveryPipelineWritesEverySampleOfItsEyes) {
+  const Scene scene = test::load_builtin(GetParam());
+  const RenderScene prepared(scene);
+  const StereoRig rig = test::rig_at(scene, 90, 54);
+  const PoisonUnsetPlanes poison;
+  ASSERT_NE(unwritten(make_eye_image(4, 4, PlaneInit::unset)), "") << "the poison is on";
+  std::vector<std::pair<std::string, std::map<std::string, std::string>>> runs;
+  for (const Pipeline* p : pipelines()) runs.push_back({p->info().name, {}});
+  runs.push_back({"fw-warp", {{"warp", "rows"}}});
+  for (const auto& [name, options] : runs) {
+    const StereoResult r = test::render_with(name, prepared, rig, 2, options);
+    const std::string what = name + (options.empty() ? "" : " (warp=rows)") + " on " + GetParam();
+    EXPECT_EQ(unwritten(r.left), "") << "left eye of " << what;
+    EXPECT_EQ(unwritten(r.right), "") << "right eye of " << what;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, EyeWrites, ::testing::Values("spheres", "box-wall"));

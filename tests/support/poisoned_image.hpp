@@ -10,8 +10,8 @@
 
 namespace sb::test {
 
-/// The sentinel's bits: a NaN no stage writes.
-inline constexpr uint32_t kSentinel = 0x7fc0dead;
+/// The sentinel's bits: a NaN no stage writes (the poison of poison_unset_planes).
+inline constexpr uint32_t kSentinel = kUnsetPoison;
 
 /// Fills every sample of every plane of `image` with the sentinel's bits.
 inline void poison(Image& image) {
