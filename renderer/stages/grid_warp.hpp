@@ -142,6 +142,8 @@ struct WarpStats {
   uint64_t pixels_discarded = 0;
   uint64_t pixels_occluding_edge = 0;
   uint64_t pixels_uncovered = 0;
+
+  [[nodiscard]] bool operator==(const WarpStats&) const = default;
 };
 
 /// Warps `source` (an eye image with rgb, depth, normal, albedo and primid planes, seen by `from`)

@@ -1,9 +1,9 @@
 // The adaptive warping grid and the warp: the parallax metric and its subdivision rules on
 // synthetic depth, exact pixel-centre warps of a fronto-parallel plane, no cracks on a slanted
-// plane and on `spheres`, the grid overlay, and option checks.
+// plane and on `spheres`, every target sample written, the per-row and whole-grid paths giving the
+// same bits, the grid overlay, and option checks.
 #include <gtest/gtest.h>
 
-#include <bit>
 #include <cmath>
 #include <numbers>
 
@@ -218,17 +218,20 @@ LeftEyeGrid left_eye_grid(const std::string& name, int width, int height, double
 }
 
 /// repro-rt makes its right eye with unset samples (PlaneInit::unset), so grid_warp must write
-/// every sample of every plane: on a target pre-filled with a sentinel none may remain, with and
-/// without disocclusion detection.
+/// every sample of every plane: on a target whose unset planes are poisoned none of the poison may
+/// remain, with and without disocclusion detection (the pipeline-wide EyeWrites test sees repro-rt's
+/// right eye only after its hole fill, which would hide holes the warp left unwritten).
 TEST(GridWarp, WritesEverySampleOfTheTarget) {
   const LeftEyeGrid g = left_eye_grid("spheres", 240, 135);
   const EyeCamera left = g.rig.eye(Eye::left), right = g.rig.eye(Eye::right);
   const Executor executor(2);
   for (const bool detect : {false, true}) {
-    Image target = make_eye_image(right.width, right.height, PlaneInit::unset);
-    test::poison(target);
-    for (const Plane& p : target.planes())
-      ASSERT_EQ(test::sentinel_count(p), p.value_count()) << p.name();  // the fill kept the NaN's bits
+    Image target;
+    {
+      const test::PoisonUnsetPlanes poison;
+      target = make_eye_image(right.width, right.height, PlaneInit::unset);
+    }
+    for (const Plane& p : target.planes()) ASSERT_EQ(test::sentinel_count(p), p.value_count()) << p.name();
     WarpOptions options;
     options.detect_disocclusions = detect;
     WarpStats stats;
@@ -265,28 +268,12 @@ TEST(GridWarp, PerCellRowResolveGivesTheSameImage) {
       const std::string where = std::string(name) + (detect ? ", detection on" : ", detection off");
       EXPECT_EQ(states[0], states[1]) << where;
       EXPECT_GT(stats[0].pixels_covered, image[0].pixel_count() / 2) << where;
-      EXPECT_EQ(stats[0].pixels_covered, stats[1].pixels_covered) << where;
-      EXPECT_EQ(stats[0].pixels_discarded, stats[1].pixels_discarded) << where;
-      EXPECT_EQ(stats[0].pixels_occluding_edge, stats[1].pixels_occluding_edge) << where;
-      EXPECT_EQ(stats[0].pixels_uncovered, stats[1].pixels_uncovered) << where;
-      EXPECT_EQ(stats[0].fragments, stats[1].fragments) << where;
-      EXPECT_EQ(stats[0].fragments_discarded, stats[1].fragments_discarded) << where;
-      EXPECT_EQ(stats[0].triangles, stats[1].triangles) << where;
-      EXPECT_EQ(stats[0].triangles_culled, stats[1].triangles_culled) << where;
+      EXPECT_TRUE(stats[0] == stats[1]) << where;
       if (detect) {
         EXPECT_GT(stats[0].pixels_discarded, 0u) << where;
       }
-      for (const Plane& plane : image[0].planes()) {
-        const Plane& other = image[1].plane(plane.name());
-        size_t differing = 0;
-        if (plane.type() == PlaneType::u32) {
-          for (size_t i = 0; i < plane.u32().size(); ++i) differing += plane.u32()[i] != other.u32()[i] ? 1 : 0;
-        } else {
-          for (size_t i = 0; i < plane.f32().size(); ++i)
-            differing += std::bit_cast<uint32_t>(plane.f32()[i]) != std::bit_cast<uint32_t>(other.f32()[i]) ? 1 : 0;
-        }
-        EXPECT_EQ(differing, 0u) << where << ", plane " << plane.name();
-      }
+      for (const Plane& plane : image[0].planes())
+        EXPECT_TRUE(plane == image[1].plane(plane.name())) << where << ", plane " << plane.name();
     }
   }
 }

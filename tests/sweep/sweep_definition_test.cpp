@@ -417,15 +417,16 @@ TEST(SweepDefinition, ShippedDefinitionsLoad) {
   size_t checked = 0;
   for (const auto& s : shipped) {
     const SweepDefinition d = validation::load_sweep(ci / s.file);
-    EXPECT_EQ(validation::expand_cells(d).size(), s.cells) << s.file;
+    const std::vector<validation::SweepCell> cells = validation::expand_cells(d);
+    EXPECT_EQ(cells.size(), s.cells) << s.file;
     EXPECT_EQ(d.pipelines.size(), s.pipelines ? s.pipelines : n_pipelines) << s.file;
     // A results line's cell fields give back the cell's id (check_cell_record compares them).
-    for (const validation::SweepCell& cell : validation::expand_cells(d))
+    for (const validation::SweepCell& cell : cells)
       EXPECT_EQ(validation::cell_id_from_json(validation::cell_to_json(cell)), std::optional<std::string>(cell.id))
           << s.file;
     // The gate config it is checked with puts no warning level beyond a failure level in force.
     const validation::GateConfig gate = validation::load_gate_config(d.gate_config.value_or(ci / "gate.toml"));
-    for (const validation::SweepCell& cell : validation::expand_cells(d))
+    for (const validation::SweepCell& cell : cells)
       for (const std::string& pipeline : d.pipelines) {
         std::map<std::string, std::string> origins;
         const validation::ThresholdValues t =
