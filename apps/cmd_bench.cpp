@@ -125,8 +125,22 @@ void run_bench_command(const BenchArgs& a) {
       fmt::print("  {:<22} {:>10.2f} ({:.2f}..{:.2f})\n", st, s.median * 1e3, s.min * 1e3, s.max * 1e3);
     }
   }
+  fmt::print("\nper-eye medians, ms: the stages of each eye, and those that serve both\n");
+  fmt::print("{:<{}} {:>11} {:>11} {:>11}  {}\n", "pipeline", name_w, "left eye", "right eye", "both", "right / left");
+  for (const PipelineBench& b : r.pipelines) {
+    const Summary share = summarize(b.right_over_left);
+    const std::string ratio =
+        b.right_over_left.empty()
+            ? "-"
+            : fmt::format("{:.1f} % ({:.1f}..{:.1f})", share.median * 100.0, share.min * 100.0, share.max * 100.0);
+    const std::string shared = b.shared_stages.empty() ? "" : fmt::format("; both: {}", fmt::join(b.shared_stages, ", "));
+    fmt::print("{:<{}} {:>11.2f} {:>11.2f} {:>11.2f}  {}{}\n", b.name, name_w, summarize(b.left_seconds).median * 1e3,
+               summarize(b.right_seconds).median * 1e3, summarize(b.both_seconds).median * 1e3, ratio, shared);
+  }
   fmt::print("\nspeed-up = median over repetitions of {}'s total / the pipeline's total, paired per repetition\n",
              r.baseline);
+  fmt::print("right / left = median (min..max) over repetitions of the right eye's stages / the left eye's, paired per "
+             "repetition\n");
   fmt::print("peak resident memory {:.0f} MiB\n", peak_rss_mib());
   if (!a.json_out.empty()) {
     nlohmann::json j = bench_to_json(r);

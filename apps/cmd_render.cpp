@@ -33,8 +33,16 @@ struct RenderArgs {
 };
 
 void print_timings(const StereoResult& r) {
-  for (const auto& [stage, s] : r.timings.stages()) fmt::print("  {:<22} {:>10.2f} ms\n", stage, s * 1e3);
-  fmt::print("  {:<22} {:>10.2f} ms\n", "total", r.timings.total() * 1e3);
+  const Timings& t = r.timings;
+  for (size_t i = 0; i < t.stages().size(); ++i)
+    fmt::print("  {:<22} {:>10.2f} ms  {} eye{}\n", t.stages()[i].first, t.stages()[i].second * 1e3,
+               stage_eye_name(t.eyes()[i]), t.eyes()[i] == StageEye::both ? "s" : "");
+  fmt::print("  {:<22} {:>10.2f} ms\n", "total", t.total() * 1e3);
+  const double left = t.eye_total(StageEye::left), right = t.eye_total(StageEye::right);
+  if (left > 0.0)
+    fmt::print("  {:<22} {:.2f} / {:.2f} ms = {:.1f} %{}\n", "right eye / left eye", right * 1e3, left * 1e3,
+               100.0 * right / left,
+               t.shared_stages().empty() ? "" : fmt::format(" ({:.2f} ms serve both)", t.eye_total(StageEye::both) * 1e3));
 }
 
 void print_holes(const HoleAnalysis& h, size_t pixels) {

@@ -61,6 +61,9 @@ class PipelineOptions {
 };
 
 /// A pipeline's output: both eyes with AOVs and source tags, per-stage timings and counters.
+/// The stage eye of a rendered eye's own work (StageEye::left or StageEye::right).
+[[nodiscard]] inline StageEye stage_eye(Eye eye) { return eye == Eye::right ? StageEye::right : StageEye::left; }
+
 struct StereoResult {
   Image left;
   Image right;

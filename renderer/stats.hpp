@@ -5,22 +5,39 @@
 #include <cstdint>
 #include <map>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace sb {
 
-/// Named stage timings in the order the stages ran; a repeated name accumulates.
+/// Which eye a stage's work is for. A reprojecting pipeline renders its left eye and synthesizes
+/// its right from it, so what its right eye costs beside its left is its whole point; a stage whose
+/// work serves both eyes at once (a shared pass, a scan-line loop that traces the left eye and
+/// reprojects into the right as it goes) belongs to neither.
+enum class StageEye : uint8_t { left, right, both };
+
+/// "left", "right" or "both".
+[[nodiscard]] inline const char* stage_eye_name(StageEye eye) {
+  return eye == StageEye::left ? "left" : eye == StageEye::right ? "right" : "both";
+}
+
+/// Named stage timings in the order the stages ran, each with the eye it serves; a repeated name
+/// accumulates (and must name the same eye).
 class Timings {
  public:
-  void add(const std::string& stage, double seconds) {
-    for (auto& [name, s] : stages_)
-      if (name == stage) {
-        s += seconds;
+  void add(const std::string& stage, double seconds, StageEye eye) {
+    for (size_t i = 0; i < stages_.size(); ++i)
+      if (stages_[i].first == stage) {
+        if (eyes_[i] != eye)
+          throw std::logic_error("stage '" + stage + "' timed for the " + stage_eye_name(eyes_[i]) + " eye and for the " +
+                                 stage_eye_name(eye) + " eye");
+        stages_[i].second += seconds;
         return;
       }
     stages_.emplace_back(stage, seconds);
+    eyes_.push_back(eye);
   }
   [[nodiscard]] double get(const std::string& stage) const {
     for (const auto& [name, s] : stages_)
@@ -33,18 +50,41 @@ class Timings {
     return t;
   }
   [[nodiscard]] const std::vector<std::pair<std::string, double>>& stages() const { return stages_; }
+  /// The eye of each stage, in the order of stages().
+  [[nodiscard]] const std::vector<StageEye>& eyes() const { return eyes_; }
+
+  /// Seconds of the stages that serve `eye`.
+  [[nodiscard]] double eye_total(StageEye eye) const {
+    double t = 0.0;
+    for (size_t i = 0; i < stages_.size(); ++i)
+      if (eyes_[i] == eye) t += stages_[i].second;
+    return t;
+  }
+  /// The stages that serve both eyes, in order: while there is one, the time does not split
+  /// into a left and a right eye's share.
+  [[nodiscard]] std::vector<std::string> shared_stages() const {
+    std::vector<std::string> out;
+    for (size_t i = 0; i < stages_.size(); ++i)
+      if (eyes_[i] == StageEye::both) out.push_back(stages_[i].first);
+    return out;
+  }
 
  private:
   std::vector<std::pair<std::string, double>> stages_;
+  std::vector<StageEye> eyes_;
 };
 
-/// Times a scope into a Timings entry.
+/// Times a scope into a Timings entry for the stage `stage`, which serves `eye`.
 class ScopedStage {
  public:
-  ScopedStage(Timings& timings, std::string stage)
-      : timings_(timings), stage_(std::move(stage)), start_(std::chrono::steady_clock::now()) {}
+  /// Enters the stage at once (in the order stages start), so that a stage named before for the
+  /// other eye throws here rather than in the destructor.
+  ScopedStage(Timings& timings, std::string stage, StageEye eye) : timings_(timings), stage_(std::move(stage)), eye_(eye) {
+    timings_.add(stage_, 0.0, eye_);
+    start_ = std::chrono::steady_clock::now();
+  }
   ~ScopedStage() {
-    timings_.add(stage_, std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count());
+    timings_.add(stage_, std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(), eye_);
   }
   ScopedStage(const ScopedStage&) = delete;
   ScopedStage& operator=(const ScopedStage&) = delete;
@@ -52,6 +92,7 @@ class ScopedStage {
  private:
   Timings& timings_;
   std::string stage_;
+  StageEye eye_;
   std::chrono::steady_clock::time_point start_;
 };
 

@@ -83,6 +83,12 @@ BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const Benc
         b.stage_seconds[stage].push_back(s);
       }
       b.total_seconds.push_back(r.timings.total());
+      const double left = r.timings.eye_total(StageEye::left), right = r.timings.eye_total(StageEye::right);
+      b.left_seconds.push_back(left);
+      b.right_seconds.push_back(right);
+      b.both_seconds.push_back(r.timings.eye_total(StageEye::both));
+      if (left > 0.0) b.right_over_left.push_back(right / left);
+      b.shared_stages = r.timings.shared_stages();
       b.counters = r.counters.snapshot();
       if (progress)
         progress(fmt::format("repetition {}/{} {} {:.1f} ms", rep + 1, config.repetitions, b.name, r.timings.total() * 1e3));
@@ -112,6 +118,14 @@ nlohmann::json bench_to_json(const BenchResult& r) {
                                 {"total_samples_s", b.total_seconds},
                                 {"stages_s", stages},
                                 {"speedup_vs_baseline", summary(b.speedup)},
+                                {"eyes_s",
+                                 {{"left", summary(summarize(b.left_seconds))},
+                                  {"right", summary(summarize(b.right_seconds))},
+                                  {"both", summary(summarize(b.both_seconds))},
+                                  {"shared_stages", b.shared_stages}}},
+                                {"right_over_left", b.right_over_left.empty()
+                                                        ? nlohmann::json(nullptr)
+                                                        : summary(summarize(b.right_over_left))},
                                 {"options", b.options},
                                 {"counters", b.counters}});
   }

@@ -53,6 +53,13 @@ struct PipelineBench {
   std::vector<std::string> stage_order;
   std::map<std::string, std::vector<double>> stage_seconds;  ///< per repetition
   std::vector<double> total_seconds;
+  /// Per repetition, the seconds of the stages that serve the left eye, the right eye and both
+  /// (StageEye); left + right + both = total.
+  std::vector<double> left_seconds, right_seconds, both_seconds;
+  std::vector<std::string> shared_stages;  ///< the stages that serve both eyes, in order
+  /// Per repetition, right eye / left eye where the left eye took any time (its summary is
+  /// empty otherwise): what a synthesized right eye costs beside the rendered left one.
+  std::vector<double> right_over_left;
   std::map<std::string, uint64_t> counters;  ///< of the last repetition (counters are deterministic)
   Summary speedup;  ///< baseline total / this total, paired per repetition
   std::map<std::string, std::string> options;  ///< every option's value, defaults included

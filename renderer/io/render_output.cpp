@@ -37,6 +37,9 @@ json result_to_json(const std::string& pipeline, const RenderScene& scene, const
                     const StereoResult& result, int threads, const PipelineOptions& options) {
   json timings = json::object();
   for (const auto& [stage, seconds] : result.timings.stages()) timings[stage] = seconds;
+  json eyes = json::object();
+  for (size_t i = 0; i < result.timings.stages().size(); ++i)
+    eyes[result.timings.stages()[i].first] = stage_eye_name(result.timings.eyes()[i]);
   json counters = json::object();
   for (const auto& [name, value] : result.counters.snapshot()) counters[name] = value;
   return {{"pipeline", pipeline},
@@ -45,6 +48,7 @@ json result_to_json(const std::string& pipeline, const RenderScene& scene, const
           {"rig", rig_to_json(rig)},
           {"threads", threads},
           {"timings_s", timings},
+          {"stage_eyes", eyes},
           {"total_s", result.timings.total()},
           {"counters", counters},
           {"bvh", {{"build_s", scene.bvh_build_seconds()}, {"memory_bytes", scene.rays().memory_bytes()}}},

@@ -27,7 +27,7 @@ class BidirWarp final : public Pipeline {
     StereoResult r;
     render_bidirectional(scene, rig, BidirSettings::from("bidir-warp", options), ctx.executor, r);
     {
-      ScopedStage stage(r.timings, "background");
+      ScopedStage stage(r.timings, "background", StageEye::both);
       r.counters.set("holes_shown_as_background", show_background_in_holes(scene, r.right));
       (void)show_background_in_holes(scene, r.left);
     }

@@ -25,7 +25,7 @@ class BidirWarpRt final : public Pipeline {
     render_bidirectional(scene, rig, BidirSettings::from("bidir-warp-rt", options), ctx.executor, r);
     TraceCounts right, left;
     {
-      ScopedStage stage(r.timings, "hole_fill");
+      ScopedStage stage(r.timings, "hole_fill", StageEye::both);
       trace_pixels(scene, rig.eye(Eye::right), ctx.executor, hole_list(r.right), r.right, right,
                    Source::reshaded_traced);
       trace_pixels(scene, rig.eye(Eye::left), ctx.executor, hole_list(r.left), r.left, left, Source::reshaded_traced);

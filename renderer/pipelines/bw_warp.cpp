@@ -233,14 +233,14 @@ class BwWarp final : public Pipeline {
     r.left = raster_eye(scene, rig, Eye::left, settings.raster, ctx.executor, r);
     BackwardCounts counts;
     {
-      ScopedStage stage(r.timings, "backward_warp");
+      ScopedStage stage(r.timings, "backward_warp", StageEye::right);
       // backward_warp writes every pixel (a copy or a hole), so the eye needs no fill.
       r.right = make_eye_image(rig.params().width, rig.params().height, PlaneInit::unset);
       counts = backward_warp(r.left, rig, settings, ctx.executor, r.right);
     }
     CrackFillStats cracks;
     {
-      ScopedStage stage(r.timings, "crack_fill");
+      ScopedStage stage(r.timings, "crack_fill", StageEye::right);
       cracks = fill_cracks(r.right, settings.max_crack, ctx.executor);
     }
     r.counters.set("converged", counts.converged);

@@ -152,10 +152,10 @@ class FwWarp final : public Pipeline {
     if (settings.rows) {
       MotionField motion;
       {
-        ScopedStage stage(r.timings, "motion");
+        ScopedStage stage(r.timings, "motion", StageEye::right);
         motion = disparity_motion_field(r.left, rig, Eye::left, settings.row, ctx.executor);
       }
-      ScopedStage stage(r.timings, "row_warp");
+      ScopedStage stage(r.timings, "row_warp", StageEye::right);
       r.right = make_hole_image(w, h, ctx.executor);
       const RowWarpStats s = row_warp(r.left, motion, settings.row, ctx.executor, r.right);
       counts.landed = s.landed;
@@ -163,17 +163,17 @@ class FwWarp final : public Pipeline {
     } else {
       std::vector<uint64_t> keys;
       {
-        ScopedStage stage(r.timings, "warp_depth");
+        ScopedStage stage(r.timings, "warp_depth", StageEye::right);
         keys = splat_depth(r.left, rig, settings.row.warp_background, ctx.executor, counts.landed);
       }
-      ScopedStage stage(r.timings, "warp_color");
+      ScopedStage stage(r.timings, "warp_color", StageEye::right);
       // splat_color writes every pixel (a copy or a hole), so the eye needs no fill.
       r.right = make_eye_image(w, h, PlaneInit::unset);
       counts.written = splat_color(r.left, keys, ctx.executor, r.right);
     }
     CrackFillStats cracks;
     {
-      ScopedStage stage(r.timings, "crack_fill");
+      ScopedStage stage(r.timings, "crack_fill", StageEye::right);
       cracks = fill_cracks(r.right, settings.max_crack, ctx.executor);
     }
     r.counters.set("pixels_reprojected_right", counts.written);

@@ -22,12 +22,12 @@ class IdealCopy final : public Pipeline {
     StereoResult r;
     TraceCounts counts;
     {
-      ScopedStage stage(r.timings, "left_trace");
+      ScopedStage stage(r.timings, "left_trace", StageEye::left);
       r.left = traced_eye(scene, rig.eye(Eye::left), ctx.executor, counts);
     }
     add_counts(r.counters, counts, "left", true);
     {
-      ScopedStage stage(r.timings, "right_copy");
+      ScopedStage stage(r.timings, "right_copy", StageEye::right);
       r.right = r.left;
       // Every right pixel is the left pixel at the same position: a zero-disparity reprojection.
       Plane& source = r.right.plane(planes::source);

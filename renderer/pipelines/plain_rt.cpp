@@ -22,7 +22,7 @@ class PlainRt final : public Pipeline {
       const char* name = eye_name(e);
       TraceCounts counts;
       {
-        ScopedStage stage(r.timings, std::string(name) + "_trace");
+        ScopedStage stage(r.timings, std::string(name) + "_trace", stage_eye(e));
         (e == Eye::left ? r.left : r.right) = traced_eye(scene, rig.eye(e), ctx.executor, counts);
       }
       add_counts(r.counters, counts, name, true);

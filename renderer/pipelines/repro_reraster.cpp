@@ -31,7 +31,7 @@ class ReproReraster final : public Pipeline {
     TraceCounts counts;
     RasterStats rs;
     {
-      ScopedStage stage(r.timings, "hole_fill");
+      ScopedStage stage(r.timings, "hole_fill", StageEye::right);
       // The stencil: the warp marked covered pixels; the re-raster pass writes the others only.
       for (uint8_t& s : states) s = s == static_cast<uint8_t>(WarpPixel::covered) ? 0 : 1;
       RasterOptions ro = settings.raster;

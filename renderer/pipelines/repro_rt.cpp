@@ -29,7 +29,7 @@ class ReproRt final : public Pipeline {
         warp_left_to_right(scene, rig, ReprojectionSettings::from("repro-rt", options, true), ctx.executor, r);
     TraceCounts counts;
     {
-      ScopedStage stage(r.timings, "hole_fill");
+      ScopedStage stage(r.timings, "hole_fill", StageEye::right);
       trace_unless(scene, rig.eye(Eye::right), ctx.executor, states, static_cast<uint8_t>(WarpPixel::covered), r.right,
                    counts, Source::reshaded_traced);
     }

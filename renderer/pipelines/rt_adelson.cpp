@@ -29,16 +29,16 @@ class RtAdelson final : public Pipeline {
     const PixelReprojector reprojector(rig);
     ScanlineCounts counts;
     {
-      ScopedStage stage(r.timings, "allocate");
+      ScopedStage stage(r.timings, "allocate", StageEye::both);
       // scanline_band writes every sample of both eyes.
       r.left = make_eye_image(w, h, PlaneInit::unset);
       r.right = make_eye_image(w, h, PlaneInit::unset);
     }
     // Scan-lines in order, in this thread; the bands are the ray packets' height.
     for (int y0 = 0; y0 < h; y0 += kScanlineBand) scanline_band(scene, reprojector, y0, std::min(y0 + kScanlineBand, h), r.left, r.right, counts);
-    r.timings.add("left_trace", counts.left_seconds);
-    r.timings.add("reproject", counts.reproject_seconds);
-    r.timings.add("right_trace", counts.right_seconds);
+    r.timings.add("left_trace", counts.left_seconds, StageEye::left);
+    r.timings.add("reproject", counts.reproject_seconds, StageEye::right);
+    r.timings.add("right_trace", counts.right_seconds, StageEye::right);
     add_scanline_counters(r, counts, rig);
     return r;
   }

@@ -36,7 +36,7 @@ class RtAtomic final : public Pipeline {
     const PixelReprojector reprojector(rig);
     RightSources sources{w, h, {}};
     {
-      ScopedStage stage(r.timings, "reproject");
+      ScopedStage stage(r.timings, "reproject", StageEye::right);
       sources.column.assign(static_cast<size_t>(w) * h, kNoSource);
       const float* depth = r.left.data_f32(planes::depth);
       ctx.executor.for_tiles(w, h, kTraceTile, [&](const PixelRect& tile) {

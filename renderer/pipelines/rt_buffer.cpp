@@ -58,7 +58,7 @@ class RtBuffer final : public Pipeline {
     std::vector<int32_t> buffer;
     std::vector<uint64_t> collisions(static_cast<size_t>(h), 0);
     {
-      ScopedStage stage(r.timings, "reproject");
+      ScopedStage stage(r.timings, "reproject", StageEye::right);
       buffer.resize(static_cast<size_t>(w) * h * slots);
       const float* depth = r.left.data_f32(planes::depth);
       // A row's reprojections stay in that row, so a task owns whole rows: no two tasks write one
@@ -79,7 +79,7 @@ class RtBuffer final : public Pipeline {
     }
     RightSources sources{w, h, {}};
     {
-      ScopedStage stage(r.timings, "right_resolve");
+      ScopedStage stage(r.timings, "right_resolve", StageEye::right);
       sources.column.resize(static_cast<size_t>(w) * h);
       ctx.executor.for_range(sources.column.size(), 4096, [&](size_t begin, size_t end) {
         for (size_t p = begin; p < end; ++p) {

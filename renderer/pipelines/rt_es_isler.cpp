@@ -28,13 +28,13 @@ class RtEsIsler final : public Pipeline {
     const size_t bands = static_cast<size_t>((h + kScanlineBand - 1) / kScanlineBand);
     std::vector<ScanlineCounts> per_band(bands);
     {
-      ScopedStage stage(r.timings, "allocate");
+      ScopedStage stage(r.timings, "allocate", StageEye::both);
       // scanline_band writes every sample of both eyes.
       r.left = make_eye_image(w, h, PlaneInit::unset);
       r.right = make_eye_image(w, h, PlaneInit::unset);
     }
     {
-      ScopedStage stage(r.timings, "scanlines");
+      ScopedStage stage(r.timings, "scanlines", StageEye::both);
       ctx.executor.for_each(bands, [&](size_t b) {
         const int y0 = static_cast<int>(b) * kScanlineBand;
         scanline_band(scene, reprojector, y0, std::min(y0 + kScanlineBand, h), r.left, r.right, per_band[b]);

@@ -28,7 +28,7 @@ Image shade_partial(const RenderScene& scene, const StereoRig& rig, Eye which, c
   Image image;
   TraceCounts counts;
   {
-    ScopedStage stage(r.timings, name + "_shading");
+    ScopedStage stage(r.timings, name + "_shading", StageEye::both);
     image = make_hole_image(g.width, g.height, executor);
     std::vector<uint8_t> covered;
     if (mask == nullptr) {
@@ -48,7 +48,7 @@ Image partial_eye(const RenderScene& scene, const StereoRig& rig, Eye which, con
   RasterOptions ro = settings.raster;
   ro.triangle_mask = bits.data();
   ro.triangle_bit = share_bit(which);
-  return shade_partial(scene, rig, which, gbuffer_eye(scene, rig, which, ro, executor, r), nullptr, executor, r);
+  return shade_partial(scene, rig, which, gbuffer_eye(scene, rig, which, StageEye::both, ro, executor, r), nullptr, executor, r);
 }
 
 /// The pixels an eye shades under the z-test: those whose nearest triangle is in its share, those
@@ -88,11 +88,11 @@ std::pair<Image, Image> ztest_partials(const RenderScene& scene, const StereoRig
                                        const BidirSettings& settings, const Executor& executor, StereoResult& r) {
   const Eye eyes[2] = {Eye::left, Eye::right};
   GBuffer g[2];
-  for (int k = 0; k < 2; ++k) g[k] = gbuffer_eye(scene, rig, eyes[k], settings.raster, executor, r);
+  for (int k = 0; k < 2; ++k) g[k] = gbuffer_eye(scene, rig, eyes[k], StageEye::both, settings.raster, executor, r);
   std::vector<uint8_t> mask[2];
   uint64_t hidden[2] = {0, 0};
   {
-    ScopedStage stage(r.timings, "ztest");
+    ScopedStage stage(r.timings, "ztest", StageEye::both);
     for (int k = 0; k < 2; ++k)
       mask[k] =
           ztest_mask(g[k], g[1 - k], bits, share_bit(eyes[k]), DisparityMotion(rig, eyes[k]), executor, hidden[k]);
@@ -154,7 +154,7 @@ void render_bidirectional(const RenderScene& scene, const StereoRig& rig, const 
   RedirectionCounts sent;
   std::vector<uint8_t> bits;
   {
-    ScopedStage stage(r.timings, "redirect");
+    ScopedStage stage(r.timings, "redirect", StageEye::both);
     bits = redirect_triangles(scene.geometry(), rig, executor, sent);
   }
   r.counters.set("triangles_to_left", sent.left);
@@ -169,13 +169,13 @@ void render_bidirectional(const RenderScene& scene, const StereoRig& rig, const 
   }
   MotionField to_right, to_left;
   {
-    ScopedStage stage(r.timings, "motion");
+    ScopedStage stage(r.timings, "motion", StageEye::both);
     to_right = disparity_motion_field(left, rig, Eye::left, settings.warp, executor);
     to_left = disparity_motion_field(right, rig, Eye::right, settings.warp, executor);
   }
   RowWarpStats into_right, into_left;
   {
-    ScopedStage stage(r.timings, "warp");
+    ScopedStage stage(r.timings, "warp", StageEye::both);
     // Each eye's own partial pixels take part in the depth resolution of what the other warps in.
     r.right = right;
     into_right = row_warp(left, to_right, settings.warp, executor, r.right);
@@ -190,7 +190,7 @@ void render_bidirectional(const RenderScene& scene, const StereoRig& rig, const 
   r.counters.set("pixels_warped_left", into_left.written);
   CrackFillStats cracks_right, cracks_left;
   {
-    ScopedStage stage(r.timings, "crack_fill");
+    ScopedStage stage(r.timings, "crack_fill", StageEye::both);
     if (settings.crack_depth_ratio > 0.0) {
       r.counters.set("depth_cracks_right",
                      mark_depth_cracks(r.right, settings.max_crack, settings.crack_depth_ratio, executor));

@@ -119,7 +119,7 @@ Validation validate_and_copy(const RenderScene& scene, const PixelReprojector& r
 void trace_left_eye(const RenderScene& scene, const StereoRig& rig, const Executor& executor, StereoResult& r) {
   TraceCounts left;
   {
-    ScopedStage stage(r.timings, "left_trace");
+    ScopedStage stage(r.timings, "left_trace", StageEye::left);
     r.left = traced_eye(scene, rig.eye(Eye::left), executor, left);
   }
   add_counts(r.counters, left, "left", true);
@@ -139,14 +139,14 @@ void complete_right_eye(const RenderScene& scene, const StereoRig& rig, const Pi
                         StereoResult& r) {
   Validation v;
   {
-    ScopedStage stage(r.timings, "validate");
+    ScopedStage stage(r.timings, "validate", StageEye::right);
     // Every pixel is written: approved ones by the copy below, the others by right_trace.
     r.right = make_eye_image(sources.width, sources.height, PlaneInit::unset);
     v = validate_and_copy(scene, reprojector, sources, r.left, settings, executor, r.right);
   }
   TraceCounts counts;
   {
-    ScopedStage stage(r.timings, "right_trace");
+    ScopedStage stage(r.timings, "right_trace", StageEye::right);
     trace_unless(scene, rig.eye(Eye::right), executor, v.state, kApproved, r.right, counts, Source::reshaded_traced);
   }
   add_counts(r.counters, counts, "right", true);

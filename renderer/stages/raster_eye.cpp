@@ -9,13 +9,13 @@
 
 namespace sb {
 
-GBuffer gbuffer_eye(const RenderScene& scene, const StereoRig& rig, Eye which, const RasterOptions& options,
-                    const Executor& executor, StereoResult& result) {
+GBuffer gbuffer_eye(const RenderScene& scene, const StereoRig& rig, Eye which, StageEye serves,
+                    const RasterOptions& options, const Executor& executor, StereoResult& result) {
   const std::string name = eye_name(which);
   RasterStats rs;
   GBuffer g;
   {
-    ScopedStage stage(result.timings, name + "_gbuffer");
+    ScopedStage stage(result.timings, name + "_gbuffer", serves);
     g = rasterize(scene.geometry(), rig.eye(which), executor, options, &rs);
   }
   result.counters.add("triangles_rasterized_" + name, rs.triangles_rasterized);
@@ -27,11 +27,11 @@ Image raster_eye(const RenderScene& scene, const StereoRig& rig, Eye which, cons
                  const Executor& executor, StereoResult& result, GBuffer* gbuffer) {
   const std::string name = eye_name(which);
   const EyeCamera cam = rig.eye(which);
-  GBuffer g = gbuffer_eye(scene, rig, which, options, executor, result);
+  GBuffer g = gbuffer_eye(scene, rig, which, stage_eye(which), options, executor, result);
   Image image;
   TraceCounts counts;
   {
-    ScopedStage stage(result.timings, name + "_shading");
+    ScopedStage stage(result.timings, name + "_shading", stage_eye(which));
     image = make_eye_image(cam.width, cam.height, PlaneInit::unset);  // shade_gbuffer writes every pixel
     shade_gbuffer(scene, cam, g, executor, image, counts);
   }

@@ -7,9 +7,10 @@
 
 namespace sb {
 
-/// Rasterizes the G-buffer of `which` eye of the rig, timing the stage "<eye>_gbuffer" and counting
+/// Rasterizes the G-buffer of `which` eye of the rig, timing the stage "<eye>_gbuffer" as work for
+/// `serves` (the eye itself, or both eyes where its pixels are shared between them) and counting
 /// rasterized triangles and fragments into `result`.
-[[nodiscard]] GBuffer gbuffer_eye(const RenderScene& scene, const StereoRig& rig, Eye which,
+[[nodiscard]] GBuffer gbuffer_eye(const RenderScene& scene, const StereoRig& rig, Eye which, StageEye serves,
                                   const RasterOptions& options, const Executor& executor, StereoResult& result);
 
 /// Rasterizes and shades `which` eye of the rig into a new eye image, timing the stages

@@ -74,7 +74,7 @@ std::vector<uint8_t> warp_left_to_right(const RenderScene& scene, const StereoRi
   const double e = rig.params().interaxial;
   WarpGrid grid;
   {
-    ScopedStage stage(r.timings, "grid_metric");
+    ScopedStage stage(r.timings, "grid_metric", StageEye::right);
     GridSettings gs;
     gs.interaxial = e;
     gs.focal_px = left.f_px;
@@ -86,7 +86,7 @@ std::vector<uint8_t> warp_left_to_right(const RenderScene& scene, const StereoRi
   SourceFrustumStats frustum;
   std::vector<uint8_t> states;
   {
-    ScopedStage stage(r.timings, "grid_warp");
+    ScopedStage stage(r.timings, "grid_warp", StageEye::right);
     // grid_warp writes every pixel of every plane.
     r.right = make_eye_image(right.width, right.height, PlaneInit::unset);
     states = grid_warp(grid, r.left, left, right, e, settings.warp, executor, r.right, ws);

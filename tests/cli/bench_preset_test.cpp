@@ -4,6 +4,7 @@
 // against the reference and the memory check, crossover and stage grouping of the complexity table.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -200,6 +201,46 @@ TEST(BenchOptions, GivenOptionsArePrintedAndRecorded) {
   ASSERT_EQ(preset.code, 0) << preset.out;
   EXPECT_NE(preset.out.find("options: bidir-warp.occlusion=ztest\n"), std::string::npos) << preset.out;
   EXPECT_EQ(json::parse(test::read_text(dir / "focal.json")).at("options").at("bidir-warp").at("occlusion"), "ztest");
+}
+
+TEST(BenchEyes, EachPipelinesTimeSplitsIntoItsEyesAndWhatTheyShare) {
+  test::ScratchDir dir("bencheyes");
+  const CliRun b = test::run_cli("bench --pipelines plain-raster,repro-rt,bidir-warp -n 2 -w 0 --scene box-wall "
+                                 "--resolution 64x36 --scenes-dir '" +
+                                 (dir / "scenes").string() + "' --json '" + (dir / "bench.json").string() + "'");
+  ASSERT_EQ(b.code, 0) << b.out;
+  EXPECT_NE(b.out.find("per-eye medians"), std::string::npos) << b.out;
+  EXPECT_NE(b.out.find("; both: redirect, left_gbuffer"), std::string::npos) << b.out;
+  const json pipelines = json::parse(test::read_text(dir / "bench.json")).at("pipelines");
+  ASSERT_EQ(pipelines.size(), 3u);
+  for (const json& p : pipelines) {
+    SCOPED_TRACE(p.at("name").get<std::string>());
+    const json& eyes = p.at("eyes_s");
+    // Each repetition's shares add up to its total; with two repetitions the medians are means.
+    const double sum = eyes.at("left").at("median").get<double>() + eyes.at("right").at("median").get<double>() +
+                       eyes.at("both").at("median").get<double>();
+    EXPECT_NEAR(sum, p.at("total_s").at("median").get<double>(), 1e-9);
+  }
+  // Rendered left eyes: the right eye's share is measured; repro-rt's right eye is its grid and holes.
+  for (int i : {0, 1}) {
+    const json& p = pipelines[static_cast<size_t>(i)];
+    EXPECT_TRUE(p.at("eyes_s").at("shared_stages").empty());
+    EXPECT_EQ(p.at("eyes_s").at("both").at("median").get<double>(), 0.0);
+    EXPECT_GT(p.at("right_over_left").at("median").get<double>(), 0.0);
+  }
+  const json& repro = pipelines[1];
+  const json& st = repro.at("stages_s");
+  EXPECT_NEAR(repro.at("eyes_s").at("right").at("min").get<double>(),
+              std::min(st.at("grid_metric").at("samples")[0].get<double>() + st.at("grid_warp").at("samples")[0].get<double>() +
+                           st.at("hole_fill").at("samples")[0].get<double>(),
+                       st.at("grid_metric").at("samples")[1].get<double>() + st.at("grid_warp").at("samples")[1].get<double>() +
+                           st.at("hole_fill").at("samples")[1].get<double>()),
+              1e-12);
+  // Bidirectional warping shares every stage between the eyes: no split.
+  const json& bidir = pipelines[2];
+  EXPECT_TRUE(bidir.at("right_over_left").is_null());
+  EXPECT_EQ(bidir.at("eyes_s").at("left").at("median").get<double>(), 0.0);
+  EXPECT_EQ(bidir.at("eyes_s").at("shared_stages").size(), bidir.at("stages_s").size());
 }
 
 TEST(BenchOptions, VariantsRunBesideTheirPipelineWithTheirOwnOptions) {

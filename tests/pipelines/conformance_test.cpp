@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <map>
+#include <string>
 
 #include "renderer/render_scene.hpp"
 #include "scenes/generators.hpp"
@@ -53,6 +55,44 @@ TEST_P(Conformance, BitIdenticalWithOneAndTwoThreads) {
     EXPECT_TRUE(a.left == b.left) << GetParam() << " left eye differs between 1 and 2 threads";
     EXPECT_TRUE(a.right == b.right) << GetParam() << " right eye differs between 1 and 2 threads";
   }
+}
+
+/// The eye each pipeline's stages serve (bench's per-eye table rests on it), stage by stage as
+/// "stage=eye", in the order the stages start. A reprojecting pipeline's right eye is every stage
+/// after its left eye's; bidirectional warping and the parallel scan-lines share their work.
+TEST_P(Conformance, StagesSayWhichEyeTheyServe) {
+  static const std::map<std::string, std::string> expected = {
+      {"plain-raster", "left_gbuffer=left left_shading=left right_gbuffer=right right_shading=right"},
+      {"plain-rt", "left_trace=left right_trace=right"},
+      {"ideal-copy", "left_trace=left right_copy=right"},
+      {"repro-warp", "left_gbuffer=left left_shading=left grid_metric=right grid_warp=right"},
+      {"repro-rt", "left_gbuffer=left left_shading=left grid_metric=right grid_warp=right hole_fill=right"},
+      {"repro-reraster", "left_gbuffer=left left_shading=left grid_metric=right grid_warp=right hole_fill=right"},
+      {"rt-adelson", "allocate=both left_trace=left reproject=right right_trace=right"},
+      {"rt-es-isler", "allocate=both scanlines=both"},
+      {"rt-buffer", "left_trace=left reproject=right right_resolve=right validate=right right_trace=right"},
+      {"rt-atomic", "left_trace=left reproject=right validate=right right_trace=right"},
+      {"fw-warp", "left_gbuffer=left left_shading=left warp_depth=right warp_color=right crack_fill=right"},
+      {"bw-warp", "left_gbuffer=left left_shading=left backward_warp=right crack_fill=right"},
+      {"bidir-warp",
+       "redirect=both left_gbuffer=both left_shading=both right_gbuffer=both right_shading=both motion=both warp=both "
+       "crack_fill=both background=both"},
+      {"bidir-warp-rt",
+       "redirect=both left_gbuffer=both left_shading=both right_gbuffer=both right_shading=both motion=both warp=both "
+       "crack_fill=both hole_fill=both"},
+  };
+  const auto it = expected.find(GetParam());
+  ASSERT_NE(it, expected.end()) << GetParam() << " is registered but its stages' eyes are not listed here";
+  const Scene scene = test::load_builtin("box-wall");
+  const RenderScene rs(scene);
+  const StereoResult r = test::render_with(GetParam(), rs, test::rig_at(scene, 200, 120));
+  const Timings& t = r.timings;
+  std::string got;
+  for (size_t i = 0; i < t.stages().size(); ++i)
+    got += (got.empty() ? "" : " ") + t.stages()[i].first + "=" + stage_eye_name(t.eyes()[i]);
+  EXPECT_EQ(got, it->second);
+  // The three shares are the whole time.
+  EXPECT_NEAR(t.eye_total(StageEye::left) + t.eye_total(StageEye::right) + t.eye_total(StageEye::both), t.total(), 1e-12);
 }
 
 INSTANTIATE_TEST_SUITE_P(Registry, Conformance, ::testing::ValuesIn(registered_pipelines()),
