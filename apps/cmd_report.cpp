@@ -51,14 +51,15 @@ void print_summary_table(const reports::ReportSummary& s) {
   std::vector<std::string> names;
   for (const nlohmann::json& name : s.pipeline_names) names.push_back(name.get<std::string>());
   const size_t name_w = pipeline_column(names);
-  fmt::print("\n{:<{}} {:>8} {:>8} {:>8} {:>11} {:>9}   (medians over {} cell(s))\n", "pipeline", name_w, "PSNR dB",
-             "SSIM", "holes %", "time ms", "speed-up", s.cells.size());
+  fmt::print("\n{:<{}} {:>8} {:>8} {:>8} {:>11} {:>9} {:>13}   (medians over {} cell(s))\n", "pipeline", name_w,
+             "PSNR dB", "SSIM", "holes %", "time ms", "speed-up", "right/left %", s.cells.size());
   for (const std::string& p : names) {
     const double speedup = cell_median(s.cells, p, "speedup");
-    fmt::print("{:<{}} {:>8} {:>8} {:>8} {:>11} {:>9}\n", p, name_w, number(cell_median(s.cells, p, "psnr"), 2),
+    fmt::print("{:<{}} {:>8} {:>8} {:>8} {:>11} {:>9} {:>13}\n", p, name_w, number(cell_median(s.cells, p, "psnr"), 2),
                number(cell_median(s.cells, p, "ssim"), 4), number(cell_median(s.cells, p, "hole_fraction"), 3, 100.0),
                number(cell_median(s.cells, p, "time_s"), 2, 1000.0),
-               std::isnan(speedup) ? std::string("-") : number(speedup, 2) + "x");
+               std::isnan(speedup) ? std::string("-") : number(speedup, 2) + "x",
+               number(cell_median(s.cells, p, "right_over_left"), 1, 100.0));
   }
   fmt::print("\n");
 }

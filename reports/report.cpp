@@ -71,6 +71,20 @@ json region_summary(const json& region) {
               {"mse", get_or_null(region, "mse")}};
 }
 
+/// A single run's right-eye time over its left-eye time, from its stage timings and the eye each
+/// stage serves; null without a left-eye stage or without the stages' eyes (older records).
+json right_over_left(const json& timings, const json& eyes) {
+  if (!timings.is_object() || !eyes.is_object()) return nullptr;
+  double left = 0.0, right = 0.0;
+  for (const auto& [stage, seconds] : timings.items()) {
+    const json eye = get_or_null(eyes, stage.c_str());
+    if (!seconds.is_number() || !eye.is_string()) continue;
+    if (eye == "left") left += seconds.get<double>();
+    if (eye == "right") right += seconds.get<double>();
+  }
+  return left > 0.0 ? json(right / left) : json(nullptr);
+}
+
 /// One pipeline of a cell: quality, holes, time, images.
 json pipeline_summary(const json& p, const json& baseline_total) {
   const json& v = p["validation"];
@@ -97,6 +111,7 @@ json pipeline_summary(const json& p, const json& baseline_total) {
     out["repetitions"] = get_or_null(timing, "repetitions");
     out["speedup"] = get_or_null(timing, "speedup_median");
     out["stages_s"] = timing.contains("stages_median_s") ? timing["stages_median_s"] : get_or_null(v, "timings_s");
+    out["right_over_left"] = get_or_null(timing, "right_over_left_median");
     out["timing_source"] = "median";
   } else {
     const json total = get_or_null(v, "total_s");
@@ -107,6 +122,7 @@ json pipeline_summary(const json& p, const json& baseline_total) {
     const bool ratio = total.is_number() && baseline_total.is_number() && total.get<double>() > 0.0;
     out["speedup"] = ratio ? json(baseline_total.get<double>() / total.get<double>()) : json(nullptr);
     out["stages_s"] = get_or_null(v, "timings_s");
+    out["right_over_left"] = right_over_left(out["stages_s"], get_or_null(v, "stage_eyes"));
     out["timing_source"] = "single run";
   }
   if (out["stages_s"].is_null()) out["stages_s"] = json::object();

@@ -3,6 +3,7 @@
 
 #include <chrono>
 
+#include "renderer/io/render_output.hpp"
 #include "validation/validate.hpp"
 
 namespace sb::validation {
@@ -34,10 +35,9 @@ void run_path(Scene& scene, const PathRun& run, const Executor& executor,
     json pipelines = json::object();
     for (const PipelineEntry& entry : run.pipelines) {
       const PipelineValidation v = validate_pipeline(target, entry, entry.options(), executor);
-      json timings = json::object();
-      for (const auto& [stage, s] : v.result.timings.stages()) timings[stage] = s;
       pipelines[v.pipeline] = {{"total_s", v.result.timings.total()},
-                               {"timings_s", timings},
+                               {"timings_s", io::timings_to_json(v.result.timings)},
+                               {"stage_eyes", io::stage_eyes_to_json(v.result.timings)},
                                {"counters", v.result.counters.snapshot()},
                                {"metrics", to_json(v.whole)},
                                {"hole_fraction", v.holes.hole_fraction},

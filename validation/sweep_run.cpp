@@ -236,7 +236,13 @@ json timing_json(const PipelineBench& b, const BenchResult& r, int warmup) {
           {"median_s", total.median},       {"min_s", total.min},
           {"max_s", total.max},             {"samples_s", b.total_seconds},
           {"stages_median_s", stages},      {"speedup_median", b.speedup.median},
-          {"speedup_min", b.speedup.min},   {"speedup_max", b.speedup.max}};
+          {"speedup_min", b.speedup.min},   {"speedup_max", b.speedup.max},
+          {"eyes_median_s",
+           {{"left", summarize(b.left_seconds).median},
+            {"right", summarize(b.right_seconds).median},
+            {"both", summarize(b.both_seconds).median}}},
+          {"right_over_left_median",
+           b.right_over_left.empty() ? json(nullptr) : json(summarize(b.right_over_left).median)}};
 }
 
 /// Validates and times every pipeline of the definition in one cell; returns its results line.

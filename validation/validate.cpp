@@ -80,8 +80,6 @@ PipelineValidation validate_pipeline(const ValidationTarget& target, const Pipel
 json validation_record(const ValidationTarget& target, const PipelineValidation& v, int threads, const json& images) {
   json regions = json::object();
   for (const auto& [name, m] : v.regions) regions[name] = to_json(m);
-  json timings = json::object();
-  for (const auto& [stage, s] : v.result.timings.stages()) timings[stage] = s;
   json counters = json::object();
   for (const auto& [name, value] : v.result.counters.snapshot()) counters[name] = value;
   const Scene& scene = target.scene.scene();
@@ -102,7 +100,8 @@ json validation_record(const ValidationTarget& target, const PipelineValidation&
           {"metrics", to_json(v.whole)},
           {"regions", regions},
           {"holes", to_json(v.holes)},
-          {"timings_s", timings},
+          {"timings_s", io::timings_to_json(v.result.timings)},
+          {"stage_eyes", io::stage_eyes_to_json(v.result.timings)},
           {"total_s", v.result.timings.total()},
           {"counters", counters},
           {"threads", threads},

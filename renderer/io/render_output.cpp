@@ -33,13 +33,20 @@ json versions_json() {
           {"gltf", gltf_loader_version()}};
 }
 
+json timings_to_json(const Timings& timings) {
+  json out = json::object();
+  for (const auto& [stage, seconds] : timings.stages()) out[stage] = seconds;
+  return out;
+}
+
+json stage_eyes_to_json(const Timings& timings) {
+  json out = json::object();
+  for (size_t i = 0; i < timings.stages().size(); ++i) out[timings.stages()[i].first] = stage_eye_name(timings.eyes()[i]);
+  return out;
+}
+
 json result_to_json(const std::string& pipeline, const RenderScene& scene, const StereoRig& rig,
                     const StereoResult& result, int threads, const PipelineOptions& options) {
-  json timings = json::object();
-  for (const auto& [stage, seconds] : result.timings.stages()) timings[stage] = seconds;
-  json eyes = json::object();
-  for (size_t i = 0; i < result.timings.stages().size(); ++i)
-    eyes[result.timings.stages()[i].first] = stage_eye_name(result.timings.eyes()[i]);
   json counters = json::object();
   for (const auto& [name, value] : result.counters.snapshot()) counters[name] = value;
   return {{"pipeline", pipeline},
@@ -47,8 +54,8 @@ json result_to_json(const std::string& pipeline, const RenderScene& scene, const
           {"scene", {{"name", scene.scene().name}, {"path", scene.scene().path}, {"triangles", scene.scene().triangle_count()}}},
           {"rig", rig_to_json(rig)},
           {"threads", threads},
-          {"timings_s", timings},
-          {"stage_eyes", eyes},
+          {"timings_s", timings_to_json(result.timings)},
+          {"stage_eyes", stage_eyes_to_json(result.timings)},
           {"total_s", result.timings.total()},
           {"counters", counters},
           {"bvh", {{"build_s", scene.bvh_build_seconds()}, {"memory_bytes", scene.rays().memory_bytes()}}},

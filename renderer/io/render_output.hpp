@@ -21,6 +21,11 @@ namespace sb::io {
 /// Versions of stereobench and the libraries it renders with.
 [[nodiscard]] nlohmann::json versions_json();
 
+/// A run's stage timings, {"stage": seconds, ...}.
+[[nodiscard]] nlohmann::json timings_to_json(const Timings& timings);
+/// The eye each of a run's stages serves, {"stage": "left" | "right" | "both", ...}.
+[[nodiscard]] nlohmann::json stage_eyes_to_json(const Timings& timings);
+
 /// A run's record: pipeline, scene, rig, threads, per-stage timings, counters, versions.
 [[nodiscard]] nlohmann::json result_to_json(const std::string& pipeline, const RenderScene& scene,
                                             const StereoRig& rig, const StereoResult& result, int threads,

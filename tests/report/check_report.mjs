@@ -81,6 +81,17 @@ try {
   const infinite = data.cells.reduce((n, c) => n + Object.values(c.pipelines).filter((p) => p.psnr === 'inf').length, 0);
   const shownInfinite = await page.evaluate(() => [...document.querySelectorAll('#cells tbody td')].filter((td) => td.textContent === '∞').length);
   if (shownInfinite < infinite) problems.push(`cells table shows ∞ ${shownInfinite} times for ${infinite} infinite PSNR values`);
+  // The right eye's share of the left's: a number for a pipeline with one in any cell, — otherwise.
+  const shares = await page.evaluate(() => {
+    const heads = [...document.querySelectorAll('#summary thead th')].map((th) => th.textContent);
+    const k = heads.indexOf('Right / left %');
+    return k < 0 ? null : [...document.querySelectorAll('#summary tbody tr')].map((tr) => [tr.children[0].textContent, tr.children[k].textContent]);
+  });
+  if (shares === null) problems.push('summary table: no "Right / left %" column');
+  else for (const [pipeline, text] of shares) {
+    const has = data.cells.some((c) => c.pipelines[pipeline] && typeof c.pipelines[pipeline].right_over_left === 'number');
+    if (has ? !/^\d+\.\d$/.test(text) : text !== '—') problems.push(`summary table: right / left of ${pipeline} shows "${text}"`);
+  }
   const bodyText = await page.evaluate(() => document.body.innerText);
   for (const bad of ['NaN', 'undefined', 'Infinity', '[object Object]'])
     if (bodyText.includes(bad)) problems.push(`the page text contains "${bad}"`);

@@ -94,6 +94,16 @@ TEST(Report, SmokeSweepReportsPassTheBrowserCheck) {
   const std::string counts = std::to_string(lines.size()) + " cell(s) x " + std::to_string(pipeline_count) +
                              " pipeline(s), " + std::to_string(lines.size() * (3 + 4 * pipeline_count)) + " image(s) copied";
   EXPECT_NE(r.out.find(counts), std::string::npos) << r.out;
+  // The terminal summary's last column: the right eye's share of the left, - where stages serve both eyes.
+  EXPECT_NE(r.out.find("right/left %"), std::string::npos) << r.out;
+  const auto last_column = [&](const std::string& pipeline) {
+    const size_t at = r.out.find("\n" + pipeline + " ");
+    const size_t end = r.out.find('\n', at + 1);
+    const std::string row = at == std::string::npos ? "" : r.out.substr(at + 1, end - at - 1);
+    return row.substr(row.find_last_of(' ') + 1);
+  };
+  EXPECT_EQ(last_column("bidir-warp"), "-") << r.out;
+  EXPECT_NE(last_column("repro-rt").find_first_of("0123456789"), std::string::npos) << r.out;
 
   // The embedded data: cells in cell order, infinite PSNR kept as "inf", the sweep's timing, images copied.
   const json data = embedded_data(dir / "report" / "index.html");
@@ -110,6 +120,9 @@ TEST(Report, SmokeSweepReportsPassTheBrowserCheck) {
     EXPECT_EQ(cell["pipelines"]["plain-rt"]["psnr"], "inf") << "plain-rt's right eye is the built-in truth";
     EXPECT_EQ(cell["pipelines"]["repro-rt"]["timing_source"], "median");
     EXPECT_EQ(cell["pipelines"]["repro-rt"]["speedup"], lines[i]["pipelines"]["repro-rt"]["timing"]["speedup_median"]);
+    EXPECT_EQ(cell["pipelines"]["repro-rt"]["right_over_left"],
+              lines[i]["pipelines"]["repro-rt"]["timing"]["right_over_left_median"]);
+    EXPECT_TRUE(cell["pipelines"]["bidir-warp"]["right_over_left"].is_null()) << "bidir-warp's stages serve both eyes";
     EXPECT_EQ(cell["pipelines"]["repro-rt"]["psnr"], lines[i]["pipelines"]["repro-rt"]["validation"]["metrics"]["psnr"]);
     for (const auto& [key, path] : cell["images"].items()) {
       ASSERT_TRUE(path.is_string()) << key;
@@ -161,7 +174,12 @@ json minimal_line(const std::string& id, int index) {
               {"baseline", "plain-rt"},
               {"pipelines",
                {{"plain-rt", {{"validation", {{"metrics", metrics}, {"total_s", 0.01}}}}},
-                {"repro-rt", {{"validation", {{"metrics", metrics}, {"total_s", 0.004}, {"timings_s", {{"hole_fill", 0.001}}}}}}}}}};
+                {"repro-rt",
+                 {{"validation",
+                   {{"metrics", metrics},
+                    {"total_s", 0.004},
+                    {"timings_s", {{"left_gbuffer", 0.002}, {"hole_fill", 0.001}}},
+                    {"stage_eyes", {{"left_gbuffer", "left"}, {"hole_fill", "right"}}}}}}}}}};
 }
 
 TEST(Report, MalformedResultsExit3NamingFileAndLine) {
@@ -233,6 +251,7 @@ TEST(Report, MalformedResultsExit3NamingFileAndLine) {
 TEST(Report, WarnsOnTornTailAndMissingImagesAndGuardsForeignFolders) {
   test::ScratchDir dir;
   json with_images = minimal_line("b", 1);
+  with_images["pipelines"]["repro-rt"]["validation"].erase("stage_eyes");  // as written before stages named eyes
   with_images["images"] = {{"left_png", "cells/0001/left.png"}, {"pipelines", {{"plain-rt", {{"right_png", "cells/0001/r.png"}}}}}};
   write_text(dir / "results.jsonl", minimal_line("a", 0).dump() + "\n" + with_images.dump() + "\n{\"kind\": \"stereob");
   const test::CliRun r = test::run_cli("report " + quoted(dir / "results.jsonl") + " --out " + quoted(dir / "out"));
@@ -247,6 +266,9 @@ TEST(Report, WarnsOnTornTailAndMissingImagesAndGuardsForeignFolders) {
   EXPECT_EQ(repro["timing_source"], "single run");
   EXPECT_DOUBLE_EQ(repro["speedup"].get<double>(), 2.5);
   EXPECT_EQ(repro["stages_s"]["hole_fill"], 0.001);
+  // Its right eye's share of the left from the stages' eyes: 0.001 s / 0.002 s; none without them.
+  EXPECT_DOUBLE_EQ(repro["right_over_left"].get<double>(), 0.5);
+  EXPECT_TRUE(data["cells"][1]["pipelines"]["repro-rt"]["right_over_left"].is_null());
   EXPECT_TRUE(data["cells"][0]["pipelines"]["plain-rt"]["hole_fraction"].is_null()) << "absent in the line: null, shown as —";
   EXPECT_EQ(data["warnings"].size(), 1u) << "the torn line is reported in the page";
   for (const char* asset : {"report.js", "report.css", "chart.umd.min.js"})

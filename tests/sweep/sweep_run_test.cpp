@@ -295,6 +295,13 @@ TEST(SweepRun, SmokeSweepRunsAndEveryLineIsWellFormed) {
       EXPECT_EQ(t["samples_s"].size(), 1u);
       EXPECT_GT(t["median_s"].get<double>(), 0.0);
       EXPECT_GT(t["speedup_median"].get<double>(), 0.0);
+      // The right eye's share of the left's, where the stages split between the eyes.
+      const bool shared = name.rfind("bidir-warp", 0) == 0 || name == "rt-es-isler";
+      EXPECT_EQ(t["right_over_left_median"].is_null(), shared) << t.dump();
+      if (!shared) {
+        EXPECT_GT(t["right_over_left_median"].get<double>(), 0.0);
+      }
+      EXPECT_FALSE(v["stage_eyes"].empty());
       if (name == "plain-rt") {
         EXPECT_EQ(t["speedup_median"], 1.0);
         EXPECT_EQ(v["metrics"]["psnr"], "inf");  // plain-rt's right eye is the built-in truth
