@@ -162,7 +162,7 @@ void run_bench_command(const BenchArgs& a) {
 
 void register_bench_command(CLI::App& root) {
   auto a = std::make_shared<BenchArgs>();
-  CLI::App* b = root.add_subcommand("bench", "Time pipelines side by side: medians per stage, throughput, speed-ups");
+  CLI::App* b = root.add_subcommand("bench", "Time pipelines side by side: medians per stage, throughput, speed-ups, and the right eye's time beside the left eye's");
   b->add_option("--scene,-s", a->scene, "Scene file (.gltf/.glb) or built-in scene name")->capture_default_str();
   b->add_option("--pipelines,-p", a->pipelines,
                 "Pipelines to time, comma-separated (default: all registered; with --preset, the preset's); "

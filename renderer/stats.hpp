@@ -23,7 +23,7 @@ enum class StageEye : uint8_t { left, right, both };
   return eye == StageEye::left ? "left" : eye == StageEye::right ? "right" : "both";
 }
 
-/// Named stage timings in the order the stages ran, each with the eye it serves; a repeated name
+/// Named stage timings in the order the stages started, each with the eye it serves; a repeated name
 /// accumulates (and must name the same eye).
 class Timings {
  public:
