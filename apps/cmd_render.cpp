@@ -39,10 +39,13 @@ void print_timings(const StereoResult& r) {
                stage_eye_name(t.eyes()[i]), t.eyes()[i] == StageEye::both ? "s" : "");
   fmt::print("  {:<22} {:>10.2f} ms\n", "total", t.total() * 1e3);
   const double left = t.eye_total(StageEye::left), right = t.eye_total(StageEye::right);
+  const std::string shared =
+      t.shared_stages().empty() ? "" : fmt::format(" ({:.2f} ms serve both eyes)", t.eye_total(StageEye::both) * 1e3);
   if (left > 0.0)
     fmt::print("  {:<22} {:.2f} / {:.2f} ms = {:.1f} %{}\n", "right eye / left eye", right * 1e3, left * 1e3,
-               100.0 * right / left,
-               t.shared_stages().empty() ? "" : fmt::format(" ({:.2f} ms serve both)", t.eye_total(StageEye::both) * 1e3));
+               100.0 * right / left, shared);
+  else
+    fmt::print("  {:<22} -{}: no stage serves the left eye alone\n", "right eye / left eye", shared);
 }
 
 void print_holes(const HoleAnalysis& h, size_t pixels) {

@@ -60,10 +60,10 @@ class PipelineOptions {
   std::map<std::string, std::string> values_;
 };
 
-/// A pipeline's output: both eyes with AOVs and source tags, per-stage timings and counters.
 /// The stage eye of a rendered eye's own work (StageEye::left or StageEye::right).
 [[nodiscard]] inline StageEye stage_eye(Eye eye) { return eye == Eye::right ? StageEye::right : StageEye::left; }
 
+/// A pipeline's output: both eyes with AOVs and source tags, per-stage timings and counters.
 struct StereoResult {
   Image left;
   Image right;

@@ -404,7 +404,7 @@ void check_cell_record(const json& line, const std::string& where) {
       require_within(p, where, prefix, f, 0.0, 1.0);
     require_within(p, where, prefix, "validation.total_s", 0.0, kMax);
     if (p.contains("timing")) {
-      for (const char* t : {"median_s", "min_s", "max_s", "speedup_median"}) {
+      for (const char* t : {"median_s", "min_s", "max_s", "speedup_median", "right_over_left_median"}) {
         require(p, where, prefix, std::string("timing.") + t, Kind::number_or_null, true);
         require_within(p, where, prefix, std::string("timing.") + t, 0.0, kMax);
       }
@@ -619,7 +619,8 @@ std::string results_csv(const std::vector<json>& cells) {
                           value_at(p, "validation.holes.not_reprojected.recall"),
                           value_at(p, "validation.holes.not_reprojected.precision"),
                           value_at(p, "timing.median_s"),
-                          value_at(p, "timing.speedup_median")};
+                          value_at(p, "timing.speedup_median"),
+                          value_at(p, "timing.right_over_left_median")};
       static_assert(std::size(row) == std::size(kCsvColumns));
       std::string line;
       for (size_t i = 0; i < std::size(row); ++i) line += (i ? "," : "") + csv_quote(field(row[i]));

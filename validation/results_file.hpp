@@ -102,6 +102,6 @@ inline constexpr const char* kCsvColumns[] = {
     "interaxial_m", "max_disparity_px", "convergence_m", "lights", "frame",  "bvh_update_s", "truth",
     "pipeline",   "baseline",
     "psnr",       "ssim",       "mse",            "error_fraction", "hole_fraction", "recall", "precision",
-    "median_s",   "speedup_median"};
+    "median_s",   "speedup_median", "right_over_left_median"};
 
 }  // namespace sb::validation

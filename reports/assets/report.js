@@ -334,7 +334,7 @@
     { text: 'Precision', title: 'Share of not-reprojected pixels that needed it', key: 'precision', digits: 4 },
     { text: 'Time ms', title: 'Median wall-clock time of the pipeline', key: 'time_s', digits: 2, scale: 1000 },
     { text: 'Speed-up', title: `Over ${data.baseline}, paired per repetition in the same cell`, key: 'speedup', digits: 2 },
-    { text: 'Right / left %', title: 'Time of the stages that serve the right eye over those that serve the left, paired per repetition; — where the stages serve both eyes', key: 'right_over_left', digits: 1, scale: 100 },
+    { text: 'Right / left %', title: 'Time of the stages that serve the right eye over those that serve the left (the sweep: median over repetitions of each repetition’s ratio); — where no stage serves the left eye alone', key: 'right_over_left', digits: 1, scale: 100 },
   ];
 
   function summarySection() {

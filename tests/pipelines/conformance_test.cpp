@@ -83,16 +83,19 @@ TEST_P(Conformance, StagesSayWhichEyeTheyServe) {
   };
   const auto it = expected.find(GetParam());
   ASSERT_NE(it, expected.end()) << GetParam() << " is registered but its stages' eyes are not listed here";
-  const Scene scene = test::load_builtin("box-wall");
-  const RenderScene rs(scene);
-  const StereoResult r = test::render_with(GetParam(), rs, test::rig_at(scene, 200, 120));
-  const Timings& t = r.timings;
-  std::string got;
-  for (size_t i = 0; i < t.stages().size(); ++i)
-    got += (got.empty() ? "" : " ") + t.stages()[i].first + "=" + stage_eye_name(t.eyes()[i]);
-  EXPECT_EQ(got, it->second);
-  // The three shares are the whole time.
-  EXPECT_NEAR(t.eye_total(StageEye::left) + t.eye_total(StageEye::right) + t.eye_total(StageEye::both), t.total(), 1e-12);
+  EXPECT_EQ(test::stage_eyes_of(GetParam()), it->second);
+}
+
+/// The same for the option values that run other stages: fw-warp's row warp, the z-test of
+/// bidirectional warping.
+TEST(StageEyes, OptionsThatRunOtherStagesSayWhichEyeTheyServe) {
+  EXPECT_EQ(test::stage_eyes_of("fw-warp", {{"warp", "rows"}}),
+            "left_gbuffer=left left_shading=left motion=right row_warp=right crack_fill=right");
+  const std::string ztest =
+      "redirect=both left_gbuffer=both right_gbuffer=both ztest=both left_shading=both right_shading=both motion=both "
+      "warp=both crack_fill=both ";
+  EXPECT_EQ(test::stage_eyes_of("bidir-warp", {{"occlusion", "ztest"}}), ztest + "background=both");
+  EXPECT_EQ(test::stage_eyes_of("bidir-warp-rt", {{"occlusion", "ztest"}}), ztest + "hole_fill=both");
 }
 
 INSTANTIATE_TEST_SUITE_P(Registry, Conformance, ::testing::ValuesIn(registered_pipelines()),

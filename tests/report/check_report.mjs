@@ -81,16 +81,30 @@ try {
   const infinite = data.cells.reduce((n, c) => n + Object.values(c.pipelines).filter((p) => p.psnr === 'inf').length, 0);
   const shownInfinite = await page.evaluate(() => [...document.querySelectorAll('#cells tbody td')].filter((td) => td.textContent === '∞').length);
   if (shownInfinite < infinite) problems.push(`cells table shows ∞ ${shownInfinite} times for ${infinite} infinite PSNR values`);
-  // The right eye's share of the left's: a number for a pipeline with one in any cell, — otherwise.
-  const shares = await page.evaluate(() => {
-    const heads = [...document.querySelectorAll('#summary thead th')].map((th) => th.textContent);
-    const k = heads.indexOf('Right / left %');
-    return k < 0 ? null : [...document.querySelectorAll('#summary tbody tr')].map((tr) => [tr.children[0].textContent, tr.children[k].textContent]);
-  });
-  if (shares === null) problems.push('summary table: no "Right / left %" column');
-  else for (const [pipeline, text] of shares) {
+  // The right eye's share of the left's: in the summary a number for a pipeline with one in any
+  // cell, — otherwise; in the cells table a number exactly where the cell has one.
+  // The column is the tables' last; a row's pipeline is its first td (summary: its th), since the
+  // cells table's first row of a cell starts with the cell's th spanning the cell's rows.
+  const column = (id) => page.evaluate((id) => {
+    const heads = [...document.querySelectorAll(`#${id} thead th`)];
+    if (!heads.length || heads[heads.length - 1].textContent !== 'Right / left %') return null;
+    return [...document.querySelectorAll(`#${id} tbody tr`)].map((tr) =>
+      [(tr.querySelector('td:not(.num)') || tr.querySelector('th')).textContent, tr.lastElementChild.textContent]);
+  }, id);
+  const shown = (has, text) => (has ? /^\d+\.\d$/.test(text) : text === '—');
+  const summaryShares = await column('summary');
+  if (summaryShares === null) problems.push('summary table: no "Right / left %" column');
+  else for (const [pipeline, text] of summaryShares) {
     const has = data.cells.some((c) => c.pipelines[pipeline] && typeof c.pipelines[pipeline].right_over_left === 'number');
-    if (has ? !/^\d+\.\d$/.test(text) : text !== '—') problems.push(`summary table: right / left of ${pipeline} shows "${text}"`);
+    if (!shown(has, text)) problems.push(`summary table: right / left of ${pipeline} shows "${text}"`);
+  }
+  const cellShares = await column('cells');
+  if (cellShares === null) problems.push('cells table: no "Right / left %" column');
+  else {
+    const expected = data.cells.flatMap((c) => data.pipelines.filter((p) => c.pipelines[p])
+      .map((p) => [p, typeof c.pipelines[p].right_over_left === 'number']));
+    const wrong = cellShares.filter(([pipeline, text], i) => !expected[i] || expected[i][0] !== pipeline || !shown(expected[i][1], text));
+    if (wrong.length) problems.push(`cells table: right / left shown wrongly in ${wrong.length} row(s), e.g. ${JSON.stringify(wrong[0])}`);
   }
   const bodyText = await page.evaluate(() => document.body.innerText);
   for (const bad of ['NaN', 'undefined', 'Infinity', '[object Object]'])

@@ -39,6 +39,18 @@ inline StereoResult render_with(const std::string& pipeline, const RenderScene& 
   return p.render(scene, rig, PipelineOptions(p.info(), options), RenderContext{executor});
 }
 
+/// A render's stages with the eye each serves, "stage=eye ..." in the order they started, on
+/// box-wall at 200x120.
+inline std::string stage_eyes_of(const std::string& pipeline, const std::map<std::string, std::string>& options = {}) {
+  const Scene scene = load_builtin("box-wall");
+  const RenderScene rs(scene);
+  const StereoResult r = render_with(pipeline, rs, rig_at(scene, 200, 120), 0, options);
+  std::string out;
+  for (size_t i = 0; i < r.timings.stages().size(); ++i)
+    out += (out.empty() ? "" : " ") + r.timings.stages()[i].first + "=" + stage_eye_name(r.timings.eyes()[i]);
+  return out;
+}
+
 /// PSNR of the sRGB-encoded 8-bit rgb planes (validation::encode_srgb8, mse and psnr_from_mse):
 /// infinity for identical images.
 inline double psnr_srgb8(const Image& a, const Image& b) {

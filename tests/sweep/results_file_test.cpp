@@ -38,7 +38,7 @@ json cell(size_t index, const std::string& id, double psnr = 40.0) {
                {{"scene", {{"lights", 1}}},
                 {"metrics", {{"psnr", psnr}, {"ssim", 0.99}, {"mse", 1.5}, {"error_fraction", 0.01}}},
                 {"holes", {{"hole_fraction", 0.0}, {"not_reprojected", {{"recall", 1.0}, {"precision", 0.02}}}}}}},
-              {"timing", {{"median_s", 0.01}, {"speedup_median", 1.0}}}}}}}};
+              {"timing", {{"median_s", 0.01}, {"speedup_median", 1.0}, {"right_over_left_median", 0.98}}}}}}}};
 }
 
 void append_text(const std::filesystem::path& file, const std::string& text) {
@@ -288,7 +288,7 @@ TEST(ResultsFile, CsvRowsAndQuoting) {
   const std::string row = csv.substr(eol + 2);
   EXPECT_EQ(row,
             "0,\"box-wall|e=0.064m,\"\"x\"\"\",t,box-wall,size=0.5,96,54,0.064,3.5,2,1,,,full,plain-rt,plain-rt,40,0.99,"
-            "1.5,0.01,0,1,0.02,0.01,1\r\n");
+            "1.5,0.01,0,1,0.02,0.01,1,0.98\r\n");
   // A frame of a camera path: its frame number and BVH update time.
   json f = cell(3, "spheres|frame=2");
   f["animation"] = {{"frame", 2}, {"bvh_update_s", 0.038}};

@@ -297,11 +297,18 @@ TEST(SweepRun, SmokeSweepRunsAndEveryLineIsWellFormed) {
       EXPECT_GT(t["speedup_median"].get<double>(), 0.0);
       // The right eye's share of the left's, where the stages split between the eyes.
       const bool shared = name.rfind("bidir-warp", 0) == 0 || name == "rt-es-isler";
-      EXPECT_EQ(t["right_over_left_median"].is_null(), shared) << t.dump();
+      ASSERT_TRUE(t.contains("right_over_left_median")) << t.dump();
+      EXPECT_EQ(t.at("right_over_left_median").is_null(), shared) << t.dump();
       if (!shared) {
-        EXPECT_GT(t["right_over_left_median"].get<double>(), 0.0);
+        EXPECT_GT(t.at("right_over_left_median").get<double>(), 0.0);
       }
-      EXPECT_FALSE(v["stage_eyes"].empty());
+      // The validation run names the eye of each of its stages.
+      ASSERT_TRUE(v.contains("stage_eyes") && v.at("stage_eyes").is_object()) << v.dump();
+      EXPECT_EQ(v.at("stage_eyes").size(), v.at("timings_s").size());
+      for (const auto& [stage, eye] : v.at("stage_eyes").items()) {
+        EXPECT_TRUE(v.at("timings_s").contains(stage)) << stage;
+        EXPECT_TRUE(eye == "left" || eye == "right" || eye == "both") << stage << " " << eye;
+      }
       if (name == "plain-rt") {
         EXPECT_EQ(t["speedup_median"], 1.0);
         EXPECT_EQ(v["metrics"]["psnr"], "inf");  // plain-rt's right eye is the built-in truth
