@@ -1,6 +1,6 @@
 // Google Benchmark micro-benchmarks of the hot kernels: rasterizing a G-buffer, shading it, and
 // tracing a whole eye, on a built-in scene at 960x540; the adaptive grid warp of the repro-*
-// pipelines at 1920x1080 on temple and bistro. Run `build/tests/sb_kernels_bench`.
+// pipelines and repro-rt's hole fill at 1920x1080 on temple and bistro. Run `build/tests/sb_kernels_bench`.
 #include <benchmark/benchmark.h>
 
 #include <map>
@@ -119,6 +119,26 @@ void BM_GridWarp(benchmark::State& state, const std::string& scene) {
   state.counters["subdivided"] = static_cast<double>(f.grid.subdivided_count());
 }
 
+/// repro-rt's hole fill: the pixels the warp left uncovered or discarded (without the
+/// source-frustum search), traced from the right eye and shaded into the warped image.
+void BM_HoleFill(benchmark::State& state, const std::string& scene) {
+  WarpFixture& f = warp_fixture(scene);
+  const Executor executor(static_cast<int>(state.range(0)));
+  const EyeCamera left = f.rig.eye(Eye::left), right = f.rig.eye(Eye::right);
+  Image target = make_eye_image(right.width, right.height, PlaneInit::unset);
+  WarpStats stats;
+  const std::vector<uint8_t> states =
+      grid_warp(f.grid, f.left, left, right, f.rig.params().interaxial, WarpOptions{}, executor, target, stats);
+  TraceCounts counts;
+  for (auto _ : state) {
+    counts = TraceCounts{};
+    trace_unless(f.prepared, right, executor, states, static_cast<uint8_t>(WarpPixel::covered), target, counts,
+                 Source::reshaded_traced);
+  }
+  state.counters["holes"] = static_cast<double>(counts.pixels_traced);
+  state.counters["shadow_rays"] = static_cast<double>(counts.shadow_rays);
+}
+
 /// Two 8-bit images of a size: uniform noise and the same noise with every code shifted.
 std::pair<validation::Srgb8Image, validation::Srgb8Image> noise_pair(int width, int height) {
   validation::Srgb8Image a{width, height, std::vector<uint8_t>(size_t(width) * size_t(height) * 3)};
@@ -152,6 +172,8 @@ BENCHMARK(BM_TraceEye)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTi
 BENCHMARK_CAPTURE(BM_GridMetric, temple, std::string("temple"))->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_GridWarp, temple, std::string("temple"))->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_GridWarp, bistro, std::string("bistro"))->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_HoleFill, temple, std::string("temple"))->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_HoleFill, bistro, std::string("bistro"))->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace sb
