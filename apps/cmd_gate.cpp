@@ -146,12 +146,13 @@ void register_gate_command(CLI::App& root) {
   CLI::App* g = root.add_subcommand(
       "gate",
       "The CI quality gate: apply the thresholds of a gate config (min PSNR, SSIM, disocclusion recall,\n"
-      "speed-up; max hole and error-pixel fractions; time regression against a stored baseline by\n"
-      "median, tolerance and a Mann-Whitney rank test) to every pipeline of every cell of a sweep's\n"
-      "results file. Exit 0 all pass, 1 warnings only, 2 any failure, 3 bad input, 4 an output that\n"
-      "cannot be written; on 3 and 4 no --junit or --json file is left (an earlier one is removed).\n"
-      "Each failure comes with the command that re-measures it: `stereobench validate` for quality,\n"
-      "`stereobench bench` for the speed-up and the time regression. See docs/gate.md.");
+      "speed-up; max hole and error-pixel fractions, right eye's time over the left eye's; time\n"
+      "regression against a stored baseline by median, tolerance and a Mann-Whitney rank test) to\n"
+      "every pipeline of every cell of a sweep's results file. Exit 0 all pass, 1 warnings only,\n"
+      "2 any failure, 3 bad input, 4 an output that cannot be written; on 3 and 4 no --junit or\n"
+      "--json file is left (an earlier one is removed). Each failure comes with the command that\n"
+      "re-measures it: `stereobench validate` for quality, `stereobench bench` for the speed-up, the\n"
+      "right eye's share and the time regression. See docs/gate.md.");
   g->add_option("--config", a->config, "Gate thresholds (TOML)")->capture_default_str();
   g->add_option("--results", a->results, "A sweep's results.jsonl")->required();
   g->add_option("--baseline", a->baseline,

@@ -13,6 +13,8 @@ build it was derived from and fails on a clear regression:
             where the lowest is under 0.5 (ideal-copy and repro-warp trace no holes)
   fractions (error pixels, holes): fail 1.25 x highest + 0.002, warn 1.12 x highest + 0.001
   speed-up  warn only, at 0.7 x the lowest median (timings move with machine load)
+  right eye / left eye time: warn only, at the highest median / 0.7 (where the stages split
+            between the eyes; records written before the share carry none)
 
 Usage: ci/derive_gate_rules.py RESULTS.jsonl [RESULTS.jsonl ...] > ci/gate-nightly.toml
 """
@@ -79,7 +81,8 @@ def main(paths):
                              ("error_fraction", m.get("error_fraction")),
                              ("hole_fraction", h.get("hole_fraction")),
                              ("recall", (h.get("not_reprojected") or {}).get("recall")),
-                             ("speedup", p.get("timing", {}).get("speedup_median"))):
+                             ("speedup", p.get("timing", {}).get("speedup_median")),
+                             ("right_share", p.get("timing", {}).get("right_over_left_median"))):
                 if isinstance(val, (int, float)):
                     got[key].append(float(val))
                 elif val == "inf" or (key == "psnr" and val is None and m):
@@ -132,6 +135,10 @@ def main(paths):
             lo = min(got["speedup"])
             t["warn_speedup"] = fmt(floor_to(0.7 * lo, 0.01), 2)
             note.append(f"speed-up {lo:.2f}..{max(got['speedup']):.2f}x")
+        if got["right_share"]:
+            hi = max(got["right_share"])
+            t["warn_right_share"] = fmt(ceil_to(hi / 0.7, 0.01), 2)
+            note.append(f"right/left {min(got['right_share']):.3f}..{hi:.3f}")
         fields = ", ".join([f'pipeline = "{name}"', f'scene = "{scene}"', f'cell = "{scene}|{e}|*"'] +
                            [f"{k} = {v}" for k, v in t.items()])
         n = len(cells[(scene, e)])

@@ -212,6 +212,7 @@ std::string value_text(const std::string& check, double v) {
   if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
   if (check == "psnr") return fmt::format("{:.2f} dB", v);
   if (check == "speedup") return fmt::format("{:.2f}x", v);
+  if (check == "right_share") return fmt::format("{:.1f} %", 100.0 * v);
   if (check == kRegressionCheck) return fmt::format("{:+.1f} %", 100.0 * v);
   return fmt::format("{:.4g}", v);
 }
@@ -758,7 +759,8 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
         check.cell_id = cell.cell_id;
         check.scene = cell.scene;
         check.pipeline = pipeline;
-        const bool timed = check.check == kRegressionCheck || check.check == std::string_view("speedup");
+        const bool timed = check.check == kRegressionCheck || check.check == std::string_view("speedup") ||
+                           check.check == std::string_view("right_share");
         check.reproduce = timed ? timing_command : quality_command;
         report.checks.push_back(std::move(check));
       };

@@ -51,6 +51,8 @@ inline constexpr MetricCheck kMetricChecks[] = {
     {"disocclusion_recall", "min_recall", "warn_recall", Direction::at_least,
      "/validation/holes/not_reprojected/recall", "disocclusion recall", 1.0},
     {"speedup", "min_speedup", "warn_speedup", Direction::at_least, "/timing/speedup_median", "median speed-up"},
+    {"right_share", "max_right_share", "warn_right_share", Direction::at_most, "/timing/right_over_left_median",
+     "right eye's time over the left eye's"},
 };
 
 /// Name of the time-regression check.

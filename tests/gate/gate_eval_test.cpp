@@ -89,6 +89,41 @@ TEST(GateEval, ThresholdAboveTheMeasuredValueFails) {
             "--interaxial 0.064 --convergence 2");
 }
 
+TEST(GateEval, RightEyeShareOfTheLeft) {
+  const std::string config = kConfig + "max_right_share = 0.2\nwarn_right_share = 0.18\n";
+  std::vector<json> cells = passing_cells();
+  auto& first = cells[0]["pipelines"]["repro-rt"]["timing"];
+  auto& second = cells[1]["pipelines"]["repro-rt"]["timing"];
+  for (const auto& [share, verdict] : std::vector<std::pair<double, Verdict>>{
+           {0.15, Verdict::pass}, {0.18, Verdict::pass}, {0.19, Verdict::warn}, {0.2, Verdict::warn}, {0.21, Verdict::fail}}) {
+    first["right_over_left_median"] = share;
+    const validation::GateReport r = evaluate(cells, {}, config);
+    const validation::GateCheck* c = find_check(r, "repro-rt", "right_share");
+    ASSERT_NE(c, nullptr);
+    EXPECT_EQ(c->verdict, verdict) << share << ": " << c->message;
+    EXPECT_DOUBLE_EQ(c->measured, share);
+    EXPECT_EQ(find_check(r, "plain-rt", "right_share"), nullptr) << "no level set for plain-rt";
+  }
+  // A failure says what was measured against which level and reproduces with bench.
+  first["right_over_left_median"] = 0.25;
+  validation::GateReport r = evaluate(cells, {}, config);
+  const validation::GateCheck* c = find_check(r, "repro-rt", "right_share");
+  EXPECT_NE(c->message.find("right eye's time over the left eye's 25.0 % is above the maximum 20.0 %"),
+            std::string::npos)
+      << c->message;
+  EXPECT_EQ(c->reproduce.rfind("stereobench bench ", 0), 0u) << c->reproduce;
+  // Null (no stage serves the left eye alone) is a skip; so is a record written before the share.
+  second["right_over_left_median"] = nullptr;
+  first.erase("right_over_left_median");
+  r = evaluate(cells, {}, config);
+  EXPECT_EQ(find_check(r, "repro-rt", "right_share", 0)->verdict, Verdict::skip);
+  EXPECT_EQ(find_check(r, "repro-rt", "right_share", 1)->verdict, Verdict::skip);
+  EXPECT_NE(find_check(r, "repro-rt", "right_share", 1)->message.find("is null"), std::string::npos);
+  // A warning level above the failure level of a maximum could never be raised: bad input.
+  EXPECT_THROW((void)validation::parse_gate_config(kConfig + "max_right_share = 0.2\nwarn_right_share = 0.3\n", "g.toml"),
+               InputError);
+}
+
 TEST(GateEval, WarnLevelsAndEveryMetric) {
   std::vector<json> cells = passing_cells();
   // PSNR 33 dB: above the 30 dB failure level, below the 35 dB warning level.
