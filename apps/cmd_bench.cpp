@@ -128,11 +128,10 @@ void run_bench_command(const BenchArgs& a) {
   fmt::print("\nper-eye medians, ms: the stages of each eye, and those that serve both\n");
   fmt::print("{:<{}} {:>11} {:>11} {:>11}  {}\n", "pipeline", name_w, "left eye", "right eye", "both", "right / left");
   for (const PipelineBench& b : r.pipelines) {
-    const Summary share = summarize(b.right_over_left);
+    const std::optional<Summary> share = b.right_over_left();
     const std::string ratio =
-        b.right_over_left.empty()
-            ? "-"
-            : fmt::format("{:.1f} % ({:.1f}..{:.1f})", share.median * 100.0, share.min * 100.0, share.max * 100.0);
+        share ? fmt::format("{:.1f} % ({:.1f}..{:.1f})", share->median * 100.0, share->min * 100.0, share->max * 100.0)
+              : "-";
     const std::string shared = b.shared_stages.empty() ? "" : fmt::format("; both: {}", fmt::join(b.shared_stages, ", "));
     fmt::print("{:<{}} {:>11.2f} {:>11.2f} {:>11.2f}  {}{}\n", b.name, name_w, summarize(b.left_seconds).median * 1e3,
                summarize(b.right_seconds).median * 1e3, summarize(b.both_seconds).median * 1e3, ratio, shared);

@@ -34,9 +34,9 @@ struct RenderArgs {
 
 void print_timings(const StereoResult& r) {
   const Timings& t = r.timings;
-  for (size_t i = 0; i < t.stages().size(); ++i)
-    fmt::print("  {:<22} {:>10.2f} ms  {} eye{}\n", t.stages()[i].first, t.stages()[i].second * 1e3,
-               stage_eye_name(t.eyes()[i]), t.eyes()[i] == StageEye::both ? "s" : "");
+  for (const StageTime& s : t.stages())
+    fmt::print("  {:<22} {:>10.2f} ms  {} eye{}\n", s.name, s.seconds * 1e3, stage_eye_name(s.eye),
+               s.eye == StageEye::both ? "s" : "");
   fmt::print("  {:<22} {:>10.2f} ms\n", "total", t.total() * 1e3);
   const double left = t.eye_total(StageEye::left), right = t.eye_total(StageEye::right);
   const std::string shared =

@@ -23,55 +23,57 @@ enum class StageEye : uint8_t { left, right, both };
   return eye == StageEye::left ? "left" : eye == StageEye::right ? "right" : "both";
 }
 
+/// One timed stage: its name, its seconds so far, and the eye its work serves.
+struct StageTime {
+  std::string name;
+  double seconds = 0.0;
+  StageEye eye = StageEye::both;
+};
+
 /// Named stage timings in the order the stages started, each with the eye it serves; a repeated name
 /// accumulates (and must name the same eye).
 class Timings {
  public:
   void add(const std::string& stage, double seconds, StageEye eye) {
-    for (size_t i = 0; i < stages_.size(); ++i)
-      if (stages_[i].first == stage) {
-        if (eyes_[i] != eye)
-          throw std::logic_error("stage '" + stage + "' timed for the " + stage_eye_name(eyes_[i]) + " eye and for the " +
+    for (StageTime& s : stages_)
+      if (s.name == stage) {
+        if (s.eye != eye)
+          throw std::logic_error("stage '" + stage + "' timed for the " + stage_eye_name(s.eye) + " eye and for the " +
                                  stage_eye_name(eye) + " eye");
-        stages_[i].second += seconds;
+        s.seconds += seconds;
         return;
       }
-    stages_.emplace_back(stage, seconds);
-    eyes_.push_back(eye);
+    stages_.push_back({stage, seconds, eye});
   }
   [[nodiscard]] double get(const std::string& stage) const {
-    for (const auto& [name, s] : stages_)
-      if (name == stage) return s;
+    for (const StageTime& s : stages_)
+      if (s.name == stage) return s.seconds;
     return 0.0;
   }
   [[nodiscard]] double total() const {
     double t = 0.0;
-    for (const auto& [name, s] : stages_) t += s;
+    for (const StageTime& s : stages_) t += s.seconds;
     return t;
   }
-  [[nodiscard]] const std::vector<std::pair<std::string, double>>& stages() const { return stages_; }
-  /// The eye of each stage, in the order of stages().
-  [[nodiscard]] const std::vector<StageEye>& eyes() const { return eyes_; }
+  [[nodiscard]] const std::vector<StageTime>& stages() const { return stages_; }
 
   /// Seconds of the stages that serve `eye`.
   [[nodiscard]] double eye_total(StageEye eye) const {
     double t = 0.0;
-    for (size_t i = 0; i < stages_.size(); ++i)
-      if (eyes_[i] == eye) t += stages_[i].second;
+    for (const StageTime& s : stages_)
+      if (s.eye == eye) t += s.seconds;
     return t;
   }
-  /// The stages that serve both eyes, in order: while there is one, the time does not split
-  /// into a left and a right eye's share.
+  /// The stages that serve both eyes, in order: their time belongs to neither eye's share.
   [[nodiscard]] std::vector<std::string> shared_stages() const {
     std::vector<std::string> out;
-    for (size_t i = 0; i < stages_.size(); ++i)
-      if (eyes_[i] == StageEye::both) out.push_back(stages_[i].first);
+    for (const StageTime& s : stages_)
+      if (s.eye == StageEye::both) out.push_back(s.name);
     return out;
   }
 
  private:
-  std::vector<std::pair<std::string, double>> stages_;
-  std::vector<StageEye> eyes_;
+  std::vector<StageTime> stages_;
 };
 
 /// Times a scope into a Timings entry for the stage `stage`, which serves `eye`.

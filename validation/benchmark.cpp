@@ -22,6 +22,14 @@ Summary summarize(std::vector<double> v) {
   return s;
 }
 
+std::optional<Summary> PipelineBench::right_over_left() const {
+  std::vector<double> ratios;
+  for (size_t i = 0; i < left_seconds.size() && i < right_seconds.size(); ++i)
+    if (left_seconds[i] > 0.0) ratios.push_back(right_seconds[i] / left_seconds[i]);
+  if (ratios.empty()) return std::nullopt;
+  return summarize(std::move(ratios));
+}
+
 std::vector<BenchEntry> BenchConfig::entries() const {
   // The same bounds as a sweep's [timing].
   if (repetitions < 1 || repetitions > 10000)
@@ -78,16 +86,14 @@ BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const Benc
     for (size_t i = 0; i < entries.size(); ++i) {
       const StereoResult r = render(i);
       PipelineBench& b = result.pipelines[i];
-      for (const auto& [stage, s] : r.timings.stages()) {
-        if (!b.stage_seconds.count(stage)) b.stage_order.push_back(stage);
-        b.stage_seconds[stage].push_back(s);
+      for (const StageTime& s : r.timings.stages()) {
+        if (!b.stage_seconds.count(s.name)) b.stage_order.push_back(s.name);
+        b.stage_seconds[s.name].push_back(s.seconds);
       }
       b.total_seconds.push_back(r.timings.total());
-      const double left = r.timings.eye_total(StageEye::left), right = r.timings.eye_total(StageEye::right);
-      b.left_seconds.push_back(left);
-      b.right_seconds.push_back(right);
+      b.left_seconds.push_back(r.timings.eye_total(StageEye::left));
+      b.right_seconds.push_back(r.timings.eye_total(StageEye::right));
       b.both_seconds.push_back(r.timings.eye_total(StageEye::both));
-      if (left > 0.0) b.right_over_left.push_back(right / left);
       b.shared_stages = r.timings.shared_stages();
       b.counters = r.counters.snapshot();
       if (progress)
@@ -108,6 +114,7 @@ nlohmann::json bench_to_json(const BenchResult& r) {
   nlohmann::json out = {{"baseline", r.baseline}, {"repetitions", r.repetitions}, {"threads", r.threads}};
   auto summary = [](const Summary& s) { return nlohmann::json{{"median", s.median}, {"min", s.min}, {"max", s.max}}; };
   for (const PipelineBench& b : r.pipelines) {
+    const std::optional<Summary> share = b.right_over_left();
     nlohmann::json stages = nlohmann::json::object();
     for (const std::string& st : b.stage_order) {
       stages[st] = summary(summarize(b.stage_seconds.at(st)));
@@ -123,9 +130,7 @@ nlohmann::json bench_to_json(const BenchResult& r) {
                                   {"right", summary(summarize(b.right_seconds))},
                                   {"both", summary(summarize(b.both_seconds))},
                                   {"shared_stages", b.shared_stages}}},
-                                {"right_over_left", b.right_over_left.empty()
-                                                        ? nlohmann::json(nullptr)
-                                                        : summary(summarize(b.right_over_left))},
+                                {"right_over_left", share ? summary(*share) : nlohmann::json(nullptr)},
                                 {"options", b.options},
                                 {"counters", b.counters}});
   }

@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -57,12 +58,13 @@ struct PipelineBench {
   /// (StageEye); left + right + both = total.
   std::vector<double> left_seconds, right_seconds, both_seconds;
   std::vector<std::string> shared_stages;  ///< the stages that serve both eyes, in order
-  /// Per repetition, right eye / left eye where the left eye took any time (its summary is
-  /// empty otherwise): what a synthesized right eye costs beside the rendered left one.
-  std::vector<double> right_over_left;
   std::map<std::string, uint64_t> counters;  ///< of the last repetition (counters are deterministic)
   Summary speedup;  ///< baseline total / this total, paired per repetition
   std::map<std::string, std::string> options;  ///< every option's value, defaults included
+
+  /// Right eye / left eye, paired per repetition and summarized: what a synthesized right eye
+  /// costs beside the rendered left one. Nothing where no stage serves the left eye alone.
+  [[nodiscard]] std::optional<Summary> right_over_left() const;
 };
 
 struct BenchResult {

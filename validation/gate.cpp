@@ -207,6 +207,14 @@ std::vector<double> record_samples(const json& entry) {
   return entry.contains(ptr) ? entry.at(ptr).get<std::vector<double>>() : std::vector<double>{};
 }
 
+/// Whether a check reads a time (the regression, or a metric of the record's "timing" block),
+/// which `stereobench bench` re-measures, rather than an image measure of `validate`.
+bool timed_check(std::string_view check) {
+  return check == kRegressionCheck || std::any_of(std::begin(kMetricChecks), std::end(kMetricChecks), [&](const MetricCheck& m) {
+           return check == m.name && std::string_view(m.pointer).starts_with("/timing/");
+         });
+}
+
 std::string value_text(const std::string& check, double v) {
   if (std::isnan(v)) return "-";
   if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
@@ -759,9 +767,7 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
         check.cell_id = cell.cell_id;
         check.scene = cell.scene;
         check.pipeline = pipeline;
-        const bool timed = check.check == kRegressionCheck || check.check == std::string_view("speedup") ||
-                           check.check == std::string_view("right_share");
-        check.reproduce = timed ? timing_command : quality_command;
+        check.reproduce = timed_check(check.check) ? timing_command : quality_command;
         report.checks.push_back(std::move(check));
       };
       // The baseline's speed-up over itself is 1 by definition: a minimum speed-up is for the others.

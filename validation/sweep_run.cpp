@@ -230,6 +230,7 @@ json relative_images(const json& files, const fs::path& base) {
 
 json timing_json(const PipelineBench& b, const BenchResult& r, int warmup) {
   const Summary total = summarize(b.total_seconds);
+  const std::optional<Summary> share = b.right_over_left();
   json stages = json::object();
   for (const std::string& stage : b.stage_order) stages[stage] = summarize(b.stage_seconds.at(stage)).median;
   return {{"repetitions", r.repetitions},   {"warmup", warmup},
@@ -242,7 +243,7 @@ json timing_json(const PipelineBench& b, const BenchResult& r, int warmup) {
             {"right", summarize(b.right_seconds).median},
             {"both", summarize(b.both_seconds).median}}},
           {"right_over_left_median",
-           b.right_over_left.empty() ? json(nullptr) : json(summarize(b.right_over_left).median)}};
+           share ? json(share->median) : json(nullptr)}};
 }
 
 /// Validates and times every pipeline of the definition in one cell; returns its results line.

@@ -35,13 +35,13 @@ json versions_json() {
 
 json timings_to_json(const Timings& timings) {
   json out = json::object();
-  for (const auto& [stage, seconds] : timings.stages()) out[stage] = seconds;
+  for (const StageTime& s : timings.stages()) out[s.name] = s.seconds;
   return out;
 }
 
 json stage_eyes_to_json(const Timings& timings) {
   json out = json::object();
-  for (size_t i = 0; i < timings.stages().size(); ++i) out[timings.stages()[i].first] = stage_eye_name(timings.eyes()[i]);
+  for (const StageTime& s : timings.stages()) out[s.name] = stage_eye_name(s.eye);
   return out;
 }
 

@@ -34,9 +34,9 @@ TEST(Timings, AStageServesOneEyeThroughout) {
   {
     ScopedStage s(t, "crack_fill", StageEye::right);
     ASSERT_EQ(t.stages().size(), 2u);
-    EXPECT_EQ(t.stages()[1].first, "crack_fill");
+    EXPECT_EQ(t.stages()[1].name, "crack_fill");
   }
-  EXPECT_EQ(t.eyes()[1], StageEye::right);
+  EXPECT_EQ(t.stages()[1].eye, StageEye::right);
 }
 
 }  // namespace

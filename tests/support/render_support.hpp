@@ -46,8 +46,7 @@ inline std::string stage_eyes_of(const std::string& pipeline, const std::map<std
   const RenderScene rs(scene);
   const StereoResult r = render_with(pipeline, rs, rig_at(scene, 200, 120), 0, options);
   std::string out;
-  for (size_t i = 0; i < r.timings.stages().size(); ++i)
-    out += (out.empty() ? "" : " ") + r.timings.stages()[i].first + "=" + stage_eye_name(r.timings.eyes()[i]);
+  for (const StageTime& s : r.timings.stages()) out += (out.empty() ? "" : " ") + s.name + "=" + stage_eye_name(s.eye);
   return out;
 }
 
