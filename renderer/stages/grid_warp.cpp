@@ -80,6 +80,16 @@ class Reprojector {
     row_.reserve(static_cast<size_t>(from.height) + 2);
     for (int j = -1; j <= from.height; ++j)
       row_.push_back((from.cy - lattice_y(j)) / from.f_px * matrix_[1] - matrix_[2]);
+    // Eyes that look the same way (any parallel rig) give every point the same clip w: the terms
+    // of one kind all carry one w, and 1/z none. The reciprocal is then taken once, exactly as
+    // every vertex would take it.
+    const auto same_w = [](const std::vector<dvec4>& terms) {
+      return std::all_of(terms.begin(), terms.end(), [&](const dvec4& t) { return t.w == terms.front().w; });
+    };
+    if (matrix_[3].w == 0.0 && same_w(column_) && same_w(row_)) {
+      const double w = column_.front().w + row_.front().w;
+      if (w > 0.0) fixed_inv_w_ = 1.0 / w;
+    }
   }
 
   /// Target pixel position of lattice point (i, j) at inverse depth inv_z (0: infinity), or
@@ -88,7 +98,7 @@ class Reprojector {
   [[nodiscard]] std::optional<dvec2> position(int i, int j, double inv_z, double* inv_w = nullptr) const {
     const dvec4 c = column_[static_cast<size_t>(i + 1)] + row_[static_cast<size_t>(j + 1)] + inv_z * matrix_[3];
     if (!(c.w > 0.0)) return std::nullopt;
-    const double r = 1.0 / c.w;
+    const double r = fixed_inv_w_ ? *fixed_inv_w_ : 1.0 / c.w;
     if (inv_w != nullptr) *inv_w = r;
     return dvec2((c.x * r + 1.0) * 0.5 * to_w_, (1.0 - c.y * r) * 0.5 * to_h_);
   }
@@ -132,6 +142,7 @@ class Reprojector {
   dmat4 matrix_{1.0};
   std::vector<dvec4> column_;  ///< X·M[0] per lattice column i + 1
   std::vector<dvec4> row_;     ///< Y·M[1] − M[2] per lattice row j + 1
+  std::optional<double> fixed_inv_w_;  ///< 1 / the clip w where it is the same for every point
 };
 
 /// Calls emit(i0, j0, i1, j1, i2, j2) for every triangle of cell (cx, cy), in source lattice
