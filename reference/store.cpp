@@ -211,6 +211,27 @@ Prepared prepare(const ReferenceSpec& spec, const fs::path& scenes_dir) {
   return p;
 }
 
+/// Why provenance `prov` of the entry in folder `id` contradicts itself or its folder, if it does:
+/// it names another id, another image file, or another provider than its spec.
+std::optional<std::string> inconsistent_provenance(const json& prov, const std::string& id, const ReferenceSpec& spec) {
+  const auto text = [&prov](const char* object, const char* key) -> std::optional<std::string> {
+    const json* o = object == nullptr ? &prov : (prov.contains(object) ? &prov.at(object) : nullptr);
+    if (o == nullptr || !o->is_object() || !o->contains(key) || !o->at(key).is_string()) return std::nullopt;
+    return o->at(key).get<std::string>();
+  };
+  const std::optional<std::string> recorded_id = text(nullptr, "id");
+  if (recorded_id != id)
+    return fmt::format("it records id {} but lies in folder '{}'", recorded_id ? "'" + *recorded_id + "'" : "(none)", id);
+  const std::optional<std::string> image = text("image", "file");
+  if (image != kImage)
+    return fmt::format("it names image file {}, the store keeps '{}'", image ? "'" + *image + "'" : "(none)", kImage);
+  const std::optional<std::string> provider = text("provider", "name");
+  if (provider != spec.provider)
+    return fmt::format("provider.name {} is not its spec's provider '{}'", provider ? "'" + *provider + "'" : "(none)",
+                       spec.provider);
+  return std::nullopt;
+}
+
 }  // namespace
 
 fs::path default_store_dir() { return fs::path(SB_SOURCE_DIR) / "reference" / "store"; }
@@ -236,7 +257,9 @@ std::vector<std::string> ReferenceStore::ids() const {
                     root_.string(), fs::exists(root_, ec) ? "is not a folder" : "does not exist"));
   for (const fs::directory_entry& e : fs::directory_iterator(root_)) {
     const std::string name = e.path().filename().string();
-    if (e.is_directory() && name[0] != '.' && fs::exists(e.path() / kProvenance)) out.push_back(name);
+    // Every visible folder is an entry: one without its provenance is a damaged entry, which
+    // verify reports, not a folder to pass over.
+    if (e.is_directory() && name[0] != '.') out.push_back(name);
   }
   std::sort(out.begin(), out.end());
   return out;
@@ -244,7 +267,12 @@ std::vector<std::string> ReferenceStore::ids() const {
 
 json ReferenceStore::provenance(const std::string& id) const {
   const fs::path file = root_ / id / kProvenance;
-  if (!fs::exists(file)) {
+  std::error_code ec;
+  if (fs::is_directory(root_ / id, ec) && !fs::exists(file, ec))
+    throw InputError(fmt::format("{} is missing: the entry's spec is lost with it; remove {} and make the reference "
+                                 "again with `stereobench reference generate` and its scene and rig",
+                                 file.string(), (root_ / id).string()));
+  if (!fs::exists(file, ec)) {
     const std::vector<std::string> known = ids();
     throw InputError(fmt::format("no reference '{}' in {} ({}); run `stereobench reference list`", id, root_.string(),
                                  known.empty() ? "the store is empty" : fmt::format("it holds {} references", known.size())));
@@ -361,10 +389,16 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
     prov = provenance(id);
     spec = spec_in(prov, prov_file);
   } catch (const InputError& e) {
-    if (!fs::exists(prov_file, ec)) throw;  // an id the store does not hold
+    if (!fs::is_directory(root_ / id, ec)) throw;  // an id the store does not hold
     // A damaged entry is a finding of the verification, not a reason to stop it.
     r.status = Status::corrupt;
     r.detail = e.what();
+    return r;
+  }
+  if (const std::optional<std::string> why = inconsistent_provenance(prov, id, spec)) {
+    r.status = Status::corrupt;
+    r.detail = fmt::format("{}: {}; remove {} and make the reference again with `stereobench reference generate`",
+                           prov_file.string(), *why, (root_ / id).string());
     return r;
   }
   const fs::path image_file = root_ / id / kImage;
@@ -397,6 +431,15 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
     return r;
   }
   const Prepared& p = *loaded;
+  // The folder's name is the id its spec gives: a renamed folder would be found under a name
+  // that `reference generate` never writes, and regenerated beside itself.
+  if (const std::string expected = reference_id(p.loaded.scene, spec, *p.rig); expected != id) {
+    r.status = Status::corrupt;
+    r.detail = fmt::format("{}: its spec makes the reference '{}', but the entry lies in folder '{}'; rename the "
+                           "folder back, or remove it and regenerate",
+                           prov_file.string(), expected, id);
+    return r;
+  }
   const std::string scene_hash = validation::hash_scene(p.loaded.scene);
   const json scene_record = prov.value("scene", json::object());
   const std::string recorded_scene = scene_record.is_object() && scene_record.contains("content_sha256") &&

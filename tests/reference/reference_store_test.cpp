@@ -180,6 +180,61 @@ TEST(ReferenceStore, DamagedProvenanceIsAFindingNotAStop) {
   EXPECT_NE(negative.out.find("--min-psnr -1 is not a PSNR in dB"), std::string::npos) << negative.out;
 }
 
+TEST(ReferenceStore, AnEntryThatContradictsItsFolderIsCorrupt) {
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene box-wall --resolution 64x36").code, 0);
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene thin-pole --resolution 48x32").code, 0);
+  const fs::path store = dir / "store";
+  const std::string box = "box-wall_full_64x36_e64.0mm_c4.08m";
+  const std::string pole = "thin-pole_full_48x32_e64.0mm_c2m";
+  const json original = json::parse(test::read_text(store / pole / "provenance.json"));
+  const auto verify_pole = [&] { return test::run_cli(ref(dir, "verify") + " --no-render"); };
+  const auto expect_corrupt = [&](const test::CliRun& r, const std::string& why) {
+    EXPECT_EQ(r.code, 2) << r.out;
+    EXPECT_NE(r.out.find("corrupt        " + pole), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(why), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("1 of 2 reference(s) verified"), std::string::npos) << r.out;
+  };
+
+  // An entry whose provenance is gone is still an entry: reported, never passed over.
+  fs::rename(store / pole / "provenance.json", dir / "kept.json");
+  expect_corrupt(verify_pole(), (store / pole / "provenance.json").string() + " is missing");
+  const test::CliRun list = test::run_cli(ref(dir, "list"));
+  EXPECT_NE(list.out.find("2 reference(s)"), std::string::npos) << list.out;
+  EXPECT_NE(list.out.find("1 of 2 reference(s) damaged"), std::string::npos) << list.out;
+  fs::rename(dir / "kept.json", store / pole / "provenance.json");
+
+  // Fields that contradict the folder, the stored image or the spec.
+  const std::pair<const char*, std::pair<json, const char*>> edits[] = {
+      {"id", {box, "it records id 'box-wall_full_64x36_e64.0mm_c4.08m' but lies in folder"}},
+      {"image", {json{{"file", "../../elsewhere.exr"}}, "it names image file '../../elsewhere.exr'"}},
+      {"provider", {json{{"name", "nope"}}, "provider.name 'nope' is not its spec's provider 'full'"}},
+  };
+  for (const auto& [key, edit] : edits) {
+    json p = original;
+    if (edit.first.is_object()) {
+      p[key].update(edit.first);
+    } else {
+      p[key] = edit.first;
+    }
+    std::ofstream(store / pole / "provenance.json", std::ios::trunc) << p.dump(2);
+    expect_corrupt(verify_pole(), edit.second);
+  }
+
+  // A folder renamed away from the id its spec gives, provenance edited to match.
+  std::ofstream(store / pole / "provenance.json", std::ios::trunc) << original.dump(2);
+  const std::string renamed = "thin-pole_full_renamed";
+  fs::rename(store / pole, store / renamed);
+  json moved = original;
+  moved["id"] = renamed;
+  std::ofstream(store / renamed / "provenance.json", std::ios::trunc) << moved.dump(2);
+  const test::CliRun r = test::run_cli(ref(dir, "verify") + " --no-render " + renamed);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("its spec makes the reference '" + pole + "', but the entry lies in folder '" + renamed + "'"),
+            std::string::npos)
+      << r.out;
+}
+
 TEST(ReferenceStore, AnotherSceneOfTheSameNameDoesNotReplaceAnEntry) {
   test::ScratchDir dir;
   // A copy of box-wall as a file of its own: the same scene name, hence the same id.
