@@ -741,6 +741,21 @@ std::optional<std::string> unused_rules_note(const GateConfig& config, const Gat
       count == 1 ? "its" : "their", fmt::join(parts, "; "));
 }
 
+/// Why a gate measured nothing: its checks (all skipped) grouped by check and reason.
+std::string nothing_checked_message(const GateConfig& config, const GateResults& results,
+                                    const std::vector<GateCheck>& skipped) {
+  std::map<std::pair<std::string, std::string>, int> reasons;
+  for (const GateCheck& c : skipped) ++reasons[{c.check, c.message}];
+  std::vector<std::string> parts;
+  for (const auto& [why, count] : reasons) parts.push_back(fmt::format("{} x {}: {}", count, why.first, why.second));
+  return fmt::format("{}: none of its checks applies to {} ({} cell{}): {}; a pass would say nothing. Give limits the "
+                     "records carry in [defaults] or a [[rule]], or a baseline for [regression] (gate "
+                     "--update-baseline stores one)",
+                     config.source, results.file.string(), results.cells.size(), results.cells.size() == 1 ? "" : "s",
+                     parts.empty() ? "no limit of the config matches a pipeline of the results"
+                                   : fmt::format("every one was skipped ({})", fmt::join(parts, "; ")));
+}
+
 }  // namespace
 
 GateReport evaluate_gate(const GateConfig& config, const GateResults& results, const Baseline& baseline,
@@ -855,6 +870,11 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
       add(std::move(check));
     }
   }
+  // A gate whose every threshold and regression check was skipped measured nothing: its pass
+  // would be as empty as an empty config's (e.g. only [regression], and no baseline to compare with).
+  if (!results.cells.empty() && std::all_of(report.checks.begin(), report.checks.end(),
+                                            [](const GateCheck& c) { return c.verdict == Verdict::skip; }))
+    throw InputError(nothing_checked_message(config, results, report.checks));
   if (std::optional<GateCheck> complete = completeness_check(results)) report.checks.push_back(std::move(*complete));
   if (std::optional<std::string> note = unused_rules_note(config, results, rule_used)) report.notes.push_back(*note);
   for (const GateCheck& c : report.checks) {

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <fmt/format.h>
@@ -201,6 +203,46 @@ TEST(GateEval, TimeRegressionAgainstTheBaseline) {
   // The other cell and pipeline have no baseline entry.
   EXPECT_EQ(find_check(r, "repro-rt", "time_regression", 1)->message, "no baseline");
   EXPECT_EQ(find_check(r, "plain-rt", "time_regression")->message, "no baseline");
+}
+
+TEST(GateEval, AGateThatChecksNothingIsBadInputNotAPass) {
+  // Only [regression], and no baseline entry to compare with: every check is skipped.
+  const std::string regression_only = "[regression]\ntolerance = 0.1\n";
+  try {
+    (void)evaluate(passing_cells(), {}, regression_only);
+    ADD_FAILURE() << "a gate that checked nothing passed";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("test.toml: none of its checks applies to results.jsonl (2 cells)"), std::string::npos) << m;
+    EXPECT_NE(m.find("4 x time_regression: no baseline"), std::string::npos) << m;
+    EXPECT_NE(m.find("--update-baseline"), std::string::npos) << m;
+  }
+  // Limits only for a pipeline the results do not hold: only the (skipped) time regressions remain.
+  try {
+    (void)evaluate(passing_cells(), {}, "[[rule]]\npipeline = \"bidir-warp\"\nmin_psnr = 30\n");
+    ADD_FAILURE() << "a gate that checked nothing passed";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("every one was skipped (4 x time_regression: no baseline)"), std::string::npos)
+        << e.what();
+  }
+  // With a baseline entry the regression is measured, and the gate stands.
+  const std::vector<json> cells = passing_cells();
+  validation::Baseline baseline;
+  baseline.cells[cells[0]["cell_id"]]["repro-rt"] = {{0.4, 0.4, 0.4}, 0.4, "earlier", "host"};
+  EXPECT_NO_THROW((void)evaluate(cells, baseline, regression_only));
+
+  // Through the command, with a baseline that has no entry for these cells: exit 3, and no JUnit
+  // file that could read as a pass.
+  ScratchDir dir;
+  write_results(dir / "results.jsonl", cells);
+  validation::save_baseline(dir / "baseline.json", validation::Baseline{});
+  std::ofstream(dir / "gate.toml") << regression_only;
+  const CliRun run = run_cli("gate --config " + (dir / "gate.toml").string() + " --results " +
+                             (dir / "results.jsonl").string() + " --baseline " + (dir / "baseline.json").string() +
+                             " --junit " + (dir / "gate.xml").string());
+  EXPECT_EQ(run.code, 3) << run.out;
+  EXPECT_NE(run.out.find("none of its checks applies"), std::string::npos) << run.out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "gate.xml"));
 }
 
 TEST(GateEval, BaselineUpdateTouchesOnlyWhatIsNamed) {
