@@ -8,6 +8,7 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <regex>
@@ -126,6 +127,26 @@ fs::path choose_run_dir(const fs::path& out, const SweepDefinition& d, bool* res
   return out / id;
 }
 
+/// Makes sure the history line can be appended at the end of the run, before the sweep costs
+/// anything: the history file's folder exists or is made, and the file, where it exists, is a
+/// writable regular file. `given`: the path came from --history.
+void check_history_writable(const fs::path& file, bool given) {
+  const std::string named =
+      given ? fmt::format("--history {}", file.string()) : fmt::format("history file {}", file.string());
+  const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (ec || !fs::is_directory(folder))
+    throw IoError(fmt::format("{}: cannot make its folder {}: {}; give a history file in a writable folder", named,
+                              folder.string(), ec ? ec.message() : "a file of that name is in the way"));
+  const bool exists = fs::exists(file, ec);
+  if (exists && !fs::is_regular_file(file, ec))
+    throw InputError(fmt::format("{} is not a regular file; give the JSON Lines file the runs are appended to", named));
+  if (::access(exists ? file.c_str() : folder.c_str(), W_OK) != 0)
+    throw IoError(fmt::format("{}: {} is not writable ({}); give a history file in a writable folder", named,
+                              exists ? "the file" : "its folder", std::strerror(errno)));
+}
+
 void run_nightly(const NightlyArgs& a) {
   if (a.jobs < 1 || a.jobs > 256) throw InputError(fmt::format("--jobs {} is outside 1..256", a.jobs));
   const SweepDefinition d = load_sweep(a.definition);
@@ -142,6 +163,7 @@ void run_nightly(const NightlyArgs& a) {
   // Read before any cell runs: a malformed history stops the run before it costs anything, and so
   // does a missing report asset (the report is written last).
   const HistoryFile history_before = read_history(history_file);
+  check_history_writable(history_file, !a.history.empty());
   reports::check_report_assets(reports::report_assets_dir());
   for (const std::string& w : history_before.warnings) fmt::print(stderr, "warning: {}\n", w);
 
@@ -186,18 +208,20 @@ void run_nightly(const NightlyArgs& a) {
                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
 
-  // 2. The gate.
+  // 2. The gate. Its files are written once the history and the report are, so that a run that
+  // stops on the way (exit 3 or 4) leaves no verdict behind; those of an earlier attempt at this
+  // run go first.
+  const fs::path junit_file = run_dir / "gate-junit.xml", gate_json_file = run_dir / "gate.json";
+  for (const fs::path& f : {junit_file, gate_json_file}) {
+    std::error_code ec;
+    fs::remove(f, ec);
+    if (ec) throw IoError(fmt::format("cannot remove the earlier {}: {}", f.string(), ec.message()));
+  }
   const GateResults results = load_gate_results(o.results);
   GateReport gate =
       evaluate_gate(gate_config, results, baseline, registered_reproduce_settings());  // notes the read warnings
   if (!baseline_note.empty()) gate.notes.push_back(baseline_note);
   fmt::print("{}", format_gate_table(gate));
-  io::write_text_atomically(run_dir / "gate-junit.xml", junit_xml(gate, "stereobench nightly " + o.results.string()));
-  io::write_text_atomically(run_dir / "gate.json",
-                            gate_report_json(gate, gate_file, o.results.string(),
-                                             baseline_note.empty() ? baseline_file.string() : "")
-                                    .dump(2) +
-                                "\n");
 
   // 3. The history line (once per run, also when a run killed after appending it is resumed).
   NightlyRun run;
@@ -230,6 +254,11 @@ void run_nightly(const NightlyArgs& a) {
   const reports::ReportSummary s = reports::write_report(report_results, options);
   for (const std::string& w : s.warnings) fmt::print(stderr, "warning: {}\n", w);
 
+  io::write_text_atomically(junit_file, junit_xml(gate, "stereobench nightly " + o.results.string()));
+  io::write_text_atomically(gate_json_file, gate_report_json(gate, gate_file, o.results.string(),
+                                                             baseline_note.empty() ? baseline_file.string() : "")
+                                                    .dump(2) +
+                                                "\n");
   const int code = exit_code(gate.worst);
   io::write_text_atomically(run_dir / kRunDoneFile,
                             json{{"run_id", run_id},

@@ -182,7 +182,7 @@ HistoryFile read_history(const fs::path& file) {
 
 void append_history(const fs::path& file, const json& entry) {
   check_history_line(entry, "history line for " + file.string());
-  append_result(file, entry);
+  append_result(file, entry, "history file");
 }
 
 }  // namespace sb::validation

@@ -53,9 +53,9 @@ std::string line_of(const json& cell) {
   return finite_json(cell).dump(-1, ' ', false, json::error_handler_t::replace) + "\n";
 }
 
-[[noreturn]] void io_fail(const fs::path& file, const char* what) {
-  throw IoError(fmt::format("{}: cannot {} the results file: {}; check the folder's permissions and free space",
-                            file.string(), what, std::strerror(errno)));
+[[noreturn]] void io_fail(const fs::path& file, const char* what, const char* kind = "results file") {
+  throw IoError(fmt::format("{}: cannot {} the {}: {}; check the folder's permissions and free space", file.string(),
+                            what, kind, std::strerror(errno)));
 }
 
 /// An open file descriptor, closed on every path out.
@@ -80,13 +80,13 @@ fs::path lock_path(const fs::path& results) {
 
 /// Cuts an unterminated tail (a line torn by a killed writer) so that the next line starts on a
 /// line of its own. The caller holds the exclusive lock.
-void cut_torn_tail(int fd, const fs::path& file) {
+void cut_torn_tail(int fd, const fs::path& file, const char* kind) {
   struct stat st {};
-  if (::fstat(fd, &st) != 0) io_fail(file, "inspect");
+  if (::fstat(fd, &st) != 0) io_fail(file, "inspect", kind);
   off_t end = st.st_size;
   if (end == 0) return;
   char last = 0;
-  if (::pread(fd, &last, 1, end - 1) != 1) io_fail(file, "read");
+  if (::pread(fd, &last, 1, end - 1) != 1) io_fail(file, "read", kind);
   if (last == '\n') return;
   // Scan back for the last line break.
   char buf[4096];
@@ -94,7 +94,7 @@ void cut_torn_tail(int fd, const fs::path& file) {
   for (off_t pos = end; pos > 0 && keep == 0;) {
     const off_t start = std::max<off_t>(0, pos - static_cast<off_t>(sizeof buf));
     const ssize_t n = ::pread(fd, buf, static_cast<size_t>(pos - start), start);
-    if (n != pos - start) io_fail(file, "read");
+    if (n != pos - start) io_fail(file, "read", kind);
     for (ssize_t i = n - 1; i >= 0; --i)
       if (buf[i] == '\n') {
         keep = start + i + 1;
@@ -102,7 +102,7 @@ void cut_torn_tail(int fd, const fs::path& file) {
       }
     pos = start;
   }
-  if (::ftruncate(fd, keep) != 0) io_fail(file, "truncate a torn line of");
+  if (::ftruncate(fd, keep) != 0) io_fail(file, "truncate a torn line of", kind);
 }
 
 std::string field(const json& v) {
@@ -296,14 +296,14 @@ ResultsWriterLock::~ResultsWriterLock() {
   if (fd_ >= 0) ::close(fd_);  // releases the locks
 }
 
-void append_result(const fs::path& file, const json& cell) {
+void append_result(const fs::path& file, const json& cell, const char* kind) {
   const std::string line = line_of(cell);
   std::error_code ec;
   if (file.has_parent_path()) fs::create_directories(file.parent_path(), ec);
   const Fd fd(::open(file.c_str(), O_RDWR | O_APPEND | O_CREAT | O_CLOEXEC, 0644));
-  if (fd.get() < 0) io_fail(file, "open");
-  if (::flock(fd.get(), LOCK_EX) != 0) io_fail(file, "lock");
-  cut_torn_tail(fd.get(), file);
+  if (fd.get() < 0) io_fail(file, "open", kind);
+  if (::flock(fd.get(), LOCK_EX) != 0) io_fail(file, "lock", kind);
+  cut_torn_tail(fd.get(), file, kind);
   // One write of the whole line; a short write is completed, and a failed one (a full disk) is
   // undone, so that no part of the line stays behind.
   const off_t before = ::lseek(fd.get(), 0, SEEK_END);
@@ -311,7 +311,7 @@ void append_result(const fs::path& file, const json& cell) {
     const int saved = errno;
     if (before >= 0) (void)!::ftruncate(fd.get(), before);
     errno = saved;
-    io_fail(file, what);
+    io_fail(file, what, kind);
   };
   size_t done = 0;
   while (done < line.size()) {

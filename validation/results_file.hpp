@@ -24,8 +24,9 @@ inline constexpr int kSweepSchemaVersion = 1;
 /// Appends one cell's line: the whole line (finite_json, no line breaks inside, '\n' at the end)
 /// in one write under an exclusive flock on a file opened with O_APPEND, then fsync. A torn,
 /// unterminated tail left by a killed writer is cut off first (under the same lock), so lines
-/// never run together. Creates the file and its folder. IoError when it cannot be written.
-void append_result(const std::filesystem::path& file, const nlohmann::json& cell);
+/// never run together. Creates the file and its folder. IoError, calling the file `kind`, when it
+/// cannot be written.
+void append_result(const std::filesystem::path& file, const nlohmann::json& cell, const char* kind = "results file");
 
 /// Holds the cells a run may write into a results file while it lives: one byte per cell index,
 /// locked for writing (an open-file-description lock) in a hidden lock file beside the results file

@@ -274,6 +274,18 @@ TEST(NightlyTest, MalformedHistoryIsBadInputNamingFileAndLine) {
   for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs")) run_folders += e.is_directory() ? 1 : 0;
   EXPECT_EQ(run_folders, 0u);
 
+  // A history that cannot be appended to (its folder is a file) is found before the sweep too,
+  // named by the flag: it used to fail after the sweep, leaving a passing gate-junit.xml behind.
+  write_text(dir / "afile", "x\n");
+  const test::CliRun blocked = test::run_cli(nightly_args(dir) + " --history " + quoted(dir / "afile" / "h.jsonl"));
+  EXPECT_EQ(blocked.code, 4) << blocked.out;
+  EXPECT_NE(blocked.out.find("--history " + (dir / "afile" / "h.jsonl").string() + ": cannot make its folder"),
+            std::string::npos)
+      << blocked.out;
+  run_folders = 0;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs")) run_folders += e.is_directory() ? 1 : 0;
+  EXPECT_EQ(run_folders, 0u);
+
   // `report --history` reads the history before the results: the message names the history's line.
   write_text(history, "not json\n");
   const test::CliRun r2 = test::run_cli("report " + quoted(dir / "none.jsonl") + " --out " + quoted(dir / "rep") +
