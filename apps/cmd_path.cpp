@@ -88,6 +88,7 @@ void run_path_command(const PathArgs& a) {
   prepare_output_folder(a.out, "--out");
   scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
   const StereoRig rig = resolve_rig(loaded.scene, overrides);
+  for (const PipelineEntry& e : run.pipelines) e.check_rig(e.options(), rig);
   run.scene_file = loaded.file;
   run.rig = rig.params();
   run.pose = rig.pose();

@@ -67,6 +67,7 @@ void run_render(const RenderArgs& a) {
   const Scene& scene = loaded.scene;
   const size_t lights_in_file = loaded.lights_in_file;
   const StereoRig rig = resolve_rig(scene, overrides);
+  entry.check_rig(options, rig);
   const RenderScene prepared(scene);
   require_frame_memory(rig.params().width, rig.params().height, fmt::format("render {}", entry.name));
   warn_geometry_before_near_plane(prepared, rig, executor);

@@ -82,12 +82,20 @@ void run_validate(const ValidateArgs& a) {
   const Scene& scene = loaded.scene;
   const size_t lights_in_file = loaded.lights_in_file;
   const StereoRig rig = resolve_rig(scene, overrides);
+  // What a pipeline cannot do with this rig stops the run before any pipeline renders.
+  for (size_t i = 0; i < chosen.size(); ++i) chosen[i].check_rig(options[i], rig);
   const RenderScene prepared(scene);
   fmt::print("validating {} pipeline(s) on {} ({} triangles, {}), {}, {} threads, truth: {}\n", chosen.size(),
              scene.name, scene.triangle_count(), describe_lights(scene.lights.size(), lights_in_file),
              describe(rig), executor.threads(), provider->name());
 
   const fs::path out = a.out;
+  // The summary of an earlier run goes first: the records this run writes must not sit beside a
+  // summary that looks complete but describes another run, should this one stop on the way.
+  const std::string scene_stem = fmt::format("{}_{}", scene.file_stem(), provider->name());
+  const fs::path summary = out / fmt::format("{}_summary.json", scene_stem);
+  if (std::error_code ec; fs::remove(summary, ec), ec)
+    throw IoError(fmt::format("cannot remove the earlier summary {}: {}", summary.string(), ec.message()));
   const std::optional<validation::TruthCache> cache =
       a.no_cache || a.cache.empty() ? std::nullopt
                                     : std::optional<validation::TruthCache>(validation::TruthCache(a.cache));
@@ -98,7 +106,6 @@ void run_validate(const ValidateArgs& a) {
              target.truth.render.seconds,
              100.0 * double(target.disocclusions.count()) / double(target.truth_srgb8.pixel_count()));
   warn_geometry_before_near_plane(prepared, rig, executor);
-  const std::string scene_stem = fmt::format("{}_{}", scene.file_stem(), provider->name());
   const json shared_images = validation::write_target_images(out, scene.file_stem(), target, executor);
 
   const validation::MetricOptions metric_options{a.error_threshold};
@@ -123,7 +130,6 @@ void run_validate(const ValidateArgs& a) {
                number(100.0 * v.whole.error_fraction, "{:.3f}"), number(100.0 * h.hole_fraction, "{:.3f}"),
                number(h.scores.recall, "{:.4f}"), number(h.scores.precision, "{:.4f}"), v.result.timings.total() * 1e3);
   }
-  const fs::path summary = out / fmt::format("{}_summary.json", scene_stem);
   io::write_text_atomically(summary, json{{"kind", "stereobench.validation_summary"}, {"records", records}}.dump(2) + "\n");
   fmt::print("\nwrote {} (one record per pipeline beside it, images under {})\n", summary.string(), out.string());
 }

@@ -82,6 +82,17 @@ PipelineOptions PipelineEntry::options(const std::map<std::string, std::string>&
   }
 }
 
+void PipelineEntry::check_rig(const PipelineOptions& options, const StereoRig& rig) const {
+  const auto check = pipeline->info().check_rig;
+  if (check == nullptr) return;
+  try {
+    check(options, rig);
+  } catch (const InputError& error) {
+    if (fixed.empty()) throw;
+    throw InputError(fmt::format("pipeline entry '{}': {}", name, error.what()));
+  }
+}
+
 std::string entry_file_stem(const std::string& entry) {
   std::string stem = entry;
   for (char& c : stem) {

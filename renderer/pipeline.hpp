@@ -39,6 +39,10 @@ struct PipelineInfo {
   /// Checks option values (ranges, choices) the way render() reads them, throwing InputError naming
   /// the option; PipelineOptions calls it, so a bad value is refused before anything renders.
   void (*check_options)(const PipelineOptions&) = nullptr;
+  /// Checks what the options cannot do with a rig (a buffer sized by the disparity, say), throwing
+  /// InputError naming the option and what to change; callers run it for every chosen pipeline
+  /// (PipelineEntry::check_rig) before any of them renders.
+  void (*check_rig)(const PipelineOptions&, const StereoRig&) = nullptr;
 };
 
 /// Options after checking: every key is one the pipeline declared (InputError otherwise, naming
@@ -104,6 +108,9 @@ struct PipelineEntry {
   /// The options it runs with: `given` (options given for its pipeline), the fixed ones over them,
   /// all checked by the pipeline; an InputError about a variant names the entry.
   [[nodiscard]] PipelineOptions options(const std::map<std::string, std::string>& given = {}) const;
+  /// The pipeline's check_rig for `options` (made by options()) and `rig`; an InputError about a
+  /// variant names the entry.
+  void check_rig(const PipelineOptions& options, const StereoRig& rig) const;
 };
 
 /// Parses an entry: InputError for an unknown pipeline, a part that is not KEY=VALUE, a key fixed

@@ -75,6 +75,7 @@ BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const Benc
     result.pipelines[i].name = entries[i].entry.name;
     result.pipelines[i].options = entries[i].options.values();
   }
+  for (const BenchEntry& e : entries) e.entry.check_rig(e.options, rig);  // before any entry renders
   const RenderContext ctx{executor};
   const auto render = [&](size_t i) { return entries[i].entry.pipeline->render(scene, rig, entries[i].options, ctx); };
   for (int w = 0; w < config.warmup; ++w)

@@ -411,11 +411,17 @@ void check_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, 
     if (first) at->second = scene_file(cells[i].scene, scenes_dir);
     by_file[at->second].push_back(i);
   }
+  BenchConfig bench;  // as run_cell times them: each entry with the options it runs with
+  bench.pipelines = d.pipelines;
+  bench.baseline = d.baseline;
+  bench.options = d.options;
+  const std::vector<BenchEntry> entries = bench.entries();
   for (const auto& [file, indices] : by_file) {
     Scene scene = io::load_gltf(file);
     for (size_t i : indices) {
       try {
-        (void)resolve_rig(scene, cell_overrides(cells[i]));
+        const StereoRig rig = resolve_rig(scene, cell_overrides(cells[i]));
+        for (const BenchEntry& e : entries) e.entry.check_rig(e.options, rig);
       } catch (const InputError& e) {
         throw InputError(fmt::format("{}: cell {} '{}': {}; fix the definition (no cell has run)", d.file.string(),
                                      cells[i].index, cells[i].id, e.what()));

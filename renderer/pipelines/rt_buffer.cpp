@@ -35,10 +35,12 @@ class RtBuffer final : public Pipeline {
         "rt-buffer", "Al-Hagri 2012", "3.1.2.1, 3.3.1 (Algorithms 2-3)",
         "per-pixel parallel reprojection into a w x h x t buffer (max source x wins), length-restricted validation "
         "rays, missed and blocked pixels traced",
-        buffer_option_specs(), 200.0, 36.0, [](const PipelineOptions& o) {
+        buffer_option_specs(), 200.0, 36.0,
+        [](const PipelineOptions& o) {
           (void)ValidationSettings::from("rt-buffer", o);
           (void)depth_option(o);
-        }};
+        },
+        [](const PipelineOptions& o, const StereoRig& rig) { (void)buffer_depth(depth_option(o), rig); }};
     return i;
   }
 

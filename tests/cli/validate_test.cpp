@@ -138,6 +138,36 @@ TEST(Validate, VariantsAreMeasuredBesideTheirPipelineUnderTheirOwnName) {
   }
 }
 
+TEST(Validate, WhatARigForbidsIsRefusedBeforeAnythingRendersAndAStopLeavesNoSummary) {
+  test::ScratchDir dir;
+  const fs::path out = dir / "out";
+  // A convergence of 1 mm gives a max disparity of some 2900 px at 160x90: rt-buffer's default
+  // depth 2e exceeds its limit. It is refused before plain-rt, listed first, renders.
+  const test::CliRun near = test::run_cli(base_args(dir) + " --convergence 0.001 --pipelines plain-rt,rt-buffer");
+  EXPECT_EQ(near.code, 3) << near.out;
+  EXPECT_NE(near.out.find("rt-buffer: the default depth t = 2 x max disparity"), std::string::npos) << near.out;
+  EXPECT_FALSE(fs::exists(out / "box-wall_full_plain-rt.json")) << "a pipeline rendered before the refusal";
+  // Under a variant the message names the entry.
+  const test::CliRun variant =
+      test::run_cli(base_args(dir) + " --convergence 0.001 --pipelines plain-rt,rt-buffer:margin=0.02");
+  EXPECT_EQ(variant.code, 3) << variant.out;
+  EXPECT_NE(variant.out.find("pipeline entry 'rt-buffer:margin=0.02': rt-buffer: the default depth"),
+            std::string::npos)
+      << variant.out;
+
+  // A run that stops after a record is written (here: the second record's path is a folder)
+  // leaves no summary of an earlier run beside its records.
+  ASSERT_EQ(test::run_cli(base_args(dir) + " --pipelines plain-rt,repro-rt").code, 0);
+  ASSERT_TRUE(fs::exists(out / "box-wall_full_summary.json"));
+  fs::remove(out / "box-wall_full_repro-rt.json");
+  fs::create_directories(out / "box-wall_full_repro-rt.json");
+  const test::CliRun stopped = test::run_cli(base_args(dir) + " --pipelines plain-rt,repro-rt");
+  EXPECT_EQ(stopped.code, 3) << stopped.out;
+  EXPECT_NE(stopped.out.find("box-wall_full_repro-rt.json is a folder"), std::string::npos) << stopped.out;
+  EXPECT_TRUE(fs::exists(out / "box-wall_full_plain-rt.json"));
+  EXPECT_FALSE(fs::exists(out / "box-wall_full_summary.json")) << "an earlier run's summary beside this run's records";
+}
+
 TEST(Validate, BadInputAndMissingTools) {
   test::ScratchDir dir;
   const test::CliRun unknown = test::run_cli(base_args(dir) + " --pipelines plain-rt,no-such-pipeline");

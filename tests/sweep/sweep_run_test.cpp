@@ -505,6 +505,18 @@ TEST(SweepRun, BadDefinitionAndShardAreUsageErrors) {
   EXPECT_NE(near.out.find("fix the definition (no cell has run)"), std::string::npos) << near.out;
   EXPECT_EQ(near.out.find("[1/2]"), std::string::npos) << "no cell may run: " << near.out;
   EXPECT_FALSE(fs::exists(dir / "n" / "results.jsonl"));
+  // So is a cell whose rig a pipeline cannot work with: at a convergence of 1 mm the max disparity
+  // at 96x54 is some 3000 px, and rt-buffer's default depth 2e exceeds its limit.
+  std::ofstream(dir / "deep.toml") << "[sweep]\nname = \"deep\"\nscenes = [\"box-wall\"]\n"
+                                      "pipelines = [\"plain-rt\", \"rt-buffer\"]\nconvergence_m = [2.0, 0.001]\n"
+                                      "resolutions = [\"96x54\"]\n";
+  const test::CliRun deep = test::run_cli("sweep run " + quoted(dir / "deep.toml") + " --out " + quoted(dir / "d") +
+                                          " --scenes-dir " + quoted(dir / "scenes"));
+  EXPECT_EQ(deep.code, 3) << deep.out;
+  EXPECT_NE(deep.out.find((dir / "deep.toml").string() + ": cell 1 "), std::string::npos) << deep.out;
+  EXPECT_NE(deep.out.find("rt-buffer: the default depth t = 2 x max disparity"), std::string::npos) << deep.out;
+  EXPECT_EQ(deep.out.find("[1/2]"), std::string::npos) << "no cell may run: " << deep.out;
+  EXPECT_FALSE(fs::exists(dir / "d" / "results.jsonl"));
   // Fixed, it runs into the same folder: the refused run did not claim it for the old definition.
   std::ofstream(dir / "near.toml", std::ios::trunc)
       << "[sweep]\nname = \"near\"\nscenes = [\"box-wall\"]\npipelines = [\"plain-rt\"]\n"
