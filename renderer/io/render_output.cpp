@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <filesystem>
 #include <string_view>
 
 #include <fmt/format.h>
@@ -17,6 +18,7 @@
 
 namespace sb::io {
 
+namespace fs = std::filesystem;
 using nlohmann::json;
 
 json rig_to_json(const StereoRig& rig) {
@@ -113,22 +115,39 @@ RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::st
   f.anaglyph_png = dir / (stem + "_anaglyph.png");
   f.side_by_side_png = dir / (stem + "_sbs.png");
   f.stats_json = dir / (stem + "_stats.json");
-  ImageMetadata meta;
-  meta["stereobench/record"] = record.dump();
-  write_exr_stereo(f.exr, result.left, result.right, meta);
-  write_png_preview(f.left_png, result.left);
-  write_png_preview(f.right_png, result.right);
-  write_png_preview(f.anaglyph_png, anaglyph_dubois(result.left, result.right));
-  write_png_preview(f.side_by_side_png, side_by_side(result.left, result.right));
-  if (holes_overlay) {
-    f.holes_png = dir / (stem + "_holes.png");
-    write_png_preview(*f.holes_png, *holes_overlay);
+  // The stats JSON, written last, marks a complete set: an earlier render's goes first, and a
+  // failure on the way (a full disk) removes what this call wrote, so no set is left looking
+  // complete.
+  std::error_code ec;
+  fs::remove(f.stats_json, ec);
+  if (ec) throw IoError(fmt::format("cannot remove the earlier {}: {}", f.stats_json.string(), ec.message()));
+  std::vector<fs::path> written;
+  try {
+    ImageMetadata meta;
+    meta["stereobench/record"] = record.dump();
+    write_exr_stereo(f.exr, result.left, result.right, meta);
+    written.push_back(f.exr);
+    const auto png = [&written](const fs::path& file, const Image& image) {
+      write_png_preview(file, image);
+      written.push_back(file);
+    };
+    png(f.left_png, result.left);
+    png(f.right_png, result.right);
+    png(f.anaglyph_png, anaglyph_dubois(result.left, result.right));
+    png(f.side_by_side_png, side_by_side(result.left, result.right));
+    if (holes_overlay) {
+      f.holes_png = dir / (stem + "_holes.png");
+      png(*f.holes_png, *holes_overlay);
+    }
+    for (const auto& [name, image] : result.extras) {
+      f.extras.push_back(dir / (stem + "_" + name + ".png"));
+      png(f.extras.back(), image);
+    }
+    write_text_atomically(f.stats_json, record.dump(2) + "\n");
+  } catch (...) {
+    for (const fs::path& file : written) fs::remove(file, ec);
+    throw;
   }
-  for (const auto& [name, image] : result.extras) {
-    f.extras.push_back(dir / (stem + "_" + name + ".png"));
-    write_png_preview(f.extras.back(), image);
-  }
-  write_text_atomically(f.stats_json, record.dump(2) + "\n");
   return f;
 }
 

@@ -166,6 +166,18 @@ TEST(Cli, RenderWritesEveryOutputAndBenchPrintsATable) {
   EXPECT_GT(j.at("counters").at("shadow_rays").get<uint64_t>(), 0u);
   EXPECT_EQ(j.at("rig").at("width").get<int>(), 64);
 
+  // A render that stops while writing (here: the side-by-side image's path is a folder) leaves no
+  // set behind: neither the files it wrote before nor the stats of the earlier render.
+  std::filesystem::remove(dir / "box-wall_plain-raster_sbs.png");
+  std::filesystem::create_directories(dir / "box-wall_plain-raster_sbs.png");
+  const CliRun stopped =
+      run("render --scene box-wall --pipeline plain-raster --out '" + dir.path().string() + "'" + common);
+  EXPECT_EQ(stopped.code, 3) << stopped.out;
+  EXPECT_NE(stopped.out.find("box-wall_plain-raster_sbs.png is a folder"), std::string::npos) << stopped.out;
+  for (const char* suffix : {".exr", "_left.png", "_right.png", "_anaglyph.png", "_stats.json"})
+    EXPECT_FALSE(std::filesystem::exists(dir / (std::string("box-wall_plain-raster") + suffix))) << suffix;
+  std::filesystem::remove(dir / "box-wall_plain-raster_sbs.png");
+
   // A variant renders under its own name; its files say which options it fixed.
   const CliRun v =
       run("render --scene box-wall --pipeline plain-raster:tile=8 --out '" + dir.path().string() + "'" + common);
