@@ -1,6 +1,7 @@
 // Camera paths and rigid node animation.
 #include "renderer/animation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -69,6 +70,19 @@ void PathSpec::validate() const {
                                      "or add a key between them",
                                      f, frames, at.segment + 1, at.segment + 2));
     }
+  // Between frames too: the view direction target - position is linear along a segment; where it
+  // passes through zero the camera turns about instantly, between two frames however close.
+  for (size_t i = 0; i + 1 < camera_keys.size() && frames > 1; ++i) {
+    const dvec3 from = camera_keys[i].target - camera_keys[i].position;
+    const dvec3 change = camera_keys[i + 1].target - camera_keys[i + 1].position - from;
+    const double len2 = glm::dot(change, change);
+    const double t = len2 > 0.0 ? std::clamp(-glm::dot(from, change) / len2, 0.0, 1.0) : 0.0;
+    if (glm::length(from + t * change) < 1e-9)
+      throw InputError(fmt::format("the camera passes through its target between camera keys {} and {} ({:.0f} % of "
+                                   "the way; position and target cross), where its view direction turns about "
+                                   "between two frames; move a target or add a key between them",
+                                   i + 1, i + 2, 100.0 * t));
+  }
   if (spin) {
     if (!finite(spin->axis) || glm::length(spin->axis) < 1e-12)
       throw InputError("the spin axis is zero or not finite; give a direction such as 0,1,0");

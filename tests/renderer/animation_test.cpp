@@ -75,7 +75,23 @@ TEST(Animation, APathWhoseCameraReachesItsTargetIsRejected) {
               std::string::npos)
         << e.what();
   }
-  crossing.frames = 2;  // only the keys themselves: each looks somewhere
+  // No frame on the target, but the path passes through it between two frames: the camera would
+  // turn about between them. Refused for any number of frames, naming the keys.
+  for (const int frames : {2, 10}) {
+    crossing.frames = frames;
+    crossing.camera_keys = parse_camera_keys("0,1,4>0,1,0;0,1,-4>0,1,0");
+    try {
+      crossing.validate();
+      ADD_FAILURE() << frames << " frames: a path through its target was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("the camera passes through its target between camera keys 1 and 2 (50 % of "
+                                           "the way"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  // Passing beside the target is a path like any other.
+  crossing.camera_keys = parse_camera_keys("0,1,4>0.01,1,0;0,1,-4>0.01,1,0");
   EXPECT_NO_THROW(crossing.validate());
 }
 
