@@ -104,6 +104,17 @@ int run_compare(const CompareArgs& a) {
     check_limit(*o, o == &a.fail_ssim ? "--fail-ssim" : "--warn-ssim", -1.0, 1.0, "an SSIM");
   for (const auto* o : {&a.fail_percent, &a.warn_percent})
     check_limit(*o, o == &a.fail_percent ? "--fail-percent" : "--warn-percent", 0.0, 100.0, "a percentage");
+  // A warning level on the far side of its failure level could never be reached before the failure.
+  const auto ordered = [](const std::optional<double>& warn, const std::optional<double>& fail, bool at_least,
+                          const char* metric) {
+    if (warn && fail && (at_least ? *warn < *fail : *warn > *fail))
+      throw InputError(fmt::format("--warn-{0} {1} lies beyond --fail-{0} {2}: a comparison would fail before it "
+                                   "warned; give a warning level {3} the failure level, or drop one of them",
+                                   metric, *warn, *fail, at_least ? "at or above" : "at or below"));
+  };
+  ordered(a.warn_psnr, a.fail_psnr, true, "psnr");
+  ordered(a.warn_ssim, a.fail_ssim, true, "ssim");
+  ordered(a.warn_percent, a.fail_percent, false, "percent");
 
   check_outputs(a);
 

@@ -22,7 +22,8 @@ void SweepSlurmCli::add_to(CLI::App& run) {
   options_.push_back(run.add_option("--shards", shards,
                                     "slurm: array tasks, each running the cells with cell_index % N == task\n"
                                     "(default: one task per cell)")
-                         ->check(CLI::Range(1, 1000000)));
+                         ->check(CLI::Range(1, 1000000))
+                         ->default_str(""));  // unset means one task per cell; 0 is not a value to give
   options_.push_back(run.add_option("--partition", partition, "slurm: partition to submit to (default: the cluster's)"));
   options_.push_back(run.add_option("--time-limit", time_limit,
                                     "slurm: time limit per task, HH:MM:SS (default: the partition's)"));

@@ -115,6 +115,13 @@ TEST_F(Compare, ThresholdsGiveFailAndWarnExitCodes) {
     r = compare(ab() + bad);
     EXPECT_EQ(r.code, 3) << bad << ": " << r.out;
   }
+  // So is a warning level beyond its failure level (it could never warn before failing).
+  for (const char* bad : {" --warn-psnr 10 --fail-psnr 20", " --warn-ssim 0.5 --fail-ssim 0.9",
+                          " --warn-percent 5 --fail-percent 1"}) {
+    r = compare(ab() + bad);
+    EXPECT_EQ(r.code, 3) << bad << ": " << r.out;
+    EXPECT_NE(r.out.find("lies beyond --fail-"), std::string::npos) << bad << ": " << r.out;
+  }
 }
 
 TEST_F(Compare, MismatchedAndMissingInputsAreBadInput) {
