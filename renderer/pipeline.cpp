@@ -53,6 +53,9 @@ std::map<std::string, std::string> entry_fixed_options(const std::string& name) 
           fmt::format("pipeline entry '{}': '{}' is not KEY=VALUE; write a variant as "
                       "NAME:KEY=VALUE[:KEY=VALUE...], e.g. bidir-warp:occlusion=ztest",
                       name, pair));
+    // A variant's name names its files: a blank in it would become part of them ("=_1").
+    if (pair.find_first_of(" \t\n\r\v\f") != std::string::npos)
+      throw InputError(fmt::format("pipeline entry '{}': '{}' holds a blank; write KEY=VALUE without spaces", name, pair));
     if (!fixed.emplace(pair.substr(0, eq), pair.substr(eq + 1)).second)
       throw InputError(
           fmt::format("pipeline entry '{}' fixes option {} twice; give each option once", name, pair.substr(0, eq)));
@@ -71,26 +74,30 @@ PipelineEntry parse_pipeline_entry(const std::string& name) {
   return {name, &find_pipeline(entry_pipeline_name(name)), entry_fixed_options(name)};
 }
 
-PipelineOptions PipelineEntry::options(const std::map<std::string, std::string>& given) const {
-  std::map<std::string, std::string> values = given;
-  for (const auto& [key, value] : fixed) values[key] = value;
+namespace {
+
+/// Runs `check`; an InputError it throws about a variant is rethrown naming the entry (the
+/// pipeline's own message names a plain pipeline already).
+template <class Check>
+auto naming_the_entry(const PipelineEntry& entry, Check&& check) {
   try {
-    return PipelineOptions(pipeline->info(), values);
+    return check();
   } catch (const InputError& error) {
-    if (fixed.empty()) throw;  // the pipeline's own message names it
-    throw InputError(fmt::format("pipeline entry '{}': {}", name, error.what()));
+    if (entry.fixed.empty()) throw;
+    throw InputError(fmt::format("pipeline entry '{}': {}", entry.name, error.what()));
   }
 }
 
+}  // namespace
+
+PipelineOptions PipelineEntry::options(const std::map<std::string, std::string>& given) const {
+  std::map<std::string, std::string> values = given;
+  for (const auto& [key, value] : fixed) values[key] = value;
+  return naming_the_entry(*this, [&] { return PipelineOptions(pipeline->info(), values); });
+}
+
 void PipelineEntry::check_rig(const PipelineOptions& options, const StereoRig& rig) const {
-  const auto check = pipeline->info().check_rig;
-  if (check == nullptr) return;
-  try {
-    check(options, rig);
-  } catch (const InputError& error) {
-    if (fixed.empty()) throw;
-    throw InputError(fmt::format("pipeline entry '{}': {}", name, error.what()));
-  }
+  if (const auto check = pipeline->info().check_rig) naming_the_entry(*this, [&] { check(options, rig); });
 }
 
 std::string entry_file_stem(const std::string& entry) {

@@ -125,7 +125,8 @@ TEST(Validate, VariantsAreMeasuredBesideTheirPipelineUnderTheirOwnName) {
       {"no-such:tile=8", "unknown pipeline 'no-such'"},
       // A value of 300 zeros and an 8 reads as 8; the name would pass a file name's 255 bytes.
       {"plain-raster:tile=" + std::string(300, '0') + "8", "is 319 characters long; it names files"},
-      {"bidir-warp:max_crack=3/1,bidir-warp:max_crack=3 1", "would write files of the same name"},
+      {"bidir-warp:max_crack=3/1,bidir-warp:max_crack=3#1", "would write files of the same name"},
+      {"repro-rt:threshold_arcmin= 1", "'threshold_arcmin= 1' holds a blank; write KEY=VALUE without spaces"},
       // One variant under two spellings would be rendered and measured twice.
       {"bidir-warp:max_crack=2:occlusion=ztest,bidir-warp:occlusion=ztest:max_crack=2",
        "'bidir-warp:max_crack=2:occlusion=ztest' and 'bidir-warp:occlusion=ztest:max_crack=2' name the same variant of "
