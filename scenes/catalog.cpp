@@ -2,6 +2,8 @@
 // parameters) no longer matches.
 #include "scenes/catalog.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 #include <cstdlib>
 
@@ -99,6 +101,18 @@ fs::path resolve_scene(const std::string& spec, const fs::path& scenes_dir) {
   if (!info) {
     std::string names;
     for (const GeneratorInfo& g : generators()) names += (names.empty() ? "" : ", ") + g.name;
+    // "spheres:count=5" is how a sweep names a generated variant; here it takes a file.
+    const size_t colon = spec.find(':');
+    const std::string base = spec.substr(0, colon);
+    const bool variant = colon != std::string::npos &&
+                         std::any_of(generators().begin(), generators().end(), [&](const GeneratorInfo& g) {
+                           return g.name == base;
+                         });
+    if (variant)
+      throw InputError(fmt::format("scene '{}': parameters in a scene's name are read by sweep definitions only; "
+                                   "write the variant with `stereobench scenes generate {} --param KEY=VALUE`, "
+                                   "then give the file it prints",
+                                   spec, base));
     throw InputError(fmt::format("unknown scene '{}': not a .gltf/.glb file and not a built-in scene ({})",
                                  spec, names));
   }

@@ -46,6 +46,9 @@ TEST(Cli, BadArgumentsExitWith3AndSayWhy) {
   struct Case { std::string args; std::string expect; };
   const Case cases[] = {
       {"scenes info no-such-scene" + sd, "unknown scene 'no-such-scene'"},
+      {"scenes info spheres:count=5" + sd,
+       "parameters in a scene's name are read by sweep definitions only; write the variant with `stereobench scenes "
+       "generate spheres --param KEY=VALUE`"},
       {"scenes generate no-such-scene --out '" + dir.path().string() + "'", "unknown scene generator 'no-such-scene'"},
       {"scenes info " + scene + " --interaxial -0.064", "--interaxial -0.064 is not a positive finite number"},
       {"scenes info " + scene + " --interaxial 0", "--interaxial 0 is not a positive"},
