@@ -247,6 +247,17 @@ json timing_json(const PipelineBench& b, const BenchResult& r, int warmup) {
 }
 
 /// Validates and times every pipeline of the definition in one cell; returns its results line.
+/// The timing of a cell: the definition's pipelines, baseline, repetitions and options.
+BenchConfig bench_config(const SweepDefinition& d) {
+  BenchConfig bench;
+  bench.pipelines = d.pipelines;
+  bench.baseline = d.baseline;
+  bench.warmup = d.warmup;
+  bench.repetitions = d.repetitions;
+  bench.options = d.options;
+  return bench;
+}
+
 json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count, const SweepRunOptions& options,
               SceneCache& scenes_cache, const Executor& executor) {
   const auto start = std::chrono::steady_clock::now();
@@ -281,12 +292,7 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
     if (target_images.contains("truth_exr")) images["truth_exr"] = target_images["truth_exr"];
   }
   // The timing run's configuration; each pipeline is measured with the options it is timed with.
-  BenchConfig bench;
-  bench.pipelines = d.pipelines;
-  bench.baseline = d.baseline;
-  bench.warmup = d.warmup;
-  bench.repetitions = d.repetitions;
-  bench.options = d.options;
+  const BenchConfig bench = bench_config(d);
   json pipelines = json::object();
   for (const BenchEntry& entry : bench.entries()) {
     const std::string& name = entry.entry.name;
@@ -411,11 +417,7 @@ void check_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, 
     if (first) at->second = scene_file(cells[i].scene, scenes_dir);
     by_file[at->second].push_back(i);
   }
-  BenchConfig bench;  // as run_cell times them: each entry with the options it runs with
-  bench.pipelines = d.pipelines;
-  bench.baseline = d.baseline;
-  bench.options = d.options;
-  const std::vector<BenchEntry> entries = bench.entries();
+  const std::vector<BenchEntry> entries = bench_config(d).entries();  // as run_cell runs them
   for (const auto& [file, indices] : by_file) {
     Scene scene = io::load_gltf(file);
     for (size_t i : indices) {
