@@ -225,7 +225,19 @@ class Checker {
       }
       opt_index(n, "mesh", p, "meshes");
       opt_index(n, "camera", p, "cameras");
-      opt_number_array(n, "matrix", p, 16);
+      if (const json* m = member(n, "matrix", p)) {
+        number_array(*m, p + "/matrix", 16);
+        // Column-major: the last row is elements 3, 7, 11 and 15. A projective row would divide
+        // positions by w, which the renderer's affine transforms never do.
+        const double row[4] = {(*m)[3].get<double>(), (*m)[7].get<double>(), (*m)[11].get<double>(),
+                               (*m)[15].get<double>()};
+        if (row[0] != 0.0 || row[1] != 0.0 || row[2] != 0.0 || row[3] != 1.0)
+          fail(p + "/matrix", fmt::format("its last row (elements 3, 7, 11 and 15; glTF matrices are column-major) is "
+                                          "({:g}, {:g}, {:g}, {:g}), not (0, 0, 0, 1): a node matrix must be affine, "
+                                          "decomposable into translation, rotation and scale; fix the matrix or give "
+                                          "translation, rotation and scale instead",
+                                          row[0], row[1], row[2], row[3]));
+      }
       opt_number_array(n, "translation", p, 3);
       if (const json* r = member(n, "rotation", p)) {
         number_array(*r, p + "/rotation", 4);

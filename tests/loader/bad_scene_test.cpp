@@ -59,6 +59,11 @@ std::vector<BadCase> corpus() {
   c.push_back({"mesh_is_string", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["mesh"] = "tri"; }), "/nodes/0/mesh"});
   c.push_back({"translation_wrong_length", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["translation"] = {1, 2}; }), "/nodes/0/translation: must have 3 elements"});
   c.push_back({"matrix_has_string", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["matrix"] = json::array({1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, "x", 0, 1}); }), "/nodes/0/matrix/13"});
+  // glTF node matrices are affine; a projective last row was used as it stood.
+  c.push_back({"matrix_w_zero", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["matrix"] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0}; }),
+               "/nodes/0/matrix: its last row (elements 3, 7, 11 and 15; glTF matrices are column-major) is (0, 0, 0, 0), not (0, 0, 0, 1)"});
+  c.push_back({"matrix_projective_row", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["matrix"] = {1, 0, 0, 0.5, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; }),
+               "/nodes/0/matrix: its last row (elements 3, 7, 11 and 15; glTF matrices are column-major) is (0.5, 0, 0, 1)"});
   c.push_back({"primitives_not_array", "a.gltf", edited([](MiniGltf& g) { g.doc["meshes"][0]["primitives"] = json::object(); }), "/meshes/0/primitives: expected a JSON array"});
   c.push_back({"attributes_missing", "a.gltf", edited([](MiniGltf& g) { g.doc["meshes"][0]["primitives"][0].erase("attributes"); }), "/meshes/0/primitives/0/attributes: required"});
   c.push_back({"no_position", "a.gltf", edited([](MiniGltf& g) { g.doc["meshes"][0]["primitives"][0]["attributes"] = json::object(); }), "/meshes/0/primitives/0/attributes: primitive has no POSITION"});
