@@ -100,7 +100,9 @@ void print_info(const InfoArgs& args) {
     size_t textured = 0;
     for (const Material& m : scene.materials) textured += m.base_color_texture >= 0;
     fmt::print("scene      {} ({})\n", scene.name, path.string());
-    fmt::print("geometry   {} triangles, {} vertices, {} meshes\n", scene.triangle_count(), scene.vertex_count(),
+    const size_t zero_area = scene.zero_area_triangle_count();
+    fmt::print("geometry   {} triangles{}, {} vertices, {} meshes\n", scene.triangle_count(),
+               zero_area ? fmt::format(" ({} of zero area)", zero_area) : std::string(), scene.vertex_count(),
                scene.meshes.size());
     fmt::print("materials  {} ({} textured), {} textures\n", scene.materials.size(), textured, scene.textures.size());
     fmt::print("lights     {} point, {} directional, {} spot\n", lights_by_type[0], lights_by_type[1], lights_by_type[2]);

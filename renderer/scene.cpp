@@ -13,6 +13,28 @@ size_t Scene::triangle_count() const {
   return n;
 }
 
+bool Mesh::zero_area(size_t t) const {
+  const dvec3 a(positions[indices[3 * t]]);
+  const dvec3 b(positions[indices[3 * t + 1]]);
+  const dvec3 c(positions[indices[3 * t + 2]]);
+  const dvec3 n = glm::cross(b - a, c - a);
+  return n.x == 0.0 && n.y == 0.0 && n.z == 0.0;
+}
+
+size_t Scene::zero_area_triangle_count() const {
+  size_t n = 0;
+  for (const Mesh& m : meshes)
+    for (size_t t = 0; t < m.triangle_count(); ++t) n += m.zero_area(t);
+  return n;
+}
+
+bool Scene::has_triangle_with_area() const {
+  for (const Mesh& m : meshes)
+    for (size_t t = 0; t < m.triangle_count(); ++t)
+      if (!m.zero_area(t)) return true;
+  return false;
+}
+
 size_t Scene::vertex_count() const {
   size_t n = 0;
   for (const Mesh& m : meshes) n += m.positions.size();

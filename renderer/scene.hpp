@@ -42,6 +42,9 @@ struct Mesh {
   std::vector<uint32_t> indices;  ///< three per triangle
 
   [[nodiscard]] size_t triangle_count() const { return indices.size() / 3; }
+  /// Whether triangle t has zero area (its vertices coincide or lie on one line): it covers no
+  /// pixel and no ray hits it.
+  [[nodiscard]] bool zero_area(size_t t) const;
 };
 
 /// A punctual light (KHR_lights_punctual). Intensity is used as radiometric: a point light of
@@ -107,6 +110,10 @@ struct Scene {
   std::vector<std::string> warnings;  ///< unsupported features, each named once
 
   [[nodiscard]] size_t triangle_count() const;
+  /// Triangles of zero area (Mesh::zero_area); one pass over every triangle.
+  [[nodiscard]] size_t zero_area_triangle_count() const;
+  /// Whether some triangle has a non-zero area; stops at the first one found.
+  [[nodiscard]] bool has_triangle_with_area() const;
   [[nodiscard]] size_t vertex_count() const;
   [[nodiscard]] Bounds3 bounds() const;
   /// The name as the start of output file names: characters other than ASCII letters, digits and

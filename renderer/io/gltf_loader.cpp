@@ -310,6 +310,12 @@ class Converter {
                                    "TRIANGLE_STRIP or TRIANGLE_FAN primitives is reachable from the scene's "
                                    "nodes){}; add geometry or pick another scene", file_, skipped));
     }
+    // Triangles of zero area render as background alone, which any comparison passes.
+    if (!scene.has_triangle_with_area())
+      throw InputError(fmt::format("{}: the scene has no triangles to render: every one of its {} triangles has zero "
+                                   "area (its vertices coincide or lie on one line), so nothing can be seen; check "
+                                   "the primitives' indices and POSITION accessors, or pick another scene",
+                                   file_, scene.triangle_count()));
     if (!m_.animations.empty()) warn("animations", fmt::format("{} animation(s) are not played; the scene is rendered at rest", m_.animations.size()));
     if (!m_.skins.empty()) warn("skins", fmt::format("{} skin(s) ignored: meshes render in their bind pose", m_.skins.size()));
     for (const auto& [key, count] : warning_counts_)

@@ -131,6 +131,19 @@ TEST(Cli, SceneInfoPrintsRigAndDisparities) {
   EXPECT_NE(r.out.find("max disparity 20.00 px"), std::string::npos) << r.out;
 }
 
+TEST(Cli, SceneInfoCountsZeroAreaTriangles) {
+  test::ScratchDir dir("clizero");
+  test::MiniGltf g;
+  const int pos = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  std::vector<uint16_t> idx = {0, 1, 2, 1, 1, 1};
+  const int ia = g.add_accessor(g.add_view(idx), 5123, idx.size(), "SCALAR");
+  g.add_node({{"mesh", g.add_mesh(nlohmann::json::array({{{"attributes", {{"POSITION", pos}}}, {"indices", ia}}}))}});
+  g.write_gltf(dir / "z.gltf");
+  const CliRun r = run("scenes info '" + (dir / "z.gltf").string() + "'");
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("2 triangles (1 of zero area), 3 vertices"), std::string::npos) << r.out;
+}
+
 TEST(Cli, MoreThreadsThanCoresAreTheCoresAndSaySo) {
   test::ScratchDir dir("threads");
   const CliRun r = run("render --scene box-wall --pipeline plain-rt --resolution 32x18 --threads 1024 --scenes-dir " +

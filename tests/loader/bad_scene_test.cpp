@@ -53,6 +53,13 @@ std::vector<BadCase> corpus() {
   c.push_back({"version_1", "a.gltf", [](auto& p) { write_text(p, R"({"asset":{"version":"1.0"}})"); }, "/asset/version"});
   c.push_back({"empty_scene", "a.gltf", [](auto& p) { write_text(p, R"({"asset":{"version":"2.0"}})"); }, "no triangles"});
   c.push_back({"empty_node_list", "a.gltf", [](auto& p) { write_text(p, R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[]}],"scene":0})"); }, "no triangles"});
+  // Triangles of zero area render as background only, which every comparison passes.
+  c.push_back({"all_triangles_zero_area", "a.gltf", edited([](MiniGltf& g) {
+    std::vector<uint16_t> idx = {0, 0, 0, 1, 1, 2};
+    g.doc["meshes"][0]["primitives"][0]["indices"] = g.add_accessor(g.add_view(idx), 5123, 6, "SCALAR");
+  }), "the scene has no triangles to render: every one of its 2 triangles has zero area"});
+  c.push_back({"all_triangles_flattened_to_lines", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["scale"] = {1, 0, 1}; }),
+               "every one of its 1 triangles has zero area"});
   c.push_back({"count_is_string", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["count"] = "three"; }), "/accessors/0/count: must be an integer"});
   c.push_back({"count_is_float", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["count"] = 3.5; }), "/accessors/0/count"});
   c.push_back({"count_negative", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["count"] = -3; }), "/accessors/0/count"});

@@ -147,6 +147,20 @@ TEST(GltfLoader, APrimitiveWhosePositionsAreAllZeroIsSkippedWithAWarning) {
   EXPECT_EQ(named, 1) << fmt::format("{}", fmt::join(scene.warnings, "\n"));
 }
 
+TEST(GltfLoader, ZeroAreaTrianglesBesideRealOnesAreKeptAndCounted) {
+  ScratchDir dir("zeroarea");
+  MiniGltf g;
+  const int pos = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0, 2, 0, 0});
+  std::vector<uint16_t> idx = {0, 1, 2, 0, 1, 3, 2, 2, 2};  // a triangle, one on a line, one at a point
+  const int ia = g.add_accessor(g.add_view(idx), 5123, idx.size(), "SCALAR");
+  g.add_node({{"mesh", g.add_mesh(json::array({{{"attributes", {{"POSITION", pos}}}, {"indices", ia}}}))}});
+  g.write_gltf(dir / "z.gltf");
+  const Scene scene = io::load_gltf(dir / "z.gltf");
+  EXPECT_EQ(scene.triangle_count(), 3u);
+  EXPECT_EQ(scene.zero_area_triangle_count(), 2u);
+  EXPECT_TRUE(scene.has_triangle_with_area());
+}
+
 TEST(GltfLoader, StripsAndFansAreTriangulated) {
   ScratchDir dir("strip");
   MiniGltf g;
