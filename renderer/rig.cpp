@@ -235,6 +235,28 @@ StereoRig resolve_rig(const Scene& scene, const RigOverrides& o) {
     require_positive(p.convergence, "convergence", "give the zero-parallax distance in meters");
     p.interaxial = interaxial_from_max_disparity(*o.max_disparity_px, p.convergence, p.vfov, p.height);
   }
+  // A disparity out of range that the scene's extras set up is named by file and JSON path: the
+  // message must not read as if an option were at fault.
+  const bool e_from_scene = scene.rig.interaxial && !o.interaxial && !o.max_disparity_px;
+  const bool c_from_scene = scene.rig.convergence && !o.convergence;
+  const bool vfov_ok = std::isfinite(p.vfov) && p.vfov > 0.0 && p.vfov < kPi;
+  if ((e_from_scene || c_from_scene) && !scene.rig.where.empty() && vfov_ok) {
+    const double disparity = max_disparity_from_interaxial(p.interaxial, p.convergence, p.vfov, p.height);
+    if (!(disparity <= kMaxDisparityPx)) {
+      const char* key = c_from_scene ? "convergence" : "interaxial";
+      const auto source = [](bool from_scene, bool from_option, const char* option) {
+        return from_scene ? std::string("the scene's") : from_option ? fmt::format("from {}", option) : "the default";
+      };
+      throw InputError(fmt::format(
+          "{}: {}/{}: interaxial {:g} m ({}) with convergence {:g} m ({}) gives a disparity at infinity of {:g} px at "
+          "{} px height and a vertical field of view of {:g} degrees, beyond the {:g} px a rig may have; fix the "
+          "scene's {} (a larger convergence or a smaller interaxial, in metres), or override it with --{}",
+          scene.path, scene.rig.where, key, p.interaxial, source(e_from_scene, o.interaxial || o.max_disparity_px,
+                                                                 "--interaxial/--max-disparity"),
+          p.convergence, source(c_from_scene, o.convergence.has_value(), "--convergence"), disparity, p.height,
+          radians_to_degrees(p.vfov), kMaxDisparityPx, key, key));
+    }
+  }
   // Far plane far enough for the whole scene as seen from the camera.
   const double reach = glm::length(pose.position - dvec3(b.empty() ? vec3(0.0f) : b.center())) + radius;
   p.zfar = std::max(p.zfar, 2.0 * reach);

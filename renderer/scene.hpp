@@ -93,6 +93,7 @@ struct RigDefaults {
   std::optional<double> convergence;  ///< m
   std::optional<int> width;
   std::optional<int> height;
+  std::string where;  ///< JSON path of the extras they came from ("/nodes/4/extras/stereobench"), or empty
 };
 
 /// A loaded scene.

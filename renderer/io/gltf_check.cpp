@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "renderer/error.hpp"
+#include "renderer/scene.hpp"
 
 namespace sb::io {
 
@@ -186,7 +187,11 @@ class Checker {
     if (!sb) return;
     const std::string p = path + "/extras/stereobench";
     require_object(*sb, p);
-    if (const json* v = member(*sb, "interaxial", p)) positive(*v, p + "/interaxial", "the eye separation in metres");
+    if (const json* v = member(*sb, "interaxial", p))
+      if (positive(*v, p + "/interaxial", "the eye separation in metres") > kMaxSceneCoordinate)
+        fail(p + "/interaxial", fmt::format("value {:g} m is beyond the {:g} m a scene may span; give the eye "
+                                            "separation in metres, e.g. 0.064",
+                                            v->get<double>(), kMaxSceneCoordinate));
     if (const json* v = member(*sb, "convergence", p))
       positive(*v, p + "/convergence", "the zero-parallax distance in metres");
     opt_integer(*sb, "width", p, 1, 16384);

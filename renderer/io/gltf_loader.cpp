@@ -757,6 +757,16 @@ class Converter {
            fmt::format("places the camera at ({:g}, {:g}, {:g}) m, beyond the ±{:g} m a scene may span; check the "
                        "node's translation and the file's units",
                        world[3].x, world[3].y, world[3].z, kMaxSceneCoordinate));
+    // The rig's pose needs a viewing direction and an up axis that are not parallel.
+    const dvec3 up(world[1]), back(world[2]);
+    if (glm::length(back) == 0.0 || glm::length(up) == 0.0)
+      fail(fmt::format("/nodes/{}", ni), "the camera's transform (this node's with its parents') has zero scale, so "
+                                         "it has no viewing direction; fix the scale or matrix of the node or its "
+                                         "parents");
+    if (glm::length(glm::cross(up, glm::normalize(back))) < 1e-12)
+      fail(fmt::format("/nodes/{}", ni), "the camera's transform (this node's with its parents') makes its up axis "
+                                         "parallel to its viewing direction (a zero scale on one axis or a shear); "
+                                         "fix the scale or matrix of the node or its parents");
     SceneCamera cam;
     cam.name = n.name.empty() ? (gc.name.empty() ? fmt::format("camera{}", n.camera) : gc.name) : n.name;
     cam.node = ni;
@@ -773,6 +783,7 @@ class Converter {
           if (sbx->contains("convergence")) scene.rig.convergence = sbx->at("convergence").get<double>();
           if (sbx->contains("width")) scene.rig.width = sbx->at("width").get<int>();
           if (sbx->contains("height")) scene.rig.height = sbx->at("height").get<int>();
+          scene.rig.where = fmt::format("/nodes/{}/extras/stereobench", ni);
         }
     } else {
       warn("cameras", "more than one camera: the first in node order is the default rig's pose");

@@ -29,6 +29,14 @@ struct BadCase {
   std::string expect;                                ///< substring of the message (JSON pointer etc.)
 };
 
+/// Adds a perspective camera node (a root unless `root` is false) with `node` merged in; returns its index.
+int add_camera(MiniGltf& g, const json& node, bool root = true) {
+  g.doc["cameras"] = json::array({{{"type", "perspective"}, {"perspective", {{"yfov", 0.7}, {"znear", 0.1}}}}});
+  json n = {{"camera", 0}, {"translation", {0, 0, 3}}};
+  n.update(node);
+  return g.add_node(n, root);
+}
+
 /// A valid one-triangle scene with `edit` applied to its JSON before writing.
 std::function<void(const std::filesystem::path&)> edited(std::function<void(MiniGltf&)> edit,
                                                            int form = 0) {
@@ -168,6 +176,18 @@ std::vector<BadCase> corpus() {
     g.doc["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}});
     g.doc["meshes"][0]["primitives"][0]["material"] = 0;
   }), "/images/0: cannot decode"});
+  // Camera transforms without a viewing direction failed later, in the rig, naming neither file nor node.
+  c.push_back({"camera_zero_scale", "a.gltf", edited([](MiniGltf& g) { add_camera(g, {{"scale", {0, 0, 0}}}); }),
+               "/nodes/1: the camera's transform (this node's with its parents') has zero scale"});
+  c.push_back({"camera_parent_zero_scale", "a.gltf", edited([](MiniGltf& g) {
+    const int cam = add_camera(g, json::object(), false);
+    g.add_node({{"scale", {1, 1, 0}}, {"children", {cam}}});
+  }), "/nodes/1: the camera's transform (this node's with its parents') has zero scale"});
+  c.push_back({"camera_up_along_view", "a.gltf", edited([](MiniGltf& g) {
+    add_camera(g, {{"matrix", {1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 3, 1}}});
+  }), "/nodes/1: the camera's transform (this node's with its parents') makes its up axis parallel"});
+  c.push_back({"rig_extras_huge_interaxial", "a.gltf", edited([](MiniGltf& g) { add_camera(g, {{"extras", {{"stereobench", {{"interaxial", 1e20}}}}}}); }),
+               "/nodes/1/extras/stereobench/interaxial: value 1e+20 m is beyond the 1e+15 m a scene may span"});
   c.push_back({"rig_extras_negative_convergence", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["extras"]["stereobench"]["convergence"] = -1; }), "/nodes/0/extras/stereobench/convergence: value -1 must be positive"});
   c.push_back({"zero_quaternion", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["rotation"] = {0, 0, 0, 0}; }), "/nodes/0/rotation: the quaternion has length zero"});
   c.push_back({"base_color_above_one", "a.gltf", edited([](MiniGltf& g) { g.doc["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorFactor", {2, 0.5, 0.5, 1}}}}}}); }), "/materials/0/pbrMetallicRoughness/baseColorFactor/0: value 2 is out of range [0, 1]"});
@@ -256,6 +276,28 @@ TEST(BadScenes, CommandLineExitsWithCode3AndNamesTheFault) {
     EXPECT_EQ(code, 3) << err;
     EXPECT_NE(err.find(bc.expect), std::string::npos) << err;
   }
+}
+
+TEST(BadScenes, RigExtrasOutOfRangeNameTheSceneAndTheirKeyAndOptionsTheirOption) {
+  ScratchDir dir("rigextras");
+  MiniGltf g;
+  g.add_triangle();
+  add_camera(g, {{"extras", {{"stereobench", {{"convergence", 1e-9}}}}}});
+  const auto path = dir / "tiny.gltf";
+  g.write_gltf(path);
+  const auto [code, err] = scene_info(path);
+  EXPECT_EQ(code, 3) << err;
+  EXPECT_NE(err.find(path.string() + ": /nodes/1/extras/stereobench/convergence: interaxial 0.064 m (the default) "
+                                     "with convergence 1e-09 m (the scene's) gives a disparity at infinity of"),
+            std::string::npos) << err;
+  EXPECT_NE(err.find("fix the scene's convergence"), std::string::npos) << err;
+  // An option overrides the scene's value, and an option's own fault is worded as the option's.
+  const auto overridden = test::run_cli("scenes info '" + path.string() + "' --convergence 2");
+  EXPECT_EQ(overridden.code, 0) << overridden.out;
+  const auto option = test::run_cli("scenes info '" + path.string() + "' --convergence 2 --interaxial 1e9");
+  EXPECT_EQ(option.code, 3) << option.out;
+  EXPECT_EQ(option.out.find("/extras/"), std::string::npos) << option.out;
+  EXPECT_NE(option.out.find("interaxial 1e+09 m"), std::string::npos) << option.out;
 }
 
 TEST(BadScenes, NonExistentPathAndDirectory) {
