@@ -166,9 +166,43 @@ bool has_scheme(const std::string& uri) {
   });
 }
 
-/// External buffers and images must exist, and buffers must hold their declared byteLength. A
-/// buffer without a uri is a .glb's BIN chunk, which the file must have.
-void check_external_files(const json& doc, const fs::path& dir, const std::string& file, const GlbParts& parts) {
+/// A path with a root ("/x", "\\server\x") or a Windows drive ("C:\x", "C:x"), after percent-decoding.
+bool is_absolute_path(const std::string& path) {
+  if (!path.empty() && (path[0] == '/' || path[0] == '\\')) return true;
+  return path.size() >= 2 && std::isalpha(static_cast<unsigned char>(path[0])) && path[1] == ':';
+}
+
+/// The one rule for external buffers and images, quoted by every message that enforces it.
+constexpr const char* kUriRule =
+    "buffers and images are read from paths relative to the scene file's folder (subfolders and '..' "
+    "are allowed) or from base64 data: URIs";
+
+/// The file an external URI names, resolved against the scene's folder. URIs with a scheme and
+/// absolute paths are refused here, before any file is looked at.
+fs::path resolve_uri(const std::string& uri, const fs::path& dir, const std::string& file, const std::string& where) {
+  if (has_scheme(uri))
+    throw InputError(fmt::format("{}: {}: '{}' is a {} URI; {} — copy the file next to the scene (or into a "
+                                 "folder below or beside it) and make the URI relative to the scene file",
+                                 file, where, uri, uri.substr(0, uri.find(':') + 1), kUriRule));
+  const std::string path = percent_decode(uri);
+  if (is_absolute_path(path))
+    throw InputError(fmt::format("{}: {}: '{}' is an absolute path; {} — make the URI relative to the scene "
+                                 "file's folder '{}'",
+                                 file, where, uri, kUriRule, dir.string()));
+  return dir / path;
+}
+
+/// The files an external URI check let through; tinygltf may read these and nothing else.
+using AllowedFiles = std::set<std::string>;
+
+std::string file_key(const fs::path& p) { return p.lexically_normal().string(); }
+
+/// External buffers and images must name files by the rule of kUriRule that exist, and buffers
+/// must hold their declared byteLength. A buffer without a uri is a .glb's BIN chunk, which the
+/// file must have. Returns the files the scene may read.
+AllowedFiles check_external_files(const json& doc, const fs::path& dir, const std::string& file,
+                                  const GlbParts& parts) {
+  AllowedFiles allowed;
   for (const char* top : {"buffers", "images"}) {
     auto it = doc.find(top);
     if (it == doc.end()) continue;
@@ -188,16 +222,12 @@ void check_external_files(const json& doc, const fs::path& dir, const std::strin
         continue;
       }
       const std::string where = fmt::format("/{}/{}/uri", top, i);
-      if (has_scheme(u->get<std::string>()))
-        throw InputError(fmt::format("{}: {}: '{}' is a URL; only files beside the scene (relative paths) and "
-                                     "base64 data URIs are read — copy the file beside the scene and give its "
-                                     "relative path",
-                                     file, where, u->get<std::string>()));
-      const fs::path p = dir / percent_decode(u->get<std::string>());
+      const fs::path p = resolve_uri(u->get<std::string>(), dir, file, where);
       std::error_code ec;
       if (!fs::exists(p, ec))
-        throw InputError(fmt::format("{}: {}: referenced file '{}' does not exist; put it beside the "
-                                     "scene or fix the uri", file, where, p.string()));
+        throw InputError(fmt::format("{}: {}: referenced file '{}' does not exist; URIs are relative to the "
+                                     "scene file's folder: put the file there or fix the uri", file, where,
+                                     p.string()));
       if (!fs::is_regular_file(p, ec))
         throw InputError(fmt::format("{}: {}: '{}' is {}, not a regular file; fix the uri", file, where, p.string(),
                                      fs::is_directory(p, ec) ? "a folder" : "a device, pipe or socket"));
@@ -209,8 +239,25 @@ void check_external_files(const json& doc, const fs::path& dir, const std::strin
                                        "{} or the file is inconsistent", file, where, p.string(), have, need,
                                        have < need ? "truncated" : "of another size"));
       }
+      allowed.insert(file_key(p));
     }
   }
+  return allowed;
+}
+
+/// tinygltf's file access limited to the files check_external_files let through. On its own it
+/// also looks in the working folder for a file missing from the scene's folder, and it decodes '+'
+/// in a URI as a space, so it could ask for another file than the one checked.
+bool allowed_file_exists(const std::string& path, void* allowed) {
+  return static_cast<const AllowedFiles*>(allowed)->count(file_key(path)) > 0;
+}
+
+bool read_allowed_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* allowed) {
+  if (!allowed_file_exists(path, allowed)) {
+    if (err) *err += fmt::format("'{}' is not a file the scene's URIs name", path);
+    return false;
+  }
+  return tinygltf::ReadWholeFile(out, err, path, nullptr);
 }
 
 /// Keeps the encoded bytes of an image; decoding happens in the converter through image_io.
@@ -865,10 +912,12 @@ Scene load_gltf(const fs::path& path, const GltfLoadOptions& options) {
   }
   check_gltf_json(doc, file);
   const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
-  check_external_files(doc, dir, file, parts);
+  AllowedFiles allowed = check_external_files(doc, dir, file, parts);
 
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(keep_image_bytes, nullptr);
+  loader.SetFsCallbacks({allowed_file_exists, tinygltf::ExpandFilePath, read_allowed_file, tinygltf::WriteWholeFile,
+                         &allowed});
   tinygltf::Model model;
   std::string err, warn;
   const bool ok = parts.is_glb

@@ -783,6 +783,21 @@ std::string sniff_format(std::span<const unsigned char> b) {
   return "";
 }
 
+/// What bytes without an image signature look like. The bytes themselves are not quoted: a scene
+/// may name any readable file as its image, and its error message must not show that file's
+/// contents. Text or not already tells the usual mistakes apart: a Git LFS pointer or a saved web
+/// page in the image's place.
+std::string describe_unrecognised(std::span<const unsigned char> b) {
+  constexpr std::string_view lfs = "version https://git-lfs";
+  if (b.size() >= lfs.size() && std::memcmp(b.data(), lfs.data(), lfs.size()) == 0)
+    return "it is a Git LFS pointer file, not the image; fetch the LFS objects (git lfs pull)";
+  const std::size_t n = std::min<std::size_t>(b.size(), 64);
+  const bool text = std::all_of(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(n), [](unsigned char c) {
+    return (c >= 0x20 && c < 0x7f) || c == '\n' || c == '\r' || c == '\t';
+  });
+  return text ? "it holds text, not image data" : "binary data without a known image signature";
+}
+
 /// Whether 8/16-bit samples of this spec are sRGB-encoded (unless the file says linear).
 bool is_srgb(const OIIO::ImageSpec& spec) {
   const std::string colour_space = lowercase(spec.get_string_attribute("oiio:ColorSpace"));
@@ -999,12 +1014,9 @@ DecodedImage decode_image(std::span<const unsigned char> bytes, const std::strin
     const std::string extension = lowercase(fs::path(name).extension().string());
     if (extension.size() > 1 && OIIO::is_imageio_format_name(extension.substr(1))) format = extension.substr(1);
   }
-  if (format.empty()) {
-    std::string head;
-    for (std::size_t i = 0; i < std::min<std::size_t>(bytes.size(), 8); ++i) head += fmt::format("{:02x} ", bytes[i]);
-    throw InputError(fmt::format(
-        "image {} is in a format OpenImageIO does not recognise (first bytes: {}); use PNG or JPEG", name, head));
-  }
+  if (format.empty())
+    throw InputError(fmt::format("image {} is in a format OpenImageIO does not recognise ({}); use PNG or JPEG",
+                                 name, describe_unrecognised(bytes)));
   return guarded_read(fs::path(name), [&] {
     OIIO::Filesystem::IOMemReader proxy(bytes.data(), bytes.size());
     auto in = OIIO::ImageInput::create(OIIO::string_view(format), false, nullptr, nullptr, OIIO::string_view());

@@ -201,7 +201,11 @@ std::vector<BadCase> corpus() {
   c.push_back({"number_overflows_double", "a.gltf", [](auto& p) { write_text(p, R"({"asset":{"version":"2.0"},"extras":{"count":35e400}})"); }, "its JSON exceeds what the reader accepts: number overflow parsing '35e400'"});
   // A folder or a device named as a file was reported as a file that does not exist.
   c.push_back({"image_uri_is_a_folder", "a.gltf", edited([](MiniGltf& g) { g.doc["images"] = json::array({{{"uri", "."}}}); }), "is a folder, not a regular file"});
-  c.push_back({"buffer_uri_is_a_device", "a.gltf", [](auto& p) { write_text(p, R"({"asset":{"version":"2.0"},"buffers":[{"uri":"/dev/zero","byteLength":12}]})"); }, "is a device, pipe or socket, not a regular file"});
+  c.push_back({"buffer_uri_is_a_device", "a.gltf", [](auto& p) {
+                 std::filesystem::create_symlink("/dev/zero", p.parent_path() / "zero.bin");
+                 write_text(p, R"({"asset":{"version":"2.0"},"buffers":[{"uri":"zero.bin","byteLength":12}]})");
+               },
+               "is a device, pipe or socket, not a regular file"});
   // glTF fills an accessor without a bufferView with zeros: every vertex at the origin, nothing to
   // see. The primitive is skipped (it may declare any count), and the empty scene says why.
   c.push_back({"positions_without_data", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0].erase("bufferView"); g.doc["accessors"][0]["count"] = 300000000; }),
@@ -230,10 +234,34 @@ std::vector<BadCase> corpus() {
                  write_text(p, bytes);
                },
                "the .glb's BIN chunk (at byte "});
+  // One rule for buffers and images, checked before any file is looked at: paths relative to the
+  // scene's folder or data: URIs. An absolute path to a file that exists was read by some routes
+  // and refused with the glTF library's words by others.
   for (const char* url : {"file:///etc/passwd", "https://example.com/a.bin"})
     c.push_back({std::string("buffer_url_") + url[0], "a.gltf",
                  edited([url](MiniGltf& g) { g.doc["buffers"] = json::array({{{"byteLength", 36}, {"uri", url}}}); }),
-                 fmt::format("/buffers/0/uri: '{}' is a URL; only files beside the scene", url)});
+                 fmt::format("/buffers/0/uri: '{}' is a {} URI; buffers and images are read from paths relative to "
+                             "the scene file's folder", url, std::string(url).substr(0, std::string(url).find(':') + 1))});
+  c.push_back({"image_url", "a.gltf", edited([](MiniGltf& g) { g.doc["images"] = json::array({{{"uri", "http://example.com/t.png"}}}); }),
+               "/images/0/uri: 'http://example.com/t.png' is a http: URI"});
+  c.push_back({"buffer_absolute_path_that_exists", "a.gltf", [](const std::filesystem::path& p) {
+                 MiniGltf g;
+                 g.add_triangle();
+                 g.write_gltf(p);
+                 g.doc["buffers"][0]["uri"] = std::filesystem::absolute(p.parent_path() / "a.bin").string();
+                 write_text(p, g.doc.dump());
+               },
+               "is an absolute path; buffers and images are read from paths relative"});
+  c.push_back({"buffer_absolute_path", "a.gltf", [](auto& p) { write_text(p, R"({"asset":{"version":"2.0"},"buffers":[{"uri":"/etc/passwd","byteLength":12}]})"); },
+               "/buffers/0/uri: '/etc/passwd' is an absolute path; buffers and images are read from paths relative to "
+               "the scene file's folder (subfolders and '..' are allowed) or from base64 data: URIs — make the URI "
+               "relative to the scene file's folder"});
+  c.push_back({"buffer_percent_encoded_absolute_path", "a.gltf", [](auto& p) { write_text(p, R"({"asset":{"version":"2.0"},"buffers":[{"uri":"%2Fetc%2Fpasswd","byteLength":12}]})"); },
+               "/buffers/0/uri: '%2Fetc%2Fpasswd' is an absolute path"});
+  c.push_back({"buffer_windows_drive", "a.gltf", [](auto& p) { write_text(p, R"({"asset":{"version":"2.0"},"buffers":[{"uri":"C:/scene/a.bin","byteLength":12}]})"); },
+               "/buffers/0/uri: 'C:/scene/a.bin' is an absolute path"});
+  c.push_back({"image_absolute_path", "a.gltf", edited([](MiniGltf& g) { g.doc["images"] = json::array({{{"uri", "/etc/hostname"}}}); }),
+               "/images/0/uri: '/etc/hostname' is an absolute path"});
   c.push_back({"missing_image_file", "a.gltf", edited([](MiniGltf& g) { g.doc["images"] = json::array({{{"uri", "nope.png"}}}); }), "/images/0/uri: referenced file"});
   return c;
 }

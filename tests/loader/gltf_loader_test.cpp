@@ -10,6 +10,7 @@
 #include <fmt/ranges.h>
 
 #include "renderer/color.hpp"
+#include "renderer/error.hpp"
 #include "renderer/io/gltf_loader.hpp"
 #include "renderer/io/image_io.hpp"
 #include "renderer/rig.hpp"
@@ -194,6 +195,48 @@ TEST(GltfLoader, ExternalEmbeddedAndBinaryContainersAgree) {
     ASSERT_EQ(s.meshes.size(), 1u);
     EXPECT_EQ(s.meshes[0].positions, scenes[0].meshes[0].positions);
     EXPECT_EQ(s.meshes[0].indices, scenes[0].meshes[0].indices);
+  }
+}
+
+TEST(GltfLoader, UrisAreRelativeToTheSceneFolderWithSubfoldersAndDotDot) {
+  ScratchDir dir("uris");
+  std::filesystem::create_directories(dir / "pack" / "scenes");
+  std::filesystem::create_directories(dir / "pack" / "data" / "bin");
+  MiniGltf g;
+  g.add_triangle();
+  g.finish_buffer("../data/bin/tri%20angle.bin");
+  MiniGltf::write_bytes(dir / "pack" / "data" / "bin" / "tri angle.bin", g.bin);
+  MiniGltf::write_text(dir / "pack" / "scenes" / "up.gltf", g.doc.dump());
+  EXPECT_EQ(io::load_gltf(dir / "pack" / "scenes" / "up.gltf").triangle_count(), 1u);
+
+  g.doc["buffers"][0]["uri"] = "scenes/../data/bin/tri%20angle.bin";
+  MiniGltf::write_text(dir / "pack" / "down.gltf", g.doc.dump());
+  EXPECT_EQ(io::load_gltf(dir / "pack" / "down.gltf").triangle_count(), 1u);
+}
+
+TEST(GltfLoader, AnImageThatIsNoImageIsNotQuotedInTheError) {
+  ScratchDir dir("notimage");
+  std::filesystem::create_directories(dir / "scene");
+  MiniGltf::write_text(dir / "notes.txt", "user:secret-token:1000:1000\n");
+  MiniGltf g;
+  const int pos = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  std::vector<float> uv = {0, 0, 1, 0, 0, 1};
+  const int uva = g.add_accessor(g.add_view(uv), 5126, 3, "VEC2");
+  g.doc["images"] = json::array({{{"uri", "../notes.txt"}}});
+  g.doc["textures"] = json::array({{{"source", 0}}});
+  g.doc["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}});
+  const int m = g.add_mesh(json::array({{{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uva}}}, {"material", 0}}}));
+  g.add_node({{"mesh", m}});
+  g.write_gltf(dir / "scene" / "s.gltf");
+  try {
+    (void)io::load_gltf(dir / "scene" / "s.gltf");
+    ADD_FAILURE() << "a text file loaded as an image";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("/images/0: cannot decode the image"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("it holds text, not image data"), std::string::npos) << msg;
+    EXPECT_EQ(msg.find("secret-token"), std::string::npos) << "the file's contents are quoted: " << msg;
+    EXPECT_EQ(msg.find("75 73 65 72"), std::string::npos) << "the file's contents are quoted: " << msg;
   }
 }
 
