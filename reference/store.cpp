@@ -232,6 +232,14 @@ std::optional<std::string> inconsistent_provenance(const json& prov, const std::
   return std::nullopt;
 }
 
+/// An id names one visible folder of the store: not a path, not "." or "..", not hidden.
+void check_entry_name(const std::string& id) {
+  if (id.empty() || id[0] == '.' || id.find_first_of("/\\") != std::string::npos)
+    throw InputError(fmt::format("'{}' is not a reference id (a folder name of the store, as `stereobench reference "
+                                 "list` prints it)",
+                                 id));
+}
+
 }  // namespace
 
 fs::path default_store_dir() { return fs::path(SB_SOURCE_DIR) / "reference" / "store"; }
@@ -266,6 +274,7 @@ std::vector<std::string> ReferenceStore::ids() const {
 }
 
 json ReferenceStore::provenance(const std::string& id) const {
+  check_entry_name(id);
   const fs::path file = root_ / id / kProvenance;
   std::error_code ec;
   if (fs::is_directory(root_ / id, ec) && !fs::exists(file, ec))
@@ -379,6 +388,7 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
 
 VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scenes_dir, const VerifyOptions& options,
                                     const Executor& executor) const {
+  check_entry_name(id);
   VerifyResult r;
   r.id = id;
   const fs::path prov_file = root_ / id / kProvenance;
@@ -431,15 +441,6 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
     return r;
   }
   const Prepared& p = *loaded;
-  // The folder's name is the id its spec gives: a renamed folder would be found under a name
-  // that `reference generate` never writes, and regenerated beside itself.
-  if (const std::string expected = reference_id(p.loaded.scene, spec, *p.rig); expected != id) {
-    r.status = Status::corrupt;
-    r.detail = fmt::format("{}: its spec makes the reference '{}', but the entry lies in folder '{}'; rename the "
-                           "folder back, or remove it and regenerate",
-                           prov_file.string(), expected, id);
-    return r;
-  }
   const std::string scene_hash = validation::hash_scene(p.loaded.scene);
   const json scene_record = prov.value("scene", json::object());
   const std::string recorded_scene = scene_record.is_object() && scene_record.contains("content_sha256") &&
@@ -467,6 +468,15 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
     r.detail = fmt::format("its spec now resolves to another rig than the recorded one (now {}, recorded {}): the "
                            "scene's camera or the rig defaults changed; regenerate the entry",
                            brief(rig_now), brief(recorded_rig));
+    return r;
+  }
+  // With scene and rig as recorded, the folder's name is the id its spec gives: a renamed folder
+  // would be found under a name that `reference generate` never writes, and regenerated beside it.
+  if (const std::string expected = reference_id(p.loaded.scene, spec, *p.rig); expected != id) {
+    r.status = Status::corrupt;
+    r.detail = fmt::format("{}: its spec makes the reference '{}', but the entry lies in folder '{}'; rename the "
+                           "folder back, or remove it and regenerate",
+                           prov_file.string(), expected, id);
     return r;
   }
   if (!options.rerender) {

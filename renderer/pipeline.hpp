@@ -41,7 +41,8 @@ struct PipelineInfo {
   void (*check_options)(const PipelineOptions&) = nullptr;
   /// Checks what the options cannot do with a rig (a buffer sized by the disparity, say), throwing
   /// InputError naming the option and what to change; callers run it for every chosen pipeline
-  /// (PipelineEntry::check_rig) before any of them renders.
+  /// (PipelineEntry::check_rig) before any of them renders with that rig (a sweep: for every cell
+  /// before the first runs).
   void (*check_rig)(const PipelineOptions&, const StereoRig&) = nullptr;
 };
 

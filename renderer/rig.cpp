@@ -6,6 +6,7 @@
 #include <utility>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "renderer/error.hpp"
 #include "renderer/scene.hpp"
@@ -235,26 +236,25 @@ StereoRig resolve_rig(const Scene& scene, const RigOverrides& o) {
     require_positive(p.convergence, "convergence", "give the zero-parallax distance in meters");
     p.interaxial = interaxial_from_max_disparity(*o.max_disparity_px, p.convergence, p.vfov, p.height);
   }
-  // A disparity out of range that the scene's extras set up is named by file and JSON path: the
-  // message must not read as if an option were at fault.
-  const bool e_from_scene = scene.rig.interaxial && !o.interaxial && !o.max_disparity_px;
-  const bool c_from_scene = scene.rig.convergence && !o.convergence;
+  // A disparity out of range that the scene's extras alone set up (no option gave the interaxial or
+  // the convergence) is named by file and JSON path: the message must not read as if an option were
+  // at fault. Where an option took part, RigParams::validate names the values as options.
+  const bool options_set_rig = o.interaxial || o.max_disparity_px || o.convergence;
   const bool vfov_ok = std::isfinite(p.vfov) && p.vfov > 0.0 && p.vfov < kPi;
-  if ((e_from_scene || c_from_scene) && !scene.rig.where.empty() && vfov_ok) {
+  if (!options_set_rig && (scene.rig.interaxial || scene.rig.convergence) && !scene.rig.where.empty() && vfov_ok) {
     const double disparity = max_disparity_from_interaxial(p.interaxial, p.convergence, p.vfov, p.height);
     if (!(disparity <= kMaxDisparityPx)) {
-      const char* key = c_from_scene ? "convergence" : "interaxial";
-      const auto source = [](bool from_scene, bool from_option, const char* option) {
-        return from_scene ? std::string("the scene's") : from_option ? fmt::format("from {}", option) : "the default";
-      };
+      std::vector<std::string> keys;
+      if (scene.rig.interaxial) keys.push_back(scene.rig.where + "/interaxial");
+      if (scene.rig.convergence) keys.push_back(scene.rig.where + "/convergence");
+      const auto origin = [](bool from_scene) { return from_scene ? "the scene's" : "the default"; };
       throw InputError(fmt::format(
-          "{}: {}/{}: interaxial {:g} m ({}) with convergence {:g} m ({}) gives a disparity at infinity of {:g} px at "
-          "{} px height and a vertical field of view of {:g} degrees, beyond the {:g} px a rig may have; fix the "
-          "scene's {} (a larger convergence or a smaller interaxial, in metres), or override it with --{}",
-          scene.path, scene.rig.where, key, p.interaxial, source(e_from_scene, o.interaxial || o.max_disparity_px,
-                                                                 "--interaxial/--max-disparity"),
-          p.convergence, source(c_from_scene, o.convergence.has_value(), "--convergence"), disparity, p.height,
-          radians_to_degrees(p.vfov), kMaxDisparityPx, key, key));
+          "{}: {}: interaxial {:g} m ({}) with convergence {:g} m ({}) gives a disparity at infinity of {:g} px at {} "
+          "px height and a vertical field of view of {:g} degrees, beyond the {:g} px a rig may have; fix the scene's "
+          "values (a larger convergence or a smaller interaxial, in metres), or override them with --convergence or "
+          "--interaxial",
+          scene.path, fmt::join(keys, " and "), p.interaxial, origin(scene.rig.interaxial.has_value()), p.convergence,
+          origin(scene.rig.convergence.has_value()), disparity, p.height, radians_to_degrees(p.vfov), kMaxDisparityPx));
     }
   }
   // Far plane far enough for the whole scene as seen from the camera.

@@ -3,7 +3,6 @@
 #include "scenes/catalog.hpp"
 
 #include <algorithm>
-
 #include <cmath>
 #include <cstdlib>
 

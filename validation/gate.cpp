@@ -302,10 +302,10 @@ GateConfig parse_gate_config(const std::string& text, const std::string& source)
     return std::any_of(values.begin(), values.end(),
                        [](const auto& kv) { return kv.first != kToleranceKey && kv.second.has_value(); });
   };
-  const bool any_limit = sets_limit(config.defaults) ||
-                         std::any_of(config.rules.begin(), config.rules.end(),
-                                     [&](const GateRule& r) { return sets_limit(r.values); });
-  if (!any_limit && !root.contains("regression"))
+  config.sets_limits = sets_limit(config.defaults) ||
+                       std::any_of(config.rules.begin(), config.rules.end(),
+                                   [&](const GateRule& r) { return sets_limit(r.values); });
+  if (!config.sets_limits && !root.contains("regression"))
     throw InputError(fmt::format("{}: the gate config sets no threshold and no [regression]: it would pass anything; "
                                  "give a limit a value in [defaults] or a [[rule]] (see docs/gate.md)",
                                  source));
@@ -872,10 +872,13 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
   }
   // A gate whose every threshold and regression check was skipped measured nothing: its pass
   // would be as empty as an empty config's (e.g. only [regression], and no baseline to compare with).
-  if (!results.cells.empty() && std::all_of(report.checks.begin(), report.checks.end(),
-                                            [](const GateCheck& c) { return c.verdict == Verdict::skip; }))
+  // An incomplete sweep is reported as such instead (a failure of the completeness check).
+  const std::optional<GateCheck> complete = completeness_check(results);
+  if (!results.cells.empty() && (!complete || complete->verdict == Verdict::pass) &&
+      std::all_of(report.checks.begin(), report.checks.end(),
+                  [](const GateCheck& c) { return c.verdict == Verdict::skip; }))
     throw InputError(nothing_checked_message(config, results, report.checks));
-  if (std::optional<GateCheck> complete = completeness_check(results)) report.checks.push_back(std::move(*complete));
+  if (complete) report.checks.push_back(*complete);
   if (std::optional<std::string> note = unused_rules_note(config, results, rule_used)) report.notes.push_back(*note);
   for (const GateCheck& c : report.checks) {
     ++report.counts[c.verdict];

@@ -89,6 +89,9 @@ struct GateConfig {
   ThresholdValues defaults;  ///< `[defaults]`
   std::vector<GateRule> rules;
   RegressionSettings regression;
+  /// Whether some table gives a threshold a value; without one, only time regressions against a
+  /// baseline are checked.
+  bool sets_limits = false;
 };
 
 /// Parses gate.toml text. InputError naming `source`, the line and the key for a syntax error, an

@@ -246,7 +246,6 @@ json timing_json(const PipelineBench& b, const BenchResult& r, int warmup) {
            share ? json(share->median) : json(nullptr)}};
 }
 
-/// Validates and times every pipeline of the definition in one cell; returns its results line.
 /// The timing of a cell: the definition's pipelines, baseline, repetitions and options.
 BenchConfig bench_config(const SweepDefinition& d) {
   BenchConfig bench;
@@ -258,6 +257,7 @@ BenchConfig bench_config(const SweepDefinition& d) {
   return bench;
 }
 
+/// Validates and times every pipeline of the definition in one cell; returns its results line.
 json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count, const SweepRunOptions& options,
               SceneCache& scenes_cache, const Executor& executor) {
   const auto start = std::chrono::steady_clock::now();

@@ -236,7 +236,10 @@ class Checker {
         // positions by w, which the renderer's affine transforms never do.
         const double row[4] = {(*m)[3].get<double>(), (*m)[7].get<double>(), (*m)[11].get<double>(),
                                (*m)[15].get<double>()};
-        if (row[0] != 0.0 || row[1] != 0.0 || row[2] != 0.0 || row[3] != 1.0)
+        // Within float rounding: an exporter may write 1 as 0.99999994.
+        constexpr double kTolerance = 1e-6;
+        if (std::abs(row[0]) > kTolerance || std::abs(row[1]) > kTolerance || std::abs(row[2]) > kTolerance ||
+            std::abs(row[3] - 1.0) > kTolerance)
           fail(p + "/matrix", fmt::format("its last row (elements 3, 7, 11 and 15; glTF matrices are column-major) is "
                                           "({:g}, {:g}, {:g}, {:g}), not (0, 0, 0, 1): a node matrix must be affine, "
                                           "decomposable into translation, rotation and scale; fix the matrix or give "

@@ -26,6 +26,7 @@
 #include "renderer/io/image_io.hpp"
 #include "renderer/io/json_text.hpp"
 #include "renderer/memory.hpp"
+#include "renderer/rig.hpp"
 #include "renderer/text.hpp"
 
 namespace sb::io {
@@ -192,8 +193,10 @@ fs::path resolve_uri(const std::string& uri, const fs::path& dir, const std::str
   return dir / path;
 }
 
-/// The files an external URI check let through; tinygltf may read these and nothing else.
-using AllowedFiles = std::set<std::string>;
+/// The files an external URI check let through, by the path tinygltf asks for: it decodes a URI
+/// in its own way ('+' as a blank, as in a query string), so "a+b.bin" reaches it as "a b.bin";
+/// it reads the file checked, and nothing else.
+using AllowedFiles = std::map<std::string, fs::path>;
 
 std::string file_key(const fs::path& p) { return p.lexically_normal().string(); }
 
@@ -239,25 +242,27 @@ AllowedFiles check_external_files(const json& doc, const fs::path& dir, const st
                                        "{} or the file is inconsistent", file, where, p.string(), have, need,
                                        have < need ? "truncated" : "of another size"));
       }
-      allowed.insert(file_key(p));
+      allowed.emplace(file_key(dir / tinygltf::dlib::urldecode(u->get<std::string>())), p);
     }
   }
   return allowed;
 }
 
 /// tinygltf's file access limited to the files check_external_files let through. On its own it
-/// also looks in the working folder for a file missing from the scene's folder, and it decodes '+'
-/// in a URI as a space, so it could ask for another file than the one checked.
+/// also looks in the working folder for a file missing from the scene's folder, and its decoding
+/// of a URI differs from RFC 3986's, so it could ask for another file than the one checked.
 bool allowed_file_exists(const std::string& path, void* allowed) {
   return static_cast<const AllowedFiles*>(allowed)->count(file_key(path)) > 0;
 }
 
 bool read_allowed_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* allowed) {
-  if (!allowed_file_exists(path, allowed)) {
+  const AllowedFiles& files = *static_cast<const AllowedFiles*>(allowed);
+  const auto it = files.find(file_key(path));
+  if (it == files.end()) {
     if (err) *err += fmt::format("'{}' is not a file the scene's URIs name", path);
     return false;
   }
-  return tinygltf::ReadWholeFile(out, err, path, nullptr);
+  return tinygltf::ReadWholeFile(out, err, it->second.string(), nullptr);
 }
 
 /// Keeps the encoded bytes of an image; decoding happens in the converter through image_io.
@@ -804,16 +809,19 @@ class Converter {
            fmt::format("places the camera at ({:g}, {:g}, {:g}) m, beyond the ±{:g} m a scene may span; check the "
                        "node's translation and the file's units",
                        world[3].x, world[3].y, world[3].z, kMaxSceneCoordinate));
-    // The rig's pose needs a viewing direction and an up axis that are not parallel.
-    const dvec3 up(world[1]), back(world[2]);
-    if (glm::length(back) == 0.0 || glm::length(up) == 0.0)
-      fail(fmt::format("/nodes/{}", ni), "the camera's transform (this node's with its parents') has zero scale, so "
-                                         "it has no viewing direction; fix the scale or matrix of the node or its "
-                                         "parents");
-    if (glm::length(glm::cross(up, glm::normalize(back))) < 1e-12)
-      fail(fmt::format("/nodes/{}", ni), "the camera's transform (this node's with its parents') makes its up axis "
-                                         "parallel to its viewing direction (a zero scale on one axis or a shear); "
-                                         "fix the scale or matrix of the node or its parents");
+    // The first camera is the rig's: its pose needs a viewing direction and an up axis that are not
+    // parallel, checked here so that the message names the node. Other cameras are not used (an
+    // exporter may hide one with a zero scale).
+    if (scene.cameras.empty()) {
+      try {
+        (void)CameraPose::from_matrix(world);
+      } catch (const InputError& e) {
+        fail(fmt::format("/nodes/{}", ni),
+             fmt::format("the camera's transform (this node's with its parents') cannot place the rig: {}; fix the "
+                         "scale or matrix of the node or its parents",
+                         e.what()));
+      }
+    }
     SceneCamera cam;
     cam.name = n.name.empty() ? (gc.name.empty() ? fmt::format("camera{}", n.camera) : gc.name) : n.name;
     cam.node = ni;

@@ -225,6 +225,10 @@ TEST(GateEval, AGateThatChecksNothingIsBadInputNotAPass) {
     EXPECT_NE(std::string(e.what()).find("every one was skipped (4 x time_regression: no baseline)"), std::string::npos)
         << e.what();
   }
+  // An unfinished sweep whose cells all skip fails its completeness check instead.
+  const validation::GateReport incomplete = evaluate({passing_cells()[0]}, {}, regression_only);
+  EXPECT_EQ(incomplete.worst, Verdict::fail);
+  EXPECT_EQ(validation::exit_code(incomplete.worst), 2);
   // With a baseline entry the regression is measured, and the gate stands.
   const std::vector<json> cells = passing_cells();
   validation::Baseline baseline;

@@ -178,14 +178,14 @@ std::vector<BadCase> corpus() {
   }), "/images/0: cannot decode"});
   // Camera transforms without a viewing direction failed later, in the rig, naming neither file nor node.
   c.push_back({"camera_zero_scale", "a.gltf", edited([](MiniGltf& g) { add_camera(g, {{"scale", {0, 0, 0}}}); }),
-               "/nodes/1: the camera's transform (this node's with its parents') has zero scale"});
+               "/nodes/1: the camera's transform (this node's with its parents') cannot place the rig: camera transform is degenerate (zero scale)"});
   c.push_back({"camera_parent_zero_scale", "a.gltf", edited([](MiniGltf& g) {
     const int cam = add_camera(g, json::object(), false);
     g.add_node({{"scale", {1, 1, 0}}, {"children", {cam}}});
-  }), "/nodes/1: the camera's transform (this node's with its parents') has zero scale"});
+  }), "/nodes/1: the camera's transform (this node's with its parents') cannot place the rig: camera transform is degenerate (zero scale)"});
   c.push_back({"camera_up_along_view", "a.gltf", edited([](MiniGltf& g) {
     add_camera(g, {{"matrix", {1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 3, 1}}});
-  }), "/nodes/1: the camera's transform (this node's with its parents') makes its up axis parallel"});
+  }), "/nodes/1: the camera's transform (this node's with its parents') cannot place the rig: camera transform is degenerate (up parallel to view direction)"});
   c.push_back({"rig_extras_huge_interaxial", "a.gltf", edited([](MiniGltf& g) { add_camera(g, {{"extras", {{"stereobench", {{"interaxial", 1e20}}}}}}); }),
                "/nodes/1/extras/stereobench/interaxial: value 1e+20 m is beyond the 1e+15 m a scene may span"});
   c.push_back({"rig_extras_negative_convergence", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["extras"]["stereobench"]["convergence"] = -1; }), "/nodes/0/extras/stereobench/convergence: value -1 must be positive"});
@@ -318,7 +318,7 @@ TEST(BadScenes, RigExtrasOutOfRangeNameTheSceneAndTheirKeyAndOptionsTheirOption)
   EXPECT_NE(err.find(path.string() + ": /nodes/1/extras/stereobench/convergence: interaxial 0.064 m (the default) "
                                      "with convergence 1e-09 m (the scene's) gives a disparity at infinity of"),
             std::string::npos) << err;
-  EXPECT_NE(err.find("fix the scene's convergence"), std::string::npos) << err;
+  EXPECT_NE(err.find("fix the scene's values"), std::string::npos) << err;
   // An option overrides the scene's value, and an option's own fault is worded as the option's.
   const auto overridden = test::run_cli("scenes info '" + path.string() + "' --convergence 2");
   EXPECT_EQ(overridden.code, 0) << overridden.out;
@@ -326,6 +326,19 @@ TEST(BadScenes, RigExtrasOutOfRangeNameTheSceneAndTheirKeyAndOptionsTheirOption)
   EXPECT_EQ(option.code, 3) << option.out;
   EXPECT_EQ(option.out.find("/extras/"), std::string::npos) << option.out;
   EXPECT_NE(option.out.find("interaxial 1e+09 m"), std::string::npos) << option.out;
+  // With the scene's convergence and an option's interaxial, the option is at fault, not the scene.
+  const auto mixed = test::run_cli("scenes info '" + path.string() + "' --interaxial 1e5");
+  EXPECT_EQ(mixed.code, 3) << mixed.out;
+  EXPECT_EQ(mixed.out.find("/extras/"), std::string::npos) << mixed.out;
+  // Both values from the scene: both keys named.
+  g.doc["nodes"][1]["extras"]["stereobench"]["interaxial"] = 0.07;
+  g.write_gltf(path);
+  const auto [both_code, both] = scene_info(path);
+  EXPECT_EQ(both_code, 3) << both;
+  EXPECT_NE(both.find("/nodes/1/extras/stereobench/interaxial and /nodes/1/extras/stereobench/convergence: interaxial "
+                      "0.07 m (the scene's) with convergence 1e-09 m (the scene's)"),
+            std::string::npos)
+      << both;
 }
 
 TEST(BadScenes, NonExistentPathAndDirectory) {

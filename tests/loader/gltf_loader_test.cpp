@@ -212,6 +212,12 @@ TEST(GltfLoader, UrisAreRelativeToTheSceneFolderWithSubfoldersAndDotDot) {
   g.doc["buffers"][0]["uri"] = "scenes/../data/bin/tri%20angle.bin";
   MiniGltf::write_text(dir / "pack" / "down.gltf", g.doc.dump());
   EXPECT_EQ(io::load_gltf(dir / "pack" / "down.gltf").triangle_count(), 1u);
+
+  // A '+' in a URI's path is the character itself (RFC 3986), not a blank as in a query string.
+  MiniGltf::write_bytes(dir / "pack" / "data" / "a+b.bin", g.bin);
+  g.doc["buffers"][0]["uri"] = "data/a+b.bin";
+  MiniGltf::write_text(dir / "pack" / "plus.gltf", g.doc.dump());
+  EXPECT_EQ(io::load_gltf(dir / "pack" / "plus.gltf").triangle_count(), 1u);
 }
 
 TEST(GltfLoader, AnImageThatIsNoImageIsNotQuotedInTheError) {
@@ -238,6 +244,20 @@ TEST(GltfLoader, AnImageThatIsNoImageIsNotQuotedInTheError) {
     EXPECT_EQ(msg.find("secret-token"), std::string::npos) << "the file's contents are quoted: " << msg;
     EXPECT_EQ(msg.find("75 73 65 72"), std::string::npos) << "the file's contents are quoted: " << msg;
   }
+}
+
+TEST(GltfLoader, OnlyTheRigsCameraNeedsAViewingDirection) {
+  ScratchDir dir("cams");
+  MiniGltf g;
+  g.add_triangle();
+  g.doc["cameras"] = json::array({{{"type", "perspective"}, {"perspective", {{"yfov", 0.7}, {"znear", 0.1}}}}});
+  g.add_node({{"name", "main"}, {"camera", 0}, {"translation", {0, 0, 3}}});
+  // A second camera hidden by a zero scale, as exporters do: not used, so not refused.
+  g.add_node({{"name", "hidden"}, {"camera", 0}, {"scale", {0, 0, 0}}});
+  g.write_gltf(dir / "two.gltf");
+  const Scene scene = io::load_gltf(dir / "two.gltf");
+  ASSERT_EQ(scene.cameras.size(), 2u);
+  EXPECT_EQ(scene.cameras.front().name, "main");
 }
 
 TEST(GltfLoader, BaseColourFactorAndEmbeddedTextureAreLinear) {

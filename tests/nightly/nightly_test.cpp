@@ -286,6 +286,23 @@ TEST(NightlyTest, MalformedHistoryIsBadInputNamingFileAndLine) {
   for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs")) run_folders += e.is_directory() ? 1 : 0;
   EXPECT_EQ(run_folders, 0u);
 
+  // A gate config of [regression] alone with no baseline file would check nothing: refused before
+  // the sweep, not after it.
+  write_text(dir / "reg-only.toml", "[regression]\ntolerance = 0.1\n");
+  // Run from the scratch folder, where the default baseline (ci/baseline.json) does not exist.
+  const test::CliRun reg_only =
+      run_shell("cd " + quoted(dir.path()) + " && " + SB_CLI_PATH + " nightly " + quoted(dir / "tiny.toml") + " --out " +
+                quoted(dir / "runs") + " --history " + quoted(dir / "fresh.jsonl") + " --gate-config " +
+                quoted(dir / "reg-only.toml") + " --scenes-dir " +
+                quoted(dir / "scenes") + " --cache '' --threads 1");
+  EXPECT_EQ(reg_only.code, 3) << reg_only.out;
+  EXPECT_NE(reg_only.out.find("sets no threshold, only [regression], and there is no baseline file ci/baseline.json"),
+            std::string::npos)
+      << reg_only.out;
+  run_folders = 0;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs")) run_folders += e.is_directory() ? 1 : 0;
+  EXPECT_EQ(run_folders, 0u);
+
   // `report --history` reads the history before the results: the message names the history's line.
   write_text(history, "not json\n");
   const test::CliRun r2 = test::run_cli("report " + quoted(dir / "none.jsonl") + " --out " + quoted(dir / "rep") +

@@ -188,7 +188,7 @@ TEST(ReferenceStore, AnEntryThatContradictsItsFolderIsCorrupt) {
   const std::string box = "box-wall_full_64x36_e64.0mm_c4.08m";
   const std::string pole = "thin-pole_full_48x32_e64.0mm_c2m";
   const json original = json::parse(test::read_text(store / pole / "provenance.json"));
-  const auto verify_pole = [&] { return test::run_cli(ref(dir, "verify") + " --no-render"); };
+  const auto verify_all = [&] { return test::run_cli(ref(dir, "verify") + " --no-render"); };
   const auto expect_corrupt = [&](const test::CliRun& r, const std::string& why) {
     EXPECT_EQ(r.code, 2) << r.out;
     EXPECT_NE(r.out.find("corrupt        " + pole), std::string::npos) << r.out;
@@ -198,11 +198,18 @@ TEST(ReferenceStore, AnEntryThatContradictsItsFolderIsCorrupt) {
 
   // An entry whose provenance is gone is still an entry: reported, never passed over.
   fs::rename(store / pole / "provenance.json", dir / "kept.json");
-  expect_corrupt(verify_pole(), (store / pole / "provenance.json").string() + " is missing");
+  expect_corrupt(verify_all(), (store / pole / "provenance.json").string() + " is missing");
   const test::CliRun list = test::run_cli(ref(dir, "list"));
   EXPECT_NE(list.out.find("2 reference(s)"), std::string::npos) << list.out;
   EXPECT_NE(list.out.find("1 of 2 reference(s) damaged"), std::string::npos) << list.out;
   fs::rename(dir / "kept.json", store / pole / "provenance.json");
+
+  // A path, or "." / "..", is no id: not taken for a (damaged) entry of the store.
+  for (const char* not_an_id : {"..", ".", "../store", "a/b"}) {
+    const test::CliRun r = test::run_cli(ref(dir, "verify") + " --no-render " + quoted(not_an_id));
+    EXPECT_EQ(r.code, 3) << not_an_id << ": " << r.out;
+    EXPECT_NE(r.out.find("is not a reference id"), std::string::npos) << r.out;
+  }
 
   // Fields that contradict the folder, the stored image or the spec.
   const std::pair<const char*, std::pair<json, const char*>> edits[] = {
@@ -218,7 +225,7 @@ TEST(ReferenceStore, AnEntryThatContradictsItsFolderIsCorrupt) {
       p[key] = edit.first;
     }
     std::ofstream(store / pole / "provenance.json", std::ios::trunc) << p.dump(2);
-    expect_corrupt(verify_pole(), edit.second);
+    expect_corrupt(verify_all(), edit.second);
   }
 
   // A folder renamed away from the id its spec gives, provenance edited to match.
