@@ -80,9 +80,11 @@ class Reprojector {
     row_.reserve(static_cast<size_t>(from.height) + 2);
     for (int j = -1; j <= from.height; ++j)
       row_.push_back((from.cy - lattice_y(j)) / from.f_px * matrix_[1] - matrix_[2]);
-    // Eyes that look the same way (any parallel rig) give every point the same clip w: the terms
-    // of one kind all carry one w, and 1/z none. The reciprocal is then taken once, exactly as
-    // every vertex would take it.
+    // Eyes that look the same way give every point the same clip w. Where the matrix shows it
+    // exactly (the terms of one kind all carry one w, and 1/z none: a rig whose camera is aligned
+    // with the world axes, as spheres', atrium's and bistro's are), the reciprocal is taken once,
+    // exactly as every vertex would take it. Rounding in the inverse of a turned camera's view
+    // leaves a w term of 1e-15 or so (temple, dragon), and every vertex divides.
     const auto same_w = [](const std::vector<dvec4>& terms) {
       return std::all_of(terms.begin(), terms.end(), [&](const dvec4& t) { return t.w == terms.front().w; });
     };
