@@ -73,7 +73,7 @@ CameraPose CameraPose::from_matrix(const dmat4& m) {
   p.back = glm::normalize(back);
   p.right = glm::cross(up, p.back);
   if (glm::length(p.right) < 1e-12)
-    throw InputError("camera transform is degenerate (up parallel to view direction)");
+    throw InputError("camera transform is degenerate (up parallel to view direction); fix the camera node's transform");
   p.right = glm::normalize(p.right);
   p.up = glm::cross(p.back, p.right);
   return p;

@@ -817,8 +817,8 @@ class Converter {
         (void)CameraPose::from_matrix(world);
       } catch (const InputError& e) {
         fail(fmt::format("/nodes/{}", ni),
-             fmt::format("the camera's transform (this node's with its parents') cannot place the rig: {}; fix the "
-                         "scale or matrix of the node or its parents",
+             fmt::format("the camera's transform (this node's with its parents') cannot place the rig: {} (or "
+                         "its parents')",
                          e.what()));
       }
     }
