@@ -44,6 +44,12 @@ try {
 // pipeline), 127,000 for the stacked bars; a chart of three single markers measured 127; an
 // empty plot area has 0.
 const MIN_CHART_DATA_PIXELS = 100;
+// A chart of a few single markers may show fewer: markers whose values coincide are drawn on one
+// another, and one on the edge of the plot area is cut in half (a nightly test's speed-up chart,
+// three markers from one timing repetition, measured 74). Such a chart needs this many per
+// distinct marker position Chart.js laid out, a third of one marker's 42 pixels, up to the
+// minimum above.
+const MIN_PIXELS_PER_POSITION = 14;
 // Share of an anaglyph canvas's screenshot that is not black: the smoke sweep's anaglyphs measured
 // 0.988-1.0 (box-wall's 0.987, black being its shadow); an undrawn canvas has nothing, i.e. 0.
 const MIN_ANAGLYPH_LIT_SHARE = 0.3;
@@ -129,14 +135,26 @@ try {
       const hi = Math.max(px[i], px[i + 1], px[i + 2]), lo = Math.min(px[i], px[i + 1], px[i + 2]);
       if (px[i + 3] > 128 && hi - lo > 80) saturated++;
     }
-    return { title: canvas.getAttribute('aria-label').split('.')[0], pixels: saturated };
+    // Distinct positions of the drawn data elements (markers, line points, bars).
+    const positions = new Set();
+    chart.data.datasets.forEach((_, i) => {
+      const meta = chart.getDatasetMeta(i);
+      if (meta.hidden) return;
+      for (const el of meta.data)
+        if (Number.isFinite(el.x) && Number.isFinite(el.y)) positions.add(`${Math.round(el.x)},${Math.round(el.y)}`);
+    });
+    return { title: canvas.getAttribute('aria-label').split('.')[0], pixels: saturated, positions: positions.size };
   }));
   // The charts of every report: speed-up vs resolution, PSNR, SSIM, MSE and holes vs interaxial,
   // per-stage time (a chart without a finite value is left out and named in the caption).
   const minCharts = 6;
   if (charts.length < minCharts) problems.push(`${charts.length} charts, expected at least ${minCharts}`);
-  for (const c of charts)
-    if (c.pixels < MIN_CHART_DATA_PIXELS) problems.push(`chart "${c.title}": ${c.pixels} data pixels (< ${MIN_CHART_DATA_PIXELS})${c.missing ? ', no chart object' : ''}`);
+  for (const c of charts) {
+    const need = c.missing ? MIN_CHART_DATA_PIXELS : Math.min(MIN_CHART_DATA_PIXELS, MIN_PIXELS_PER_POSITION * c.positions);
+    if (!c.missing && c.positions === 0) problems.push(`chart "${c.title}": no data element laid out`);
+    else if (c.pixels < need)
+      problems.push(`chart "${c.title}": ${c.pixels} data pixels (< ${need})${c.missing ? ', no chart object' : ''}`);
+  }
   report.charts = charts.map((c) => `${c.title}: ${c.pixels}`);
 
   // Trends (a report written with a history file): the median-time and gate-verdict charts always,
