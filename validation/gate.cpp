@@ -741,19 +741,25 @@ std::optional<std::string> unused_rules_note(const GateConfig& config, const Gat
       count == 1 ? "its" : "their", fmt::join(parts, "; "));
 }
 
-/// Why a gate measured nothing: its checks (all skipped) grouped by check and reason.
-std::string nothing_checked_message(const GateConfig& config, const GateResults& results,
-                                    const std::vector<GateCheck>& skipped) {
+/// The skipped checks, counted by (check, reason): every cell without a baseline entry is one line.
+std::map<std::pair<std::string, std::string>, int> skip_reasons(const std::vector<GateCheck>& checks) {
   std::map<std::pair<std::string, std::string>, int> reasons;
-  for (const GateCheck& c : skipped) ++reasons[{c.check, c.message}];
+  for (const GateCheck& c : checks)
+    if (c.verdict == Verdict::skip) ++reasons[{c.check, c.message}];
+  return reasons;
+}
+
+/// Why a gate measured nothing: its checks, all skipped, by reason.
+std::string nothing_checked_message(const GateConfig& config, const GateResults& results,
+                                    const std::vector<GateCheck>& checks) {
   std::vector<std::string> parts;
-  for (const auto& [why, count] : reasons) parts.push_back(fmt::format("{} x {}: {}", count, why.first, why.second));
-  return fmt::format("{}: none of its checks applies to {} ({} cell{}): {}; a pass would say nothing. Give limits the "
-                     "records carry in [defaults] or a [[rule]], or a baseline for [regression] (gate "
-                     "--update-baseline stores one)",
+  for (const auto& [why, count] : skip_reasons(checks))
+    parts.push_back(fmt::format("{} x {}: {}", count, why.first, why.second));
+  return fmt::format("{}: none of its checks applies to {} ({} cell{}): every one was skipped ({}); a pass would say "
+                     "nothing. Give limits the records carry in [defaults] or a [[rule]], or a baseline for "
+                     "[regression] (gate --update-baseline stores one)",
                      config.source, results.file.string(), results.cells.size(), results.cells.size() == 1 ? "" : "s",
-                     parts.empty() ? "no limit of the config matches a pipeline of the results"
-                                   : fmt::format("every one was skipped ({})", fmt::join(parts, "; ")));
+                     fmt::join(parts, "; "));
 }
 
 }  // namespace
@@ -917,11 +923,8 @@ std::string format_gate_table(const GateReport& report) {
       out << "        " << c.message << "\n";
       if (c.verdict == Verdict::fail) out << "        reproduce: " << c.reproduce << "\n";
     }
-  // Skipped checks, grouped by check and reason (e.g. every cell without a baseline entry).
-  std::map<std::pair<std::string, std::string>, int> skipped;
-  for (const GateCheck& c : report.checks)
-    if (c.verdict == Verdict::skip) ++skipped[{c.check, c.message}];
-  for (const auto& [key, n] : skipped) out << fmt::format("SKIP    {} x{}: {}\n", key.first, n, key.second);
+  for (const auto& [key, n] : skip_reasons(report.checks))
+    out << fmt::format("SKIP    {} x{}: {}\n", key.first, n, key.second);
   for (const std::string& note : report.notes) out << "note: " << note << "\n";
   auto count = [&](Verdict v) {
     const auto it = report.counts.find(v);
