@@ -152,6 +152,15 @@ bool names_file(const NamedPath& p) {
 
 }  // namespace
 
+void remove_earlier_output(const std::filesystem::path& path, const std::string& what) {
+  if (path.empty()) return;
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return;  // a folder is refused while the arguments are read
+  if (!std::filesystem::remove(path, ec) || ec)
+    throw IoError(fmt::format("cannot remove the earlier {} file {}: {}; make it writable or give another path", what,
+                              path.string(), ec ? ec.message() : "not removed"));
+}
+
 void prepare_output_folder(const std::string& folder, const char* option) {
   if (const auto why = io::unwritable_folder(folder))
     throw IoError(fmt::format("{} {}: {}; give a folder you can write", option, folder, *why));

@@ -1,6 +1,7 @@
 // Options shared by several subcommands (rig, scene folder), declared once with their help.
 #pragma once
 
+#include <filesystem>
 #include <initializer_list>
 #include <map>
 #include <optional>
@@ -65,6 +66,12 @@ void refuse_overwriting(std::initializer_list<NamedPath> inputs, std::initialize
 /// created in it, before any rendering: a folder that cannot be written fails at once, not after
 /// the work. IoError naming the option, the folder and the reason.
 void prepare_output_folder(const std::string& folder, const char* option);
+
+/// Removes what an earlier run left at an output path before this run writes anything, so that a
+/// run stopped on the way leaves no output that looks like its own (a CI step publishing a JUnit
+/// file finds none; records do not sit beside an earlier run's summary). `what` names the output
+/// in the message ("--junit", "summary"). IoError when it cannot be removed; nothing for an empty path.
+void remove_earlier_output(const std::filesystem::path& path, const std::string& what);
 
 /// The same for the folder of an output file (a --json written after a long benchmark); nothing
 /// for "" (no file), "-" (standard output) or a bare file name (the current folder).

@@ -73,19 +73,6 @@ void run_update(const GateArgs& a, const fs::path& file) {
                fewest, short_entries == 1 ? "it" : "them", min_repetitions);
 }
 
-/// Removes what an earlier gate run left at an output path, so that a run stopped by bad input
-/// leaves no verdict that looks like its own (a CI step publishing the JUnit file finds none).
-void remove_earlier_output(const std::string& path, const char* option) {
-  if (path.empty()) return;
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return;  // a folder is refused while the arguments are read
-  if (!fs::remove(path, ec) || ec)
-    throw IoError(
-        fmt::format("cannot remove the earlier {} file {} before gating: {}; make it writable or give "
-                    "another path",
-                    option, path, ec ? ec.message() : "not removed"));
-}
-
 void run_gate(const GateArgs& a) {
   // The default baseline counts as an input too: a report written over ci/baseline.json would lose
   // the stored timings.

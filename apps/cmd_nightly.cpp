@@ -217,11 +217,8 @@ void run_nightly(const NightlyArgs& a) {
   // stops on the way (exit 3 or 4) leaves no verdict behind; those of an earlier attempt at this
   // run go first.
   const fs::path junit_file = run_dir / "gate-junit.xml", gate_json_file = run_dir / "gate.json";
-  for (const fs::path& f : {junit_file, gate_json_file}) {
-    std::error_code ec;
-    fs::remove(f, ec);
-    if (ec) throw IoError(fmt::format("cannot remove the earlier {}: {}", f.string(), ec.message()));
-  }
+  remove_earlier_output(junit_file, "gate JUnit");
+  remove_earlier_output(gate_json_file, "gate JSON");
   const GateResults results = load_gate_results(o.results);
   GateReport gate =
       evaluate_gate(gate_config, results, baseline, registered_reproduce_settings());  // notes the read warnings

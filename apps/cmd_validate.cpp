@@ -94,8 +94,7 @@ void run_validate(const ValidateArgs& a) {
   // summary that looks complete but describes another run, should this one stop on the way.
   const std::string scene_stem = fmt::format("{}_{}", scene.file_stem(), provider->name());
   const fs::path summary = out / fmt::format("{}_summary.json", scene_stem);
-  if (std::error_code ec; fs::remove(summary, ec), ec)
-    throw IoError(fmt::format("cannot remove the earlier summary {}: {}", summary.string(), ec.message()));
+  remove_earlier_output(summary, "summary");
   const std::optional<validation::TruthCache> cache =
       a.no_cache || a.cache.empty() ? std::nullopt
                                     : std::optional<validation::TruthCache>(validation::TruthCache(a.cache));
