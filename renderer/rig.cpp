@@ -30,6 +30,18 @@ void require_positive(double value, const char* name, const char* hint) {
     throw InputError(fmt::format("{} must be a positive finite number, got {}; {}", name, value, hint));
 }
 
+/// InputError when the disparity at infinity exceeds what a rig may have.
+void check_disparity(const RigParams& p) {
+  const double disparity = max_disparity_from_interaxial(p.interaxial, p.convergence, p.vfov, p.height);
+  if (!(disparity <= kMaxDisparityPx))
+    throw InputError(fmt::format("interaxial {:g} m with convergence {:g} m gives a disparity at infinity of {:g} px "
+                                 "at {} px height and a vertical field of view of {:g} degrees, beyond the {:g} px a "
+                                 "rig may have; increase the convergence distance, reduce the interaxial or widen the "
+                                 "field of view",
+                                 p.interaxial, p.convergence, disparity, p.height, radians_to_degrees(p.vfov),
+                                 kMaxDisparityPx));
+}
+
 }  // namespace
 
 void RigParams::validate() const {
@@ -46,14 +58,7 @@ void RigParams::validate() const {
   if (!std::isfinite(vfov) || vfov <= 0.0 || vfov >= kPi)
     throw InputError(fmt::format("vertical field of view {} degrees is out of range (0, 180)",
                                  radians_to_degrees(vfov)));
-  const double disparity = max_disparity_from_interaxial(interaxial, convergence, vfov, height);
-  if (!(disparity <= kMaxDisparityPx))
-    throw InputError(fmt::format("interaxial {:g} m with convergence {:g} m gives a disparity at infinity of {:g} px "
-                                 "at {} px height and a vertical field of view of {:g} degrees, beyond the {:g} px a "
-                                 "rig may have; increase the convergence distance, reduce the interaxial or widen the "
-                                 "field of view",
-                                 interaxial, convergence, disparity, height, radians_to_degrees(vfov),
-                                 kMaxDisparityPx));
+  check_disparity(*this);
   require_positive(znear, "znear", "the near plane must lie in front of the camera");
   if (!std::isfinite(zfar) || zfar <= znear)
     throw InputError(fmt::format("zfar {} must be finite and greater than znear {}", zfar, znear));
@@ -242,19 +247,15 @@ StereoRig resolve_rig(const Scene& scene, const RigOverrides& o) {
   const bool options_set_rig = o.interaxial || o.max_disparity_px || o.convergence;
   const bool vfov_ok = std::isfinite(p.vfov) && p.vfov > 0.0 && p.vfov < kPi;
   if (!options_set_rig && (scene.rig.interaxial || scene.rig.convergence) && !scene.rig.where.empty() && vfov_ok) {
-    const double disparity = max_disparity_from_interaxial(p.interaxial, p.convergence, p.vfov, p.height);
-    if (!(disparity <= kMaxDisparityPx)) {
+    try {
+      check_disparity(p);
+    } catch (const InputError& e) {
       std::vector<std::string> keys;
       if (scene.rig.interaxial) keys.push_back(scene.rig.where + "/interaxial");
       if (scene.rig.convergence) keys.push_back(scene.rig.where + "/convergence");
-      const auto origin = [](bool from_scene) { return from_scene ? "the scene's" : "the default"; };
-      throw InputError(fmt::format(
-          "{}: {}: interaxial {:g} m ({}) with convergence {:g} m ({}) gives a disparity at infinity of {:g} px at {} "
-          "px height and a vertical field of view of {:g} degrees, beyond the {:g} px a rig may have; fix the scene's "
-          "values (a larger convergence or a smaller interaxial, in metres), or override them with --convergence or "
-          "--interaxial",
-          scene.path, fmt::join(keys, " and "), p.interaxial, origin(scene.rig.interaxial.has_value()), p.convergence,
-          origin(scene.rig.convergence.has_value()), disparity, p.height, radians_to_degrees(p.vfov), kMaxDisparityPx));
+      throw InputError(fmt::format("{}: {}: the scene's rig: {}; fix it in the scene (in metres), or override it with "
+                                   "--convergence or --interaxial",
+                                   scene.path, fmt::join(keys, " and "), e.what()));
     }
   }
   // Far plane far enough for the whole scene as seen from the camera.

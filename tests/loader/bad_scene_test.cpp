@@ -315,10 +315,10 @@ TEST(BadScenes, RigExtrasOutOfRangeNameTheSceneAndTheirKeyAndOptionsTheirOption)
   g.write_gltf(path);
   const auto [code, err] = scene_info(path);
   EXPECT_EQ(code, 3) << err;
-  EXPECT_NE(err.find(path.string() + ": /nodes/1/extras/stereobench/convergence: interaxial 0.064 m (the default) "
-                                     "with convergence 1e-09 m (the scene's) gives a disparity at infinity of"),
+  EXPECT_NE(err.find(path.string() + ": /nodes/1/extras/stereobench/convergence: the scene's rig: interaxial 0.064 m "
+                                     "with convergence 1e-09 m gives a disparity at infinity of"),
             std::string::npos) << err;
-  EXPECT_NE(err.find("fix the scene's values"), std::string::npos) << err;
+  EXPECT_NE(err.find("fix it in the scene (in metres), or override it with --convergence"), std::string::npos) << err;
   // An option overrides the scene's value, and an option's own fault is worded as the option's.
   const auto overridden = test::run_cli("scenes info '" + path.string() + "' --convergence 2");
   EXPECT_EQ(overridden.code, 0) << overridden.out;
@@ -335,8 +335,8 @@ TEST(BadScenes, RigExtrasOutOfRangeNameTheSceneAndTheirKeyAndOptionsTheirOption)
   g.write_gltf(path);
   const auto [both_code, both] = scene_info(path);
   EXPECT_EQ(both_code, 3) << both;
-  EXPECT_NE(both.find("/nodes/1/extras/stereobench/interaxial and /nodes/1/extras/stereobench/convergence: interaxial "
-                      "0.07 m (the scene's) with convergence 1e-09 m (the scene's)"),
+  EXPECT_NE(both.find("/nodes/1/extras/stereobench/interaxial and /nodes/1/extras/stereobench/convergence: the scene's "
+                      "rig: interaxial 0.07 m with convergence 1e-09 m"),
             std::string::npos)
       << both;
 }
