@@ -2,7 +2,6 @@
 // parameters) no longer matches.
 #include "scenes/catalog.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
@@ -94,24 +93,23 @@ fs::path resolve_scene(const std::string& spec, const fs::path& scenes_dir) {
                                    "name (see `stereobench scenes list`)", spec));
     return as_path;
   }
-  const GeneratorInfo* info = nullptr;
-  for (const GeneratorInfo& g : generators())
-    if (g.name == spec) info = &g;
+  const auto builtin = [](const std::string& name) -> const GeneratorInfo* {
+    for (const GeneratorInfo& g : generators())
+      if (g.name == name) return &g;
+    return nullptr;
+  };
+  const GeneratorInfo* info = builtin(spec);
   if (!info) {
-    std::string names;
-    for (const GeneratorInfo& g : generators()) names += (names.empty() ? "" : ", ") + g.name;
     // "spheres:count=5" is how a sweep names a generated variant; here it takes a file.
     const size_t colon = spec.find(':');
     const std::string base = spec.substr(0, colon);
-    const bool variant = colon != std::string::npos &&
-                         std::any_of(generators().begin(), generators().end(), [&](const GeneratorInfo& g) {
-                           return g.name == base;
-                         });
-    if (variant)
+    if (colon != std::string::npos && builtin(base) != nullptr)
       throw InputError(fmt::format("scene '{}': parameters in a scene's name are read by sweep definitions only; "
                                    "write the variant with `stereobench scenes generate {} --param KEY=VALUE`, "
                                    "then give the file it prints",
                                    spec, base));
+    std::string names;
+    for (const GeneratorInfo& g : generators()) names += (names.empty() ? "" : ", ") + g.name;
     throw InputError(fmt::format("unknown scene '{}': not a .gltf/.glb file and not a built-in scene ({})",
                                  spec, names));
   }
