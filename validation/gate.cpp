@@ -210,9 +210,10 @@ std::vector<double> record_samples(const json& entry) {
 /// Whether a check reads a time (the regression, or a metric of the record's "timing" block),
 /// which `stereobench bench` re-measures, rather than an image measure of `validate`.
 bool timed_check(std::string_view check) {
-  return check == kRegressionCheck || std::any_of(std::begin(kMetricChecks), std::end(kMetricChecks), [&](const MetricCheck& m) {
-           return check == m.name && std::string_view(m.pointer).starts_with("/timing/");
-         });
+  const auto reads_timing = [&](const MetricCheck& m) {
+    return check == m.name && std::string_view(m.pointer).starts_with("/timing/");
+  };
+  return check == kRegressionCheck || std::any_of(std::begin(kMetricChecks), std::end(kMetricChecks), reads_timing);
 }
 
 std::string value_text(const std::string& check, double v) {

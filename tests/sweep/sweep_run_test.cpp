@@ -493,35 +493,31 @@ TEST(SweepRun, BadDefinitionAndShardAreUsageErrors) {
                                              quoted(dir / "marked") + " --scenes-dir " + quoted(dir / "scenes"));
   EXPECT_EQ(damaged.code, 3) << damaged.out;
   EXPECT_NE(damaged.out.find("holds the cells of sweep '?'"), std::string::npos) << damaged.out;
-  // A cell whose rig cannot be (the last one here: a convergence that puts the disparity at
-  // infinity beyond any image) is refused before the first cell runs; it used to stop the sweep
-  // only when its turn came, after the cells before it.
-  std::ofstream(dir / "near.toml") << "[sweep]\nname = \"near\"\nscenes = [\"box-wall\"]\npipelines = [\"plain-rt\"]\n"
-                                      "convergence_m = [2.0, 1e-300]\nresolutions = [\"96x54\"]\n";
-  const test::CliRun near = test::run_cli("sweep run " + quoted(dir / "near.toml") + " --out " + quoted(dir / "n") +
-                                          " --scenes-dir " + quoted(dir / "scenes"));
-  EXPECT_EQ(near.code, 3) << near.out;
-  EXPECT_NE(near.out.find((dir / "near.toml").string() + ": cell 1 "), std::string::npos) << near.out;
-  EXPECT_NE(near.out.find("fix the definition (no cell has run)"), std::string::npos) << near.out;
-  EXPECT_EQ(near.out.find("[1/2]"), std::string::npos) << "no cell may run: " << near.out;
-  EXPECT_FALSE(fs::exists(dir / "n" / "results.jsonl"));
-  // So is a cell whose rig a pipeline cannot work with: at a convergence of 1 mm the max disparity
-  // at 96x54 is some 3000 px, and rt-buffer's default depth 2e exceeds its limit.
-  std::ofstream(dir / "deep.toml") << "[sweep]\nname = \"deep\"\nscenes = [\"box-wall\"]\n"
-                                      "pipelines = [\"plain-rt\", \"rt-buffer\"]\nconvergence_m = [2.0, 0.001]\n"
-                                      "resolutions = [\"96x54\"]\n";
-  const test::CliRun deep = test::run_cli("sweep run " + quoted(dir / "deep.toml") + " --out " + quoted(dir / "d") +
-                                          " --scenes-dir " + quoted(dir / "scenes"));
-  EXPECT_EQ(deep.code, 3) << deep.out;
-  EXPECT_NE(deep.out.find((dir / "deep.toml").string() + ": cell 1 "), std::string::npos) << deep.out;
-  EXPECT_NE(deep.out.find("rt-buffer: the default depth t = 2 x max disparity"), std::string::npos) << deep.out;
-  EXPECT_EQ(deep.out.find("[1/2]"), std::string::npos) << "no cell may run: " << deep.out;
-  EXPECT_FALSE(fs::exists(dir / "d" / "results.jsonl"));
+  // A definition with a cell that cannot run is refused before the first cell runs, naming the
+  // cell (the last of two here); it used to stop the sweep only when its turn came.
+  const auto refused = [&](const std::string& name, const std::string& axes, const std::string& message) {
+    std::ofstream(dir / (name + ".toml")) << "[sweep]\nname = \"" << name << "\"\nscenes = [\"box-wall\"]\n" << axes
+                                          << "resolutions = [\"96x54\"]\n";
+    const test::CliRun r = test::run_cli("sweep run " + quoted(dir / (name + ".toml")) + " --out " +
+                                         quoted(dir / name) + " --scenes-dir " + quoted(dir / "scenes"));
+    EXPECT_EQ(r.code, 3) << r.out;
+    EXPECT_NE(r.out.find((dir / (name + ".toml")).string() + ": cell 1 "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(message), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("[1/2]"), std::string::npos) << "no cell may run: " << r.out;
+    EXPECT_FALSE(fs::exists(dir / name / "results.jsonl"));
+  };
+  // A rig that cannot be: a convergence that puts the disparity at infinity beyond any image.
+  refused("near", "pipelines = [\"plain-rt\"]\nconvergence_m = [2.0, 1e-300]\n",
+          "fix the definition (no cell has run)");
+  // A rig a pipeline cannot work with: at a convergence of 1 mm the max disparity at 96x54 is some
+  // 3000 px, and rt-buffer's default depth 2e exceeds its limit.
+  refused("deep", "pipelines = [\"plain-rt\", \"rt-buffer\"]\nconvergence_m = [2.0, 0.001]\n",
+          "rt-buffer: the default depth t = 2 x max disparity");
   // Fixed, it runs into the same folder: the refused run did not claim it for the old definition.
   std::ofstream(dir / "near.toml", std::ios::trunc)
       << "[sweep]\nname = \"near\"\nscenes = [\"box-wall\"]\npipelines = [\"plain-rt\"]\n"
          "convergence_m = [2.0, 3.0]\nresolutions = [\"96x54\"]\n[timing]\nrepetitions = 1\nwarmup = 0\n";
-  const test::CliRun fixed = test::run_cli("sweep run " + quoted(dir / "near.toml") + " --out " + quoted(dir / "n") +
+  const test::CliRun fixed = test::run_cli("sweep run " + quoted(dir / "near.toml") + " --out " + quoted(dir / "near") +
                                            " --scenes-dir " + quoted(dir / "scenes"));
   EXPECT_EQ(fixed.code, 0) << fixed.out;
 }
