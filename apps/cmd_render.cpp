@@ -3,12 +3,14 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <fmt/format.h>
 
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
+#include "renderer/error.hpp"
 #include "renderer/io/render_output.hpp"
 #include "renderer/memory.hpp"
 #include "renderer/pipeline.hpp"
@@ -58,6 +60,10 @@ void print_holes(const HoleAnalysis& h, size_t pixels) {
 
 void run_render(const RenderArgs& a) {
   const RigOverrides overrides = a.rig.overrides();
+  if (a.pipeline.find(',') != std::string::npos || a.pipeline == "all")
+    throw InputError(fmt::format("--pipeline {}: render renders one pipeline; give one name, or measure several side "
+                                 "by side with `stereobench validate` or `stereobench bench`",
+                                 a.pipeline));
   const PipelineEntry entry = parse_pipeline_entry(a.pipeline);
   const Pipeline& pipeline = *entry.pipeline;
   const PipelineOptions options = entry.options(parse_key_values(a.options, "--option"));

@@ -359,6 +359,8 @@ TEST(Cli, RenderAndBenchRejectBadArguments) {
   struct Case { std::string args; std::string expect; };
   const Case cases[] = {
       {"render --scene box-wall --pipeline warp-drive" + common, "unknown pipeline 'warp-drive'"},
+      {"render --scene box-wall --pipeline plain-rt,plain-raster" + common, "render renders one pipeline"},
+      {"render --scene box-wall --pipeline all" + common, "`stereobench validate` or `stereobench bench`"},
       {"render --scene box-wall --pipeline plain-raster --option tile=3" + common, "tile=3 is out of range"},
       {"render --scene box-wall --pipeline plain-raster --option tiles=32" + common, "has no option 'tiles'"},
       {"render --scene box-wall --pipeline plain-raster:tile=3" + common,
