@@ -49,7 +49,7 @@ double peak_rss_mib() {
 /// folder made: all before any scene is loaded.
 BenchConfig bench_config(const BenchArgs& a, const std::vector<std::string>& default_pipelines) {
   BenchConfig config;
-  config.pipelines = split_list(a.pipelines, "--pipelines");
+  config.pipelines = expand_all_pipelines(split_list(a.pipelines, "--pipelines"), "--pipelines");
   if (config.pipelines.empty()) config.pipelines = default_pipelines;
   config.baseline = a.baseline;
   if (std::find(config.pipelines.begin(), config.pipelines.end(), config.baseline) == config.pipelines.end())
@@ -83,9 +83,7 @@ void run_preset_command(const BenchArgs& a) {
 
 void run_bench_command(const BenchArgs& a) {
   const RigOverrides overrides = a.rig.overrides();
-  std::vector<std::string> all;
-  for (const Pipeline* p : pipelines()) all.push_back(p->info().name);
-  const BenchConfig config = bench_config(a, all);
+  const BenchConfig config = bench_config(a, pipeline_names());
   const Executor executor(checked_threads(a.threads));
   const scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
   const std::string scene_file = loaded.file.string();
@@ -164,9 +162,9 @@ void register_bench_command(CLI::App& root) {
   CLI::App* b = root.add_subcommand("bench", "Time pipelines side by side: medians per stage, throughput, speed-ups, and the right eye's time beside the left eye's");
   b->add_option("--scene,-s", a->scene, "Scene file (.gltf/.glb) or built-in scene name")->capture_default_str();
   b->add_option("--pipelines,-p", a->pipelines,
-                "Pipelines to time, comma-separated (default: all registered; with --preset, the preset's); "
-                "NAME:KEY=VALUE[:KEY=VALUE...] times a variant with those options, beside NAME itself "
-                "(e.g. bidir-warp,bidir-warp:occlusion=ztest)");
+                "Pipelines to time, comma-separated, 'all' for every registered one (default: all; with --preset, "
+                "the preset's); NAME:KEY=VALUE[:KEY=VALUE...] times a variant with those options, beside NAME "
+                "itself (e.g. bidir-warp,bidir-warp:occlusion=ztest)");
   CLI::Option* baseline = b->add_option("--baseline,-b", a->baseline,
                                         "Pipeline the speed-ups are measured against (with --preset: the preset's)")
                               ->capture_default_str();

@@ -50,7 +50,7 @@ std::vector<PipelineEntry> chosen_pipelines(const std::vector<std::string>& name
   };
   for (const std::string& name : split_list(names, "--pipelines")) {
     if (name == "all")
-      for (const Pipeline* p : pipelines()) add(p->info().name);
+      for (const std::string& n : pipeline_names()) add(n);
     else
       add(name);
   }

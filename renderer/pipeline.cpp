@@ -32,11 +32,35 @@ std::vector<const Pipeline*> pipelines() {
   return out;
 }
 
+std::vector<std::string> pipeline_names() {
+  std::vector<std::string> names;
+  for (const Pipeline* p : pipelines()) names.push_back(p->info().name);
+  return names;
+}
+
+std::vector<std::string> expand_all_pipelines(const std::vector<std::string>& names, const std::string& what) {
+  std::vector<std::string> out;
+  bool all = false;
+  const auto listed = [&out](const std::string& name) { return std::find(out.begin(), out.end(), name) != out.end(); };
+  for (const std::string& name : names) {
+    if (name == "all") {
+      all = true;
+      for (const std::string& n : pipeline_names())
+        if (!listed(n)) out.push_back(n);
+      continue;
+    }
+    if (all && listed(name))
+      throw InputError(fmt::format("{}: '{}' is one of the pipelines 'all' includes; drop one of them", what, name));
+    out.push_back(name);
+  }
+  return out;
+}
+
 const Pipeline& find_pipeline(const std::string& name) {
   for (const Pipeline* p : pipelines())
     if (p->info().name == name) return *p;
   std::string names;
-  for (const Pipeline* p : pipelines()) names += (names.empty() ? "" : ", ") + p->info().name;
+  for (const std::string& n : pipeline_names()) names += (names.empty() ? "" : ", ") + n;
   throw InputError(fmt::format("unknown pipeline '{}'; registered pipelines: {}", name, names));
 }
 

@@ -227,12 +227,6 @@ SweepScene parse_scene_entry(const Where& where, const toml::node& node, const s
   return s;
 }
 
-std::vector<std::string> all_pipeline_names() {
-  std::vector<std::string> names;
-  for (const Pipeline* p : pipelines()) names.push_back(p->info().name);
-  return names;
-}
-
 void parse_pipelines(const Where& where, const toml::node& node, SweepDefinition& d) {
   const std::string path = "sweep.pipelines";
   std::vector<std::string> names;
@@ -241,7 +235,7 @@ void parse_pipelines(const Where& where, const toml::node& node, SweepDefinition
     const std::string name = string_at(where, *e, path);
     if (name == "all") {
       all = true;
-      for (const std::string& n : all_pipeline_names())
+      for (const std::string& n : pipeline_names())
         if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
       continue;
     }
@@ -478,7 +472,7 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
   }
 
   // Pipelines and the baseline.
-  d.pipelines = all_pipeline_names();
+  d.pipelines = pipeline_names();
   if (const toml::node* n = sweep.get("pipelines")) parse_pipelines(where, *n, d);
   if (const toml::node* n = sweep.get("baseline")) {
     d.baseline = string_at(where, *n, "sweep.baseline");

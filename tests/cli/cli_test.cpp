@@ -11,6 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "renderer/pipeline.hpp"
+
 #include "support/mini_gltf.hpp"
 #include "support/run_cli.hpp"
 #include "support/scratch_dir.hpp"
@@ -207,6 +209,13 @@ TEST(Cli, RenderWritesEveryOutputAndBenchPrintsATable) {
   ASSERT_EQ(b.code, 0) << b.out;
   EXPECT_NE(b.out.find("ideal-copy"), std::string::npos) << b.out;
   EXPECT_NE(b.out.find("speed-up"), std::string::npos) << b.out;
+  // 'all' times every registered pipeline, beside a variant named after it.
+  const CliRun every =
+      run("bench --scene box-wall --pipelines all,bidir-warp:occlusion=ztest --baseline plain-rt -n 1 -w 0" + common);
+  ASSERT_EQ(every.code, 0) << every.out;
+  for (const std::string& name : pipeline_names())
+    EXPECT_NE(every.out.find("\n" + name + " "), std::string::npos) << name << "\n" << every.out;
+  EXPECT_NE(every.out.find("\nbidir-warp:occlusion=ztest "), std::string::npos) << every.out;
 
   const CliRun l = run("pipelines");
   EXPECT_EQ(l.code, 0);
@@ -391,6 +400,8 @@ TEST(Cli, RenderAndBenchRejectBadArguments) {
        "--repetitions 20000 is outside 1..10000"},
       {"bench --scene box-wall --pipelines plain-rt,plain-rt --baseline plain-rt" + bench_common,
        "--pipelines names 'plain-rt' twice"},
+      {"bench --scene box-wall --pipelines all,ideal-copy --baseline plain-rt" + bench_common,
+       "--pipelines: 'ideal-copy' is one of the pipelines 'all' includes; drop one of them"},
   };
   for (const Case& c : cases) {
     const CliRun r = run(c.args);
