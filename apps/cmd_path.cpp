@@ -79,7 +79,8 @@ void run_path_command(const PathArgs& a) {
   }
   run.path.validate();
   const RigOverrides overrides = a.rig.overrides();
-  run.pipelines = parse_pipeline_entries(split_list(a.pipelines, "--pipelines"), "--pipelines");
+  run.pipelines =
+      parse_pipeline_entries(expand_all_pipelines(split_list(a.pipelines, "--pipelines"), "--pipelines"), "--pipelines");
   for (const PipelineEntry& e : run.pipelines) (void)e.options();  // a variant's options, before any frame
   const std::unique_ptr<validation::TruthProvider> provider = validation::make_truth_provider(a.truth);
   if (auto why = provider->unavailable_reason())
@@ -144,7 +145,8 @@ void register_path_command(CLI::App& root) {
       "measured against the ground truth. Writes <out>/<scene>_path.jsonl (one line per frame).");
   p->add_option("--scene,-s", a->scene, "Scene file (.gltf/.glb) or built-in scene name")->capture_default_str();
   p->add_option("--pipelines,-p", a->pipelines,
-                "Pipelines to run each frame; a variant NAME:KEY=VALUE[:KEY=VALUE...] runs with those options")
+                "Pipelines to run each frame, comma-separated, 'all' for every registered one; a variant "
+                "NAME:KEY=VALUE[:KEY=VALUE...] runs with those options")
       ->capture_default_str();
   p->add_option("--truth", a->truth, "Ground truth: full, blender or povray")->capture_default_str();
   p->add_option("--frames,-n", a->frames, "Number of frames")->capture_default_str();

@@ -56,6 +56,11 @@ TEST(PathCommand, BadInput) {
   EXPECT_NE(variant.out.find("pipeline entry 'repro-rt:threshold_arcmin=-1'"), std::string::npos) << variant.out;
   const test::CliRun twice = test::run_cli(args(dir) + " --pipelines plain-rt,plain-rt");
   EXPECT_EQ(twice.code, 3) << twice.out;
+  // 'all' stands for every registered pipeline, so naming one of them beside it is a repeat too.
+  const test::CliRun beside_all = test::run_cli(args(dir) + " --pipelines all,repro-rt");
+  EXPECT_EQ(beside_all.code, 3) << beside_all.out;
+  EXPECT_NE(beside_all.out.find("'repro-rt' is one of the pipelines 'all' includes"), std::string::npos)
+      << beside_all.out;
   EXPECT_EQ(test::run_cli(args(dir) + " --camera-keys '1,2,3'").code, 3);
   EXPECT_EQ(test::run_cli(args(dir) + " --spin-deg 5 --spin-prefix nothing-like-this").code, 3);
   EXPECT_EQ(test::run_cli(args(dir) + " --spin-deg 5 --truth blender").code, 3);
