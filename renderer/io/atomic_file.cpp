@@ -2,9 +2,11 @@
 #include "renderer/io/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cerrno>
 #include <cstring>
@@ -23,10 +25,54 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// This machine's name as it goes into temporary names ("host" when it has none).
+const std::string& host_name() {
+  static const std::string name = [] {
+    std::array<char, 256> buf{};
+    if (::gethostname(buf.data(), buf.size() - 1) != 0 || buf[0] == '\0') return std::string("host");
+    return std::string(buf.data());
+  }();
+  return name;
+}
+
+/// The process that made temporary file `name` (".FILE.tmp-HOST-PID-N") on this machine, or 0
+/// when the name is not one of ours or names another machine (a folder on shared storage).
+pid_t temporary_owner(const std::string& name, const std::string& prefix) {
+  if (!name.starts_with(prefix)) return 0;
+  const std::string rest = name.substr(prefix.size());
+  const size_t last = rest.rfind('-');
+  if (last == std::string::npos || last == 0) return 0;
+  const size_t before = rest.rfind('-', last - 1);
+  if (before == std::string::npos || rest.substr(0, before) != host_name()) return 0;
+  const std::string pid = rest.substr(before + 1, last - before - 1);
+  const std::string n = rest.substr(last + 1);
+  const auto digits = [](const std::string& t) {
+    return !t.empty() && t.size() < 10 && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
+  };
+  return digits(pid) && digits(n) ? static_cast<pid_t>(std::stol(pid)) : 0;
+}
+
+/// Removes the temporary files an earlier write of `path` left behind when its process was killed
+/// (SIGKILL, a node's job limit, a power cut) before it could remove them: those of processes of
+/// this machine that no longer run. Best effort; a live process's file is never touched.
+void remove_stale_temporaries(const fs::path& path) {
+  const std::string prefix = fmt::format(".{}.tmp-", path.filename().string());
+  const fs::path folder = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  std::error_code ec;
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    const pid_t owner = temporary_owner(it->path().filename().string(), prefix);
+    if (owner <= 0 || owner == ::getpid()) continue;
+    if (::kill(owner, 0) == 0 || errno != ESRCH) continue;  // running (or not ours to ask about)
+    std::error_code ignored;
+    fs::remove(it->path(), ignored);
+  }
+}
+
 fs::path temporary_name(const fs::path& path) {
   static std::atomic<unsigned> counter{0};
+  remove_stale_temporaries(path);
   return path.parent_path() /
-         fmt::format(".{}.tmp-{}-{}", path.filename().string(), ::getpid(), counter++);
+         fmt::format(".{}.tmp-{}-{}-{}", path.filename().string(), host_name(), ::getpid(), counter++);
 }
 
 void sync_file(const fs::path& path) {

@@ -7,6 +7,7 @@
 
 #include <fcntl.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <array>
@@ -380,6 +381,35 @@ TEST_F(ImageIoTest, FailureInsideWriteAtomicallyLeavesNoFileAndNoTemporary) {
                InputError);
   EXPECT_EQ(entries(), std::vector<std::string>{"out.bin"});
   EXPECT_EQ(read_bytes(file), std::vector<unsigned char>{42});
+}
+
+TEST_F(ImageIoTest, AKilledWritesTemporaryGoesWhenTheFileIsWrittenAgain) {
+  // A process of this machine that has ended: a child that exits at once, reaped.
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) ::_exit(0);
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  std::array<char, 256> host{};
+  ASSERT_EQ(::gethostname(host.data(), host.size() - 1), 0);
+  const std::string here = host.data();
+  const std::string dead = std::to_string(child);
+  const std::string alive = std::to_string(::getppid());  // the process that started this test
+  const std::vector<std::string> kept = {
+      ".out.json.tmp-" + here + "-" + alive + "-0",         // a write still running
+      ".out.json.tmp-elsewhere-" + dead + "-0",             // another machine's (shared storage)
+      ".other.json.tmp-" + here + "-" + dead + "-0",        // another file's, left for its own next write
+      ".out.json.tmp-" + dead + "-0",                       // no machine named: not ours to judge
+      "notes.txt"};
+  const std::string stale = ".out.json.tmp-" + here + "-" + dead + "-7";
+  for (const std::string& name : kept) std::ofstream(path(name)) << "partial";
+  std::ofstream(path(stale)) << "partial";
+
+  io::write_text_atomically(path("out.json"), "whole");
+  EXPECT_FALSE(fs::exists(path(stale)));
+  for (const std::string& name : kept) EXPECT_TRUE(fs::exists(path(name))) << name;
+  std::ifstream in(path("out.json"));
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "whole");
 }
 
 TEST_F(ImageIoTest, WritingThroughALinkReplacesItsTargetAndKeepsTheLink) {
