@@ -221,9 +221,7 @@ void prepare_out_dir(const fs::path& out) {
       fs::remove_all(out / sub, ec);
       if (ec) throw IoError(fmt::format("cannot remove the earlier report's {}: {}", (out / sub).string(), ec.message()));
     }
-    // An index being written when a run was killed.
-    for (const fs::directory_entry& e : fs::directory_iterator(out, ec))
-      if (e.path().filename().string().starts_with(".index.html.tmp-")) fs::remove(e.path(), ec);
+    // An index being written when a run was killed is removed when the new index is written.
   }
   fs::create_directories(out, ec);
   if (ec) throw IoError(fmt::format("cannot create the report folder {}: {}", out.string(), ec.message()));

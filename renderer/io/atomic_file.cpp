@@ -2,17 +2,18 @@
 #include "renderer/io/atomic_file.hpp"
 
 #include <fcntl.h>
-#include <signal.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <new>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -25,54 +26,63 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// This machine's name as it goes into temporary names ("host" when it has none).
-const std::string& host_name() {
-  static const std::string name = [] {
-    std::array<char, 256> buf{};
-    if (::gethostname(buf.data(), buf.size() - 1) != 0 || buf[0] == '\0') return std::string("host");
-    return std::string(buf.data());
-  }();
-  return name;
+fs::path temporary_name(const fs::path& path) {
+  static std::atomic<unsigned> counter{0};
+  return path.parent_path() /
+         fmt::format(".{}.tmp-{}-{}", path.filename().string(), ::getpid(), counter++);
 }
 
-/// The process that made temporary file `name` (".FILE.tmp-HOST-PID-N") on this machine, or 0
-/// when the name is not one of ours or names another machine (a folder on shared storage).
-pid_t temporary_owner(const std::string& name, const std::string& prefix) {
-  if (!name.starts_with(prefix)) return 0;
+/// Closes a descriptor on every way out.
+struct FdCloser {
+  explicit FdCloser(int f) : fd(f) {}
+  FdCloser(FdCloser&& other) noexcept : fd(std::exchange(other.fd, -1)) {}
+  FdCloser(const FdCloser&) = delete;
+  FdCloser& operator=(const FdCloser&) = delete;
+  FdCloser& operator=(FdCloser&&) = delete;
+  ~FdCloser() {
+    if (fd >= 0) ::close(fd);
+  }
+  int fd;
+};
+
+/// Whether `name` is a temporary name of a write of `filename`: ".FILE.tmp-PID-N".
+bool is_temporary_of(const std::string& name, const std::string& filename) {
+  const std::string prefix = fmt::format(".{}.tmp-", filename);
+  if (!name.starts_with(prefix)) return false;
   const std::string rest = name.substr(prefix.size());
-  const size_t last = rest.rfind('-');
-  if (last == std::string::npos || last == 0) return 0;
-  const size_t before = rest.rfind('-', last - 1);
-  if (before == std::string::npos || rest.substr(0, before) != host_name()) return 0;
-  const std::string pid = rest.substr(before + 1, last - before - 1);
-  const std::string n = rest.substr(last + 1);
-  const auto digits = [](const std::string& t) {
-    return !t.empty() && t.size() < 10 && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
+  const size_t dash = rest.find('-');
+  const auto digits = [](std::string_view t) {
+    return !t.empty() && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
   };
-  return digits(pid) && digits(n) ? static_cast<pid_t>(std::stol(pid)) : 0;
+  return dash != std::string::npos && digits(std::string_view(rest).substr(0, dash)) &&
+         digits(std::string_view(rest).substr(dash + 1));
 }
 
-/// Removes the temporary files an earlier write of `path` left behind when its process was killed
-/// (SIGKILL, a node's job limit, a power cut) before it could remove them: those of processes of
-/// this machine that no longer run. Best effort; a live process's file is never touched.
+/// Removes the temporary files that earlier writes of `path` left behind when their process was
+/// killed (SIGKILL, a job's time limit) before it could remove them. A write holds an exclusive
+/// lock on its temporary file until it is renamed or removed, so a file whose lock can be taken
+/// has no writer left, whichever machine or container made it; where locks are unavailable
+/// (ENOLCK), nothing is removed. Best effort: errors leave files where they are.
 void remove_stale_temporaries(const fs::path& path) {
-  const std::string prefix = fmt::format(".{}.tmp-", path.filename().string());
+  const std::string filename = path.filename().string();
   const fs::path folder = path.parent_path().empty() ? fs::path(".") : path.parent_path();
   std::error_code ec;
   for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
-    const pid_t owner = temporary_owner(it->path().filename().string(), prefix);
-    if (owner <= 0 || owner == ::getpid()) continue;
-    if (::kill(owner, 0) == 0 || errno != ESRCH) continue;  // running (or not ours to ask about)
+    if (!is_temporary_of(it->path().filename().string(), filename)) continue;
+    const FdCloser fd{::open(it->path().c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK)};
+    if (fd.fd < 0 || ::flock(fd.fd, LOCK_EX | LOCK_NB) != 0) continue;  // a running write, or not ours
     std::error_code ignored;
     fs::remove(it->path(), ignored);
   }
 }
 
-fs::path temporary_name(const fs::path& path) {
-  static std::atomic<unsigned> counter{0};
-  remove_stale_temporaries(path);
-  return path.parent_path() /
-         fmt::format(".{}.tmp-{}-{}-{}", path.filename().string(), host_name(), ::getpid(), counter++);
+/// Creates `tmp` and holds an exclusive lock on it while it exists (see remove_stale_temporaries);
+/// the writer then opens and truncates the same file. The descriptor is closed with the object.
+FdCloser lock_temporary(const fs::path& tmp) {
+  FdCloser fd{::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644)};
+  if (fd.fd < 0) throw IoError(fmt::format("cannot create {}: {}", tmp.string(), std::strerror(errno)));
+  (void)::flock(fd.fd, LOCK_EX | LOCK_NB);  // without locks (ENOLCK) the file is only never judged stale
+  return fd;
 }
 
 void sync_file(const fs::path& path) {
@@ -139,14 +149,6 @@ void with_temporary(const fs::path& tmp, const fs::path& path, const std::functi
   }
 }
 
-/// Closes a descriptor on every way out.
-struct FdCloser {
-  int fd;
-  ~FdCloser() {
-    if (fd >= 0) ::close(fd);
-  }
-};
-
 /// Writes a stream in place: the file is made whole in the temporary folder first (a writer may
 /// need to seek, as the EXR writer does), then its bytes are appended to the stream, which keeps
 /// what a shell's `>>` put there before.
@@ -199,7 +201,9 @@ void write_atomically(const fs::path& given, const std::function<void(const fs::
       throw IoError(fmt::format("cannot create folder {} for {}: {}", parent.string(),
                                 path.filename().string(), ec.message()));
   }
+  remove_stale_temporaries(path);
   const fs::path tmp = temporary_name(path);
+  const FdCloser lock = lock_temporary(tmp);
   with_temporary(tmp, path, [&] {
     write(tmp);
     sync_file(tmp);

@@ -6,8 +6,8 @@
 #include <memory>
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <array>
@@ -384,32 +384,39 @@ TEST_F(ImageIoTest, FailureInsideWriteAtomicallyLeavesNoFileAndNoTemporary) {
 }
 
 TEST_F(ImageIoTest, AKilledWritesTemporaryGoesWhenTheFileIsWrittenAgain) {
-  // A process of this machine that has ended: a child that exits at once, reaped.
-  const pid_t child = ::fork();
-  ASSERT_GE(child, 0);
-  if (child == 0) ::_exit(0);
-  int status = 0;
-  ASSERT_EQ(::waitpid(child, &status, 0), child);
-  std::array<char, 256> host{};
-  ASSERT_EQ(::gethostname(host.data(), host.size() - 1), 0);
-  const std::string here = host.data();
-  const std::string dead = std::to_string(child);
-  const std::string alive = std::to_string(::getppid());  // the process that started this test
+  // Left by a killed write of out.json: no process holds its lock any more.
+  const std::vector<std::string> stale = {".out.json.tmp-4242-7", ".out.json.tmp-1-0"};
+  // A write of out.json still running (here or on another machine): it holds its file's lock.
+  const std::string running = ".out.json.tmp-777-3";
   const std::vector<std::string> kept = {
-      ".out.json.tmp-" + here + "-" + alive + "-0",         // a write still running
-      ".out.json.tmp-elsewhere-" + dead + "-0",             // another machine's (shared storage)
-      ".other.json.tmp-" + here + "-" + dead + "-0",        // another file's, left for its own next write
-      ".out.json.tmp-" + dead + "-0",                       // no machine named: not ours to judge
+      running,
+      ".other.json.tmp-4242-0",    // another file's, left for its own next write
+      ".out.json.tmp-host-4242-0",  // not a temporary name of ours
+      ".out.json.tmp-12",
+      "out.json.tmp-4242-0",
       "notes.txt"};
-  const std::string stale = ".out.json.tmp-" + here + "-" + dead + "-7";
+  for (const std::string& name : stale) std::ofstream(path(name)) << "partial";
   for (const std::string& name : kept) std::ofstream(path(name)) << "partial";
-  std::ofstream(path(stale)) << "partial";
+  const int fd = ::open(path(running).c_str(), O_RDONLY | O_CLOEXEC);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
 
   io::write_text_atomically(path("out.json"), "whole");
-  EXPECT_FALSE(fs::exists(path(stale)));
+  for (const std::string& name : stale) EXPECT_FALSE(fs::exists(path(name))) << name;
   for (const std::string& name : kept) EXPECT_TRUE(fs::exists(path(name))) << name;
   std::ifstream in(path("out.json"));
   EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "whole");
+
+  // A write's own temporary file is locked while the write runs: another write of the same file
+  // at that moment (another process, or another thread as here) leaves it alone.
+  io::write_atomically(path("out.json"), [&](const fs::path& tmp) {
+    std::ofstream(tmp) << "second";
+    io::write_text_atomically(path("out.json"), "nested");
+    EXPECT_TRUE(fs::exists(tmp));
+  });
+  std::ifstream again(path("out.json"));
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(again), {}), "second");
+  ::close(fd);
 }
 
 TEST_F(ImageIoTest, WritingThroughALinkReplacesItsTargetAndKeepsTheLink) {
