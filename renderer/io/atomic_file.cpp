@@ -77,11 +77,21 @@ void remove_stale_temporaries(const fs::path& path) {
 }
 
 /// Creates `tmp` and holds an exclusive lock on it while it exists (see remove_stale_temporaries);
-/// the writer then opens and truncates the same file. The descriptor is closed with the object.
+/// the writer then opens and truncates the same file. The file is made and locked under a name
+/// the cleanup does not look at, then renamed to `tmp` (the lock goes with the file), so that no
+/// other write can find it unlocked. The descriptor is closed with the object.
 FdCloser lock_temporary(const fs::path& tmp) {
-  FdCloser fd{::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644)};
-  if (fd.fd < 0) throw IoError(fmt::format("cannot create {}: {}", tmp.string(), std::strerror(errno)));
+  const fs::path staging = tmp.parent_path() / (tmp.filename().string() + ".new");
+  FdCloser fd{::open(staging.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644)};
+  if (fd.fd < 0) throw IoError(fmt::format("cannot create {}: {}", staging.string(), std::strerror(errno)));
   (void)::flock(fd.fd, LOCK_EX | LOCK_NB);  // without locks (ENOLCK) the file is only never judged stale
+  std::error_code ec;
+  fs::rename(staging, tmp, ec);
+  if (ec) {
+    const std::string why = ec.message();
+    fs::remove(staging, ec);
+    throw IoError(fmt::format("cannot rename {} to {}: {}", staging.string(), tmp.string(), why));
+  }
   return fd;
 }
 

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstdlib>
@@ -393,6 +394,7 @@ TEST_F(ImageIoTest, AKilledWritesTemporaryGoesWhenTheFileIsWrittenAgain) {
       ".other.json.tmp-4242-0",    // another file's, left for its own next write
       ".out.json.tmp-host-4242-0",  // not a temporary name of ours
       ".out.json.tmp-12",
+      ".out.json.tmp-4242-7.new",  // a write between creating and naming its locked file
       "out.json.tmp-4242-0",
       "notes.txt"};
   for (const std::string& name : stale) std::ofstream(path(name)) << "partial";
@@ -417,6 +419,32 @@ TEST_F(ImageIoTest, AKilledWritesTemporaryGoesWhenTheFileIsWrittenAgain) {
   std::ifstream again(path("out.json"));
   EXPECT_EQ(std::string(std::istreambuf_iterator<char>(again), {}), "second");
   ::close(fd);
+}
+
+TEST_F(ImageIoTest, ConcurrentWritesOfOneFileNeverRemoveEachOthersTemporaries) {
+  // Each write removes the unlocked temporaries of its file before it starts: those of writes
+  // running beside it are locked from the moment they exist, so every write completes.
+  constexpr int kWriters = 4;
+  constexpr int kWrites = 150;
+  std::atomic<int> failures{0};
+  std::vector<std::thread> writers;
+  for (int w = 0; w < kWriters; ++w)
+    writers.emplace_back([&, w] {
+      for (int i = 0; i < kWrites; ++i) {
+        try {
+          io::write_text_atomically(path("shared.json"), std::string(4096, static_cast<char>('a' + w)));
+        } catch (const std::exception&) {
+          ++failures;
+        }
+      }
+    });
+  for (std::thread& t : writers) t.join();
+  EXPECT_EQ(failures.load(), 0);
+  EXPECT_EQ(entries(), std::vector<std::string>{"shared.json"});
+  std::ifstream in(path("shared.json"));
+  const std::string text{std::istreambuf_iterator<char>(in), {}};
+  ASSERT_EQ(text.size(), 4096u);
+  EXPECT_EQ(text, std::string(4096, text.front()));
 }
 
 TEST_F(ImageIoTest, WritingThroughALinkReplacesItsTargetAndKeepsTheLink) {
