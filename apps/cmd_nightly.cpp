@@ -172,7 +172,7 @@ void run_nightly(const NightlyArgs& a) {
   const fs::path baseline_file = a.baseline.empty() ? fs::path(kDefaultBaselineFile) : fs::path(a.baseline);
   if (!a.baseline.empty() || fs::exists(baseline_file))
     baseline = load_baseline(baseline_file);
-  else if (!gate_config.sets_limits)
+  else if (!gate_config.sets_limits())
     throw InputError(fmt::format("{} sets no threshold, only [regression], and there is no baseline file {}: the gate "
                                  "would check nothing; give thresholds, or --baseline FILE (gate --update-baseline "
                                  "stores one)",

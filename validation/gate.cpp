@@ -258,6 +258,15 @@ int exit_code(Verdict worst) noexcept {
   return 0;
 }
 
+bool GateConfig::sets_limits() const {
+  const auto sets_limit = [](const ThresholdValues& values) {
+    return std::any_of(values.begin(), values.end(),
+                       [](const auto& kv) { return kv.first != kToleranceKey && kv.second.has_value(); });
+  };
+  return sets_limit(defaults) ||
+         std::any_of(rules.begin(), rules.end(), [&](const GateRule& r) { return sets_limit(r.values); });
+}
+
 GateConfig parse_gate_config(const std::string& text, const std::string& source) {
   toml::table root;
   try {
@@ -297,16 +306,7 @@ GateConfig parse_gate_config(const std::string& text, const std::string& source)
                    fmt::format("unknown key '{}'; a gate config has [defaults], [regression] and [[rule]] tables", k));
     }
   }
-  // A limit counts only when some table gives it a value: [[rule]]s without one, or keys all turned
-  // off (= false), would pass anything as surely as an empty file.
-  const auto sets_limit = [](const ThresholdValues& values) {
-    return std::any_of(values.begin(), values.end(),
-                       [](const auto& kv) { return kv.first != kToleranceKey && kv.second.has_value(); });
-  };
-  config.sets_limits = sets_limit(config.defaults) ||
-                       std::any_of(config.rules.begin(), config.rules.end(),
-                                   [&](const GateRule& r) { return sets_limit(r.values); });
-  if (!config.sets_limits && !root.contains("regression"))
+  if (!config.sets_limits() && !root.contains("regression"))
     throw InputError(fmt::format("{}: the gate config sets no threshold and no [regression]: it would pass anything; "
                                  "give a limit a value in [defaults] or a [[rule]] (see docs/gate.md)",
                                  source));

@@ -89,9 +89,11 @@ struct GateConfig {
   ThresholdValues defaults;  ///< `[defaults]`
   std::vector<GateRule> rules;
   RegressionSettings regression;
+
   /// Whether some table gives a threshold a value; without one, only time regressions against a
-  /// baseline are checked.
-  bool sets_limits = false;
+  /// baseline are checked. A limit counts only when given a value: [[rule]]s without one, or keys
+  /// all turned off (= false), would pass anything as surely as an empty file.
+  [[nodiscard]] bool sets_limits() const;
 };
 
 /// Parses gate.toml text. InputError naming `source`, the line and the key for a syntax error, an
