@@ -26,10 +26,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// How the temporary names of `path`'s writes begin: ".FILE.tmp-".
+std::string temporary_prefix(const fs::path& path) { return fmt::format(".{}.tmp-", path.filename().string()); }
+
+/// A temporary name for a write of `path`: ".FILE.tmp-PID-N".
 fs::path temporary_name(const fs::path& path) {
   static std::atomic<unsigned> counter{0};
-  return path.parent_path() /
-         fmt::format(".{}.tmp-{}-{}", path.filename().string(), ::getpid(), counter++);
+  return path.parent_path() / fmt::format("{}{}-{}", temporary_prefix(path), ::getpid(), counter++);
 }
 
 /// Closes a descriptor on every way out.
@@ -45,9 +48,9 @@ struct FdCloser {
   int fd;
 };
 
-/// Whether `name` is a temporary name of a write of `filename`: ".FILE.tmp-PID-N".
-bool is_temporary_of(const std::string& name, const std::string& filename) {
-  const std::string prefix = fmt::format(".{}.tmp-", filename);
+/// Whether `name` is a temporary name of a write of the file whose temporaries start with `prefix`
+/// (".FILE.tmp-"): ".FILE.tmp-PID-N".
+bool is_temporary_of(const std::string& name, const std::string& prefix) {
   if (!name.starts_with(prefix)) return false;
   const std::string rest = name.substr(prefix.size());
   const size_t dash = rest.find('-');
@@ -64,11 +67,11 @@ bool is_temporary_of(const std::string& name, const std::string& filename) {
 /// has no writer left, whichever machine or container made it; where locks are unavailable
 /// (ENOLCK), nothing is removed. Best effort: errors leave files where they are.
 void remove_stale_temporaries(const fs::path& path) {
-  const std::string filename = path.filename().string();
+  const std::string prefix = temporary_prefix(path);
   const fs::path folder = path.parent_path().empty() ? fs::path(".") : path.parent_path();
   std::error_code ec;
   for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
-    if (!is_temporary_of(it->path().filename().string(), filename)) continue;
+    if (!is_temporary_of(it->path().filename().string(), prefix)) continue;
     const FdCloser fd{::open(it->path().c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK)};
     if (fd.fd < 0 || ::flock(fd.fd, LOCK_EX | LOCK_NB) != 0) continue;  // a running write, or not ours
     std::error_code ignored;
