@@ -824,10 +824,21 @@ DecodedImage decode_from(OIIO::ImageInput& in, const std::string& name) {
   image.channels = spec.nchannels;
   image.srgb = is_srgb(spec);
   image.format = in.format_name();
-  image.values.resize(static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height) *
-                      static_cast<std::size_t>(spec.nchannels));
-  if (!in.read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, image.values.data()))
-    throw InputError(fmt::format("cannot decode image {}: {}; {}", name, oiio_error(&in), kCorruptHint));
+  // Decoded a band of rows at a time, the buffer grown with each band: a file that declares more
+  // rows than it holds fails at its first missing band, before the memory for the rest is touched.
+  const std::size_t row_values = static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.nchannels);
+  image.values.reserve(row_values * static_cast<std::size_t>(spec.height));
+  const int band = static_cast<int>(std::clamp<std::size_t>((std::size_t{1} << 22) / row_values, 1, 64));
+  const bool scanlines = spec.tile_width == 0;
+  for (int y0 = 0; y0 < spec.height; y0 = scanlines ? y0 + band : spec.height) {
+    const int y1 = scanlines ? std::min(spec.height, y0 + band) : spec.height;
+    const std::size_t done = image.values.size();
+    image.values.resize(done + row_values * static_cast<std::size_t>(y1 - y0));
+    float* rows = image.values.data() + done;
+    const bool ok = scanlines ? in.read_scanlines(0, 0, spec.y + y0, spec.y + y1, 0, 0, spec.nchannels, TypeDesc::FLOAT, rows)
+                              : in.read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, rows);
+    if (!ok) throw InputError(fmt::format("cannot decode image {}: {}; {}", name, oiio_error(&in), kCorruptHint));
+  }
   return image;
 }
 

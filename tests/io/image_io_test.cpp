@@ -7,6 +7,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -343,6 +344,39 @@ TEST_F(ImageIoTest, TruncatedPngIsAnInputError) {
   const std::vector<unsigned char> cut(png.begin(), png.begin() + static_cast<std::ptrdiff_t>(png.size() / 2));
   expect_error<InputError>([&] { (void)io::decode_image(cut, "half.png"); }, "half.png");
   expect_error<InputError>([&] { (void)io::decode_image({}, "empty.png"); }, "empty.png");
+}
+
+/// The PNG CRC-32 (ISO 3309) of `bytes`.
+uint32_t png_crc(const unsigned char* bytes, std::size_t n) {
+  uint32_t c = 0xffffffffu;
+  for (std::size_t i = 0; i < n; ++i) {
+    c ^= bytes[i];
+    for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xedb88320u & (0u - (c & 1u)));
+  }
+  return c ^ 0xffffffffu;
+}
+
+TEST_F(ImageIoTest, APngDeclaringMoreRowsThanItHoldsFailsBeforeTouchingTheirMemory) {
+  // A real 16x16 PNG whose header is rewritten to declare 12000x12000: decoded as float that would
+  // be 1.6 GiB, but the file holds 16 rows.
+  std::vector<uint8_t> pixels(16 * 16 * 3, 128);
+  std::vector<unsigned char> png = io::encode_png(pixels.data(), 16, 16, 3);
+  ASSERT_GT(png.size(), 33u);
+  ASSERT_EQ(std::string(png.begin() + 12, png.begin() + 16), "IHDR");
+  const auto put32 = [&](std::size_t at, uint32_t v) {
+    for (int k = 0; k < 4; ++k) png[at + static_cast<std::size_t>(k)] = static_cast<unsigned char>(v >> (24 - 8 * k));
+  };
+  put32(16, 12000);
+  put32(20, 12000);
+  put32(29, png_crc(png.data() + 12, 17));  // chunk type and 13 data bytes
+  rusage before{};
+  ASSERT_EQ(getrusage(RUSAGE_SELF, &before), 0);
+  expect_error<InputError>([&] { (void)io::decode_image(png, "tall.png"); }, "cannot decode image tall.png");
+  rusage after{};
+  ASSERT_EQ(getrusage(RUSAGE_SELF, &after), 0);
+  // ru_maxrss is the peak resident size in KiB. Decoding the whole declared size first touched
+  // all 1.6 GiB before the missing rows were noticed.
+  EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 256L * 1024L);
 }
 
 // ---- Errors on writing ----------------------------------------------------------------------
