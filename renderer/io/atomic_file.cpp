@@ -98,6 +98,19 @@ FdCloser lock_temporary(const fs::path& tmp) {
   return fd;
 }
 
+/// A write's temporary file for `path`, locked: the stale temporaries of earlier writes of `path`
+/// are removed first, then a new one is named and locked.
+struct Temporary {
+  fs::path path;
+  FdCloser lock;
+};
+Temporary new_temporary(const fs::path& path) {
+  remove_stale_temporaries(path);
+  fs::path tmp = temporary_name(path);
+  FdCloser lock = lock_temporary(tmp);
+  return Temporary{std::move(tmp), std::move(lock)};
+}
+
 void sync_file(const fs::path& path) {
   const int fd = ::open(path.c_str(), O_RDONLY);
   if (fd < 0) throw IoError(fmt::format("cannot reopen {} to flush it: {}", path.string(), std::strerror(errno)));
@@ -164,10 +177,12 @@ void with_temporary(const fs::path& tmp, const fs::path& path, const std::functi
 
 /// Writes a stream in place: the file is made whole in the temporary folder first (a writer may
 /// need to seek, as the EXR writer does), then its bytes are appended to the stream, which keeps
-/// what a shell's `>>` put there before.
+/// what a shell's `>>` put there before. The staged file is locked and cleaned up as a file's
+/// temporary is.
 void write_through(const fs::path& stream, const std::function<void(const fs::path&)>& write) {
   std::error_code ec;
-  const fs::path tmp = temporary_name(fs::temp_directory_path(ec) / stream.filename());
+  const Temporary staged = new_temporary(fs::temp_directory_path(ec) / stream.filename());
+  const fs::path& tmp = staged.path;
   with_temporary(tmp, stream, [&] {
     write(tmp);
     const FdCloser in{::open(tmp.c_str(), O_RDONLY | O_CLOEXEC)};
@@ -214,9 +229,8 @@ void write_atomically(const fs::path& given, const std::function<void(const fs::
       throw IoError(fmt::format("cannot create folder {} for {}: {}", parent.string(),
                                 path.filename().string(), ec.message()));
   }
-  remove_stale_temporaries(path);
-  const fs::path tmp = temporary_name(path);
-  const FdCloser lock = lock_temporary(tmp);
+  const Temporary staged = new_temporary(path);
+  const fs::path& tmp = staged.path;
   with_temporary(tmp, path, [&] {
     write(tmp);
     sync_file(tmp);

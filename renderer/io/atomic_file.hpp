@@ -19,8 +19,9 @@ namespace sb::io {
 /// through a process's open files (/dev/stdout, /dev/fd/N, /proc/self/fd/N, also when the shell
 /// redirected them into a file), is not replaced: the file is made in the temporary folder and its
 /// bytes appended there; a write error is still IoError. A folder at `path` is an InputError.
-/// The temporary file (.FILE.tmp-PID-N) is locked (flock) while the write runs; temporary files of
-/// `path` that no write holds (left by a killed process) are removed first.
+/// The temporary file (.FILE.tmp-PID-N; for a stream, in the temporary folder and named after the
+/// stream) is locked (flock) while the write runs; temporary files of the same name that no write
+/// holds (left by a killed process) are removed first.
 void write_atomically(const std::filesystem::path& path,
                       const std::function<void(const std::filesystem::path& tmp_path)>& write);
 

@@ -508,6 +508,31 @@ TEST_F(ImageIoTest, ADeviceIsWrittenInPlaceNotReplaced) {
   EXPECT_TRUE(fs::is_character_file(path("null")));
 }
 
+TEST_F(ImageIoTest, AStreamsStagedFileIsCleanedUpAsAFilesTemporaryIs) {
+  // A stream is written through a file staged in the temporary folder ($TMPDIR): a killed write
+  // left it there, and the next write to a stream of that name removes it; a running write's
+  // locked file stays.
+  const fs::path staging = path("tmp");
+  fs::create_directories(staging);
+  const char* old = std::getenv("TMPDIR");
+  const std::string saved = old != nullptr ? old : "";
+  ASSERT_EQ(::setenv("TMPDIR", staging.c_str(), 1), 0);
+  std::ofstream(staging / ".null.tmp-4242-7") << "partial";
+  std::ofstream(staging / ".null.tmp-777-3") << "partial";
+  const int fd = ::open((staging / ".null.tmp-777-3").c_str(), O_RDONLY | O_CLOEXEC);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+  fs::create_symlink("/dev/null", path("null"));
+  io::write_text_atomically(path("null"), "discarded");
+  ::close(fd);
+  if (old != nullptr) ::setenv("TMPDIR", saved.c_str(), 1);
+  else ::unsetenv("TMPDIR");
+  EXPECT_TRUE(fs::is_character_file(path("null")));
+  std::vector<std::string> left;
+  for (const fs::directory_entry& e : fs::directory_iterator(staging)) left.push_back(e.path().filename().string());
+  EXPECT_EQ(left, std::vector<std::string>{".null.tmp-777-3"});
+}
+
 TEST_F(ImageIoTest, AnOpenFileOfTheProcessIsAppendedToNotReplaced) {
   // `--json /dev/stdout >> log`: /dev/stdout leads to /proc/self/fd/1, here a regular file. It used
   // to be resolved to that file and replaced by a rename, losing what the log held.
