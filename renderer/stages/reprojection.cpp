@@ -1,6 +1,8 @@
 // Left eye, grid metric and grid warp of the repro-* pipelines.
 #include "renderer/stages/reprojection.hpp"
 
+#include <cstring>
+
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
@@ -95,8 +97,14 @@ std::vector<uint8_t> warp_left_to_right(const RenderScene& scene, const StereoRi
                                             static_cast<uint8_t>(WarpPixel::covered),
                                             static_cast<uint8_t>(WarpPixel::outside_source));
       EyeWriter out(r.right);
-      for (size_t i = 0; i < states.size(); ++i)
-        if (states[i] == static_cast<uint8_t>(WarpPixel::outside_source)) out.hole(i);
+      // The marked pixels are few (a strip at an image edge, if any): memchr finds them.
+      const uint8_t* const first = states.data();
+      const uint8_t* const end = first + states.size();
+      for (const void* at = std::memchr(first, static_cast<int>(WarpPixel::outside_source), states.size()); at != nullptr;) {
+        const auto* p = static_cast<const uint8_t*>(at);
+        out.hole(static_cast<size_t>(p - first));
+        at = std::memchr(p + 1, static_cast<int>(WarpPixel::outside_source), static_cast<size_t>(end - p - 1));
+      }
       ws.pixels_covered -= frustum.pixels;
     }
   }

@@ -83,6 +83,20 @@ constexpr double kOutsideTolerance = 1e-9;
 constexpr uint16_t kTargetBits = 0x3F;
 constexpr uint16_t kSourceBits = 0x7C0;
 
+/// Per target row, where the parts of triangles outside the source frustum may be seen: the
+/// nearest depth, and the columns (a conservative box) their projections may cover.
+struct RowReach {
+  double zmin = kInfinity;
+  int x0 = std::numeric_limits<int>::max();
+  int x1 = std::numeric_limits<int>::min();
+
+  void add(const RowReach& o) {
+    zmin = std::min(zmin, o.zmin);
+    x0 = std::min(x0, o.x0);
+    x1 = std::max(x1, o.x1);
+  }
+};
+
 /// The clipping geometry: the target frustum capped at a depth, and the source frustum.
 struct Regions {
   std::array<HalfSpace, 6> target;  ///< target frustum and depth <= cap
@@ -102,9 +116,10 @@ struct Regions {
     return code;
   }
 
-  /// Lowers zmin[row] for every target row the parts of triangle (a, b, c) outside the source
-  /// frustum may cover, to the nearest depth of those parts. Returns whether there was such a part.
-  bool lower_rows(const dvec3& a, const dvec3& b, const dvec3& c, std::vector<double>& zmin) const {
+  /// Widens reach[row] for every target row the parts of triangle (a, b, c) outside the source
+  /// frustum may cover, by the nearest depth and the columns of those parts. Returns whether there
+  /// was such a part.
+  bool lower_rows(const dvec3& a, const dvec3& b, const dvec3& c, std::vector<RowReach>& reach) const {
     Polygon p;
     p.v[0] = a;
     p.v[1] = b;
@@ -121,17 +136,22 @@ struct Regions {
       if (!outside) continue;
       const Polygon q = clip(p, h.outside());
       if (q.n == 0) continue;
-      double depth = kInfinity, y_lo = kInfinity, y_hi = -kInfinity;
+      double depth = kInfinity, x_lo = kInfinity, x_hi = -kInfinity, y_lo = kInfinity, y_hi = -kInfinity;
       for (int i = 0; i < q.n; ++i) {
         const dvec3 projected = to.project(q.v[static_cast<size_t>(i)]);
         depth = std::min(depth, projected.z);
+        x_lo = std::min(x_lo, projected.x);
+        x_hi = std::max(x_hi, projected.x);
         y_lo = std::min(y_lo, projected.y);
         y_hi = std::max(y_hi, projected.y);
       }
-      // Rows whose pixel centres (j + 0.5) may lie in [y_lo, y_hi], with a row to spare each side.
-      const int j0 = std::max(static_cast<int>(std::floor(y_lo - 0.5)) - 1, 0);
-      const int j1 = std::min(static_cast<int>(std::floor(y_hi - 0.5)) + 1, to.height - 1);
-      for (int j = j0; j <= j1; ++j) zmin[static_cast<size_t>(j)] = std::min(zmin[static_cast<size_t>(j)], depth);
+      // Rows and columns whose pixel centres (j + 0.5, i + 0.5) may lie in [y_lo, y_hi] and
+      // [x_lo, x_hi], with one to spare each side. The part lies in the target frustum, so its
+      // projection lies in the image, up to rounding.
+      const auto first = [](double lo, int n) { return std::clamp(static_cast<int>(std::floor(lo - 0.5)) - 1, 0, n - 1); };
+      const auto last = [](double hi, int n) { return std::clamp(static_cast<int>(std::floor(hi - 0.5)) + 1, 0, n - 1); };
+      const RowReach part{depth, first(x_lo, to.width), last(x_hi, to.width)};
+      for (int j = first(y_lo, to.height); j <= last(y_hi, to.height); ++j) reach[static_cast<size_t>(j)].add(part);
       any = true;
     }
     return any;
@@ -262,9 +282,9 @@ SourceFrustumStats mark_outside_source_frustum(const RenderScene& scene, const E
   const double cap = *std::max_element(row_cap.begin(), row_cap.end());
 
   // Per target row, the nearest depth at which a triangle outside the source frustum (and inside
-  // the target frustum, not deeper than the cap) may be seen.
+  // the target frustum, not deeper than the cap) may be seen, and the columns where.
   SourceFrustumStats stats;
-  std::vector<double> zmin(static_cast<size_t>(h), kInfinity);
+  std::vector<RowReach> reach(static_cast<size_t>(h));
   if (cap > 0.0) {
     Regions regions;
     const std::array<HalfSpace, 5> target = frustum_half_spaces(to);
@@ -286,11 +306,11 @@ SourceFrustumStats mark_outside_source_frustum(const RenderScene& scene, const E
         codes[v] = regions.outcode(dvec3(s.meshes[m].positions[v - first_vertex[m]]));
       }
     });
-    // Triangles in fixed chunks, each lowering its own copy of the row minima (merged below: the
-    // minimum does not depend on the order).
+    // Triangles in fixed chunks, each widening its own copy of the rows' reach (merged below: the
+    // minima and maxima do not depend on the order).
     const size_t triangles = geometry.triangle_count();
     const size_t chunks = (triangles + kGrain - 1) / kGrain;
-    std::vector<std::vector<double>> chunk_zmin(chunks);
+    std::vector<std::vector<RowReach>> chunk_reach(chunks);
     std::vector<uint64_t> chunk_near(chunks, 0);
     executor.for_each(chunks, [&](size_t k) {
       const size_t begin = k * kGrain, end = std::min(begin + kGrain, triangles);
@@ -303,16 +323,16 @@ SourceFrustumStats mark_outside_source_frustum(const RenderScene& scene, const E
         const uint16_t c0 = codes[first_vertex[m] + i0], c1 = codes[first_vertex[m] + i1], c2 = codes[first_vertex[m] + i2];
         // Wholly outside one target half-space, or wholly inside the (convex) source frustum.
         if ((c0 & c1 & c2 & kTargetBits) != 0 || ((c0 | c1 | c2) & kSourceBits) == 0) continue;
-        if (chunk_zmin[k].empty()) chunk_zmin[k].assign(static_cast<size_t>(h), kInfinity);
+        if (chunk_reach[k].empty()) chunk_reach[k].resize(static_cast<size_t>(h));
         if (regions.lower_rows(dvec3(mesh.positions[i0]), dvec3(mesh.positions[i1]), dvec3(mesh.positions[i2]),
-                               chunk_zmin[k]))
+                               chunk_reach[k]))
           ++chunk_near[k];
       }
     });
     for (size_t k = 0; k < chunks; ++k) {
       stats.triangles_near += chunk_near[k];
-      if (chunk_zmin[k].empty()) continue;
-      for (size_t j = 0; j < zmin.size(); ++j) zmin[j] = std::min(zmin[j], chunk_zmin[k][j]);
+      if (chunk_reach[k].empty()) continue;
+      for (size_t j = 0; j < reach.size(); ++j) reach[j].add(chunk_reach[k][j]);
     }
   }
 
@@ -361,12 +381,15 @@ SourceFrustumStats mark_outside_source_frustum(const RenderScene& scene, const E
         }
       }
       flush();
-      // Rays that may meet a clipped triangle before entering the source frustum.
-      if (!(zmin[j] < row_cap[j])) continue;
-      for (int x = 0; x < w; ++x) {
+      // Rays that may meet a clipped triangle before entering the source frustum: whatever a ray
+      // hits before it enters lies outside the source frustum, so on a clipped part, which
+      // projects onto the pixel's centre; only the row's columns of those parts are looked at.
+      const RowReach& row = reach[j];
+      if (!(row.zmin < row_cap[j])) continue;
+      for (int x = row.x0; x <= row.x1; ++x) {
         if (states[j * static_cast<size_t>(w) + static_cast<size_t>(x)] != candidate) continue;
         RaySpan span;
-        if (pixel_rays.check(x, static_cast<int>(j), span) == Check::near_part && span.in > zmin[j]) add(x, span, false);
+        if (pixel_rays.check(x, static_cast<int>(j), span) == Check::near_part && span.in > row.zmin) add(x, span, false);
       }
       flush();
     }
