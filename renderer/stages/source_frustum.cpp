@@ -148,8 +148,9 @@ struct Regions {
       // Rows and columns whose pixel centres (j + 0.5, i + 0.5) may lie in [y_lo, y_hi] and
       // [x_lo, x_hi], with one to spare each side. The part lies in the target frustum, so its
       // projection lies in the image, up to rounding.
-      const auto first = [](double lo, int n) { return std::clamp(static_cast<int>(std::floor(lo - 0.5)) - 1, 0, n - 1); };
-      const auto last = [](double hi, int n) { return std::clamp(static_cast<int>(std::floor(hi - 0.5)) + 1, 0, n - 1); };
+      const auto index = [](double v, int n) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(n - 1))); };
+      const auto first = [&](double lo, int n) { return index(std::floor(lo - 0.5) - 1.0, n); };
+      const auto last = [&](double hi, int n) { return index(std::floor(hi - 0.5) + 1.0, n); };
       const RowReach part{depth, first(x_lo, to.width), last(x_hi, to.width)};
       for (int j = first(y_lo, to.height); j <= last(y_hi, to.height); ++j) reach[static_cast<size_t>(j)].add(part);
       any = true;
