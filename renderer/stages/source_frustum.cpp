@@ -99,7 +99,7 @@ struct RowReach {
 
 /// The clipping geometry: the target frustum capped at a depth, and the source frustum.
 struct Regions {
-  std::array<HalfSpace, 6> target;  ///< target frustum and depth <= cap
+  std::array<HalfSpace, 6> target;  ///< target frustum from depth 0 (not its near plane) to the cap
   std::array<HalfSpace, 5> source;
   EyeCamera to;
 
@@ -139,6 +139,13 @@ struct Regions {
       double depth = kInfinity, x_lo = kInfinity, x_hi = -kInfinity, y_lo = kInfinity, y_hi = -kInfinity;
       for (int i = 0; i < q.n; ++i) {
         const dvec3 projected = to.project(q.v[static_cast<size_t>(i)]);
+        if (!(projected.z > 0.0) || !std::isfinite(projected.x) || !std::isfinite(projected.y)) {
+          // A part reaching the eye's plane projects without bound: every row and column.
+          depth = 0.0;
+          x_lo = y_lo = -kInfinity;
+          x_hi = y_hi = kInfinity;
+          break;
+        }
         depth = std::min(depth, projected.z);
         x_lo = std::min(x_lo, projected.x);
         x_hi = std::max(x_hi, projected.x);
@@ -146,8 +153,8 @@ struct Regions {
         y_hi = std::max(y_hi, projected.y);
       }
       // Rows and columns whose pixel centres (j + 0.5, i + 0.5) may lie in [y_lo, y_hi] and
-      // [x_lo, x_hi], with one to spare each side. The part lies in the target frustum, so its
-      // projection lies in the image, up to rounding.
+      // [x_lo, x_hi], with one to spare each side, clamped to the image (the part lies inside the
+      // target frustum's side planes, so its projection lies in the image up to rounding).
       const auto index = [](double v, int n) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(n - 1))); };
       const auto first = [&](double lo, int n) { return index(std::floor(lo - 0.5) - 1.0, n); };
       const auto last = [&](double hi, int n) { return index(std::floor(hi - 0.5) + 1.0, n); };
@@ -290,9 +297,14 @@ SourceFrustumStats mark_outside_source_frustum(const RenderScene& scene, const E
     Regions regions;
     const std::array<HalfSpace, 5> target = frustum_half_spaces(to);
     std::copy(target.begin(), target.end(), regions.target.begin());
-    regions.target[5] = half_space(to.back, cap, to.origin);  // depth = −q·back <= cap
+    // Rays start at the eye, not at its near plane: the target side keeps every depth from 0 on,
+    // so that surfaces in front of the near plane, outside the source frustum, are clipped too.
+    regions.target[4] = half_space(-to.back, 0.0, to.origin);  // depth >= 0
+    regions.target[5] = half_space(to.back, cap, to.origin);    // depth = −q·back <= cap
     regions.source = source;
+    // Projected from the float-rounded origin the rays start at (see primary_ray).
     regions.to = to;
+    regions.to.origin = dvec3(vec3(to.origin));
     const Scene& s = scene.scene();
     const SceneGeometry& geometry = scene.geometry();
     // Outcodes of every vertex, meshes one after another.

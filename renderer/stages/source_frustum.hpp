@@ -33,9 +33,11 @@ struct SourceFrustumStats {
 ///   nothing there or hits before t_in;
 /// - otherwise it can only see an outside surface before t_in. The scene's triangles are clipped
 ///   to the part of the target frustum outside the source frustum and nearer than the deepest
-///   t_in; a pixel is traced over [0, t_in] only when a clipped triangle reaches its row nearer
+///   t_in (from depth 0 on, not from the near plane: the rays start at the eye); a pixel is traced
+///   over [0, t_in] only when a clipped triangle's projection reaches its row and column, nearer
 ///   than the pixel's t_in depth. With parallel eyes that region is the thin wedge between the two
-///   frusta's side planes in front of the convergence plane, so few pixels are traced.
+///   frusta's side planes in front of the convergence plane (and anything in front of the near
+///   plane), so few pixels are traced.
 /// `from` and `to` must have the size of the states (one per target pixel, row-major). The result
 /// does not depend on the executor's thread count.
 SourceFrustumStats mark_outside_source_frustum(const RenderScene& scene, const EyeCamera& from, const EyeCamera& to,
