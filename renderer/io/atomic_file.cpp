@@ -180,8 +180,11 @@ void with_temporary(const fs::path& tmp, const fs::path& path, const std::functi
 /// what a shell's `>>` put there before. The staged file is locked and cleaned up as a file's
 /// temporary is.
 void write_through(const fs::path& stream, const std::function<void(const fs::path&)>& write) {
+  // $TMPDIR, or /tmp where it is unset or names no folder.
   std::error_code ec;
-  const Temporary staged = new_temporary(fs::temp_directory_path(ec) / stream.filename());
+  fs::path folder = fs::temp_directory_path(ec);
+  if (ec || folder.empty()) folder = "/tmp";
+  const Temporary staged = new_temporary(folder / stream.filename());
   const fs::path& tmp = staged.path;
   with_temporary(tmp, stream, [&] {
     write(tmp);

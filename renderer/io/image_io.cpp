@@ -824,11 +824,14 @@ DecodedImage decode_from(OIIO::ImageInput& in, const std::string& name) {
   image.channels = spec.nchannels;
   image.srgb = is_srgb(spec);
   image.format = in.format_name();
-  // Decoded a band of rows at a time, the buffer grown with each band: a file that declares more
-  // rows than it holds fails at its first missing band, before the memory for the rest is touched.
+  // Decoded a band of rows at a time, the buffer grown with each band: where the reader decodes
+  // row by row (scan-line files other than interlaced PNG), a file that declares more rows than it
+  // holds fails at its first missing band, before the memory for the rest is touched. A band is
+  // about 64 MiB of floats, in whole multiples of 256 rows, so that the 16-, 32- and 256-row
+  // chunks of compressed EXR files are never split between two bands.
   const std::size_t row_values = static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.nchannels);
   image.values.reserve(row_values * static_cast<std::size_t>(spec.height));
-  const int band = static_cast<int>(std::clamp<std::size_t>((std::size_t{1} << 22) / row_values, 1, 64));
+  const int band = static_cast<int>(std::clamp<std::size_t>(((std::size_t{1} << 24) / row_values) / 256, 1, 256) * 256);
   const bool scanlines = spec.tile_width == 0;
   for (int y0 = 0; y0 < spec.height; y0 = scanlines ? y0 + band : spec.height) {
     const int y1 = scanlines ? std::min(spec.height, y0 + band) : spec.height;

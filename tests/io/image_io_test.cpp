@@ -357,8 +357,8 @@ uint32_t png_crc(const unsigned char* bytes, std::size_t n) {
 }
 
 TEST_F(ImageIoTest, APngDeclaringMoreRowsThanItHoldsFailsBeforeTouchingTheirMemory) {
-  // A real 16x16 PNG whose header is rewritten to declare 12000x12000: decoded as float that would
-  // be 1.6 GiB, but the file holds 16 rows.
+  // A real 16x16 PNG whose header is rewritten to declare 12000x4000: decoded as float that would
+  // be 550 MiB, but the file holds 16 rows.
   std::vector<uint8_t> pixels(16 * 16 * 3, 128);
   std::vector<unsigned char> png = io::encode_png(pixels.data(), 16, 16, 3);
   ASSERT_GT(png.size(), 33u);
@@ -367,16 +367,34 @@ TEST_F(ImageIoTest, APngDeclaringMoreRowsThanItHoldsFailsBeforeTouchingTheirMemo
     for (int k = 0; k < 4; ++k) png[at + static_cast<std::size_t>(k)] = static_cast<unsigned char>(v >> (24 - 8 * k));
   };
   put32(16, 12000);
-  put32(20, 12000);
+  put32(20, 4000);
   put32(29, png_crc(png.data() + 12, 17));  // chunk type and 13 data bytes
   rusage before{};
   ASSERT_EQ(getrusage(RUSAGE_SELF, &before), 0);
   expect_error<InputError>([&] { (void)io::decode_image(png, "tall.png"); }, "cannot decode image tall.png");
   rusage after{};
   ASSERT_EQ(getrusage(RUSAGE_SELF, &after), 0);
-  // ru_maxrss is the peak resident size in KiB. Decoding the whole declared size first touched
-  // all 1.6 GiB before the missing rows were noticed.
-  EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 256L * 1024L);
+  // ru_maxrss is the peak resident size in KiB (of this test's own process under ctest). Decoding
+  // the whole declared size first touched all 550 MiB before the missing rows were noticed; a
+  // band of 256 rows is 35 MiB.
+  EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 96L * 1024L);
+}
+
+TEST_F(ImageIoTest, AnImageOfManyBandsDecodesWhole) {
+  // 12000 x 600 RGB: bands of 256 rows (about 64 MiB of floats each rounded down to 256 rows),
+  // the third one short; every sample where it belongs.
+  constexpr int kW = 12000, kH = 600;
+  std::vector<uint8_t> pixels(static_cast<std::size_t>(kW) * kH * 3);
+  std::mt19937 rng(17);
+  for (auto& p : pixels) p = static_cast<uint8_t>(rng());
+  const io::DecodedImage decoded = io::decode_image(io::encode_png(pixels.data(), kW, kH, 3), "bands.png");
+  ASSERT_EQ(decoded.width, kW);
+  ASSERT_EQ(decoded.height, kH);
+  ASSERT_EQ(decoded.values.size(), pixels.size());
+  std::size_t wrong = 0;
+  for (std::size_t i = 0; i < pixels.size(); ++i)
+    wrong += std::abs(decoded.values[i] - static_cast<float>(pixels[i]) / 255.0f) > 1e-6f ? 1 : 0;
+  EXPECT_EQ(wrong, 0u);
 }
 
 // ---- Errors on writing ----------------------------------------------------------------------
@@ -514,19 +532,33 @@ TEST_F(ImageIoTest, AStreamsStagedFileIsCleanedUpAsAFilesTemporaryIs) {
   // locked file stays.
   const fs::path staging = path("tmp");
   fs::create_directories(staging);
-  const char* old = std::getenv("TMPDIR");
-  const std::string saved = old != nullptr ? old : "";
-  ASSERT_EQ(::setenv("TMPDIR", staging.c_str(), 1), 0);
+  /// Sets $TMPDIR for the test's span and restores it on every way out.
+  struct TmpdirFor {
+    explicit TmpdirFor(const fs::path& dir) : had(std::getenv("TMPDIR") != nullptr) {
+      if (had) saved = std::getenv("TMPDIR");
+      ::setenv("TMPDIR", dir.c_str(), 1);
+    }
+    TmpdirFor(const TmpdirFor&) = delete;
+    TmpdirFor& operator=(const TmpdirFor&) = delete;
+    ~TmpdirFor() {
+      if (had) ::setenv("TMPDIR", saved.c_str(), 1);
+      else ::unsetenv("TMPDIR");
+    }
+    bool had;
+    std::string saved;
+  };
   std::ofstream(staging / ".null.tmp-4242-7") << "partial";
   std::ofstream(staging / ".null.tmp-777-3") << "partial";
-  const int fd = ::open((staging / ".null.tmp-777-3").c_str(), O_RDONLY | O_CLOEXEC);
-  ASSERT_GE(fd, 0);
-  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
   fs::create_symlink("/dev/null", path("null"));
-  io::write_text_atomically(path("null"), "discarded");
-  ::close(fd);
-  if (old != nullptr) ::setenv("TMPDIR", saved.c_str(), 1);
-  else ::unsetenv("TMPDIR");
+  {
+    const TmpdirFor tmpdir(staging);
+    const int fd = ::open((staging / ".null.tmp-777-3").c_str(), O_RDONLY | O_CLOEXEC);
+    ASSERT_GE(fd, 0);
+    const bool locked = ::flock(fd, LOCK_EX | LOCK_NB) == 0;
+    if (locked) io::write_text_atomically(path("null"), "discarded");
+    ::close(fd);
+    ASSERT_TRUE(locked);
+  }
   EXPECT_TRUE(fs::is_character_file(path("null")));
   std::vector<std::string> left;
   for (const fs::directory_entry& e : fs::directory_iterator(staging)) left.push_back(e.path().filename().string());
