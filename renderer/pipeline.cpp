@@ -50,7 +50,8 @@ std::vector<std::string> expand_all_pipelines(const std::vector<std::string>& na
       continue;
     }
     if (all && listed(name))
-      throw InputError(fmt::format("{}: '{}' is one of the pipelines 'all' includes; drop one of them", what, name));
+      throw InputError(fmt::format("{}'{}' is one of the pipelines 'all' includes; drop one of them",
+                                   what.empty() ? "" : what + ": ", name));
     out.push_back(name);
   }
   return out;

@@ -98,7 +98,8 @@ class Pipeline {
 [[nodiscard]] std::vector<std::string> pipeline_names();
 /// A list of pipeline entries with "all" replaced by every registered name the list has not named
 /// before it. A name after "all" that "all" already includes is an InputError (`what` names the
-/// list, e.g. "--pipelines"); other repeats are left to parse_pipeline_entries.
+/// list, e.g. "--pipelines"; empty for a caller that places the message itself, as a sweep file
+/// does); other repeats are left to parse_pipeline_entries.
 [[nodiscard]] std::vector<std::string> expand_all_pipelines(const std::vector<std::string>& names,
                                                             const std::string& what);
 /// The pipeline of that name; InputError listing the registered names otherwise.

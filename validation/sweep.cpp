@@ -229,28 +229,18 @@ SweepScene parse_scene_entry(const Where& where, const toml::node& node, const s
 
 void parse_pipelines(const Where& where, const toml::node& node, SweepDefinition& d) {
   const std::string path = "sweep.pipelines";
-  std::vector<std::string> names;
-  bool all = false;
+  std::vector<std::string> given;  // as written, 'all' included
+  std::vector<std::string> names;  // 'all' expanded
   for (const toml::node* e : axis_entries(where, node, path)) {
     const std::string name = string_at(where, *e, path);
-    if (name == "all") {
-      all = true;
-      for (const std::string& n : pipeline_names())
-        if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
-      continue;
-    }
+    if (name != "all" && std::find(given.begin(), given.end(), name) != given.end())
+      where.fail(*e, path, fmt::format("lists '{}' twice", name));
+    given.push_back(name);
+    // Checked entry by entry, so that a message names this entry's line.
     try {
-      (void)parse_pipeline_entry(name).options();  // a variant's fixed options are checked here
-    } catch (const InputError& err) {
-      where.fail(*e, path, err.what());
-    }
-    if (std::find(names.begin(), names.end(), name) != names.end())
-      where.fail(*e, path,
-                 all ? fmt::format("'{}' is one of the pipelines 'all' includes; drop one of them", name)
-                     : fmt::format("lists '{}' twice", name));
-    names.push_back(name);
-    try {
-      (void)parse_pipeline_entries(names, "");  // variants whose files would coincide
+      if (name != "all") (void)parse_pipeline_entry(name).options();  // a variant's fixed options
+      names = expand_all_pipelines(given, "");                       // a name 'all' already includes
+      (void)parse_pipeline_entries(names, "");                       // variants whose files would coincide
     } catch (const InputError& err) {
       where.fail(*e, path, err.what());
     }
