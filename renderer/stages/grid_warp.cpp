@@ -46,22 +46,18 @@ void gap_row(std::span<const float> depth, int width, int j, float* inv, float* 
   const size_t row = static_cast<size_t>(j) * width;
   for (int i = 0; i < width; ++i) inv[row + i] = inverse_depth(depth[row + i]);
   // The gap between i and i+1 opens by d(i+1) - d(i) = f e (1/z(i) - 1/z(i+1)).
-  const auto opening = [&](int i) { return inv[row + i] - inv[row + i + 1]; };
-  // The excess of gap i over the smaller of its neighbours; at the row's ends the missing
-  // neighbour is the gap itself.
-  const auto gap = [&](int i) {
-    const float left = i > 0 ? opening(i - 1) : opening(i);
-    const float right = i + 2 < width ? opening(i + 1) : opening(i);
-    return std::max(0.0f, opening(i) - std::max(0.0f, std::min(left, right)));
+  // Gap i's excess opening over the smaller of its neighbours' (at the row's ends the missing
+  // neighbour is the gap itself).
+  const auto excess_of = [](float gap, float left, float right) {
+    return std::max(0.0f, gap - std::max(0.0f, std::min(left, right)));
   };
-  if (width >= 2) excess[row] = gap(0);
-  // The gaps with both neighbours, without a branch (the same operations, so the same values).
   const float* v = inv + row;
   float* out = excess + row;
-  for (int i = 1; i + 2 < width; ++i)
-    out[i] = std::max(0.0f, (v[i] - v[i + 1]) - std::max(0.0f, std::min(v[i - 1] - v[i], v[i + 1] - v[i + 2])));
-  if (width >= 3) excess[row + width - 2] = gap(width - 2);
-  excess[row + width - 1] = 0.0f;
+  if (width >= 2) out[0] = excess_of(v[0] - v[1], v[0] - v[1], width >= 3 ? v[1] - v[2] : v[0] - v[1]);
+  // The gaps with both neighbours, in a loop without a branch.
+  for (int i = 1; i + 2 < width; ++i) out[i] = excess_of(v[i] - v[i + 1], v[i - 1] - v[i], v[i + 1] - v[i + 2]);
+  if (width >= 3) out[width - 2] = excess_of(v[width - 2] - v[width - 1], v[width - 3] - v[width - 2], v[width - 2] - v[width - 1]);
+  out[width - 1] = 0.0f;
 }
 
 /// Reprojects source lattice vertices into the target eye with VP_to · VP_from⁻¹. The matrix is
