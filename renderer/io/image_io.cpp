@@ -827,19 +827,22 @@ DecodedImage decode_from(OIIO::ImageInput& in, const std::string& name) {
   // Decoded a band of rows at a time, the buffer grown with each band: where the reader decodes
   // row by row (scan-line files other than interlaced PNG), a file that declares more rows than it
   // holds fails at its first missing band, before the memory for the rest is touched. A band is
-  // about 64 MiB of floats, in whole multiples of 256 rows, so that the 16-, 32- and 256-row
-  // chunks of compressed EXR files are never split between two bands.
+  // about 64 MiB of floats rounded down to whole multiples of 256 rows (at least 256), so that the
+  // 16-, 32- and 256-row chunks of compressed EXR files are never split between two bands. A tiled
+  // file is read whole.
   const std::size_t row_values = static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.nchannels);
   image.values.reserve(row_values * static_cast<std::size_t>(spec.height));
-  const int band = static_cast<int>(std::clamp<std::size_t>(((std::size_t{1} << 24) / row_values) / 256, 1, 256) * 256);
-  const bool scanlines = spec.tile_width == 0;
-  for (int y0 = 0; y0 < spec.height; y0 = scanlines ? y0 + band : spec.height) {
-    const int y1 = scanlines ? std::min(spec.height, y0 + band) : spec.height;
+  const bool tiled = spec.tile_width != 0;
+  const int band =
+      tiled ? spec.height
+            : static_cast<int>(std::clamp<std::size_t>(((std::size_t{1} << 24) / row_values) / 256, 1, 256) * 256);
+  for (int y0 = 0; y0 < spec.height; y0 += band) {
+    const int y1 = std::min(spec.height, y0 + band);
     const std::size_t done = image.values.size();
     image.values.resize(done + row_values * static_cast<std::size_t>(y1 - y0));
     float* rows = image.values.data() + done;
-    const bool ok = scanlines ? in.read_scanlines(0, 0, spec.y + y0, spec.y + y1, 0, 0, spec.nchannels, TypeDesc::FLOAT, rows)
-                              : in.read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, rows);
+    const bool ok = tiled ? in.read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, rows)
+                          : in.read_scanlines(0, 0, spec.y + y0, spec.y + y1, 0, 0, spec.nchannels, TypeDesc::FLOAT, rows);
     if (!ok) throw InputError(fmt::format("cannot decode image {}: {}; {}", name, oiio_error(&in), kCorruptHint));
   }
   return image;
