@@ -29,12 +29,6 @@ namespace {
 /// How the temporary names of `path`'s writes begin: ".FILE.tmp-".
 std::string temporary_prefix(const fs::path& path) { return fmt::format(".{}.tmp-", path.filename().string()); }
 
-/// A temporary name for a write of `path`: ".FILE.tmp-PID-N".
-fs::path temporary_name(const fs::path& path) {
-  static std::atomic<unsigned> counter{0};
-  return path.parent_path() / fmt::format("{}{}-{}", temporary_prefix(path), ::getpid(), counter++);
-}
-
 /// Closes a descriptor on every way out.
 struct FdCloser {
   explicit FdCloser(int f) : fd(f) {}
@@ -98,15 +92,16 @@ FdCloser lock_temporary(const fs::path& tmp) {
   return fd;
 }
 
-/// A write's temporary file for `path`, locked: the stale temporaries of earlier writes of `path`
-/// are removed first, then a new one is named and locked.
+/// A write's temporary file for `path`, ".FILE.tmp-PID-N", locked: the stale temporaries of
+/// earlier writes of `path` are removed first.
 struct Temporary {
   fs::path path;
   FdCloser lock;
 };
 Temporary new_temporary(const fs::path& path) {
   remove_stale_temporaries(path);
-  fs::path tmp = temporary_name(path);
+  static std::atomic<unsigned> counter{0};
+  fs::path tmp = path.parent_path() / fmt::format("{}{}-{}", temporary_prefix(path), ::getpid(), counter++);
   FdCloser lock = lock_temporary(tmp);
   return Temporary{std::move(tmp), std::move(lock)};
 }
