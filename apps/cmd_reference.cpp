@@ -39,9 +39,11 @@ struct ReferenceArgs {
   std::string command_line;
 };
 
+/// The entries named on the command line, each checked to be one the store holds, or all of them.
 std::vector<std::string> chosen_ids(const reference::ReferenceStore& store, const std::vector<std::string>& ids) {
-  if (!ids.empty()) return ids;
   std::vector<std::string> all = store.ids();
+  for (const std::string& id : ids) store.require(id);
+  if (!ids.empty()) return ids;
   if (all.empty()) throw InputError(fmt::format("the reference store {} is empty; run `stereobench reference generate`",
                                                 store.root().string()));
   return all;
@@ -107,15 +109,29 @@ int run_verify(const ReferenceArgs& a) {
     io::write_text_atomically(a.json_out, j.dump(2) + "\n");
   }
   const int code = verdict(results);
-  // What to do differs: a failed check is rewritten by update, an unchecked one needs its tool.
-  size_t failures = 0, unchecked = 0;
+  // What to do differs: a failed check is rewritten by update, unless the entry's spec is lost with
+  // its provenance (its line says to remove it and generate it again); an unchecked one needs its tool.
+  size_t failures = 0, specless = 0, unchecked = 0;
   for (const auto& r : results) {
-    unchecked += r.status == reference::Status::unavailable ? 1 : 0;
-    failures += reference::failed(r.status) && r.status != reference::Status::unavailable ? 1 : 0;
+    if (r.status == reference::Status::unavailable) {
+      ++unchecked;
+    } else if (reference::failed(r.status)) {
+      ++failures;
+      try {
+        (void)store.spec_of(r.id);
+      } catch (const InputError&) {
+        ++specless;
+      }
+    }
   }
   std::string tail;
-  if (failures > 0)
-    tail += fmt::format("; {} did not (rewrite them with `stereobench reference update --only-failing`)", failures);
+  if (failures > specless)
+    tail += fmt::format("; {} did not (rewrite them with `stereobench reference update --only-failing`)",
+                        failures - specless);
+  if (specless > 0)
+    tail += fmt::format("; {} lost their spec with their provenance (remove each and make it again with `stereobench "
+                        "reference generate`, see above)",
+                        specless);
   if (unchecked > 0)
     tail += fmt::format("; {} could not be checked here (their tool is missing: install it, see above, and verify "
                         "again)",
@@ -209,7 +225,10 @@ void register_reference_command(CLI::App& root, const std::string& command_line)
   };
 
   CLI::App* gen = ref->add_subcommand(
-      "generate", "Render a reference right eye and store it (replacing one of the same id made from the same scene)");
+      "generate",
+      "Render a reference right eye and store it under an id of scene name, provider, size, interaxial (0.1 mm) and "
+      "convergence (3 digits), with the field of view and light count where they are not the scene's; an entry of "
+      "that id made from the same scene and rig is replaced, one made from another is refused");
   add_common(gen);
   gen->add_option("--scene,-s", a->scene, "Scene file (.gltf/.glb) or built-in scene name")->capture_default_str();
   gen->add_option("--truth", a->truth, "Provider: full, blender or povray")->capture_default_str();

@@ -173,6 +173,8 @@ std::string reference_id(const Scene& scene, const ReferenceSpec& spec, const St
   const RigParams& p = rig.params();
   std::string id = fmt::format("{}_{}_{}x{}_e{:.1f}mm_c{:.3g}m", scene.name, spec.provider, p.width, p.height,
                                p.interaxial * 1e3, p.convergence);
+  // The scene camera's field of view goes without saying; any other is part of the id.
+  if (p.vfov != resolve_rig(scene, {}).params().vfov) id += fmt::format("_v{:.4g}deg", radians_to_degrees(p.vfov));
   if (spec.lights) id += fmt::format("_l{}", *spec.lights);
   return id;
 }
@@ -273,19 +275,23 @@ std::vector<std::string> ReferenceStore::ids() const {
   return out;
 }
 
-json ReferenceStore::provenance(const std::string& id) const {
+void ReferenceStore::require(const std::string& id) const {
   check_entry_name(id);
+  std::error_code ec;
+  if (fs::is_directory(root_ / id, ec)) return;
+  const std::vector<std::string> known = ids();
+  throw InputError(fmt::format("no reference '{}' in {} ({}); run `stereobench reference list`", id, root_.string(),
+                               known.empty() ? "the store is empty" : fmt::format("it holds {} references", known.size())));
+}
+
+json ReferenceStore::provenance(const std::string& id) const {
+  require(id);
   const fs::path file = root_ / id / kProvenance;
   std::error_code ec;
-  if (fs::is_directory(root_ / id, ec) && !fs::exists(file, ec))
+  if (!fs::exists(file, ec))
     throw InputError(fmt::format("{} is missing: the entry's spec is lost with it; remove {} and make the reference "
                                  "again with `stereobench reference generate` and its scene and rig",
                                  file.string(), (root_ / id).string()));
-  if (!fs::exists(file, ec)) {
-    const std::vector<std::string> known = ids();
-    throw InputError(fmt::format("no reference '{}' in {} ({}); run `stereobench reference list`", id, root_.string(),
-                                 known.empty() ? "the store is empty" : fmt::format("it holds {} references", known.size())));
-  }
   try {
     return io::parse_json(io::read_file(file));
   } catch (const io::JsonTextError& e) {
@@ -310,20 +316,31 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
   const Prepared p = prepare(stored, scenes_dir);
   const Scene& scene = p.loaded.scene;
   const std::string id = reference_id(scene, stored, *p.rig);
-  // The id names the scene by its name alone: another file (or a built-in) of that name would
-  // silently take the entry's place. Regenerating from the same scene replaces it, as does an
-  // entry whose provenance cannot be read.
+  // The id names the scene by its name alone and the rig rounded: another file (or a built-in) of
+  // that name, or a rig that differs by less than the id shows, would silently take the entry's
+  // place. Regenerating from the same scene and spec replaces it (also when the scene's camera has
+  // changed since, as `reference update` does), as does an entry whose provenance cannot be read.
   if (fs::exists(root_ / id / kProvenance)) {
-    std::optional<std::string> before;
+    std::optional<ReferenceSpec> before;
+    json before_rig;
     try {
-      before = stored_scene(spec_of(id).scene);
+      const json prov = provenance(id);
+      before = spec_in(prov, root_ / id / kProvenance);
+      before_rig = prov.value("rig", json());
     } catch (const InputError&) {
     }
-    if (before && *before != stored.scene)
+    if (before && stored_scene(before->scene) != stored.scene)
       throw InputError(fmt::format(
           "reference '{}' in {} was made from scene {}, not {} (the id names only the scene's name, '{}'); give this "
           "one another --store, or remove {} to replace it",
-          id, root_.string(), *before, stored.scene, scene.name, (root_ / id).string()));
+          id, root_.string(), before->scene, stored.scene, scene.name, (root_ / id).string()));
+    const json rig_now = rig_record(*p.rig);
+    if (before && well_formed_rig(before_rig) && !same_record(before_rig, rig_now) &&
+        !same_record(spec_to_json(*before), spec_to_json(stored)))
+      throw InputError(fmt::format(
+          "reference '{}' in {} was made with another rig (recorded {}, now {}; the id gives the interaxial to 0.1 mm "
+          "and the convergence to 3 digits); give this one another --store, or remove {} to replace it",
+          id, root_.string(), brief(before_rig), brief(rig_now), (root_ / id).string()));
   }
   const fs::path staged = root_ / fmt::format(".{}.new-{}", id, getpid());
   std::error_code ec;

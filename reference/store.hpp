@@ -66,12 +66,16 @@ class ReferenceStore {
   /// The ids of complete entries, sorted. InputError when the store does not exist or is not a
   /// folder.
   [[nodiscard]] std::vector<std::string> ids() const;
+  /// InputError unless `id` names an entry of the store (complete or damaged): a path or "."/"..",
+  /// or a folder the store does not hold, is named as such.
+  void require(const std::string& id) const;
   /// An entry's provenance; InputError naming the id and listing the store when it is absent.
   [[nodiscard]] nlohmann::json provenance(const std::string& id) const;
 
   /// Renders the reference and stores it, replacing an entry of the same id made from the same
-  /// scene; InputError when that entry was made from another scene of the same name. A glTF path
-  /// is stored absolute. Returns the id.
+  /// scene and spec (or rig); InputError when that entry was made from another scene of the same
+  /// name, or from another spec whose rig differs by less than the id shows. A glTF path is stored
+  /// absolute. Returns the id.
   std::string generate(const ReferenceSpec& spec, const std::filesystem::path& scenes_dir,
                        const std::string& command_line, const Executor& executor) const;
 

@@ -132,7 +132,21 @@ TEST(ReferenceStore, DamagedProvenanceIsAFindingNotAStop) {
   EXPECT_NE(r.out.find("reference generate"), std::string::npos) << "update cannot rewrite it: " << r.out;
   EXPECT_NE(r.out.find("corrupt        " + pole), std::string::npos) << "verification went on past the first: " << r.out;
   EXPECT_NE(r.out.find("the recorded rig \"wide\" is not a rig record"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("0 of 2 reference(s) verified"), std::string::npos) << r.out;
+  // The summary sends the entry whose spec is readable to update and the other to generate.
+  EXPECT_NE(r.out.find("0 of 2 reference(s) verified; 1 did not (rewrite them with `stereobench reference update "
+                       "--only-failing`); 1 lost their spec with their provenance"),
+            std::string::npos)
+      << r.out;
+
+  // An id the store does not hold is named as such, not as an entry without a spec.
+  for (const char* sub : {"update", "verify --no-render"}) {
+    const test::CliRun typo = test::run_cli(ref(dir, sub) + " nosuch");
+    EXPECT_EQ(typo.code, 3) << typo.out;
+    EXPECT_NE(typo.out.find("no reference 'nosuch' in " + (dir / "store").string() + " (it holds 2 references); run "
+                            "`stereobench reference list`"),
+              std::string::npos)
+        << sub << ": " << typo.out;
+  }
 
   // Updating the failing entries rewrites the one whose spec is readable and names the other.
   const test::CliRun upd = test::run_cli(ref(dir, "update") + " --only-failing");
@@ -264,6 +278,31 @@ TEST(ReferenceStore, AnotherSceneOfTheSameNameDoesNotReplaceAnEntry) {
   // The same scene again replaces its entry, as `reference update` does.
   EXPECT_EQ(test::run_cli(ref(dir, "generate") + " --scene " + quoted(copy) + args).code, 0);
   EXPECT_EQ(store.ids().size(), 1u);
+}
+
+TEST(ReferenceStore, AnotherRigDoesNotReplaceAnEntry) {
+  test::ScratchDir dir;
+  const std::string args = " --scene box-wall --resolution 32x18 --threads 1";
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + args).code, 0);
+  const ReferenceStore store(dir / "store");
+  const std::string id = "box-wall_full_32x18_e64.0mm_c4.08m";
+  ASSERT_EQ(store.ids(), std::vector<std::string>{id});
+  const std::string before = test::read_text(dir / "store" / id / "provenance.json");
+  // Another field of view is another reference, beside the first.
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + args + " --vfov 60").code, 0);
+  EXPECT_EQ(store.ids(), (std::vector<std::string>{id, "box-wall_full_32x18_e64.0mm_c4.08m_v60deg"}));
+  // An interaxial or convergence the id rounds to the same text is refused, the entry kept.
+  for (const char* rig : {" --interaxial 0.06404", " --convergence 4.081"}) {
+    const test::CliRun other = test::run_cli(ref(dir, "generate") + args + rig);
+    EXPECT_EQ(other.code, 3) << rig << ": " << other.out;
+    EXPECT_NE(other.out.find("reference '" + id + "' in " + (dir / "store").string() + " was made with another rig"),
+              std::string::npos)
+        << other.out;
+  }
+  EXPECT_EQ(test::read_text(dir / "store" / id / "provenance.json"), before);
+  // The default interaxial given explicitly is the same rig: the entry is made again.
+  EXPECT_EQ(test::run_cli(ref(dir, "generate") + args + " --interaxial 0.064").code, 0);
+  EXPECT_EQ(store.ids().size(), 2u);
 }
 
 TEST(ReferenceStore, ChangedSceneIsReported) {
