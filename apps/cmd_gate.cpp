@@ -93,6 +93,8 @@ void run_gate(const GateArgs& a) {
                      {{"--junit", &a.junit}, {"--json", &a.json_out}});
   remove_earlier_output(a.junit, "--junit");
   remove_earlier_output(a.json_out, "--json");
+  prepare_output_file_folder(a.junit, "--junit");
+  prepare_output_file_folder(a.json_out, "--json");
   const validation::GateConfig config = validation::load_gate_config(a.config);
   const validation::GateResults results = validation::load_gate_results(a.results);
 
@@ -120,7 +122,14 @@ void run_gate(const GateArgs& a) {
   if (!a.json_out.empty()) {
     const nlohmann::json doc =
         validation::gate_report_json(report, a.config, a.results, baseline_note.empty() ? baseline_file.string() : "");
-    io::write_text_atomically(a.json_out, doc.dump(2) + "\n");
+    try {
+      io::write_text_atomically(a.json_out, doc.dump(2) + "\n");
+    } catch (const IoError&) {
+      // Exit 4 leaves neither output: a JUnit file beside a failed run would read as its verdict.
+      std::error_code ec;
+      if (!a.junit.empty()) std::filesystem::remove(a.junit, ec);
+      throw;
+    }
     fmt::print("wrote {}\n", a.json_out);
   }
   if (const int code = validation::exit_code(report.worst); code != 0) throw VerdictExit{code};

@@ -493,6 +493,14 @@ TEST(GateCli, BadInputIsExitThree) {
   EXPECT_EQ(run.code, 3) << run.out;
   EXPECT_FALSE(std::filesystem::exists(dir / "junit.xml"));
   EXPECT_FALSE(std::filesystem::exists(dir / "gate.json"));
+  // An output that cannot be written is exit 4 and leaves no output either: the JUnit file, written
+  // first, used to stay when the JSON's folder was a file.
+  write_file(dir / "notafolder", "x\n");
+  run = run_cli("gate" + config + " --results " + (dir / "pass.jsonl").string() + " --junit " +
+                (dir / "junit.xml").string() + " --json " + (dir / "notafolder" / "gate.json").string());
+  EXPECT_EQ(run.code, 4) << run.out;
+  EXPECT_NE(run.out.find("--json " + (dir / "notafolder" / "gate.json").string()), std::string::npos) << run.out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "junit.xml"));
   // A folder given as an output is bad input naming it.
   run = run_cli("gate" + config + " --results " + (dir / "pass.jsonl").string() + " --junit " + dir.path().string());
   EXPECT_EQ(run.code, 3) << run.out;
