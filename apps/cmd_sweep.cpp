@@ -123,7 +123,12 @@ void run_sweep(const SweepRunArgs& a) {
              shard.count > 1 ? fmt::format("shard {}/{}: {} cells, ", shard.index, shard.count, plan.in_shard) : "",
              plan.finished, plan.todo.size(), o.jobs, o.jobs == 1 ? "" : "s", threads_per_cell(o), o.results.string());
   std::fflush(stdout);
-  if (plan.todo.empty()) return;
+  if (plan.todo.empty()) {
+    // A shard with no cells (more shards than cells) still leaves its results file, empty, for
+    // `sweep collect` over every shard's file.
+    create_results_file(o.results);
+    return;
+  }
 
   prepare_sweep(d, plan.cells, plan.todo, o);
   const ProgressPrinter printer(plan.todo.size());

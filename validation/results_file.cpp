@@ -13,6 +13,7 @@
 #include <limits>
 #include <map>
 #include <string_view>
+#include <utility>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -67,6 +68,8 @@ class Fd {
   }
   Fd(const Fd&) = delete;
   Fd& operator=(const Fd&) = delete;
+  Fd(Fd&& other) noexcept : fd_(std::exchange(other.fd_, -1)) {}
+  Fd& operator=(Fd&&) = delete;
   [[nodiscard]] int get() const { return fd_; }
 
  private:
@@ -296,12 +299,27 @@ ResultsWriterLock::~ResultsWriterLock() {
   if (fd_ >= 0) ::close(fd_);  // releases the locks
 }
 
-void append_result(const fs::path& file, const json& cell, const char* kind) {
-  const std::string line = line_of(cell);
+namespace {
+
+/// The results file opened for appending, it and its folder created when missing.
+Fd open_for_append(const fs::path& file, const char* kind) {
   std::error_code ec;
   if (file.has_parent_path()) fs::create_directories(file.parent_path(), ec);
-  const Fd fd(::open(file.c_str(), O_RDWR | O_APPEND | O_CREAT | O_CLOEXEC, 0644));
+  Fd fd(::open(file.c_str(), O_RDWR | O_APPEND | O_CREAT | O_CLOEXEC, 0644));
   if (fd.get() < 0) io_fail(file, "open", kind);
+  return fd;
+}
+
+}  // namespace
+
+void create_results_file(const fs::path& file, const char* kind) {
+  const Fd fd = open_for_append(file, kind);
+  if (::fsync(fd.get()) != 0) io_fail(file, "flush", kind);
+}
+
+void append_result(const fs::path& file, const json& cell, const char* kind) {
+  const std::string line = line_of(cell);
+  const Fd fd = open_for_append(file, kind);
   if (::flock(fd.get(), LOCK_EX) != 0) io_fail(file, "lock", kind);
   cut_torn_tail(fd.get(), file, kind);
   // One write of the whole line; a short write is completed, and a failed one (a full disk) is

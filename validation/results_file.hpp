@@ -28,6 +28,10 @@ inline constexpr int kSweepSchemaVersion = 1;
 /// cannot be written.
 void append_result(const std::filesystem::path& file, const nlohmann::json& cell, const char* kind = "results file");
 
+/// Creates the results file (and its folder) when it does not exist, empty; an existing one is left
+/// as it is (another shard may be appending to it). IoError when it cannot be made.
+void create_results_file(const std::filesystem::path& file, const char* kind = "results file");
+
 /// Holds the cells a run may write into a results file while it lives: one byte per cell index,
 /// locked for writing (an open-file-description lock) in a hidden lock file beside the results file
 /// (".<name>.lock", found through links). A second run over any of the same cells would find them

@@ -198,6 +198,18 @@ TEST(SweepRun, ShardsCollectedEqualAnUnshardedRun) {
       test::run_cli("sweep collect " + quoted(dir / "merged.jsonl") + " " + quoted(dir / "shard1" / "results.jsonl") +
                     " " + quoted(dir / "shard0" / "results.jsonl"));
   ASSERT_EQ(collected.code, 0) << collected.out;
+  // More shards than cells: a shard with none still leaves its (empty) results file, so that
+  // collecting every shard's file works whatever the split.
+  const test::CliRun none =
+      test::run_cli("sweep run " + def + " --shard 6/7 --out " + quoted(dir / "shard6") + common);
+  ASSERT_EQ(none.code, 0) << none.out;
+  EXPECT_NE(none.out.find("shard 6/7: 0 cells"), std::string::npos) << none.out;
+  EXPECT_EQ(test::read_text(dir / "shard6" / "results.jsonl"), "");
+  const test::CliRun with_empty = test::run_cli("sweep collect " + quoted(dir / "merged7.jsonl") + " " +
+                                                quoted(dir / "shard6" / "results.jsonl") + " " +
+                                                quoted(dir / "merged.jsonl"));
+  ASSERT_EQ(with_empty.code, 0) << with_empty.out;
+  EXPECT_EQ(test::read_text(dir / "merged7.jsonl"), test::read_text(dir / "merged.jsonl"));
 
   const std::vector<json> merged = validation::read_results(dir / "merged.jsonl").cells;
   ASSERT_EQ(merged.size(), 6u);
