@@ -117,6 +117,13 @@ int run_compare(const CompareArgs& a) {
   ordered(a.warn_percent, a.fail_percent, false, "percent");
 
   check_outputs(a);
+  // An earlier run's outputs at these paths go first: a comparison stopped by bad input or an
+  // unwritable output (exit 3 or 4) leaves none, so none can be read as this run's verdict.
+  const std::pair<const char*, const std::string*> outputs[] = {
+      {"--json", &a.json}, {"--diff", &a.diff}, {"--ssim-map", &a.ssim_map}};
+  for (const auto& [option, path] : outputs)
+    if (*path != "-") remove_earlier_output(*path, option);
+  for (const auto& [option, path] : outputs) prepare_output_file_folder(*path, option);
 
   // Inputs: both images (and the mask) must have one size and one kind of colour.
   const validation::Srgb8File fa = validation::read_srgb8_file(a.a, a.eye);
@@ -166,31 +173,37 @@ int run_compare(const CompareArgs& a) {
                                             : ExitCode::ok;
   const char* verdict = code == ExitCode::gate_failure ? "fail" : code == ExitCode::gate_warning ? "warn" : "pass";
 
-  // Pictures first, so that a failing comparison still leaves them to look at.
-  if (!a.diff.empty()) validation::write_png(a.diff, validation::difference_image(fa.image, fb.image, region));
-  if (!a.ssim_map.empty())
-    validation::write_png(a.ssim_map, validation::ssim_image(ssim, region));
+  nlohmann::json record;
+  record["metrics_version"] = validation::kMetricsVersion;
+  record["a"] = file_record(a.a, fa);
+  record["b"] = file_record(a.b, fb);
+  record["mask"] =
+      a.mask.empty() ? nlohmann::json(nullptr) : nlohmann::json{{"path", a.mask}, {"pixels", mask->count()}};
+  record["metrics"] = validation::to_json(m);
+  record["thresholds"] = {
+      {"fail_psnr", optional_number(a.fail_psnr)},       {"fail_ssim", optional_number(a.fail_ssim)},
+      {"fail_percent", optional_number(a.fail_percent)}, {"warn_psnr", optional_number(a.warn_psnr)},
+      {"warn_ssim", optional_number(a.warn_ssim)},       {"warn_percent", optional_number(a.warn_percent)}};
+  record["verdict"] = verdict;
+  record["failures"] = failures;
+  record["warnings"] = warnings;
+  record["exit_code"] = static_cast<int>(code);
 
-  if (!a.json.empty()) {
-    nlohmann::json record;
-    record["metrics_version"] = validation::kMetricsVersion;
-    record["a"] = file_record(a.a, fa);
-    record["b"] = file_record(a.b, fb);
-    record["mask"] =
-        a.mask.empty() ? nlohmann::json(nullptr) : nlohmann::json{{"path", a.mask}, {"pixels", mask->count()}};
-    record["metrics"] = validation::to_json(m);
-    record["thresholds"] = {
-        {"fail_psnr", optional_number(a.fail_psnr)},       {"fail_ssim", optional_number(a.fail_ssim)},
-        {"fail_percent", optional_number(a.fail_percent)}, {"warn_psnr", optional_number(a.warn_psnr)},
-        {"warn_ssim", optional_number(a.warn_ssim)},       {"warn_percent", optional_number(a.warn_percent)}};
-    record["verdict"] = verdict;
-    record["failures"] = failures;
-    record["warnings"] = warnings;
-    record["exit_code"] = static_cast<int>(code);
+  try {
+    // Pictures first, so that a failing comparison still leaves them to look at.
+    if (!a.diff.empty()) validation::write_png(a.diff, validation::difference_image(fa.image, fb.image, region));
+    if (!a.ssim_map.empty()) validation::write_png(a.ssim_map, validation::ssim_image(ssim, region));
     if (a.json == "-")
       fmt::print("{}\n", record.dump(2));
-    else
+    else if (!a.json.empty())
       io::write_text_atomically(a.json, record.dump(2) + "\n");
+  } catch (const std::exception&) {
+    // An output that cannot be written takes the others of this run with it.
+    for (const auto& [option, path] : outputs) {
+      std::error_code ec;
+      if (!path->empty() && *path != "-") fs::remove(*path, ec);
+    }
+    throw;
   }
 
   // The human summary; on stderr when stdout carries the JSON.
@@ -255,7 +268,9 @@ Thresholds (as in OpenImageIO's idiff): the comparison fails when PSNR < --fail-
 Exit codes: 0 pass, 1 warnings only, 2 failure, 3 bad input or usage (a missing, damaged or
 non-image input file, a size or channel mismatch, an empty mask, a stereo EXR without --eye, an
 SSIM limit where SSIM is undefined),
-4 I/O failure (an existing input that cannot be opened, an output that cannot be written).)";
+4 I/O failure (an existing input that cannot be opened, an output that cannot be written).
+On 3 and 4 no --json, --diff or --ssim-map file is left (an earlier one at that path is removed);
+on 0, 1 and 2 all are written.)";
 
 }  // namespace
 

@@ -29,6 +29,9 @@ namespace {
 /// How the temporary names of `path`'s writes begin: ".FILE.tmp-".
 std::string temporary_prefix(const fs::path& path) { return fmt::format(".{}.tmp-", path.filename().string()); }
 
+/// The folder `path` lies in ("." for a bare name).
+fs::path folder_of(const fs::path& path) { return path.parent_path().empty() ? fs::path(".") : path.parent_path(); }
+
 /// Closes a descriptor on every way out.
 struct FdCloser {
   explicit FdCloser(int f) : fd(f) {}
@@ -62,9 +65,8 @@ bool is_temporary_of(const std::string& name, const std::string& prefix) {
 /// (ENOLCK), nothing is removed. Best effort: errors leave files where they are.
 void remove_stale_temporaries(const fs::path& path) {
   const std::string prefix = temporary_prefix(path);
-  const fs::path folder = path.parent_path().empty() ? fs::path(".") : path.parent_path();
   std::error_code ec;
-  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+  for (fs::directory_iterator it(folder_of(path), ec), end; !ec && it != end; it.increment(ec)) {
     if (!is_temporary_of(it->path().filename().string(), prefix)) continue;
     const FdCloser fd{::open(it->path().c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK)};
     if (fd.fd < 0 || ::flock(fd.fd, LOCK_EX | LOCK_NB) != 0) continue;  // a running write, or not ours
@@ -77,17 +79,22 @@ void remove_stale_temporaries(const fs::path& path) {
 /// the writer then opens and truncates the same file. The file is made and locked under a name
 /// the cleanup does not look at, then renamed to `tmp` (the lock goes with the file), so that no
 /// other write can find it unlocked. The descriptor is closed with the object.
-FdCloser lock_temporary(const fs::path& tmp) {
+FdCloser lock_temporary(const fs::path& tmp, const fs::path& path) {
   const fs::path staging = tmp.parent_path() / (tmp.filename().string() + ".new");
   FdCloser fd{::open(staging.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644)};
-  if (fd.fd < 0) throw IoError(fmt::format("cannot create {}: {}", staging.string(), std::strerror(errno)));
+  if (fd.fd < 0)
+    throw IoError(fmt::format("cannot write {}: cannot create a file in {} ({}); give a path in a folder you can "
+                              "write, or make room there",
+                              path.string(), folder_of(path).string(), std::strerror(errno)));
   (void)::flock(fd.fd, LOCK_EX | LOCK_NB);  // without locks (ENOLCK) the file is only never judged stale
   std::error_code ec;
   fs::rename(staging, tmp, ec);
   if (ec) {
     const std::string why = ec.message();
     fs::remove(staging, ec);
-    throw IoError(fmt::format("cannot rename {} to {}: {}", staging.string(), tmp.string(), why));
+    throw IoError(fmt::format("cannot write {}: cannot rename a file in {} ({}); give a path in a folder you can "
+                              "write",
+                              path.string(), folder_of(path).string(), why));
   }
   return fd;
 }
@@ -102,7 +109,7 @@ Temporary new_temporary(const fs::path& path) {
   remove_stale_temporaries(path);
   static std::atomic<unsigned> counter{0};
   fs::path tmp = path.parent_path() / fmt::format("{}{}-{}", temporary_prefix(path), ::getpid(), counter++);
-  FdCloser lock = lock_temporary(tmp);
+  FdCloser lock = lock_temporary(tmp, path);
   return Temporary{std::move(tmp), std::move(lock)};
 }
 
@@ -224,8 +231,8 @@ void write_atomically(const fs::path& given, const std::function<void(const fs::
   if (!parent.empty()) {
     fs::create_directories(parent, ec);
     if (ec)
-      throw IoError(fmt::format("cannot create folder {} for {}: {}", parent.string(),
-                                path.filename().string(), ec.message()));
+      throw IoError(fmt::format("cannot write {}: cannot create its folder {} ({}); give a path you can write",
+                                path.string(), parent.string(), ec.message()));
   }
   const Temporary staged = new_temporary(path);
   const fs::path& tmp = staged.path;
@@ -233,7 +240,10 @@ void write_atomically(const fs::path& given, const std::function<void(const fs::
     write(tmp);
     sync_file(tmp);
     fs::rename(tmp, path, ec);
-    if (ec) throw IoError(fmt::format("cannot rename {} to {}: {}", tmp.string(), path.string(), ec.message()));
+    if (ec)
+      throw IoError(fmt::format("cannot write {}: the finished file cannot take its name ({}); any earlier file of that "
+                                "name is left as it was",
+                                path.string(), ec.message()));
   });
 }
 

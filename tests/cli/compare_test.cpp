@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <fstream>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -144,6 +145,29 @@ TEST_F(Compare, MismatchedAndMissingInputsAreBadInput) {
 
   r = compare(q(path("a.png")));
   EXPECT_EQ(r.code, 3) << r.out;  // B is required
+}
+
+TEST_F(Compare, AStoppedComparisonLeavesNoOutputs) {
+  const std::string outputs =
+      " --json " + q(path("v.json")) + " --diff " + q(path("d.png")) + " --ssim-map " + q(path("s.png"));
+  const auto none_left = [&](const char* json) {
+    for (const char* name : {json, "d.png", "s.png"}) EXPECT_FALSE(fs::exists(path(name))) << name;
+  };
+  // A warning writes all three; bad input then removes them, so that the earlier verdict cannot be
+  // read as this run's.
+  ASSERT_EQ(compare(ab() + outputs + " --warn-psnr 90").code, 1);
+  validation::write_png(path("small.png"), picture(0, 1, 40, 30));
+  CliRun r = compare(q(path("a.png")) + " " + q(path("small.png")) + outputs);
+  EXPECT_EQ(r.code, 3) << r.out;
+  none_left("v.json");
+  // An output that cannot be written (its folder is a file) is exit 4 and leaves the others unwritten.
+  ASSERT_EQ(compare(ab() + outputs).code, 0);
+  std::ofstream(path("file")) << "x\n";
+  r = compare(ab() + " --diff " + q(path("d.png")) + " --ssim-map " + q(path("s.png")) + " --json " +
+              q(path("file") / "v.json"));
+  EXPECT_EQ(r.code, 4) << r.out;
+  EXPECT_NE(r.out.find("--json " + (path("file") / "v.json").string()), std::string::npos) << r.out;
+  none_left("file/v.json");
 }
 
 TEST_F(Compare, JsonRecord) {
