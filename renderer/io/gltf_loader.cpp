@@ -140,7 +140,7 @@ std::string percent_decode(const std::string& s) {
   return out;
 }
 
-/// A base64 data URI buffer must decode to at least its declared byteLength.
+/// A base64 data URI buffer must decode to exactly its declared byteLength (as the loader demands).
 void check_data_uri_length(const json& buffer, const std::string& where, const std::string& file) {
   const std::string& uri = buffer.at("uri").get_ref<const std::string&>();
   const size_t comma = uri.find(',');
@@ -155,6 +155,10 @@ void check_data_uri_length(const json& buffer, const std::string& where, const s
   if (have < need)
     throw InputError(fmt::format("{}: {}: the data URI holds {} bytes but byteLength says {}; the buffer is "
                                  "truncated", file, where, have, need));
+  if (have > need)
+    throw InputError(fmt::format("{}: {}: the data URI holds {} bytes but byteLength says {}; the buffer's data "
+                                 "and its length disagree: set {}/byteLength to {}, or export the scene again",
+                                 file, where, have, need, where, have));
 }
 
 /// A URI with a scheme other than data: ("file:", "https:"); one letter before the colon is a

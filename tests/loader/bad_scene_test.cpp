@@ -139,6 +139,15 @@ std::vector<BadCase> corpus() {
     g.finish_buffer("data:application/octet-stream;base64," + MiniGltf::base64(std::vector<unsigned char>(12, 0)));
     MiniGltf::write_text(p, g.doc.dump());
   }, "/buffers/0"});
+  c.push_back({"base64_too_long", "a.gltf", [](const std::filesystem::path& p) {
+    MiniGltf g;
+    g.add_triangle();
+    g.finish_buffer("");
+    const size_t length = g.doc["buffers"][0]["byteLength"].get<size_t>();
+    g.doc["buffers"][0]["uri"] =
+        "data:application/octet-stream;base64," + MiniGltf::base64(std::vector<unsigned char>(length + 12, 0));
+    MiniGltf::write_text(p, g.doc.dump());
+  }, "/buffers/0: the data URI holds"});  // the loader's own message quoted the whole URI
   c.push_back({"truncated_glb", "a.glb", [](const std::filesystem::path& p) {
     MiniGltf g;
     g.add_triangle();
