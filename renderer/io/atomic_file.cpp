@@ -11,6 +11,7 @@
 #include <cstring>
 #include <fstream>
 #include <new>
+#include <regex>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -162,12 +163,27 @@ bool is_stream(const fs::path& path) {
   return fs::exists(st) && !fs::is_regular_file(st) && !fs::is_directory(st);
 }
 
+/// A writer's message with the temporary names of `path`'s writes (".FILE.tmp-PID-N", also nested,
+/// with any folder before them) written as `path`: the hidden names are gone when the user reads it.
+std::string without_temporary_names(const std::string& message, const fs::path& path) {
+  std::string escaped;
+  for (const char c : path.filename().string()) {
+    if (std::strchr(".^$|()[]{}*+?\\", c) != nullptr) escaped += '\\';
+    escaped += c;
+  }
+  const std::regex names("[^\\s\"']*\\.+" + escaped + "(\\.tmp-[0-9]+-[0-9]+)+(\\.new)?");
+  return std::regex_replace(message, names, path.string());
+}
+
 /// Runs `work`, which writes `tmp` on the way to `path`; on any failure `tmp` is removed and the
 /// error passed on, typed errors as they are, others as an IoError naming `path`.
 void with_temporary(const fs::path& tmp, const fs::path& path, const std::function<void()>& work) {
   std::error_code ec;
   try {
     work();
+  } catch (const IoError& e) {
+    fs::remove(tmp, ec);
+    throw IoError(without_temporary_names(e.what(), path));
   } catch (const Error&) {
     fs::remove(tmp, ec);
     throw;
@@ -212,39 +228,90 @@ void write_through(const fs::path& stream, const std::function<void(const fs::pa
   });
 }
 
-}  // namespace
-
-fs::path follow_links(const fs::path& path) { return link_chain(path).back(); }
-
-void write_atomically(const fs::path& given, const std::function<void(const fs::path&)>& write) {
+/// Where a write of `given` goes: the file at the end of its links, or `given` itself when it is
+/// written through (a stream, or a path through a process's open files); InputError for a folder.
+struct Target {
+  fs::path path;
+  bool through = false;
+};
+Target target_of(const fs::path& given) {
   const std::vector<fs::path> chain = link_chain(given);
   const bool open_file = names_open_file(chain);
-  const fs::path path = open_file ? given : chain.back();
+  Target t{open_file ? given : chain.back(), false};
   std::error_code ec;
-  if (fs::is_directory(path, ec))
+  if (fs::is_directory(t.path, ec))
     throw InputError(fmt::format("{} is a folder; give the name of the file to write", given.string()));
-  if (open_file || is_stream(path)) {
-    write_through(given, write);
-    return;
-  }
+  t.through = open_file || is_stream(t.path);
+  return t;
+}
+
+}  // namespace
+
+struct StagedFiles::Entry {
+  fs::path path;
+  Temporary staged;
+  /// The lock on the file now at the temporary name: a writer that writes atomically itself
+  /// replaced the file locked when the name was made.
+  FdCloser relock{-1};
+  bool placed = false;
+};
+
+StagedFiles::StagedFiles() = default;
+
+StagedFiles::~StagedFiles() {
+  std::error_code ec;
+  for (const Entry& e : entries_)
+    if (!e.placed) fs::remove(e.staged.path, ec);
+}
+
+void StagedFiles::add(const fs::path& given, const std::function<void(const fs::path&)>& write) {
+  const Target target = target_of(given);
+  if (target.through)
+    throw InputError(fmt::format("{} is not a file that can be replaced (a device, pipe or open file); give the path "
+                                 "of a file in a folder",
+                                 given.string()));
+  const fs::path& path = target.path;
   const fs::path parent = path.parent_path();
+  std::error_code ec;
   if (!parent.empty()) {
     fs::create_directories(parent, ec);
     if (ec)
       throw IoError(fmt::format("cannot write {}: cannot create its folder {} ({}); give a path you can write",
                                 path.string(), parent.string(), ec.message()));
   }
-  const Temporary staged = new_temporary(path);
-  const fs::path& tmp = staged.path;
-  with_temporary(tmp, path, [&] {
-    write(tmp);
-    sync_file(tmp);
-    fs::rename(tmp, path, ec);
+  Temporary staged = new_temporary(path);
+  FdCloser relock{-1};
+  with_temporary(staged.path, path, [&] {
+    write(staged.path);
+    sync_file(staged.path);
+    relock.fd = ::open(staged.path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (relock.fd >= 0) (void)::flock(relock.fd, LOCK_EX | LOCK_NB);
+  });
+  entries_.push_back(Entry{path, std::move(staged), std::move(relock)});
+}
+
+void StagedFiles::commit() {
+  for (Entry& e : entries_) {
+    std::error_code ec;
+    fs::rename(e.staged.path, e.path, ec);
     if (ec)
       throw IoError(fmt::format("cannot write {}: the finished file cannot take its name ({}); any earlier file of that "
                                 "name is left as it was",
-                                path.string(), ec.message()));
-  });
+                                e.path.string(), ec.message()));
+    e.placed = true;
+  }
+}
+
+fs::path follow_links(const fs::path& path) { return link_chain(path).back(); }
+
+void write_atomically(const fs::path& given, const std::function<void(const fs::path&)>& write) {
+  if (target_of(given).through) {
+    write_through(given, write);
+    return;
+  }
+  StagedFiles one;
+  one.add(given, write);
+  one.commit();
 }
 
 void write_file_atomically(const fs::path& path, std::span<const unsigned char> bytes) {

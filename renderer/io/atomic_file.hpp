@@ -8,6 +8,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 namespace sb::io {
 
@@ -24,6 +25,30 @@ namespace sb::io {
 /// holds (left by a killed process) are removed first.
 void write_atomically(const std::filesystem::path& path,
                       const std::function<void(const std::filesystem::path& tmp_path)>& write);
+
+/// Files written as one set. add() makes each file whole under its temporary name beside its
+/// final one (as write_atomically does; a folder, device, pipe or open-file path is refused with an
+/// InputError), commit() then renames them into place in the order they were added. Until commit
+/// nothing at the final names changes, so a failure while adding (a full disk) leaves an earlier
+/// set as it was; a set destroyed uncommitted removes its temporary files.
+class StagedFiles {
+ public:
+  StagedFiles();
+  ~StagedFiles();
+  StagedFiles(const StagedFiles&) = delete;
+  StagedFiles& operator=(const StagedFiles&) = delete;
+
+  /// Calls `write(tmp_path)` and flushes the file; on failure its temporary file is removed and
+  /// the error passed on (IoError naming `path` for an untyped one).
+  void add(const std::filesystem::path& path, const std::function<void(const std::filesystem::path& tmp_path)>& write);
+  /// Renames every file added into place, in order; IoError at the first that fails (the files
+  /// before it are in place, the others' temporaries are removed with the set).
+  void commit();
+
+ private:
+  struct Entry;
+  std::vector<Entry> entries_;
+};
 
 /// The file a path names, its symbolic links followed (a dangling link gives the file it would
 /// create); `path` itself when it is no link. IoError for a loop of links.

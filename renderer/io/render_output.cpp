@@ -13,6 +13,7 @@
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/gltf_loader.hpp"
 #include "renderer/io/image_io.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/stereo_output.hpp"
 #include "sb_version.hpp"
 
@@ -103,6 +104,27 @@ void check_extra_names(const StereoResult& result) {
   }
 }
 
+/// The file names an earlier render's stats JSON lists for its set (see write_render_outputs):
+/// only plain names of this stem's outputs, so that a damaged or edited file cannot name another.
+std::vector<std::string> earlier_files(const fs::path& stats_json) {
+  std::vector<std::string> out;
+  std::error_code ec;
+  if (!fs::is_regular_file(stats_json, ec)) return out;
+  try {
+    const json j = parse_json(read_file(stats_json));
+    const std::string stem = stats_json.filename().string().substr(0, stats_json.filename().string().size() -
+                                                                         std::string_view("_stats.json").size());
+    if (!j.is_object() || !j.contains("files") || !j["files"].is_array()) return out;
+    for (const json& name : j["files"])
+      if (name.is_string()) {
+        const std::string n = name.get<std::string>();
+        if (n.starts_with(stem + "_") && n.find('/') == std::string::npos && n.ends_with(".png")) out.push_back(n);
+      }
+  } catch (const std::exception&) {
+  }
+  return out;
+}
+
 }  // namespace
 
 RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::string& stem,
@@ -115,38 +137,48 @@ RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::st
   f.anaglyph_png = dir / (stem + "_anaglyph.png");
   f.side_by_side_png = dir / (stem + "_sbs.png");
   f.stats_json = dir / (stem + "_stats.json");
-  // The stats JSON, written last, marks a complete set: an earlier render's goes first, and a
-  // failure on the way (a full disk) removes what this call wrote, so no set is left looking
-  // complete.
-  std::error_code ec;
-  fs::remove(f.stats_json, ec);
-  if (ec) throw IoError(fmt::format("cannot remove the earlier {}: {}", f.stats_json.string(), ec.message()));
-  std::vector<fs::path> written;
+  // Every file is made whole under its temporary name first, and only then are all renamed into
+  // place, the stats JSON last (it marks a complete set): a failure on the way (a full disk) leaves
+  // an earlier render's set as it was. Should a rename fail, the stats JSON is removed, so that no
+  // mixed set is left looking complete.
+  ImageMetadata meta;
+  meta["stereobench/record"] = record.dump();
+  std::vector<std::pair<fs::path, const Image*>> pngs{{f.left_png, &result.left}, {f.right_png, &result.right}};
+  const Image anaglyph = anaglyph_dubois(result.left, result.right);
+  const Image sbs = side_by_side(result.left, result.right);
+  pngs.emplace_back(f.anaglyph_png, &anaglyph);
+  pngs.emplace_back(f.side_by_side_png, &sbs);
+  if (holes_overlay) {
+    f.holes_png = dir / (stem + "_holes.png");
+    pngs.emplace_back(*f.holes_png, holes_overlay);
+  }
+  for (const auto& [name, image] : result.extras) {
+    f.extras.push_back(dir / (stem + "_" + name + ".png"));
+    pngs.emplace_back(f.extras.back(), &image);
+  }
+  // The set's file names go into the stats JSON: the next render of this stem removes those of
+  // this set it does not write again (a diagnostic image an option asked for).
+  json stats = record;
+  std::vector<std::string> names;
+  for (const fs::path& file : f.all()) names.push_back(file.filename().string());
+  stats["files"] = names;
+  const std::vector<std::string> earlier = earlier_files(f.stats_json);
+
+  StagedFiles set;
+  set.add(f.exr, [&](const fs::path& tmp) { write_exr_stereo(tmp, result.left, result.right, meta); });
+  for (const auto& [file, image] : pngs) set.add(file, [&](const fs::path& tmp) { write_png_preview(tmp, *image); });
+  set.add(f.stats_json, [&](const fs::path& tmp) { write_text_atomically(tmp, stats.dump(2) + "\n"); });
   try {
-    ImageMetadata meta;
-    meta["stereobench/record"] = record.dump();
-    write_exr_stereo(f.exr, result.left, result.right, meta);
-    written.push_back(f.exr);
-    const auto png = [&written](const fs::path& file, const Image& image) {
-      write_png_preview(file, image);
-      written.push_back(file);
-    };
-    png(f.left_png, result.left);
-    png(f.right_png, result.right);
-    png(f.anaglyph_png, anaglyph_dubois(result.left, result.right));
-    png(f.side_by_side_png, side_by_side(result.left, result.right));
-    if (holes_overlay) {
-      f.holes_png = dir / (stem + "_holes.png");
-      png(*f.holes_png, *holes_overlay);
-    }
-    for (const auto& [name, image] : result.extras) {
-      f.extras.push_back(dir / (stem + "_" + name + ".png"));
-      png(f.extras.back(), image);
-    }
-    write_text_atomically(f.stats_json, record.dump(2) + "\n");
+    set.commit();
   } catch (...) {
-    for (const fs::path& file : written) fs::remove(file, ec);
+    std::error_code ec;
+    fs::remove(f.stats_json, ec);
     throw;
+  }
+  for (const std::string& name : earlier) {
+    if (std::find(names.begin(), names.end(), name) != names.end()) continue;
+    std::error_code ec;
+    fs::remove(dir / name, ec);
   }
   return f;
 }

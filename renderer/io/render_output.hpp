@@ -45,7 +45,9 @@ struct RenderFiles {
   [[nodiscard]] std::vector<std::filesystem::path> all() const;
 };
 
-/// Writes every output of a run (atomically, file by file) and returns their paths: with
+/// Writes every output of a run as one set (io::StagedFiles: all made whole, then all renamed
+/// into place, the stats JSON last, which lists the set's files; the earlier set's files of the
+/// stem that this one does not write are then removed) and returns their paths: with
 /// `holes_overlay` also <stem>_holes.png, and a PNG preview of the "rgb" plane of each of the
 /// result's extras. An extra's name must be lowercase letters, digits and '_' and must not be
 /// one of the standard suffixes (left, right, anaglyph, sbs, stats, holes) nor appear twice;

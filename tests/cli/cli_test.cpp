@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -184,17 +185,33 @@ TEST(Cli, RenderWritesEveryOutputAndBenchPrintsATable) {
   EXPECT_GT(j.at("counters").at("shadow_rays").get<uint64_t>(), 0u);
   EXPECT_EQ(j.at("rig").at("width").get<int>(), 64);
 
-  // A render that stops while writing (here: the side-by-side image's path is a folder) leaves no
-  // set behind: neither the files it wrote before nor the stats of the earlier render.
-  std::filesystem::remove(dir / "box-wall_plain-raster_sbs.png");
-  std::filesystem::create_directories(dir / "box-wall_plain-raster_sbs.png");
-  const CliRun stopped =
-      run("render --scene box-wall --pipeline plain-raster --out '" + dir.path().string() + "'" + common);
-  EXPECT_EQ(stopped.code, 3) << stopped.out;
-  EXPECT_NE(stopped.out.find("box-wall_plain-raster_sbs.png is a folder"), std::string::npos) << stopped.out;
+  // A render that stops while writing (here: the side-by-side image's path is a folder) places
+  // none of its files: every file is made whole before any takes its name, so the earlier render's
+  // set stays as it was (it used to lose its stats and the files the new render wrote first), and
+  // no temporary file is left.
+  const std::string stem = "box-wall_plain-raster";
+  std::filesystem::remove(dir / (stem + "_sbs.png"));
+  std::filesystem::create_directories(dir / (stem + "_sbs.png"));
+  std::map<std::string, std::string> before;
   for (const char* suffix : {".exr", "_left.png", "_right.png", "_anaglyph.png", "_stats.json"})
-    EXPECT_FALSE(std::filesystem::exists(dir / (std::string("box-wall_plain-raster") + suffix))) << suffix;
-  std::filesystem::remove(dir / "box-wall_plain-raster_sbs.png");
+    before[suffix] = test::read_text(dir / (stem + suffix));
+  const CliRun stopped = run("render --scene box-wall --pipeline plain-raster --out '" + dir.path().string() +
+                             "' --scenes-dir '" + (dir / "scenes").string() + "' --resolution 48x27");
+  EXPECT_EQ(stopped.code, 3) << stopped.out;
+  EXPECT_NE(stopped.out.find(stem + "_sbs.png is a folder"), std::string::npos) << stopped.out;
+  for (const auto& [suffix, text] : before) EXPECT_EQ(test::read_text(dir / (stem + suffix)), text) << suffix;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path()))
+    EXPECT_NE(entry.path().filename().string()[0], '.') << entry.path();
+  std::filesystem::remove(dir / (stem + "_sbs.png"));
+
+  // A diagnostic image an option asked for goes with the next render of the stem that does not
+  // ask for it (it stayed, from another resolution, beside the new set).
+  const std::string repro = "render --scene box-wall --pipeline repro-rt --out '" + dir.path().string() + "'" + common;
+  ASSERT_EQ(run(repro + " --option grid_overlay=true").code, 0);
+  ASSERT_TRUE(std::filesystem::exists(dir / "box-wall_repro-rt_grid.png"));
+  ASSERT_EQ(run(repro).code, 0);
+  EXPECT_FALSE(std::filesystem::exists(dir / "box-wall_repro-rt_grid.png"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "box-wall_repro-rt_holes.png"));
 
   // A variant renders under its own name; its files say which options it fixed.
   const CliRun v =
