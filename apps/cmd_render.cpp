@@ -74,6 +74,16 @@ void run_render(const RenderArgs& a) {
   const size_t lights_in_file = loaded.lights_in_file;
   const StereoRig rig = resolve_rig(scene, overrides);
   entry.check_rig(options, rig);
+  // The outputs are <out>/<stem>.exr and <out>/<stem>_*: a scene file of such a name there would be
+  // replaced by one of them.
+  const std::string stem = fmt::format("{}_{}", scene.file_stem(), entry_file_stem(entry.name));
+  std::error_code ec;
+  const std::string scene_name = loaded.file.filename().string();
+  if (fs::equivalent(loaded.file.parent_path().empty() ? fs::path(".") : loaded.file.parent_path(), a.out, ec) &&
+      (scene_name == stem + ".exr" || scene_name.starts_with(stem + "_")))
+    throw InputError(fmt::format("--scene {}: this render's outputs in --out {} ({}.exr, {}_*) would replace the "
+                                 "scene file; give another --out",
+                                 loaded.file.string(), a.out, stem, stem));
   const RenderScene prepared(scene);
   require_frame_memory(rig.params().width, rig.params().height, fmt::format("render {}", entry.name));
   warn_geometry_before_near_plane(prepared, rig, executor);
@@ -84,7 +94,6 @@ void run_render(const RenderArgs& a) {
   if (holes) record["holes"] = io::holes_to_json(*holes);
   record["scene"]["lights"] = scene.lights.size();
   record["scene"]["lights_in_file"] = lights_in_file;
-  const std::string stem = fmt::format("{}_{}", scene.file_stem(), entry_file_stem(entry.name));
   const io::RenderFiles files =
       io::write_render_outputs(a.out, stem, result, record, holes ? &holes->overlay : nullptr);
   fmt::print("{} on {} ({} triangles, {}), {}, {} threads\n", entry.name, scene.name, scene.triangle_count(),

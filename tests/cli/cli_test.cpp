@@ -272,6 +272,17 @@ TEST(Cli, ASceneNameNeverLeadsOutputsOutOfTheOutputFolder) {
     EXPECT_TRUE(e.path().filename() == "scenes" || e.path().filename() == "out" ||
                 e.path().filename() == "box-wall-copy.gltf")
         << "written beside the output folder: " << e.path();
+
+  // A scene file named like one of the render's outputs, in the output folder, is not replaced by
+  // it (the stats JSON used to take its place).
+  doc["scenes"][0]["name"] = "box-wall";
+  const std::filesystem::path own = dir / "out" / "box-wall_plain-rt_stats.gltf";
+  { std::ofstream(own) << doc.dump(); }
+  const CliRun over = run("render --pipeline plain-rt --scene '" + own.string() + "' --out '" + (dir / "out").string() +
+                          "'" + common);
+  EXPECT_EQ(over.code, 3) << over.out;
+  EXPECT_NE(over.out.find("would replace the scene file; give another --out"), std::string::npos) << over.out;
+  EXPECT_EQ(nlohmann::json::parse(test::read_text(own)), doc);
 }
 
 TEST(Cli, AGeneratedVariantNeverTakesTheDefaultScenesFile) {
