@@ -3,7 +3,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <optional>
+#include <regex>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <fmt/format.h>
@@ -179,10 +185,61 @@ std::string reference_id(const Scene& scene, const ReferenceSpec& spec, const St
   return id;
 }
 
-/// Replaces `dir` by `staged` (a complete folder beside it) with renames only.
+/// An exclusive lock on a working folder of the store (".ID.new-PID", ".ID.old-PID",
+/// ".ID.verify-PID") while the generate or verify that made it runs: remove_stale_folders leaves
+/// a locked one alone, whichever process, container or machine holds it.
+class FolderLock {
+ public:
+  explicit FolderLock(const fs::path& folder) : fd_(::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC)) {
+    if (fd_ >= 0) (void)::flock(fd_, LOCK_EX | LOCK_NB);  // without locks the folder is only never judged stale
+  }
+  ~FolderLock() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  FolderLock(const FolderLock&) = delete;
+  FolderLock& operator=(const FolderLock&) = delete;
+
+ private:
+  int fd_;
+};
+
+/// Removes the working folders a killed generate or verify left in the store (SIGKILL, a job's
+/// time limit): hidden, named ".ID.new-PID", ".ID.old-PID" or ".ID.verify-PID", and not locked.
+/// Best effort: errors leave them where they are.
+void remove_stale_folders(const fs::path& root) {
+  static const std::regex working(R"(\..+\.(new|old|verify)-[0-9]+)");
+  std::error_code ec;
+  for (fs::directory_iterator it(root, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    std::error_code dir_ec;
+    if (!std::regex_match(name, working) || !it->is_directory(dir_ec)) continue;
+    const int fd = ::open(it->path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0) continue;
+    const bool free = ::flock(fd, LOCK_EX | LOCK_NB) == 0;
+    ::close(fd);
+    std::error_code ignored;
+    if (free) fs::remove_all(it->path(), ignored);
+  }
+}
+
+/// Replaces `dir` by `staged` (a complete folder beside it). An existing entry is swapped with the
+/// staged one in a single rename (RENAME_EXCHANGE), so that the id names the old or the new entry
+/// at every moment, and the old one is then removed under the staged name; where the file system
+/// cannot swap, the old entry is moved aside first and moved back should the new one not take
+/// its place.
 void replace_folder(const fs::path& staged, const fs::path& dir) {
   std::error_code ec;
+  if (fs::exists(dir)) {
+    if (::renameat2(AT_FDCWD, staged.c_str(), AT_FDCWD, dir.c_str(), RENAME_EXCHANGE) == 0) {
+      fs::remove_all(staged, ec);
+      return;
+    }
+    if (errno != EINVAL && errno != ENOSYS && errno != ENOTSUP)
+      throw IoError(fmt::format("cannot put the new reference in place of '{}': {}", dir.string(),
+                                std::strerror(errno)));
+  }
   const fs::path old = dir.parent_path() / fmt::format(".{}.old-{}", dir.filename().string(), getpid());
+  const FolderLock hold(dir);
   if (fs::exists(dir)) {
     fs::rename(dir, old, ec);
     if (ec) throw IoError(fmt::format("cannot move the old reference '{}' aside: {}", dir.string(), ec.message()));
@@ -342,11 +399,13 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
           "and the convergence to 3 digits); give this one another --store, or remove {} to replace it",
           id, root_.string(), brief(before_rig), brief(rig_now), (root_ / id).string()));
   }
+  remove_stale_folders(root_);
   const fs::path staged = root_ / fmt::format(".{}.new-{}", id, getpid());
   std::error_code ec;
   fs::remove_all(staged, ec);
   fs::create_directories(staged, ec);
   if (ec) throw IoError(fmt::format("cannot create '{}': {}", staged.string(), ec.message()));
+  const FolderLock hold(staged);
   try {
     const RenderScene prepared(scene);
     const validation::TruthRequest request{prepared, p.loaded.file, *p.rig, staged / "work", executor.threads()};
@@ -509,6 +568,8 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
   const Image stored = validation::rgb_plane_only(io::read_exr(image_file));
   const RenderScene prepared(p.loaded.scene);
   const fs::path work = root_ / fmt::format(".{}.verify-{}", id, getpid());
+  fs::create_directories(work, ec);
+  const FolderLock hold(work);
   const validation::TruthRequest request{prepared, p.loaded.file, *p.rig, work, executor.threads()};
   Image fresh;
   try {

@@ -2,6 +2,11 @@
 // changed scene, rewrite only failing references, and report a missing tool as unavailable.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <utility>
@@ -303,6 +308,30 @@ TEST(ReferenceStore, AnotherRigDoesNotReplaceAnEntry) {
   // The default interaxial given explicitly is the same rig: the entry is made again.
   EXPECT_EQ(test::run_cli(ref(dir, "generate") + args + " --interaxial 0.064").code, 0);
   EXPECT_EQ(store.ids().size(), 2u);
+}
+
+TEST(ReferenceStore, WorkingFoldersOfAKilledRunAreRemoved) {
+  test::ScratchDir dir;
+  const std::string args = " --scene box-wall --resolution 32x18 --threads 1";
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + args).code, 0);
+  const fs::path store = dir / "store";
+  // What a generate or verify killed mid-way leaves (the folders it works in), one still held by a
+  // running process (locked here), and a hidden folder of another kind.
+  for (const char* name : {".a_full_32x18.new-4242", ".a_full_32x18.old-4243", ".a_full_32x18.verify-4244",
+                           ".b_full_32x18.new-77", ".notes"})
+    fs::create_directories(store / name / "work");
+  const int held = ::open((store / ".b_full_32x18.new-77").c_str(), O_RDONLY | O_DIRECTORY);
+  ASSERT_GE(held, 0);
+  ASSERT_EQ(::flock(held, LOCK_EX | LOCK_NB), 0);
+  // Replacing the entry swaps it with the new one and removes the stale folders.
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + args).code, 0);
+  ::close(held);
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(store)) left.push_back(e.path().filename().string());
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{".b_full_32x18.new-77", ".notes", "box-wall_full_32x18_e64.0mm_c4.08m"}));
+  const test::CliRun verify = test::run_cli(ref(dir, "verify"));
+  EXPECT_EQ(verify.code, 0) << verify.out;
 }
 
 TEST(ReferenceStore, ChangedSceneIsReported) {
