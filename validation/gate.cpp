@@ -756,11 +756,13 @@ std::string nothing_checked_message(const GateConfig& config, const GateResults&
   std::vector<std::string> parts;
   for (const auto& [why, count] : skip_reasons(checks))
     parts.push_back(fmt::format("{} x {}: {}", count, why.first, why.second));
-  return fmt::format("{}: none of its checks applies to {} ({} cell{}): every one was skipped ({}); a pass would say "
+  const std::string why = parts.empty() ? "its rules turn every limit off for them"
+                                         : fmt::format("every one was skipped ({})", fmt::join(parts, "; "));
+  return fmt::format("{}: none of its checks applies to {} ({} cell{}): {}; a pass would say "
                      "nothing. Give limits the records carry in [defaults] or a [[rule]], or a baseline for "
                      "[regression] (gate --update-baseline stores one)",
                      config.source, results.file.string(), results.cells.size(), results.cells.size() == 1 ? "" : "s",
-                     fmt::join(parts, "; "));
+                     why);
 }
 
 }  // namespace
@@ -934,8 +936,9 @@ std::string format_gate_table(const GateReport& report) {
   std::set<std::string> cells;
   for (const GateCheck& c : report.checks)
     if (c.check != kCompleteCheck) cells.insert(c.cell_id);
-  out << fmt::format("gate: {} checks over {} cells: {} pass, {} warn, {} fail, {} skipped -> {} (exit {})\n",
-                     report.checks.size(), cells.size(), count(Verdict::pass), count(Verdict::warn),
+  out << fmt::format("gate: {} check{} over {} cell{}: {} pass, {} warn, {} fail, {} skipped -> {} (exit {})\n",
+                     report.checks.size(), report.checks.size() == 1 ? "" : "s", cells.size(),
+                     cells.size() == 1 ? "" : "s", count(Verdict::pass), count(Verdict::warn),
                      count(Verdict::fail), count(Verdict::skip),
                      report.worst == Verdict::fail   ? "FAIL"
                      : report.worst == Verdict::warn ? "WARN"

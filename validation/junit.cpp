@@ -82,11 +82,14 @@ std::string junit_xml(const GateReport& report, const std::string& name) {
         "  <testsuite name=\"{}\" id=\"{}\" package=\"stereobench.gate\" tests=\"{}\" failures=\"{}\" errors=\"0\" "
         "skipped=\"{}\">\n",
         attr(cell_id), index++, checks.size(), count(checks, Verdict::fail), count(checks, Verdict::skip));
-    out += fmt::format("    <properties>\n      <property name=\"scene\" value=\"{}\"/>\n    </properties>\n",
-                       attr(checks.front()->scene));
+    // A check of the whole sweep (its completeness) belongs to no scene: no scene property, and
+    // the class "gate.sweep" (an empty segment confuses tools that split class names at dots).
+    if (!checks.front()->scene.empty())
+      out += fmt::format("    <properties>\n      <property name=\"scene\" value=\"{}\"/>\n    </properties>\n",
+                         attr(checks.front()->scene));
     for (const GateCheck* c : checks) {
       out += fmt::format("    <testcase name=\"{}\" classname=\"{}\"", attr(c->pipeline + " " + c->check),
-                         attr("gate." + c->scene + "." + c->pipeline));
+                         attr(c->scene.empty() ? std::string("gate.sweep") : "gate." + c->scene + "." + c->pipeline));
       if (c->verdict == Verdict::pass) {
         out += "/>\n";
         continue;

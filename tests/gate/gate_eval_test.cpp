@@ -225,6 +225,16 @@ TEST(GateEval, AGateThatChecksNothingIsBadInputNotAPass) {
     EXPECT_NE(std::string(e.what()).find("every one was skipped (4 x time_regression: no baseline)"), std::string::npos)
         << e.what();
   }
+  // Every limit turned off by a rule: no check at all, said as such (it read "skipped ()").
+  try {
+    (void)evaluate(passing_cells(), {},
+                   "[defaults]\nmin_psnr = 30\n[regression]\ntolerance = 0.1\n[[rule]]\nmin_psnr = false\n"
+                   "regression_tolerance = false\n");
+    ADD_FAILURE() << "a gate that checked nothing passed";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("(2 cells): its rules turn every limit off for them"), std::string::npos)
+        << e.what();
+  }
   // An unfinished sweep whose cells all skip fails its completeness check instead.
   const validation::GateReport incomplete = evaluate({passing_cells()[0]}, {}, regression_only);
   EXPECT_EQ(incomplete.worst, Verdict::fail);
@@ -532,6 +542,12 @@ TEST(GateEval, AnUnfinishedSweepFails) {
   ASSERT_NE(complete(other), nullptr);
   EXPECT_NE(complete(other)->reproduce.find("--out runs --results runs/partial.jsonl"), std::string::npos)
       << complete(other)->reproduce;
+  // In JUnit the sweep's own check is of class "gate.sweep" in a suite without a scene property
+  // (it was "gate..(all)", an empty segment, beside scene "").
+  const std::string xml = validation::junit_xml(part, "gate");
+  EXPECT_NE(xml.find("classname=\"gate.sweep\""), std::string::npos) << xml;
+  EXPECT_EQ(xml.find("gate.."), std::string::npos) << xml;
+  EXPECT_EQ(xml.find("value=\"\""), std::string::npos) << xml;
 }
 
 TEST(GateEval, ReproduceGivesTheLightCountTheCellUsed) {
