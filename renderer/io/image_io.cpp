@@ -44,9 +44,24 @@ std::string oiio_error(const T* object) {
   const std::string global = OIIO::geterror();
   if (message.empty()) message = global;
   if (message.empty()) message = "no details reported by OpenImageIO";
-  // OIIO messages may span lines; keep ours on one.
-  std::replace(message.begin(), message.end(), '\n', ' ');
-  return message;
+  // OIIO messages may span lines, one per report of the same fault (a codec's message, then
+  // OIIO's with it quoted): ours is one line of the reports not contained in another one.
+  std::vector<std::string> lines;
+  for (size_t start = 0; start <= message.size();) {
+    const size_t end = std::min(message.find('\n', start), message.size());
+    std::string line = message.substr(start, end - start);
+    while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
+    if (!line.empty()) lines.push_back(std::move(line));
+    start = end + 1;
+  }
+  std::vector<std::string> kept;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    bool repeated = false;
+    for (size_t k = 0; k < lines.size() && !repeated; ++k)
+      repeated = k != i && lines[k].find(lines[i]) != std::string::npos && (lines[k] != lines[i] || k < i);
+    if (!repeated) kept.push_back(lines[i]);
+  }
+  return kept.empty() ? message : fmt::format("{}", fmt::join(kept, "; "));
 }
 
 std::string oiio_global_error() { return oiio_error<OIIO::ImageInput>(nullptr); }

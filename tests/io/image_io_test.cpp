@@ -344,6 +344,20 @@ TEST_F(ImageIoTest, TruncatedPngIsAnInputError) {
   const std::vector<unsigned char> cut(png.begin(), png.begin() + static_cast<std::ptrdiff_t>(png.size() / 2));
   expect_error<InputError>([&] { (void)io::decode_image(cut, "half.png"); }, "half.png");
   expect_error<InputError>([&] { (void)io::decode_image({}, "empty.png"); }, "empty.png");
+  // libpng reports the fault and OpenImageIO quotes it again: the message says each report once,
+  // on one line (it read "Read error: hit end of file PNG read error: IDAT: Read error: ...").
+  try {
+    (void)io::decode_image(cut, "half.png");
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    const std::string head = "cannot decode image half.png: ";
+    ASSERT_EQ(m.rfind(head, 0), 0u) << m;
+    // libpng's report of the fault ("Read error: hit end of file" with this libpng) once.
+    const std::string fault = "Read error";
+    ASSERT_NE(m.find(fault), std::string::npos) << m;
+    EXPECT_EQ(m.find(fault, m.find(fault) + 1), std::string::npos) << m;
+  }
 }
 
 /// The PNG CRC-32 (ISO 3309) of `bytes`.
