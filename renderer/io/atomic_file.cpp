@@ -11,7 +11,6 @@
 #include <cstring>
 #include <fstream>
 #include <new>
-#include <regex>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -163,18 +162,6 @@ bool is_stream(const fs::path& path) {
   return fs::exists(st) && !fs::is_regular_file(st) && !fs::is_directory(st);
 }
 
-/// A writer's message with the temporary names of `path`'s writes (".FILE.tmp-PID-N", also nested,
-/// with any folder before them) written as `path`: the hidden names are gone when the user reads it.
-std::string without_temporary_names(const std::string& message, const fs::path& path) {
-  std::string escaped;
-  for (const char c : path.filename().string()) {
-    if (std::strchr(".^$|()[]{}*+?\\", c) != nullptr) escaped += '\\';
-    escaped += c;
-  }
-  const std::regex names("[^\\s\"']*\\.+" + escaped + "(\\.tmp-[0-9]+-[0-9]+)+(\\.new)?");
-  return std::regex_replace(message, names, path.string());
-}
-
 /// Runs `work`, which writes `tmp` on the way to `path`; on any failure `tmp` is removed and the
 /// error passed on, typed errors as they are, others as an IoError naming `path`.
 void with_temporary(const fs::path& tmp, const fs::path& path, const std::function<void()>& work) {
@@ -182,8 +169,13 @@ void with_temporary(const fs::path& tmp, const fs::path& path, const std::functi
   try {
     work();
   } catch (const IoError& e) {
+    // The writer names the file it was given, the hidden temporary one: the message names `path`.
     fs::remove(tmp, ec);
-    throw IoError(without_temporary_names(e.what(), path));
+    std::string message = e.what();
+    const std::string hidden = tmp.string();
+    for (size_t at = message.find(hidden); at != std::string::npos; at = message.find(hidden, at + path.string().size()))
+      message.replace(at, hidden.size(), path.string());
+    throw IoError(message);
   } catch (const Error&) {
     fs::remove(tmp, ec);
     throw;
@@ -247,12 +239,13 @@ Target target_of(const fs::path& given) {
 
 }  // namespace
 
+/// The temporary file StagedFiles::add is writing in this thread, if any: a writer that writes it
+/// through write_atomically writes it in place.
+static thread_local const fs::path* staging_path = nullptr;
+
 struct StagedFiles::Entry {
   fs::path path;
   Temporary staged;
-  /// The lock on the file now at the temporary name: a writer that writes atomically itself
-  /// replaced the file locked when the name was made.
-  FdCloser relock{-1};
   bool placed = false;
 };
 
@@ -280,14 +273,21 @@ void StagedFiles::add(const fs::path& given, const std::function<void(const fs::
                                 path.string(), parent.string(), ec.message()));
   }
   Temporary staged = new_temporary(path);
-  FdCloser relock{-1};
   with_temporary(staged.path, path, [&] {
-    write(staged.path);
+    // A writer that writes atomically itself (write_exr, write_png_preview, ...) writes this file
+    // in place: its lock stays, and no second temporary name is made.
+    const fs::path* outer = staging_path;
+    staging_path = &staged.path;
+    try {
+      write(staged.path);
+    } catch (...) {
+      staging_path = outer;
+      throw;
+    }
+    staging_path = outer;
     sync_file(staged.path);
-    relock.fd = ::open(staged.path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (relock.fd >= 0) (void)::flock(relock.fd, LOCK_EX | LOCK_NB);
   });
-  entries_.push_back(Entry{path, std::move(staged), std::move(relock)});
+  entries_.push_back(Entry{path, std::move(staged)});
 }
 
 void StagedFiles::commit() {
@@ -305,6 +305,10 @@ void StagedFiles::commit() {
 fs::path follow_links(const fs::path& path) { return link_chain(path).back(); }
 
 void write_atomically(const fs::path& given, const std::function<void(const fs::path&)>& write) {
+  if (staging_path != nullptr && given == *staging_path) {
+    write(given);  // the temporary file of a StagedFiles::add, made and locked there
+    return;
+  }
   if (target_of(given).through) {
     write_through(given, write);
     return;
