@@ -153,12 +153,22 @@ bool names_file(const NamedPath& p) {
 }  // namespace
 
 void remove_earlier_output(const std::filesystem::path& path, const std::string& what) {
-  if (path.empty()) return;
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) return;  // a folder is refused while the arguments are read
-  if (!std::filesystem::remove(path, ec) || ec)
-    throw IoError(fmt::format("cannot remove the earlier {} file {}: {}; make it writable or give another path", what,
-                              path.string(), ec ? ec.message() : "not removed"));
+  if (path.empty() || path == "-") return;
+  try {
+    (void)io::remove_output_file(path);
+  } catch (const IoError& e) {
+    throw IoError(fmt::format("{}: {}", what, e.what()));
+  }
+}
+
+void discard_outputs(std::initializer_list<const std::string*> paths) noexcept {
+  for (const std::string* path : paths) {
+    if (path->empty() || *path == "-") continue;
+    try {
+      (void)io::remove_output_file(*path);
+    } catch (const std::exception&) {  // best effort: the run's own error is the one to report
+    }
+  }
 }
 
 void prepare_output_folder(const std::string& folder, const char* option) {
@@ -167,7 +177,7 @@ void prepare_output_folder(const std::string& folder, const char* option) {
 }
 
 void prepare_output_file_folder(const std::string& file, const char* option) {
-  if (file.empty() || file == "-") return;
+  if (file.empty() || file == "-" || io::written_in_place(file)) return;
   const std::filesystem::path folder = std::filesystem::path(file).parent_path();
   if (folder.empty()) return;  // the current folder
   if (const auto why = io::unwritable_folder(folder))

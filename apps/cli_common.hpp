@@ -70,8 +70,14 @@ void prepare_output_folder(const std::string& folder, const char* option);
 /// Removes what an earlier run left at an output path before this run writes anything, so that a
 /// run stopped on the way leaves no output that looks like its own (a CI step publishing a JUnit
 /// file finds none; records do not sit beside an earlier run's summary). `what` names the output
-/// in the message ("--junit", "summary"). IoError when it cannot be removed; nothing for an empty path.
+/// in the message ("--junit", "summary"). Only the regular file the path names is removed (see
+/// io::remove_output_file: a device, pipe or /dev/stdout stays). IoError when it cannot be removed;
+/// nothing for an empty path or "-".
 void remove_earlier_output(const std::filesystem::path& path, const std::string& what);
+
+/// Removes what a failing run wrote at these output paths (best effort; as remove_earlier_output:
+/// regular files only, "" and "-" skipped), so that none is left beside its error.
+void discard_outputs(std::initializer_list<const std::string*> paths) noexcept;
 
 /// The same for the folder of an output file (a --json written after a long benchmark); nothing
 /// for "" (no file), "-" (standard output) or a bare file name (the current folder).

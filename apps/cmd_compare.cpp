@@ -121,8 +121,7 @@ int run_compare(const CompareArgs& a) {
   // unwritable output (exit 3 or 4) leaves none, so none can be read as this run's verdict.
   const std::pair<const char*, const std::string*> outputs[] = {
       {"--json", &a.json}, {"--diff", &a.diff}, {"--ssim-map", &a.ssim_map}};
-  for (const auto& [option, path] : outputs)
-    if (*path != "-") remove_earlier_output(*path, option);
+  for (const auto& [option, path] : outputs) remove_earlier_output(*path, option);
   for (const auto& [option, path] : outputs) prepare_output_file_folder(*path, option);
 
   // Inputs: both images (and the mask) must have one size and one kind of colour.
@@ -199,10 +198,7 @@ int run_compare(const CompareArgs& a) {
       io::write_text_atomically(a.json, record.dump(2) + "\n");
   } catch (const std::exception&) {
     // An output that cannot be written takes the others of this run with it.
-    for (const auto& [option, path] : outputs) {
-      std::error_code ec;
-      if (!path->empty() && *path != "-") fs::remove(*path, ec);
-    }
+    discard_outputs({&a.json, &a.diff, &a.ssim_map});
     throw;
   }
 

@@ -304,6 +304,19 @@ void StagedFiles::commit() {
 
 fs::path follow_links(const fs::path& path) { return link_chain(path).back(); }
 
+bool written_in_place(const fs::path& path) { return target_of(path).through; }
+
+bool remove_output_file(const fs::path& path) {
+  if (path.empty() || written_in_place(path)) return false;
+  const fs::path file = follow_links(path);
+  std::error_code ec;
+  if (!fs::is_regular_file(fs::symlink_status(file, ec))) return false;
+  if (!fs::remove(file, ec) || ec)
+    throw IoError(fmt::format("cannot remove the earlier {}: {}; make it writable or give another path", path.string(),
+                              ec ? ec.message() : "not removed"));
+  return true;
+}
+
 void write_atomically(const fs::path& given, const std::function<void(const fs::path&)>& write) {
   if (staging_path != nullptr && given == *staging_path) {
     write(given);  // the temporary file of a StagedFiles::add, made and locked there

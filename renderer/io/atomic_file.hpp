@@ -50,6 +50,15 @@ class StagedFiles {
   std::vector<Entry> entries_;
 };
 
+/// Whether write_atomically writes `path` in place (a device, pipe or socket, or a path through a
+/// process's open files) rather than replacing a file there.
+[[nodiscard]] bool written_in_place(const std::filesystem::path& path);
+
+/// Removes the file an earlier run wrote at output path `path`: the regular file it names (its
+/// links followed; the links stay), never a device, pipe or open-file path, which are written in
+/// place. Whether there was one to remove; IoError when it could not be removed.
+bool remove_output_file(const std::filesystem::path& path);
+
 /// The file a path names, its symbolic links followed (a dangling link gives the file it would
 /// create); `path` itself when it is no link. IoError for a loop of links.
 [[nodiscard]] std::filesystem::path follow_links(const std::filesystem::path& path);

@@ -168,6 +168,16 @@ TEST_F(Compare, AStoppedComparisonLeavesNoOutputs) {
   EXPECT_EQ(r.code, 4) << r.out;
   EXPECT_NE(r.out.find("--json " + (path("file") / "v.json").string()), std::string::npos) << r.out;
   none_left("file/v.json");
+  // Through a link, the file it names is the output: written through it, and removed by a stopped
+  // run while the link stays (it used to be replaced by a plain file, or removed itself).
+  std::filesystem::create_symlink("real.json", path("link.json"));
+  ASSERT_EQ(compare(ab() + " --json " + q(path("link.json"))).code, 0);
+  EXPECT_TRUE(std::filesystem::is_symlink(path("link.json")));
+  EXPECT_NE(test::read_text(path("real.json")).find("\"verdict\""), std::string::npos);
+  r = compare(q(path("a.png")) + " " + q(path("small.png")) + " --json " + q(path("link.json")));
+  EXPECT_EQ(r.code, 3) << r.out;
+  EXPECT_TRUE(std::filesystem::is_symlink(path("link.json")));
+  EXPECT_FALSE(std::filesystem::exists(path("real.json")));
 }
 
 TEST_F(Compare, JsonRecord) {
