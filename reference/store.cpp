@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <optional>
@@ -185,48 +186,85 @@ std::string reference_id(const Scene& scene, const ReferenceSpec& spec, const St
   return id;
 }
 
-/// An exclusive lock on a working folder of the store (".ID.new-PID", ".ID.old-PID",
-/// ".ID.verify-PID") while the generate or verify that made it runs: remove_stale_folders leaves
-/// a locked one alone, whichever process, container or machine holds it.
-class FolderLock {
- public:
-  explicit FolderLock(const fs::path& folder) : fd_(::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC)) {
-    if (fd_ >= 0) (void)::flock(fd_, LOCK_EX | LOCK_NB);  // without locks the folder is only never judged stale
+/// A working folder of the store, ".ID.KIND-PID-XXXXXX" (KIND new, old or verify), held under an
+/// exclusive lock (flock) while the generate or verify that made it runs: remove_stale_folders
+/// leaves a locked one alone, whichever process, container or machine holds it.
+struct WorkingFolder {
+  fs::path path;
+  int fd = -1;
+  WorkingFolder() = default;
+  WorkingFolder(const WorkingFolder&) = delete;
+  WorkingFolder& operator=(const WorkingFolder&) = delete;
+  ~WorkingFolder() {
+    if (fd >= 0) ::close(fd);
   }
-  ~FolderLock() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  FolderLock(const FolderLock&) = delete;
-  FolderLock& operator=(const FolderLock&) = delete;
-
- private:
-  int fd_;
 };
 
-/// Removes the working folders a killed generate or verify left in the store (SIGKILL, a job's
-/// time limit): hidden, named ".ID.new-PID", ".ID.old-PID" or ".ID.verify-PID", and not locked.
-/// Best effort: errors leave them where they are.
-void remove_stale_folders(const fs::path& root) {
-  static const std::regex working(R"(\..+\.(new|old|verify)-[0-9]+)");
+/// The pattern of working folder names; the suffix is the one a folder of kind "new" was made with.
+const std::regex& working_name() {
+  static const std::regex pattern(R"(\.(.+)\.(new|old|verify)-([0-9]+-[A-Za-z0-9]{6}))");
+  return pattern;
+}
+
+/// Makes a new working folder of `kind` for entry `id`: made (mkdtemp) and locked under a name the
+/// clean-up does not look at, then renamed, so that no other run can find it unlocked.
+void make_working_folder(const fs::path& root, const std::string& id, const char* kind, WorkingFolder& out) {
+  std::error_code made_root;
+  fs::create_directories(root, made_root);  // a new store
+  std::string made = (root / fmt::format(".{}.mk-XXXXXX", id)).string();
+  if (::mkdtemp(made.data()) == nullptr)
+    throw IoError(fmt::format("cannot create a working folder in the reference store {}: {}; give a --store you "
+                              "can write",
+                              root.string(), std::strerror(errno)));
+  out.fd = ::open(made.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (out.fd >= 0) (void)::flock(out.fd, LOCK_EX | LOCK_NB);  // without locks it is only never judged stale
+  out.path = root / fmt::format(".{}.{}-{}-{}", id, kind, getpid(), made.substr(made.size() - 6));
   std::error_code ec;
-  for (fs::directory_iterator it(root, ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string name = it->path().filename().string();
-    std::error_code dir_ec;
-    if (!std::regex_match(name, working) || !it->is_directory(dir_ec)) continue;
-    const int fd = ::open(it->path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (fd < 0) continue;
-    const bool free = ::flock(fd, LOCK_EX | LOCK_NB) == 0;
-    ::close(fd);
-    std::error_code ignored;
-    if (free) fs::remove_all(it->path(), ignored);
+  fs::rename(made, out.path, ec);
+  if (ec) {
+    fs::remove_all(made, ec);
+    throw IoError(fmt::format("cannot create a working folder in the reference store {}; give a --store you can write",
+                              root.string()));
   }
 }
 
-/// Replaces `dir` by `staged` (a complete folder beside it). An existing entry is swapped with the
-/// staged one in a single rename (RENAME_EXCHANGE), so that the id names the old or the new entry
-/// at every moment, and the old one is then removed under the staged name; where the file system
-/// cannot swap, the old entry is moved aside first and moved back should the new one not take
-/// its place.
+/// Clears up after a generate or verify that was killed (SIGKILL, a job's time limit): its working
+/// folders that no lock holds are removed, except an entry moved aside (".ID.old-…") whose id
+/// names no entry any more, which is moved back. Best effort: errors leave folders where they are.
+void remove_stale_folders(const fs::path& root) {
+  // A folder being made (".ID.mk-XXXXXX") is locked and renamed within microseconds; one a minute
+  // old was left by a kill in between.
+  static const std::regex being_made(R"(\..+\.mk-[A-Za-z0-9]{6})");
+  const auto now = fs::file_time_type::clock::now();
+  std::error_code ec;
+  for (fs::directory_iterator it(root, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    std::smatch m;
+    std::error_code dir_ec;
+    if (std::regex_match(name, being_made) && it->is_directory(dir_ec)) {
+      const auto made = fs::last_write_time(it->path(), dir_ec);
+      std::error_code ignored;
+      if (!dir_ec && now - made > std::chrono::minutes(1)) fs::remove_all(it->path(), ignored);
+      continue;
+    }
+    if (!std::regex_match(name, m, working_name()) || !it->is_directory(dir_ec)) continue;
+    const int fd = ::open(it->path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0) continue;
+    const bool free = ::flock(fd, LOCK_EX | LOCK_NB) == 0;
+    std::error_code ignored;
+    if (free && m[2] == "old" && !fs::exists(root / m[1].str(), ignored))
+      fs::rename(it->path(), root / m[1].str(), ignored);
+    else if (free)
+      fs::remove_all(it->path(), ignored);
+    ::close(fd);
+  }
+}
+
+/// Replaces `dir` by `staged` (a complete working folder beside it). An existing entry is swapped
+/// with the staged one in a single rename (RENAME_EXCHANGE), so that the id names the old or the
+/// new entry at every moment, and the old one is then removed under the staged name; where the
+/// file system cannot swap, the old entry is moved aside (".ID.old-…", locked) first and moved back
+/// should the new one not take its place (remove_stale_folders moves it back after a kill).
 void replace_folder(const fs::path& staged, const fs::path& dir) {
   std::error_code ec;
   if (fs::exists(dir)) {
@@ -238,8 +276,14 @@ void replace_folder(const fs::path& staged, const fs::path& dir) {
       throw IoError(fmt::format("cannot put the new reference in place of '{}': {}", dir.string(),
                                 std::strerror(errno)));
   }
-  const fs::path old = dir.parent_path() / fmt::format(".{}.old-{}", dir.filename().string(), getpid());
-  const FolderLock hold(dir);
+  std::smatch m;
+  const std::string staged_name = staged.filename().string();
+  const fs::path old = dir.parent_path() / (std::regex_match(staged_name, m, working_name())
+                                                ? fmt::format(".{}.old-{}", dir.filename().string(), m[3].str())
+                                                : fmt::format(".{}.old-{}-aside0", dir.filename().string(), getpid()));
+  WorkingFolder hold;
+  hold.fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (hold.fd >= 0) (void)::flock(hold.fd, LOCK_EX | LOCK_NB);
   if (fs::exists(dir)) {
     fs::rename(dir, old, ec);
     if (ec) throw IoError(fmt::format("cannot move the old reference '{}' aside: {}", dir.string(), ec.message()));
@@ -400,12 +444,10 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
           id, root_.string(), brief(before_rig), brief(rig_now), (root_ / id).string()));
   }
   remove_stale_folders(root_);
-  const fs::path staged = root_ / fmt::format(".{}.new-{}", id, getpid());
+  WorkingFolder working;
+  make_working_folder(root_, id, "new", working);
+  const fs::path& staged = working.path;
   std::error_code ec;
-  fs::remove_all(staged, ec);
-  fs::create_directories(staged, ec);
-  if (ec) throw IoError(fmt::format("cannot create '{}': {}", staged.string(), ec.message()));
-  const FolderLock hold(staged);
   try {
     const RenderScene prepared(scene);
     const validation::TruthRequest request{prepared, p.loaded.file, *p.rig, staged / "work", executor.threads()};
@@ -567,9 +609,9 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
   }
   const Image stored = validation::rgb_plane_only(io::read_exr(image_file));
   const RenderScene prepared(p.loaded.scene);
-  const fs::path work = root_ / fmt::format(".{}.verify-{}", id, getpid());
-  fs::create_directories(work, ec);
-  const FolderLock hold(work);
+  WorkingFolder working;
+  make_working_folder(root_, id, "verify", working);
+  const fs::path& work = working.path;
   const validation::TruthRequest request{prepared, p.loaded.file, *p.rig, work, executor.threads()};
   Image fresh;
   try {

@@ -310,28 +310,34 @@ TEST(ReferenceStore, AnotherRigDoesNotReplaceAnEntry) {
   EXPECT_EQ(store.ids().size(), 2u);
 }
 
-TEST(ReferenceStore, WorkingFoldersOfAKilledRunAreRemoved) {
+TEST(ReferenceStore, WorkingFoldersOfAKilledRunAreClearedUp) {
   test::ScratchDir dir;
-  const std::string args = " --scene box-wall --resolution 32x18 --threads 1";
-  ASSERT_EQ(test::run_cli(ref(dir, "generate") + args).code, 0);
+  const std::string args = " --resolution 32x18 --threads 1";
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene box-wall" + args).code, 0);
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene thin-pole" + args).code, 0);
   const fs::path store = dir / "store";
-  // What a generate or verify killed mid-way leaves (the folders it works in), one still held by a
-  // running process (locked here), and a hidden folder of another kind.
-  for (const char* name : {".a_full_32x18.new-4242", ".a_full_32x18.old-4243", ".a_full_32x18.verify-4244",
-                           ".b_full_32x18.new-77", ".notes"})
+  const std::string pole = "thin-pole_full_32x18_e64.0mm_c2m";
+  // What generates and verifies killed mid-way leave: working folders, one still held by a running
+  // process (locked here), and an entry moved aside whose new version never took its place; and
+  // hidden folders of other kinds, which are not the store's to remove.
+  fs::rename(store / pole, store / ("." + pole + ".old-4245-Zz09aB"));
+  for (const char* name : {".a_full_32x18.new-4242-abcdef", ".a_full_32x18.verify-4244-ABCDEF",
+                           ".b_full_32x18.new-77-xyzXYZ", ".notes", ".backup.old-2024"})
     fs::create_directories(store / name / "work");
-  const int held = ::open((store / ".b_full_32x18.new-77").c_str(), O_RDONLY | O_DIRECTORY);
+  const int held = ::open((store / ".b_full_32x18.new-77-xyzXYZ").c_str(), O_RDONLY | O_DIRECTORY);
   ASSERT_GE(held, 0);
   ASSERT_EQ(::flock(held, LOCK_EX | LOCK_NB), 0);
-  // Replacing the entry swaps it with the new one and removes the stale folders.
-  ASSERT_EQ(test::run_cli(ref(dir, "generate") + args).code, 0);
+  // Replacing an entry swaps it with the new one, and clears up first.
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene box-wall" + args).code, 0);
   ::close(held);
   std::vector<std::string> left;
   for (const auto& e : fs::directory_iterator(store)) left.push_back(e.path().filename().string());
   std::sort(left.begin(), left.end());
-  EXPECT_EQ(left, (std::vector<std::string>{".b_full_32x18.new-77", ".notes", "box-wall_full_32x18_e64.0mm_c4.08m"}));
+  EXPECT_EQ(left, (std::vector<std::string>{".b_full_32x18.new-77-xyzXYZ", ".backup.old-2024", ".notes",
+                                            "box-wall_full_32x18_e64.0mm_c4.08m", pole}));
   const test::CliRun verify = test::run_cli(ref(dir, "verify"));
   EXPECT_EQ(verify.code, 0) << verify.out;
+  EXPECT_NE(verify.out.find("ok             " + pole), std::string::npos) << "moved back whole: " << verify.out;
 }
 
 TEST(ReferenceStore, ChangedSceneIsReported) {
