@@ -11,6 +11,7 @@
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
 #include "renderer/io/render_output.hpp"
 #include "renderer/memory.hpp"
 #include "renderer/pipeline.hpp"
@@ -74,16 +75,19 @@ void run_render(const RenderArgs& a) {
   const size_t lights_in_file = loaded.lights_in_file;
   const StereoRig rig = resolve_rig(scene, overrides);
   entry.check_rig(options, rig);
-  // The outputs are <out>/<stem>.exr and <out>/<stem>_*: a scene file of such a name there would be
-  // replaced by one of them.
+  // A scene file that is one of the outputs (<stem>.exr, <stem>_left.png, ..., <stem>_stats.json,
+  // or a diagnostic <stem>_NAME.png), by name or through a link, would be replaced by it.
   const std::string stem = fmt::format("{}_{}", scene.file_stem(), entry_file_stem(entry.name));
   std::error_code ec;
-  const std::string scene_name = loaded.file.filename().string();
-  if (fs::equivalent(loaded.file.parent_path().empty() ? fs::path(".") : loaded.file.parent_path(), a.out, ec) &&
-      (scene_name == stem + ".exr" || scene_name.starts_with(stem + "_")))
-    throw InputError(fmt::format("--scene {}: this render's outputs in --out {} ({}.exr, {}_*) would replace the "
-                                 "scene file; give another --out",
-                                 loaded.file.string(), a.out, stem, stem));
+  const fs::path scene_file = fs::weakly_canonical(io::follow_links(loaded.file), ec);
+  const std::string scene_name = scene_file.filename().string();
+  const bool named_as_output =
+      scene_name == stem + ".exr" || scene_name == stem + "_stats.json" ||
+      (scene_name.starts_with(stem + "_") && scene_name.ends_with(".png"));
+  if (named_as_output && fs::equivalent(scene_file.parent_path(), a.out, ec))
+    throw InputError(fmt::format("--scene {}: the scene file is one of this render's outputs in --out {} ({}); give "
+                                 "another --out",
+                                 loaded.file.string(), a.out, scene_file.filename().string()));
   const RenderScene prepared(scene);
   require_frame_memory(rig.params().width, rig.params().height, fmt::format("render {}", entry.name));
   warn_geometry_before_near_plane(prepared, rig, executor);

@@ -592,9 +592,10 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
   // would be found under a name that `reference generate` never writes, and regenerated beside it.
   if (const std::string expected = reference_id(p.loaded.scene, spec, *p.rig); expected != id) {
     r.status = Status::corrupt;
+    // Also an entry made before the id named a field of view other than the scene camera's.
     r.detail = fmt::format("{}: its spec makes the reference '{}', but the entry lies in folder '{}'; rename the "
-                           "folder back, or remove it and regenerate",
-                           prov_file.string(), expected, id);
+                           "folder to '{}' (and its provenance's \"id\"), or remove it and regenerate",
+                           prov_file.string(), expected, id, expected);
     return r;
   }
   if (!options.rerender) {

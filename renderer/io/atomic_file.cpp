@@ -302,6 +302,10 @@ void StagedFiles::commit() {
   }
 }
 
+size_t StagedFiles::placed() const {
+  return static_cast<size_t>(std::count_if(entries_.begin(), entries_.end(), [](const Entry& e) { return e.placed; }));
+}
+
 fs::path follow_links(const fs::path& path) { return link_chain(path).back(); }
 
 bool written_in_place(const fs::path& path) { return target_of(path).through; }

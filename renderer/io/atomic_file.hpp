@@ -44,6 +44,8 @@ class StagedFiles {
   /// Renames every file added into place, in order; IoError at the first that fails (the files
   /// before it are in place, the others' temporaries are removed with the set).
   void commit();
+  /// How many files commit() has put in place (all of them once it returned).
+  [[nodiscard]] size_t placed() const;
 
  private:
   struct Entry;

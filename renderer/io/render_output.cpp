@@ -139,8 +139,8 @@ RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::st
   f.stats_json = dir / (stem + "_stats.json");
   // Every file is made whole under its temporary name first, and only then are all renamed into
   // place, the stats JSON last (it marks a complete set): a failure on the way (a full disk) leaves
-  // an earlier render's set as it was. Should a rename fail, the stats JSON is removed, so that no
-  // mixed set is left looking complete.
+  // an earlier render's set as it was. Should a rename fail after others, the stats JSON is
+  // removed, so that no mixed set is left looking complete.
   ImageMetadata meta;
   meta["stereobench/record"] = record.dump();
   std::vector<std::pair<fs::path, const Image*>> pngs{{f.left_png, &result.left}, {f.right_png, &result.right}};
@@ -170,10 +170,15 @@ RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::st
   set.add(f.stats_json, [&](const fs::path& tmp) { write_text_atomically(tmp, stats.dump(2) + "\n"); });
   try {
     set.commit();
-  } catch (...) {
+  } catch (const IoError& e) {
+    // Some new files in place beside earlier ones: the stats JSON goes, so that the mix does not
+    // look complete. With none placed, the earlier set stands as it was.
+    if (set.placed() == 0) throw;
     std::error_code ec;
     fs::remove(f.stats_json, ec);
-    throw;
+    throw IoError(fmt::format("{}; {} of this render's files are in place beside the earlier render's, whose stats "
+                              "JSON is removed so the set does not look complete: render again",
+                              e.what(), set.placed()));
   }
   for (const std::string& name : earlier) {
     if (std::find(names.begin(), names.end(), name) != names.end()) continue;

@@ -273,16 +273,26 @@ TEST(Cli, ASceneNameNeverLeadsOutputsOutOfTheOutputFolder) {
                 e.path().filename() == "box-wall-copy.gltf")
         << "written beside the output folder: " << e.path();
 
-  // A scene file named like one of the render's outputs, in the output folder, is not replaced by
-  // it (the stats JSON used to take its place).
+  // A scene file that is one of the render's outputs, by name or through a link, is not replaced
+  // by it (the stats JSON used to take its place); a name no output takes renders.
   doc["scenes"][0]["name"] = "box-wall";
-  const std::filesystem::path own = dir / "out" / "box-wall_plain-rt_stats.gltf";
+  const std::filesystem::path out = dir / "out";
+  const std::filesystem::path own = out / "box-wall_plain-rt_stats.json";
   { std::ofstream(own) << doc.dump(); }
-  const CliRun over = run("render --pipeline plain-rt --scene '" + own.string() + "' --out '" + (dir / "out").string() +
-                          "'" + common);
-  EXPECT_EQ(over.code, 3) << over.out;
-  EXPECT_NE(over.out.find("would replace the scene file; give another --out"), std::string::npos) << over.out;
-  EXPECT_EQ(nlohmann::json::parse(test::read_text(own)), doc);
+  std::filesystem::create_symlink("out/box-wall_plain-rt_stats.json", dir / "linked.gltf");
+  for (const std::filesystem::path& scene : {own, dir / "linked.gltf"}) {
+    const CliRun over =
+        run("render --pipeline plain-rt --scene '" + scene.string() + "' --out '" + out.string() + "'" + common);
+    EXPECT_EQ(over.code, 3) << over.out;
+    EXPECT_NE(over.out.find("the scene file is one of this render's outputs"), std::string::npos) << over.out;
+    EXPECT_EQ(nlohmann::json::parse(test::read_text(own)), doc);
+  }
+  std::filesystem::remove(dir / "linked.gltf");
+  std::filesystem::rename(own, out / "box-wall_plain-rt_v2.gltf");
+  EXPECT_EQ(run("render --pipeline plain-rt --scene '" + (out / "box-wall_plain-rt_v2.gltf").string() + "' --out '" +
+                out.string() + "'" + common)
+                .code,
+            0);
 }
 
 TEST(Cli, AGeneratedVariantNeverTakesTheDefaultScenesFile) {
