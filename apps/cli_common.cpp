@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 
 #include <fmt/format.h>
 #include <tbb/info.h>
@@ -159,6 +160,18 @@ void remove_earlier_output(const std::filesystem::path& path, const std::string&
   } catch (const IoError& e) {
     throw IoError(fmt::format("{}: {}", what, e.what()));
   }
+}
+
+void remove_earlier_outputs(std::initializer_list<NamedPath> outputs) {
+  std::optional<IoError> first;
+  for (const NamedPath& o : outputs) {
+    try {
+      remove_earlier_output(*o.path, o.name);
+    } catch (const IoError& e) {
+      if (!first) first = e;  // the others are still removed
+    }
+  }
+  if (first) throw *first;
 }
 
 void discard_outputs(std::initializer_list<const std::string*> paths) noexcept {

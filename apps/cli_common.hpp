@@ -75,6 +75,10 @@ void prepare_output_folder(const std::string& folder, const char* option);
 /// nothing for an empty path or "-".
 void remove_earlier_output(const std::filesystem::path& path, const std::string& what);
 
+/// remove_earlier_output for each output; one that cannot be removed does not keep the others:
+/// all are tried, then the first error is thrown.
+void remove_earlier_outputs(std::initializer_list<NamedPath> outputs);
+
 /// Removes what a failing run wrote at these output paths (best effort; as remove_earlier_output:
 /// regular files only, "" and "-" skipped), so that none is left beside its error.
 void discard_outputs(std::initializer_list<const std::string*> paths) noexcept;

@@ -92,14 +92,16 @@ nlohmann::json optional_number(const std::optional<double>& v) {
 }
 
 int run_compare(const CompareArgs& a) {
-  // An output naming an input or another output is refused; then an earlier run's outputs at these
+  // An output naming an input or another output, or a picture not named .png, is refused; then an
+  // earlier run's outputs at these
   // paths go, before anything else is checked: a comparison stopped by bad input or an unwritable
   // output (exit 3 or 4) leaves none, so none can be read as this run's verdict.
   refuse_overwriting({{"image A", &a.a}, {"image B", &a.b}, {"--mask", &a.mask}},
                      {{"--json", &a.json}, {"--diff", &a.diff}, {"--ssim-map", &a.ssim_map}});
+  check_picture_names(a);  // a name this run would refuse to write is not its output to remove
+  remove_earlier_outputs({{"--json", &a.json}, {"--diff", &a.diff}, {"--ssim-map", &a.ssim_map}});
   const std::pair<const char*, const std::string*> outputs[] = {
       {"--json", &a.json}, {"--diff", &a.diff}, {"--ssim-map", &a.ssim_map}};
-  for (const auto& [option, path] : outputs) remove_earlier_output(*path, option);
   if (a.error_threshold < 0 || a.error_threshold > 255)
     throw InputError(
         fmt::format("--error-threshold {} is out of range; give 8-bit codes in 0..255 (default 2)", a.error_threshold));
@@ -121,7 +123,6 @@ int run_compare(const CompareArgs& a) {
   ordered(a.warn_ssim, a.fail_ssim, true, "ssim");
   ordered(a.warn_percent, a.fail_percent, false, "percent");
 
-  check_picture_names(a);
   for (const auto& [option, path] : outputs) prepare_output_file_folder(*path, option);
 
   // Inputs: both images (and the mask) must have one size and one kind of colour.
@@ -266,8 +267,8 @@ non-image input file, a size or channel mismatch, an empty mask, a stereo EXR wi
 SSIM limit where SSIM is undefined),
 4 I/O failure (an existing input that cannot be opened, an output that cannot be written).
 Exit 3 or 4 leaves no --json, --diff or --ssim-map file (an earlier one at that path is removed),
-unless the command line itself cannot be read or names an input as an output; on 0, 1 and 2 all
-are written.)";
+unless the command line itself cannot be read, names an input as an output or a picture not
+ending in .png; on 0, 1 and 2 all are written.)";
 
 }  // namespace
 

@@ -91,8 +91,7 @@ void run_gate(const GateArgs& a) {
     throw InputError("--only and --cells select what --update-baseline rewrites; add --update-baseline or drop them");
   refuse_overwriting({{"--results", &a.results}, {"--config", &a.config}, {"the baseline", &baseline_path}},
                      {{"--junit", &a.junit}, {"--json", &a.json_out}});
-  remove_earlier_output(a.junit, "--junit");
-  remove_earlier_output(a.json_out, "--json");
+  remove_earlier_outputs({{"--junit", &a.junit}, {"--json", &a.json_out}});
   prepare_output_file_folder(a.junit, "--junit");
   prepare_output_file_folder(a.json_out, "--json");
   const validation::GateConfig config = validation::load_gate_config(a.config);

@@ -76,18 +76,24 @@ void run_render(const RenderArgs& a) {
   const StereoRig rig = resolve_rig(scene, overrides);
   entry.check_rig(options, rig);
   // A scene file that is one of the outputs (<stem>.exr, <stem>_left.png, ..., <stem>_stats.json,
-  // or a diagnostic <stem>_NAME.png), by name or through a link, would be replaced by it.
+  // or a diagnostic <stem>_NAME.png already there), by name or through a link either way, would be
+  // replaced by it.
   const std::string stem = fmt::format("{}_{}", scene.file_stem(), entry_file_stem(entry.name));
+  std::vector<fs::path> outputs;
+  for (const char* suffix : {".exr", "_left.png", "_right.png", "_anaglyph.png", "_sbs.png", "_holes.png",
+                             "_stats.json"})
+    outputs.push_back(fs::path(a.out) / (stem + suffix));
   std::error_code ec;
-  const fs::path scene_file = fs::weakly_canonical(io::follow_links(loaded.file), ec);
-  const std::string scene_name = scene_file.filename().string();
-  const bool named_as_output =
-      scene_name == stem + ".exr" || scene_name == stem + "_stats.json" ||
-      (scene_name.starts_with(stem + "_") && scene_name.ends_with(".png"));
-  if (named_as_output && fs::equivalent(scene_file.parent_path(), a.out, ec))
-    throw InputError(fmt::format("--scene {}: the scene file is one of this render's outputs in --out {} ({}); give "
-                                 "another --out",
-                                 loaded.file.string(), a.out, scene_file.filename().string()));
+  for (fs::directory_iterator it(a.out, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.starts_with(stem + "_") && name.ends_with(".png")) outputs.push_back(it->path());
+  }
+  for (const fs::path& output : outputs) {
+    std::error_code same_ec;
+    if (fs::equivalent(output, loaded.file, same_ec))
+      throw InputError(fmt::format("--scene {}: the scene file is this render's output {}; give another --out",
+                                   loaded.file.string(), output.string()));
+  }
   const RenderScene prepared(scene);
   require_frame_memory(rig.params().width, rig.params().height, fmt::format("render {}", entry.name));
   warn_geometry_before_near_plane(prepared, rig, executor);

@@ -212,19 +212,31 @@ void make_working_folder(const fs::path& root, const std::string& id, const char
   std::error_code made_root;
   fs::create_directories(root, made_root);  // a new store
   std::string made = (root / fmt::format(".{}.mk-XXXXXX", id)).string();
-  if (::mkdtemp(made.data()) == nullptr)
+  if (::mkdtemp(made.data()) == nullptr) {
+    const int err = errno;
     throw IoError(fmt::format("cannot create a working folder in the reference store {}: {}; give a --store you "
                               "can write",
-                              root.string(), std::strerror(errno)));
+                              root.string(), std::strerror(err)));
+  }
   out.fd = ::open(made.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (out.fd >= 0) (void)::flock(out.fd, LOCK_EX | LOCK_NB);  // without locks it is only never judged stale
+  // Unlocked, another run's clean-up could take it; only a file system without locks is let be.
+  if (out.fd < 0 || (::flock(out.fd, LOCK_EX | LOCK_NB) != 0 && errno != ENOLCK && errno != EOPNOTSUPP)) {
+    const int err = errno;
+    std::error_code ignored;
+    fs::remove_all(made, ignored);
+    throw IoError(fmt::format("cannot lock a working folder in the reference store {}: {}; give a --store you can "
+                              "write",
+                              root.string(), std::strerror(err)));
+  }
   out.path = root / fmt::format(".{}.{}-{}-{}", id, kind, getpid(), made.substr(made.size() - 6));
   std::error_code ec;
   fs::rename(made, out.path, ec);
   if (ec) {
+    const std::string why = ec.message();
     fs::remove_all(made, ec);
-    throw IoError(fmt::format("cannot create a working folder in the reference store {}; give a --store you can write",
-                              root.string()));
+    throw IoError(fmt::format("cannot create a working folder in the reference store {}: {}; give a --store you can "
+                              "write",
+                              root.string(), why));
   }
 }
 
@@ -241,21 +253,23 @@ void remove_stale_folders(const fs::path& root) {
     const std::string name = it->path().filename().string();
     std::smatch m;
     std::error_code dir_ec;
-    if (std::regex_match(name, being_made) && it->is_directory(dir_ec)) {
-      const auto made = fs::last_write_time(it->path(), dir_ec);
-      std::error_code ignored;
-      if (!dir_ec && now - made > std::chrono::minutes(1)) fs::remove_all(it->path(), ignored);
-      continue;
-    }
-    if (!std::regex_match(name, m, working_name()) || !it->is_directory(dir_ec)) continue;
+    const bool made_here = std::regex_match(name, being_made);
+    if ((!made_here && !std::regex_match(name, m, working_name())) || !it->is_directory(dir_ec)) continue;
     const int fd = ::open(it->path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (fd < 0) continue;
     const bool free = ::flock(fd, LOCK_EX | LOCK_NB) == 0;
     std::error_code ignored;
-    if (free && m[2] == "old" && !fs::exists(root / m[1].str(), ignored))
-      fs::rename(it->path(), root / m[1].str(), ignored);
-    else if (free)
+    if (!free) {
+      // held by a running generate or verify
+    } else if (made_here) {
+      const auto made = fs::last_write_time(it->path(), dir_ec);
+      if (!dir_ec && now - made > std::chrono::minutes(1)) fs::remove_all(it->path(), ignored);
+    } else if (m[2] == "old" && fs::exists(it->path() / kProvenance, ignored) &&
+               !fs::exists(root / m[1].str(), ignored)) {
+      fs::rename(it->path(), root / m[1].str(), ignored);  // an entry moved aside whose replacement never came
+    } else {
       fs::remove_all(it->path(), ignored);
+    }
     ::close(fd);
   }
 }
@@ -272,9 +286,10 @@ void replace_folder(const fs::path& staged, const fs::path& dir) {
       fs::remove_all(staged, ec);
       return;
     }
-    if (errno != EINVAL && errno != ENOSYS && errno != ENOTSUP)
-      throw IoError(fmt::format("cannot put the new reference in place of '{}': {}", dir.string(),
-                                std::strerror(errno)));
+    const int err = errno;
+    // ENOENT: the entry went meanwhile; the new one is put in place below.
+    if (err != EINVAL && err != ENOSYS && err != ENOTSUP && err != ENOENT)
+      throw IoError(fmt::format("cannot put the new reference in place of '{}': {}", dir.string(), std::strerror(err)));
   }
   std::smatch m;
   const std::string staged_name = staged.filename().string();

@@ -316,8 +316,9 @@ bool remove_output_file(const fs::path& path) {
   std::error_code ec;
   if (!fs::is_regular_file(fs::symlink_status(file, ec))) return false;
   if (!fs::remove(file, ec) || ec)
-    throw IoError(fmt::format("cannot remove the earlier {}: {}; make it writable or give another path", path.string(),
-                              ec ? ec.message() : "not removed"));
+    throw IoError(fmt::format("cannot remove the earlier {}{}: {}; make its folder {} writable or give another path",
+                              file.string(), file == path ? "" : fmt::format(" (named by {})", path.string()),
+                              ec ? ec.message() : "not removed", folder_of(file).string()));
   return true;
 }
 

@@ -176,9 +176,12 @@ RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::st
     if (set.placed() == 0) throw;
     std::error_code ec;
     fs::remove(f.stats_json, ec);
-    throw IoError(fmt::format("{}; {} of this render's files are in place beside the earlier render's, whose stats "
-                              "JSON is removed so the set does not look complete: render again",
-                              e.what(), set.placed()));
+    const bool kept = fs::exists(f.stats_json, ec);
+    throw IoError(fmt::format("{}; {} of this render's files are in place and the others not: {}, then render again",
+                              e.what(), set.placed(),
+                              kept ? fmt::format("remove {} (it could not be removed here)", f.stats_json.string())
+                                   : fmt::format("{} is removed so that the set does not look complete",
+                                                 f.stats_json.string())));
   }
   for (const std::string& name : earlier) {
     if (std::find(names.begin(), names.end(), name) != names.end()) continue;

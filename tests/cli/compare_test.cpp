@@ -168,6 +168,11 @@ TEST_F(Compare, AStoppedComparisonLeavesNoOutputs) {
   EXPECT_EQ(r.code, 4) << r.out;
   EXPECT_NE(r.out.find("--json " + (path("file") / "v.json").string()), std::string::npos) << r.out;
   none_left("file/v.json");
+  // A picture name the run refuses is not its output: the file stays.
+  std::ofstream(path("photo.jpg")) << "a photo\n";
+  r = compare(ab() + " --diff " + q(path("photo.jpg")));
+  EXPECT_EQ(r.code, 3) << r.out;
+  EXPECT_EQ(test::read_text(path("photo.jpg")), "a photo\n");
   // Through a link, the file it names is the output: written through it, and removed by a stopped
   // run while the link stays (it used to be replaced by a plain file, or removed itself).
   std::filesystem::create_symlink("real.json", path("link.json"));
