@@ -174,11 +174,11 @@ void remove_earlier_outputs(std::initializer_list<NamedPath> outputs) {
   if (first) throw *first;
 }
 
-void discard_outputs(std::initializer_list<const std::string*> paths) noexcept {
-  for (const std::string* path : paths) {
-    if (path->empty() || *path == "-") continue;
+void discard_outputs(std::initializer_list<NamedPath> outputs) noexcept {
+  for (const NamedPath& o : outputs) {
+    if (o.path->empty() || *o.path == "-") continue;
     try {
-      (void)io::remove_output_file(*path);
+      (void)io::remove_output_file(*o.path);
     } catch (const std::exception&) {  // best effort: the run's own error is the one to report
     }
   }

@@ -81,7 +81,7 @@ void remove_earlier_outputs(std::initializer_list<NamedPath> outputs);
 
 /// Removes what a failing run wrote at these output paths (best effort; as remove_earlier_output:
 /// regular files only, "" and "-" skipped), so that none is left beside its error.
-void discard_outputs(std::initializer_list<const std::string*> paths) noexcept;
+void discard_outputs(std::initializer_list<NamedPath> outputs) noexcept;
 
 /// The same for the folder of an output file (a --json written after a long benchmark); nothing
 /// for "" (no file), "-" (standard output) or a bare file name (the current folder).

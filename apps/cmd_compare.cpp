@@ -93,15 +93,14 @@ nlohmann::json optional_number(const std::optional<double>& v) {
 
 int run_compare(const CompareArgs& a) {
   // An output naming an input or another output, or a picture not named .png, is refused; then an
-  // earlier run's outputs at these
-  // paths go, before anything else is checked: a comparison stopped by bad input or an unwritable
-  // output (exit 3 or 4) leaves none, so none can be read as this run's verdict.
-  refuse_overwriting({{"image A", &a.a}, {"image B", &a.b}, {"--mask", &a.mask}},
-                     {{"--json", &a.json}, {"--diff", &a.diff}, {"--ssim-map", &a.ssim_map}});
-  check_picture_names(a);  // a name this run would refuse to write is not its output to remove
-  remove_earlier_outputs({{"--json", &a.json}, {"--diff", &a.diff}, {"--ssim-map", &a.ssim_map}});
-  const std::pair<const char*, const std::string*> outputs[] = {
+  // earlier run's outputs at these paths go, before anything else is checked: a comparison stopped
+  // by bad input or an unwritable output (exit 3 or 4) leaves none, so none can be read as this
+  // run's verdict.
+  const std::initializer_list<NamedPath> outputs = {
       {"--json", &a.json}, {"--diff", &a.diff}, {"--ssim-map", &a.ssim_map}};
+  refuse_overwriting({{"image A", &a.a}, {"image B", &a.b}, {"--mask", &a.mask}}, outputs);
+  check_picture_names(a);  // a name this run would refuse to write is not its output to remove
+  remove_earlier_outputs(outputs);
   if (a.error_threshold < 0 || a.error_threshold > 255)
     throw InputError(
         fmt::format("--error-threshold {} is out of range; give 8-bit codes in 0..255 (default 2)", a.error_threshold));
@@ -123,7 +122,7 @@ int run_compare(const CompareArgs& a) {
   ordered(a.warn_ssim, a.fail_ssim, true, "ssim");
   ordered(a.warn_percent, a.fail_percent, false, "percent");
 
-  for (const auto& [option, path] : outputs) prepare_output_file_folder(*path, option);
+  for (const NamedPath& o : outputs) prepare_output_file_folder(*o.path, o.name);
 
   // Inputs: both images (and the mask) must have one size and one kind of colour.
   const validation::Srgb8File fa = validation::read_srgb8_file(a.a, a.eye);
@@ -199,7 +198,7 @@ int run_compare(const CompareArgs& a) {
       io::write_text_atomically(a.json, record.dump(2) + "\n");
   } catch (const std::exception&) {
     // An output that cannot be written takes the others of this run with it.
-    discard_outputs({&a.json, &a.diff, &a.ssim_map});
+    discard_outputs(outputs);
     throw;
   }
 

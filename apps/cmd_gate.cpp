@@ -125,7 +125,7 @@ void run_gate(const GateArgs& a) {
       io::write_text_atomically(a.json_out, doc.dump(2) + "\n");
     } catch (const IoError&) {
       // Exit 4 leaves neither output: a JUnit file beside a failed run would read as its verdict.
-      discard_outputs({&a.junit});
+      discard_outputs({{"--junit", &a.junit}});
       throw;
     }
     fmt::print("wrote {}\n", a.json_out);
