@@ -79,10 +79,7 @@ void run_render(const RenderArgs& a) {
   // or a diagnostic <stem>_NAME.png already there), by name or through a link either way, would be
   // replaced by it.
   const std::string stem = fmt::format("{}_{}", scene.file_stem(), entry_file_stem(entry.name));
-  std::vector<fs::path> outputs;
-  for (const char* suffix : {".exr", "_left.png", "_right.png", "_anaglyph.png", "_sbs.png", "_holes.png",
-                             "_stats.json"})
-    outputs.push_back(fs::path(a.out) / (stem + suffix));
+  std::vector<fs::path> outputs = io::render_file_names(a.out, stem).all();
   std::error_code ec;
   for (fs::directory_iterator it(a.out, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();

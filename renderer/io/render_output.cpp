@@ -106,14 +106,12 @@ void check_extra_names(const StereoResult& result) {
 
 /// The file names an earlier render's stats JSON lists for its set (see write_render_outputs):
 /// only plain names of this stem's outputs, so that a damaged or edited file cannot name another.
-std::vector<std::string> earlier_files(const fs::path& stats_json) {
+std::vector<std::string> earlier_files(const fs::path& stats_json, const std::string& stem) {
   std::vector<std::string> out;
   std::error_code ec;
   if (!fs::is_regular_file(stats_json, ec)) return out;
   try {
     const json j = parse_json(read_file(stats_json));
-    const std::string stem = stats_json.filename().string().substr(0, stats_json.filename().string().size() -
-                                                                         std::string_view("_stats.json").size());
     if (!j.is_object() || !j.contains("files") || !j["files"].is_array()) return out;
     for (const json& name : j["files"])
       if (name.is_string()) {
@@ -127,16 +125,23 @@ std::vector<std::string> earlier_files(const fs::path& stats_json) {
 
 }  // namespace
 
-RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::string& stem,
-                                 const StereoResult& result, const json& record, const Image* holes_overlay) {
-  check_extra_names(result);
+RenderFiles render_file_names(const std::filesystem::path& dir, const std::string& stem) {
   RenderFiles f;
   f.exr = dir / (stem + ".exr");
   f.left_png = dir / (stem + "_left.png");
   f.right_png = dir / (stem + "_right.png");
   f.anaglyph_png = dir / (stem + "_anaglyph.png");
   f.side_by_side_png = dir / (stem + "_sbs.png");
+  f.holes_png = dir / (stem + "_holes.png");
   f.stats_json = dir / (stem + "_stats.json");
+  return f;
+}
+
+RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::string& stem,
+                                 const StereoResult& result, const json& record, const Image* holes_overlay) {
+  check_extra_names(result);
+  RenderFiles f = render_file_names(dir, stem);
+  if (!holes_overlay) f.holes_png.reset();
   // Every file is made whole under its temporary name first, and only then are all renamed into
   // place, the stats JSON last (it marks a complete set): a failure on the way (a full disk) leaves
   // an earlier render's set as it was. Should a rename fail after others, the stats JSON is
@@ -148,10 +153,7 @@ RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::st
   const Image sbs = side_by_side(result.left, result.right);
   pngs.emplace_back(f.anaglyph_png, &anaglyph);
   pngs.emplace_back(f.side_by_side_png, &sbs);
-  if (holes_overlay) {
-    f.holes_png = dir / (stem + "_holes.png");
-    pngs.emplace_back(*f.holes_png, holes_overlay);
-  }
+  if (holes_overlay) pngs.emplace_back(*f.holes_png, holes_overlay);
   for (const auto& [name, image] : result.extras) {
     f.extras.push_back(dir / (stem + "_" + name + ".png"));
     pngs.emplace_back(f.extras.back(), &image);
@@ -162,7 +164,7 @@ RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::st
   std::vector<std::string> names;
   for (const fs::path& file : f.all()) names.push_back(file.filename().string());
   stats["files"] = names;
-  const std::vector<std::string> earlier = earlier_files(f.stats_json);
+  const std::vector<std::string> earlier = earlier_files(f.stats_json, stem);
 
   StagedFiles set;
   set.add(f.exr, [&](const fs::path& tmp) { write_exr_stereo(tmp, result.left, result.right, meta); });

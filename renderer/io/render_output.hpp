@@ -45,6 +45,10 @@ struct RenderFiles {
   [[nodiscard]] std::vector<std::filesystem::path> all() const;
 };
 
+/// The paths of a render's outputs named <stem>... in `dir`: the EXR, the four PNGs, the stats JSON
+/// and <stem>_holes.png (holes_png set); extras are named by write_render_outputs.
+[[nodiscard]] RenderFiles render_file_names(const std::filesystem::path& dir, const std::string& stem);
+
 /// Writes every output of a run as one set (io::StagedFiles: all made whole, then all renamed
 /// into place, the stats JSON last, which lists the set's files; the earlier set's files of the
 /// stem that this one does not write are then removed) and returns their paths: with
