@@ -200,9 +200,9 @@ struct WorkingFolder {
   }
 };
 
-/// The pattern of working folder names; the suffix is the one a folder of kind "new" was made with.
+/// The pattern of working folder names, ".ID.KIND-PID-XXXXXX": group 1 the id, group 2 the kind.
 const std::regex& working_name() {
-  static const std::regex pattern(R"(\.(.+)\.(new|old|verify)-([0-9]+-[A-Za-z0-9]{6}))");
+  static const std::regex pattern(R"(\.(.+)\.(new|old|verify)-[0-9]+-[A-Za-z0-9]{6})");
   return pattern;
 }
 
@@ -274,7 +274,8 @@ void remove_stale_folders(const fs::path& root) {
   }
 }
 
-/// Replaces `dir` by `staged` (a complete working folder beside it). An existing entry is swapped
+/// Replaces `dir` by `staged` (a complete working folder of kind "new" beside it, made by
+/// make_working_folder). An existing entry is swapped
 /// with the staged one in a single rename (RENAME_EXCHANGE), so that the id names the old or the
 /// new entry at every moment, and the old one is then removed under the staged name; where the
 /// file system cannot swap, the old entry is moved aside (".ID.old-…", locked) first and moved back
@@ -291,11 +292,11 @@ void replace_folder(const fs::path& staged, const fs::path& dir) {
     if (err != EINVAL && err != ENOSYS && err != ENOTSUP && err != ENOENT)
       throw IoError(fmt::format("cannot put the new reference in place of '{}': {}", dir.string(), std::strerror(err)));
   }
-  std::smatch m;
-  const std::string staged_name = staged.filename().string();
-  const fs::path old = dir.parent_path() / (std::regex_match(staged_name, m, working_name())
-                                                ? fmt::format(".{}.old-{}", dir.filename().string(), m[3].str())
-                                                : fmt::format(".{}.old-{}-aside0", dir.filename().string(), getpid()));
+  // The old entry goes aside under the staged folder's name with its kind "new" made "old" (the
+  // same run's suffix), a name remove_stale_folders knows.
+  std::string old_name = staged.filename().string();
+  old_name.replace(old_name.rfind(".new-"), 5, ".old-");
+  const fs::path old = dir.parent_path() / old_name;
   WorkingFolder hold;
   hold.fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (hold.fd >= 0) (void)::flock(hold.fd, LOCK_EX | LOCK_NB);
