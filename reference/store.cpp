@@ -19,6 +19,7 @@
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/image_io.hpp"
 #include "renderer/io/json_text.hpp"
+#include "renderer/io/unique_fd.hpp"
 #include "renderer/io/render_output.hpp"
 #include "renderer/render_scene.hpp"
 #include "renderer/text.hpp"
@@ -191,13 +192,7 @@ std::string reference_id(const Scene& scene, const ReferenceSpec& spec, const St
 /// leaves a locked one alone, whichever process, container or machine holds it.
 struct WorkingFolder {
   fs::path path;
-  int fd = -1;
-  WorkingFolder() = default;
-  WorkingFolder(const WorkingFolder&) = delete;
-  WorkingFolder& operator=(const WorkingFolder&) = delete;
-  ~WorkingFolder() {
-    if (fd >= 0) ::close(fd);
-  }
+  io::UniqueFd fd;
 };
 
 /// The pattern of working folder names, ".ID.KIND-PID-XXXXXX": group 1 the id, group 2 the kind.
@@ -218,9 +213,9 @@ void make_working_folder(const fs::path& root, const std::string& id, const char
                               "can write",
                               root.string(), std::strerror(err)));
   }
-  out.fd = ::open(made.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  out.fd.reset(::open(made.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
   // Unlocked, another run's clean-up could take it; only a file system without locks is let be.
-  if (out.fd < 0 || (::flock(out.fd, LOCK_EX | LOCK_NB) != 0 && errno != ENOLCK && errno != EOPNOTSUPP)) {
+  if (!out.fd.valid() || (::flock(out.fd.get(), LOCK_EX | LOCK_NB) != 0 && errno != ENOLCK && errno != EOPNOTSUPP)) {
     const int err = errno;
     std::error_code ignored;
     fs::remove_all(made, ignored);
@@ -255,9 +250,9 @@ void remove_stale_folders(const fs::path& root) {
     std::error_code dir_ec;
     const bool made_here = std::regex_match(name, being_made);
     if ((!made_here && !std::regex_match(name, m, working_name())) || !it->is_directory(dir_ec)) continue;
-    const int fd = ::open(it->path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (fd < 0) continue;
-    const bool free = ::flock(fd, LOCK_EX | LOCK_NB) == 0;
+    const io::UniqueFd fd(::open(it->path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+    if (!fd.valid()) continue;
+    const bool free = ::flock(fd.get(), LOCK_EX | LOCK_NB) == 0;
     std::error_code ignored;
     if (!free) {
       // held by a running generate or verify
@@ -270,7 +265,6 @@ void remove_stale_folders(const fs::path& root) {
     } else {
       fs::remove_all(it->path(), ignored);
     }
-    ::close(fd);
   }
 }
 
@@ -298,8 +292,8 @@ void replace_folder(const fs::path& staged, const fs::path& dir) {
   old_name.replace(old_name.rfind(".new-"), 5, ".old-");
   const fs::path old = dir.parent_path() / old_name;
   WorkingFolder hold;
-  hold.fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (hold.fd >= 0) (void)::flock(hold.fd, LOCK_EX | LOCK_NB);
+  hold.fd.reset(::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+  if (hold.fd.valid()) (void)::flock(hold.fd.get(), LOCK_EX | LOCK_NB);
   if (fs::exists(dir)) {
     fs::rename(dir, old, ec);
     if (ec) throw IoError(fmt::format("cannot move the old reference '{}' aside: {}", dir.string(), ec.message()));

@@ -23,6 +23,7 @@
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
+#include "renderer/io/unique_fd.hpp"
 
 extern char** environ;
 
@@ -37,41 +38,19 @@ using Clock = std::chrono::steady_clock;
 constexpr std::array kDefaultedSignals = {SIGPIPE, SIGINT,  SIGQUIT, SIGTERM, SIGHUP,  SIGALRM,
                                           SIGUSR1, SIGUSR2, SIGCHLD, SIGTSTP, SIGTTIN, SIGTTOU};
 
-/// An owned file descriptor.
-class Fd {
- public:
-  Fd() = default;
-  explicit Fd(int fd) : fd_(fd) {}
-  Fd(const Fd&) = delete;
-  Fd& operator=(const Fd&) = delete;
-  ~Fd() { reset(); }
-  [[nodiscard]] int get() const { return fd_; }
-  void reset() {
-    if (fd_ >= 0) ::close(fd_);
-    fd_ = -1;
-  }
-  void take(int fd) {
-    reset();
-    fd_ = fd;
-  }
-
- private:
-  int fd_ = -1;
-};
-
 /// A pipe whose ends are close-on-exec (no other child started meanwhile inherits them) and
 /// above 0..2, so that dup2 onto the child's stdout or stderr always makes a fresh descriptor.
-void open_pipe(Fd& read_end, Fd& write_end, const std::string& program) {
+void open_pipe(io::UniqueFd& read_end, io::UniqueFd& write_end, const std::string& program) {
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0)
     throw ToolError(fmt::format("cannot create a pipe to run {}: {}", program, std::strerror(errno)));
-  read_end.take(fds[0]);
-  write_end.take(fds[1]);
-  for (Fd* end : {&read_end, &write_end}) {
+  read_end.reset(fds[0]);
+  write_end.reset(fds[1]);
+  for (io::UniqueFd* end : {&read_end, &write_end}) {
     if (end->get() > 2) continue;
     const int moved = ::fcntl(end->get(), F_DUPFD_CLOEXEC, 3);
     if (moved < 0) throw ToolError(fmt::format("cannot create a pipe to run {}: {}", program, std::strerror(errno)));
-    end->take(moved);
+    end->reset(moved);
   }
 }
 
@@ -217,7 +196,7 @@ ProcessResult run_process(const std::vector<std::string>& argv, const ProcessOpt
   args.push_back(nullptr);
 
   // Pipes: [0] stdout (with stderr when merged), [1] stderr.
-  std::array<Fd, 2> read_ends, write_ends;
+  std::array<io::UniqueFd, 2> read_ends, write_ends;
   const bool capture_out = options.stdout_to == ChildOutput::capture;
   const bool merged = options.stderr_to == ChildOutput::to_stdout;
   const bool capture_err = options.stderr_to == ChildOutput::capture;
@@ -257,8 +236,8 @@ ProcessResult run_process(const std::vector<std::string>& argv, const ProcessOpt
     throw ToolError(fmt::format("cannot start '{}'{}: {}", executable.string(),
                                 cwd.empty() ? "" : fmt::format(" in '{}'", cwd), std::strerror(spawn_error)));
   child.pid_ = pid;
-  for (Fd& w : write_ends) w.reset();  // the child holds its own copies: EOF comes when it closes them
-  const Fd pid_fd(open_pid_fd(pid));
+  for (io::UniqueFd& w : write_ends) w.reset();  // the child holds its own copies: EOF comes when it closes them
+  const io::UniqueFd pid_fd(open_pid_fd(pid));
 
   ProcessResult result;
   result.pid = pid;
@@ -324,7 +303,7 @@ ProcessResult run_process(const std::vector<std::string>& argv, const ProcessOpt
 
   // Whatever the child left running in its group goes with it; then the zombie is reaped.
   ::kill(-pid, SIGKILL);
-  for (Fd& r : read_ends) r.reset();
+  for (io::UniqueFd& r : read_ends) r.reset();
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0) {
     if (errno != EINTR) {

@@ -21,6 +21,7 @@
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/json_text.hpp"
+#include "renderer/io/unique_fd.hpp"
 #include "validation/sweep.hpp"
 
 namespace sb::validation {
@@ -58,23 +59,6 @@ std::string line_of(const json& cell) {
   throw IoError(fmt::format("{}: cannot {} the {}: {}; check the folder's permissions and free space", file.string(),
                             what, kind, std::strerror(errno)));
 }
-
-/// An open file descriptor, closed on every path out.
-class Fd {
- public:
-  explicit Fd(int fd) : fd_(fd) {}
-  ~Fd() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  Fd(const Fd&) = delete;
-  Fd& operator=(const Fd&) = delete;
-  Fd(Fd&& other) noexcept : fd_(std::exchange(other.fd_, -1)) {}
-  Fd& operator=(Fd&&) = delete;
-  [[nodiscard]] int get() const { return fd_; }
-
- private:
-  int fd_;
-};
 
 /// The hidden lock file beside a results file.
 fs::path lock_path(const fs::path& results) {
@@ -271,8 +255,8 @@ ResultsWriterLock::ResultsWriterLock(const fs::path& results, const std::vector<
   // Through links to the file itself, so that two spellings of one results file share the lock.
   const fs::path real = fs::weakly_canonical(fs::absolute(io::follow_links(results), ec), ec);
   const fs::path path = lock_path(ec ? results : real);
-  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd_ < 0)
+  fd_.reset(::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644));
+  if (!fd_.valid())
     throw IoError(fmt::format("cannot open {}, the lock file of {}: {}; give --out (or --results) a folder you can "
                               "write",
                               path.string(), results.string(), std::strerror(errno)));
@@ -282,10 +266,9 @@ ResultsWriterLock::ResultsWriterLock(const fs::path& results, const std::vector<
     lock.l_whence = SEEK_SET;
     lock.l_start = static_cast<off_t>(cell);
     lock.l_len = 1;
-    if (::fcntl(fd_, F_OFD_SETLK, &lock) == 0) continue;
+    if (::fcntl(fd_.get(), F_OFD_SETLK, &lock) == 0) continue;
     const int err = errno;
-    ::close(fd_);
-    fd_ = -1;
+    fd_.reset();
     if (err != EAGAIN && err != EACCES)
       throw IoError(fmt::format("{}: cannot lock it: {}", path.string(), std::strerror(err)));
     throw InputError(fmt::format("{} is being written by another stereobench run, which holds cell {} of this run; "
@@ -295,17 +278,13 @@ ResultsWriterLock::ResultsWriterLock(const fs::path& results, const std::vector<
   }
 }
 
-ResultsWriterLock::~ResultsWriterLock() {
-  if (fd_ >= 0) ::close(fd_);  // releases the locks
-}
-
 namespace {
 
 /// The results file opened for appending, it and its folder created when missing.
-Fd open_for_append(const fs::path& file, const char* kind) {
+io::UniqueFd open_for_append(const fs::path& file, const char* kind) {
   std::error_code ec;
   if (file.has_parent_path()) fs::create_directories(file.parent_path(), ec);
-  Fd fd(::open(file.c_str(), O_RDWR | O_APPEND | O_CREAT | O_CLOEXEC, 0644));
+  io::UniqueFd fd(::open(file.c_str(), O_RDWR | O_APPEND | O_CREAT | O_CLOEXEC, 0644));
   if (fd.get() < 0) io_fail(file, "open", kind);
   return fd;
 }
@@ -313,13 +292,13 @@ Fd open_for_append(const fs::path& file, const char* kind) {
 }  // namespace
 
 void create_results_file(const fs::path& file, const char* kind) {
-  const Fd fd = open_for_append(file, kind);
+  const io::UniqueFd fd = open_for_append(file, kind);
   if (::fsync(fd.get()) != 0) io_fail(file, "flush", kind);
 }
 
 void append_result(const fs::path& file, const json& cell, const char* kind) {
   const std::string line = line_of(cell);
-  const Fd fd = open_for_append(file, kind);
+  const io::UniqueFd fd = open_for_append(file, kind);
   if (::flock(fd.get(), LOCK_EX) != 0) io_fail(file, "lock", kind);
   cut_torn_tail(fd.get(), file, kind);
   // One write of the whole line; a short write is completed, and a failed one (a full disk) is

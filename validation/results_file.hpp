@@ -12,6 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "renderer/io/unique_fd.hpp"
+
 namespace sb::validation {
 
 /// The `kind` and schema version of a results line.
@@ -41,12 +43,9 @@ void create_results_file(const std::filesystem::path& file, const char* kind = "
 class ResultsWriterLock {
  public:
   ResultsWriterLock(const std::filesystem::path& results, const std::vector<size_t>& cells);
-  ~ResultsWriterLock();
-  ResultsWriterLock(const ResultsWriterLock&) = delete;
-  ResultsWriterLock& operator=(const ResultsWriterLock&) = delete;
 
  private:
-  int fd_ = -1;
+  io::UniqueFd fd_;  ///< the lock file; closing it releases the locks
 };
 
 /// What was read from a results file.

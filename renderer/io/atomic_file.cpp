@@ -19,6 +19,7 @@
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
+#include "renderer/io/unique_fd.hpp"
 
 namespace sb::io {
 
@@ -31,19 +32,6 @@ std::string temporary_prefix(const fs::path& path) { return fmt::format(".{}.tmp
 
 /// The folder `path` lies in ("." for a bare name).
 fs::path folder_of(const fs::path& path) { return path.parent_path().empty() ? fs::path(".") : path.parent_path(); }
-
-/// Closes a descriptor on every way out.
-struct FdCloser {
-  explicit FdCloser(int f) : fd(f) {}
-  FdCloser(FdCloser&& other) noexcept : fd(std::exchange(other.fd, -1)) {}
-  FdCloser(const FdCloser&) = delete;
-  FdCloser& operator=(const FdCloser&) = delete;
-  FdCloser& operator=(FdCloser&&) = delete;
-  ~FdCloser() {
-    if (fd >= 0) ::close(fd);
-  }
-  int fd;
-};
 
 /// Whether `name` is a temporary name of a write of the file whose temporaries start with `prefix`
 /// (".FILE.tmp-"): ".FILE.tmp-PID-N".
@@ -68,8 +56,8 @@ void remove_stale_temporaries(const fs::path& path) {
   std::error_code ec;
   for (fs::directory_iterator it(folder_of(path), ec), end; !ec && it != end; it.increment(ec)) {
     if (!is_temporary_of(it->path().filename().string(), prefix)) continue;
-    const FdCloser fd{::open(it->path().c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK)};
-    if (fd.fd < 0 || ::flock(fd.fd, LOCK_EX | LOCK_NB) != 0) continue;  // a running write, or not ours
+    const UniqueFd fd{::open(it->path().c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK)};
+    if (fd.get() < 0 || ::flock(fd.get(), LOCK_EX | LOCK_NB) != 0) continue;  // a running write, or not ours
     std::error_code ignored;
     fs::remove(it->path(), ignored);
   }
@@ -79,14 +67,14 @@ void remove_stale_temporaries(const fs::path& path) {
 /// the writer then opens and truncates the same file. The file is made and locked under a name
 /// the cleanup does not look at, then renamed to `tmp` (the lock goes with the file), so that no
 /// other write can find it unlocked. The descriptor is closed with the object.
-FdCloser lock_temporary(const fs::path& tmp, const fs::path& path) {
+UniqueFd lock_temporary(const fs::path& tmp, const fs::path& path) {
   const fs::path staging = tmp.parent_path() / (tmp.filename().string() + ".new");
-  FdCloser fd{::open(staging.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644)};
-  if (fd.fd < 0)
+  UniqueFd fd{::open(staging.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644)};
+  if (fd.get() < 0)
     throw IoError(fmt::format("cannot write {}: cannot create a file in {} ({}); give a path in a folder you can "
                               "write, or make room there",
                               path.string(), folder_of(path).string(), std::strerror(errno)));
-  (void)::flock(fd.fd, LOCK_EX | LOCK_NB);  // without locks (ENOLCK) the file is only never judged stale
+  (void)::flock(fd.get(), LOCK_EX | LOCK_NB);  // without locks (ENOLCK) the file is only never judged stale
   std::error_code ec;
   fs::rename(staging, tmp, ec);
   if (ec) {
@@ -103,22 +91,21 @@ FdCloser lock_temporary(const fs::path& tmp, const fs::path& path) {
 /// earlier writes of `path` are removed first.
 struct Temporary {
   fs::path path;
-  FdCloser lock;
+  UniqueFd lock;
 };
 Temporary new_temporary(const fs::path& path) {
   remove_stale_temporaries(path);
   static std::atomic<unsigned> counter{0};
   fs::path tmp = path.parent_path() / fmt::format("{}{}-{}", temporary_prefix(path), ::getpid(), counter++);
-  FdCloser lock = lock_temporary(tmp, path);
+  UniqueFd lock = lock_temporary(tmp, path);
   return Temporary{std::move(tmp), std::move(lock)};
 }
 
 void sync_file(const fs::path& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY);
-  if (fd < 0) throw IoError(fmt::format("cannot reopen {} to flush it: {}", path.string(), std::strerror(errno)));
-  const int rc = ::fsync(fd);
+  const UniqueFd fd(::open(path.c_str(), O_RDONLY | O_CLOEXEC));
+  if (!fd.valid()) throw IoError(fmt::format("cannot reopen {} to flush it: {}", path.string(), std::strerror(errno)));
+  const int rc = ::fsync(fd.get());
   const int err = errno;
-  ::close(fd);
   if (rc != 0) throw IoError(fmt::format("cannot flush {} to disk: {}", path.string(), std::strerror(err)));
 }
 
@@ -198,19 +185,19 @@ void write_through(const fs::path& stream, const std::function<void(const fs::pa
   const fs::path& tmp = staged.path;
   with_temporary(tmp, stream, [&] {
     write(tmp);
-    const FdCloser in{::open(tmp.c_str(), O_RDONLY | O_CLOEXEC)};
-    const FdCloser out{::open(stream.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC)};
-    if (in.fd < 0 || out.fd < 0)
+    const UniqueFd in{::open(tmp.c_str(), O_RDONLY | O_CLOEXEC)};
+    const UniqueFd out{::open(stream.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC)};
+    if (in.get() < 0 || out.get() < 0)
       throw IoError(
-          fmt::format("cannot open {}: {}", in.fd < 0 ? tmp.string() : stream.string(), std::strerror(errno)));
+          fmt::format("cannot open {}: {}", in.get() < 0 ? tmp.string() : stream.string(), std::strerror(errno)));
     std::vector<char> block(size_t{1} << 16);
     for (;;) {
-      const ssize_t n = ::read(in.fd, block.data(), block.size());
+      const ssize_t n = ::read(in.get(), block.data(), block.size());
       if (n < 0 && errno == EINTR) continue;
       if (n < 0) throw IoError(fmt::format("cannot read {}: {}", tmp.string(), std::strerror(errno)));
       if (n == 0) break;
       for (ssize_t done = 0; done < n;) {
-        const ssize_t w = ::write(out.fd, block.data() + done, static_cast<size_t>(n - done));
+        const ssize_t w = ::write(out.get(), block.data() + done, static_cast<size_t>(n - done));
         if (w < 0 && errno == EINTR) continue;
         if (w < 0) throw IoError(fmt::format("cannot write {}: {}", stream.string(), std::strerror(errno)));
         done += w;
@@ -358,9 +345,8 @@ std::optional<std::string> unwritable_folder(const fs::path& folder) {
   if (ec) return fmt::format("cannot create the folder ({})", ec.message());
   if (!fs::is_directory(folder, ec)) return "it is not a folder";
   const fs::path probe = folder / fmt::format(".stereobench-probe-{}", ::getpid());
-  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  if (fd < 0) return fmt::format("cannot create a file in it ({})", std::strerror(errno));
-  ::close(fd);
+  if (!UniqueFd(::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600)).valid())
+    return fmt::format("cannot create a file in it ({})", std::strerror(errno));
   fs::remove(probe, ec);
   return std::nullopt;
 }
