@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -33,44 +34,61 @@ std::string temporary_prefix(const fs::path& path) { return fmt::format(".{}.tmp
 /// The folder `path` lies in ("." for a bare name).
 fs::path folder_of(const fs::path& path) { return path.parent_path().empty() ? fs::path(".") : path.parent_path(); }
 
-/// Whether `name` is a temporary name of a write of the file whose temporaries start with `prefix`
-/// (".FILE.tmp-"): ".FILE.tmp-PID-N".
-bool is_temporary_of(const std::string& name, const std::string& prefix) {
-  if (!name.starts_with(prefix)) return false;
-  const std::string rest = name.substr(prefix.size());
+/// What a name in the folder of a file is to that file's writes.
+enum class TemporaryKind {
+  none,       ///< not one of its temporary names
+  temporary,  ///< ".FILE.tmp-PID-N": a write's temporary file, locked while the write runs
+  staging,    ///< ".FILE.tmp-PID-N.new": that file before it is locked and renamed (microseconds)
+};
+
+/// What `name` is to the writes of the file whose temporaries start with `prefix` (".FILE.tmp-").
+TemporaryKind temporary_kind(const std::string& name, const std::string& prefix) {
+  if (!name.starts_with(prefix)) return TemporaryKind::none;
+  std::string_view rest = std::string_view(name).substr(prefix.size());
+  const bool staging = rest.ends_with(".new");
+  if (staging) rest.remove_suffix(4);
   const size_t dash = rest.find('-');
   const auto digits = [](std::string_view t) {
     return !t.empty() && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
   };
-  return dash != std::string::npos && digits(std::string_view(rest).substr(0, dash)) &&
-         digits(std::string_view(rest).substr(dash + 1));
+  if (dash == std::string_view::npos || !digits(rest.substr(0, dash)) || !digits(rest.substr(dash + 1)))
+    return TemporaryKind::none;
+  return staging ? TemporaryKind::staging : TemporaryKind::temporary;
 }
 
 /// Removes the temporary files that earlier writes of `path` left behind when their process was
 /// killed (SIGKILL, a job's time limit) before it could remove them. A write holds an exclusive
 /// lock on its temporary file until it is renamed or removed, so a file whose lock can be taken
 /// has no writer left, whichever machine or container made it; where locks are unavailable
-/// (ENOLCK), nothing is removed. Best effort: errors leave files where they are.
+/// (ENOLCK), nothing is removed. A staging name is locked and renamed within microseconds of its
+/// creation: one a minute old, unlocked, was left by a kill in between. Best effort: errors leave
+/// files where they are.
 void remove_stale_temporaries(const fs::path& path) {
   const std::string prefix = temporary_prefix(path);
+  const auto now = fs::file_time_type::clock::now();
   std::error_code ec;
   for (fs::directory_iterator it(folder_of(path), ec), end; !ec && it != end; it.increment(ec)) {
-    if (!is_temporary_of(it->path().filename().string(), prefix)) continue;
+    const TemporaryKind kind = temporary_kind(it->path().filename().string(), prefix);
+    if (kind == TemporaryKind::none) continue;
     const UniqueFd fd{::open(it->path().c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK)};
-    if (fd.get() < 0 || ::flock(fd.get(), LOCK_EX | LOCK_NB) != 0) continue;  // a running write, or not ours
+    if (!fd.valid() || ::flock(fd.get(), LOCK_EX | LOCK_NB) != 0) continue;  // a running write, or not ours
     std::error_code ignored;
+    if (kind == TemporaryKind::staging) {
+      const auto made = fs::last_write_time(it->path(), ignored);
+      if (ignored || now - made < std::chrono::minutes(1)) continue;
+    }
     fs::remove(it->path(), ignored);
   }
 }
 
 /// Creates `tmp` and holds an exclusive lock on it while it exists (see remove_stale_temporaries);
-/// the writer then opens and truncates the same file. The file is made and locked under a name
-/// the cleanup does not look at, then renamed to `tmp` (the lock goes with the file), so that no
-/// other write can find it unlocked. The descriptor is closed with the object.
+/// the writer then opens and truncates the same file. The file is made and locked under a staging
+/// name the cleanup lets be for a minute, then renamed to `tmp` (the lock goes with the file), so
+/// that no other write can find it unlocked. The descriptor is closed with the object.
 UniqueFd lock_temporary(const fs::path& tmp, const fs::path& path) {
   const fs::path staging = tmp.parent_path() / (tmp.filename().string() + ".new");
   UniqueFd fd{::open(staging.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644)};
-  if (fd.get() < 0)
+  if (!fd.valid())
     throw IoError(fmt::format("cannot write {}: cannot create a file in {} ({}); give a path in a folder you can "
                               "write, or make room there",
                               path.string(), folder_of(path).string(), std::strerror(errno)));

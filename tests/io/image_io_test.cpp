@@ -14,6 +14,7 @@
 #include <array>
 #include <atomic>
 #include <bit>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -454,8 +455,9 @@ TEST_F(ImageIoTest, FailureInsideWriteAtomicallyLeavesNoFileAndNoTemporary) {
 }
 
 TEST_F(ImageIoTest, AKilledWritesTemporaryGoesWhenTheFileIsWrittenAgain) {
-  // Left by a killed write of out.json: no process holds its lock any more.
-  const std::vector<std::string> stale = {".out.json.tmp-4242-7", ".out.json.tmp-1-0"};
+  // Left by a killed write of out.json: no process holds its lock any more. The staging name
+  // (a write killed between creating its file and locking it) goes once it is a minute old.
+  const std::vector<std::string> stale = {".out.json.tmp-4242-7", ".out.json.tmp-1-0", ".out.json.tmp-4242-8.new"};
   // A write of out.json still running (here or on another machine): it holds its file's lock.
   const std::string running = ".out.json.tmp-777-3";
   const std::vector<std::string> kept = {
@@ -463,11 +465,13 @@ TEST_F(ImageIoTest, AKilledWritesTemporaryGoesWhenTheFileIsWrittenAgain) {
       ".other.json.tmp-4242-0",    // another file's, left for its own next write
       ".out.json.tmp-host-4242-0",  // not a temporary name of ours
       ".out.json.tmp-12",
-      ".out.json.tmp-4242-7.new",  // a write between creating and naming its locked file
+      ".out.json.tmp-4242-7.new",  // a write between creating and naming its locked file, just now
+      ".out.json.tmp-4242-7.newer",
       "out.json.tmp-4242-0",
       "notes.txt"};
   for (const std::string& name : stale) std::ofstream(path(name)) << "partial";
   for (const std::string& name : kept) std::ofstream(path(name)) << "partial";
+  fs::last_write_time(path(".out.json.tmp-4242-8.new"), fs::file_time_type::clock::now() - std::chrono::minutes(2));
   const int fd = ::open(path(running).c_str(), O_RDONLY | O_CLOEXEC);
   ASSERT_GE(fd, 0);
   ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
