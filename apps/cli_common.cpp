@@ -191,6 +191,13 @@ void prepare_output_folder(const std::string& folder, const char* option) {
 
 void prepare_output_file_folder(const std::string& file, const char* option) {
   if (file.empty() || file == "-" || io::written_in_place(file)) return;
+  const std::filesystem::path target = io::follow_links(file);
+  std::error_code ec;
+  if (target != std::filesystem::path(file) && !target.parent_path().empty() &&
+      !std::filesystem::is_directory(target.parent_path(), ec))
+    throw IoError(fmt::format("{} {}: it is a link to {}, whose folder does not exist; make that folder, or give "
+                              "another path",
+                              option, file, target.string()));
   const std::filesystem::path folder = std::filesystem::path(file).parent_path();
   if (folder.empty()) return;  // the current folder
   if (const auto why = io::unwritable_folder(folder))

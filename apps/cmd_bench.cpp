@@ -51,14 +51,26 @@ BenchConfig bench_config(const BenchArgs& a, const std::vector<std::string>& def
   BenchConfig config;
   config.pipelines = expand_all_pipelines(split_list(a.pipelines, "--pipelines"), "--pipelines");
   if (config.pipelines.empty()) config.pipelines = default_pipelines;
-  config.baseline = a.baseline;
-  if (std::find(config.pipelines.begin(), config.pipelines.end(), config.baseline) == config.pipelines.end())
-    config.pipelines.insert(config.pipelines.begin(), config.baseline);
+  // The baseline is timed with the others; listed under another spelling of the same variant
+  // (its options in another order), it is that entry.
+  const std::vector<PipelineEntry> listed = parse_pipeline_entries(config.pipelines, "--pipelines");
+  const PipelineEntry base = [&] {
+    try {
+      return parse_pipeline_entry(a.baseline);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("--baseline: {}", e.what()));
+    }
+  }();
+  const auto same = std::find_if(listed.begin(), listed.end(), [&](const PipelineEntry& e) {
+    return e.pipeline == base.pipeline && e.fixed == base.fixed;
+  });
+  config.baseline = same != listed.end() ? same->name : a.baseline;
+  if (same == listed.end()) config.pipelines.insert(config.pipelines.begin(), config.baseline);
   config.repetitions = a.repetitions;
   config.warmup = a.warmup;
   for (const auto& [key, value] : parse_key_values(a.options, "--option")) {
     const size_t dot = key.find('.');
-    if (dot == std::string::npos || dot == 0)
+    if (dot == std::string::npos || dot == 0 || dot + 1 == key.size())
       throw InputError(fmt::format("--option {}={}: name it PIPELINE.OPTION=VALUE, e.g. plain-raster.tile=32", key, value));
     config.options[key.substr(0, dot)][key.substr(dot + 1)] = value;
   }
@@ -72,8 +84,11 @@ void run_preset_command(const BenchArgs& a) {
   run.preset = &find_bench_preset(a.preset);
   if (a.preset_rows < 0)
     throw InputError(fmt::format("--preset-rows {} must not be negative (0 = every row)", a.preset_rows));
+  if (a.json_out == "-")
+    throw InputError("--json - with --preset: the file is rewritten after every row; give a file name");
   run.overrides = a.rig.overrides();
   run.config = bench_config(a, preset_pipelines(*run.preset));
+  remove_earlier_output(a.json_out, "--json");
   run.rows_per_series = a.preset_rows;
   run.scenes_dir = a.scenes_dir;
   run.json_out = a.json_out;
@@ -82,21 +97,25 @@ void run_preset_command(const BenchArgs& a) {
 }
 
 void run_bench_command(const BenchArgs& a) {
+  // With --json - the JSON goes to standard output, and the tables to standard error.
+  std::FILE* const out = a.json_out == "-" ? stderr : stdout;
   const RigOverrides overrides = a.rig.overrides();
   const BenchConfig config = bench_config(a, pipeline_names());
   const Executor executor(checked_threads(a.threads));
   const scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
   const std::string scene_file = loaded.file.string();
   refuse_overwriting({{"the scene file", &scene_file}}, {{"--json", &a.json_out}});
+  // From here the run's own --json, or none: an earlier one is not left to be read as this run's.
+  remove_earlier_output(a.json_out, "--json");
   const Scene& scene = loaded.scene;
   const size_t lights_in_file = loaded.lights_in_file;
   const StereoRig rig = resolve_rig(scene, overrides);
   const RenderScene prepared(scene);
-  fmt::print("scene {} ({} triangles, {}), {}, {} threads, {} warm-up + {} repetitions\n", scene.name,
+  fmt::print(out, "scene {} ({} triangles, {}), {}, {} threads, {} warm-up + {} repetitions\n", scene.name,
              scene.triangle_count(), describe_lights(scene.lights.size(), lights_in_file), describe(rig),
              executor.threads(), a.warmup, a.repetitions);
-  if (const std::string given = given_options(config); !given.empty()) fmt::print("options: {}\n", given);
-  fmt::print("bvh build {:.1f} ms, {:.1f} MiB\n", prepared.bvh_build_seconds() * 1e3,
+  if (const std::string given = given_options(config); !given.empty()) fmt::print(out, "options: {}\n", given);
+  fmt::print(out, "bvh build {:.1f} ms, {:.1f} MiB\n", prepared.bvh_build_seconds() * 1e3,
              prepared.rays().memory_bytes() / 1048576.0);
   const BenchResult r = run_bench(prepared, rig, config, executor,
                                   [](const std::string& line) { fmt::print(stderr, "  {}\n", line); });
@@ -105,40 +124,40 @@ void run_bench_command(const BenchArgs& a) {
   std::vector<std::string> names;
   for (const PipelineBench& b : r.pipelines) names.push_back(b.name);
   const size_t name_w = pipeline_column(names);
-  fmt::print("\n{:<{}} {:>11} {:>11} {:>11} {:>9} {:>13} {:>13}\n", "pipeline", name_w, "median ms", "min ms", "max ms",
+  fmt::print(out, "\n{:<{}} {:>11} {:>11} {:>11} {:>9} {:>13} {:>13}\n", "pipeline", name_w, "median ms", "min ms", "max ms",
              "speed-up", "Mrays/s", "Mprimary/s");
   for (const PipelineBench& b : r.pipelines) {
     const Summary t = summarize(b.total_seconds);
     auto counter = [&](const char* n) { auto it = b.counters.find(n); return it == b.counters.end() ? 0.0 : double(it->second); };
     const double primary = counter("primary_rays"), shadow = counter("shadow_rays");
-    fmt::print("{:<{}} {:>11.2f} {:>11.2f} {:>11.2f} {:>8.2f}x {:>13.2f} {:>13.2f}\n", b.name, name_w, t.median * 1e3,
+    fmt::print(out, "{:<{}} {:>11.2f} {:>11.2f} {:>11.2f} {:>8.2f}x {:>13.2f} {:>13.2f}\n", b.name, name_w, t.median * 1e3,
                t.min * 1e3, t.max * 1e3, b.speedup.median, (primary + shadow) / t.median * 1e-6,
                primary / t.median * 1e-6);
   }
-  fmt::print("\nper-stage medians (min..max), ms\n");
+  fmt::print(out, "\nper-stage medians (min..max), ms\n");
   for (const PipelineBench& b : r.pipelines) {
-    fmt::print("{}\n", b.name);
+    fmt::print(out, "{}\n", b.name);
     for (const std::string& st : b.stage_order) {
       const Summary s = summarize(b.stage_seconds.at(st));
-      fmt::print("  {:<22} {:>10.2f} ({:.2f}..{:.2f})\n", st, s.median * 1e3, s.min * 1e3, s.max * 1e3);
+      fmt::print(out, "  {:<22} {:>10.2f} ({:.2f}..{:.2f})\n", st, s.median * 1e3, s.min * 1e3, s.max * 1e3);
     }
   }
-  fmt::print("\nper-eye medians, ms: the stages of each eye, and those that serve both\n");
-  fmt::print("{:<{}} {:>11} {:>11} {:>11}  {}\n", "pipeline", name_w, "left eye", "right eye", "both", "right / left");
+  fmt::print(out, "\nper-eye medians, ms: the stages of each eye, and those that serve both\n");
+  fmt::print(out, "{:<{}} {:>11} {:>11} {:>11}  {}\n", "pipeline", name_w, "left eye", "right eye", "both", "right / left");
   for (const PipelineBench& b : r.pipelines) {
     const std::optional<Summary> share = b.right_over_left();
     const std::string ratio =
         share ? fmt::format("{:.1f} % ({:.1f}..{:.1f})", share->median * 100.0, share->min * 100.0, share->max * 100.0)
               : "-";
     const std::string shared = b.shared_stages.empty() ? "" : fmt::format("; both: {}", fmt::join(b.shared_stages, ", "));
-    fmt::print("{:<{}} {:>11.2f} {:>11.2f} {:>11.2f}  {}{}\n", b.name, name_w, summarize(b.left_seconds).median * 1e3,
+    fmt::print(out, "{:<{}} {:>11.2f} {:>11.2f} {:>11.2f}  {}{}\n", b.name, name_w, summarize(b.left_seconds).median * 1e3,
                summarize(b.right_seconds).median * 1e3, summarize(b.both_seconds).median * 1e3, ratio, shared);
   }
-  fmt::print("\nspeed-up = median over repetitions of {}'s total / the pipeline's total, paired per repetition\n",
+  fmt::print(out, "\nspeed-up = median over repetitions of {}'s total / the pipeline's total, paired per repetition\n",
              r.baseline);
-  fmt::print("right / left = median (min..max) over repetitions of the right eye's stages / the left eye's, paired per "
+  fmt::print(out, "right / left = median (min..max) over repetitions of the right eye's stages / the left eye's, paired per "
              "repetition\n");
-  fmt::print("peak resident memory {:.0f} MiB\n", peak_rss_mib());
+  fmt::print(out, "peak resident memory {:.0f} MiB\n", peak_rss_mib());
   if (!a.json_out.empty()) {
     nlohmann::json j = bench_to_json(r);
     j["scene"] = {{"name", scene.name},
@@ -150,8 +169,12 @@ void run_bench_command(const BenchArgs& a) {
     j["bvh"] = {{"build_s", prepared.bvh_build_seconds()}, {"memory_bytes", prepared.rays().memory_bytes()}};
     j["peak_rss_mib"] = peak_rss_mib();
     j["versions"] = io::versions_json();
-    io::write_text_atomically(a.json_out, j.dump(2) + "\n");
-    fmt::print("wrote {}\n", a.json_out);
+    if (a.json_out == "-") {
+      fmt::print(stdout, "{}\n", j.dump(2));
+    } else {
+      io::write_text_atomically(a.json_out, j.dump(2) + "\n");
+      fmt::print(out, "wrote {}\n", a.json_out);
+    }
   }
 }
 
@@ -173,7 +196,10 @@ void register_bench_command(CLI::App& root) {
   b->add_option("--threads,-t", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
   b->add_option("--option,-o", a->options,
                 "Pipeline option PIPELINE.NAME=VALUE (for PIPELINE and its variants, under a variant's own)");
-  b->add_option("--json", a->json_out, "Also write the results (with raw samples) to this JSON file");
+  b->add_option("--json", a->json_out,
+                "Also write the results (with raw samples) to this JSON file ('-': standard output, the tables then "
+                "go to standard error); an earlier file there is removed when the timing starts, so a run that stops "
+                "leaves none (a preset's is rewritten after every row, \"complete\": false until the last)");
   add_scenes_dir_option(*b, a->scenes_dir);
   add_lights_option(*b, a->lights);
   CLI::Option* preset =

@@ -2,6 +2,8 @@
 // animation (e.g. Al-Hagri's Animated Spheres turning about Y), with the BVH refit or rebuilt per
 // frame and timed as its own stage; one JSON line per frame and a summary table.
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -13,7 +15,7 @@
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
-#include "renderer/io/atomic_file.hpp"
+#include "renderer/io/line_file.hpp"
 #include "scenes/catalog.hpp"
 #include "validation/path_run.hpp"
 
@@ -33,7 +35,7 @@ struct PathArgs {
   std::string cache = "out/truth-cache";
   int threads = 0;
   int frames = 10;
-  std::string camera_keys;
+  std::optional<std::string> camera_keys;
   std::optional<double> spin_deg;
   std::string spin_axis = "0,1,0";
   std::string spin_prefix;
@@ -58,6 +60,9 @@ double median(std::vector<double> v) {
   return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+/// A PSNR for the table: two decimals, or "inf" for images identical to the truth.
+std::string decibels(double db) { return std::isinf(db) ? std::string("inf") : fmt::format("{:.2f}", db); }
+
 double percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -69,7 +74,7 @@ void run_path_command(const PathArgs& a) {
     throw InputError(fmt::format("--bvh '{}' is neither refit nor rebuild", a.bvh));
   validation::PathRun run;
   run.path.frames = a.frames;
-  if (!a.camera_keys.empty()) run.path.camera_keys = parse_camera_keys(a.camera_keys);
+  if (a.camera_keys) run.path.camera_keys = parse_camera_keys(*a.camera_keys);
   if (a.spin_deg) {
     // Blender imports the scene file, which does not turn; full and povray render the moved scene.
     if (a.truth == "blender")
@@ -101,35 +106,48 @@ void run_path_command(const PathArgs& a) {
 
   fmt::print("path on {} ({} triangles): {} frames, {}{}; {}, truth {}\n", loaded.scene.name,
              loaded.scene.triangle_count(), a.frames,
-             run.path.camera_keys.empty() ? "the scene's camera" : fmt::format("{} camera keys", run.path.camera_keys.size()),
+             run.path.camera_keys.empty() ? "the scene's camera" : fmt::format("{} camera key{}", run.path.camera_keys.size(), run.path.camera_keys.size() == 1 ? "" : "s"),
              a.spin_deg ? fmt::format(", meshes turning {} deg per frame (BVH {})", *a.spin_deg, a.bvh) : "",
              describe(rig), provider->name());
+  // The frames go to <stem>_path.jsonl.partial as they finish, renamed to the final name when
+  // the last is in: a run stopped on the way leaves the frames it finished under a name that says
+  // so, and no file under the final name (an earlier run's is removed before the first frame).
   const fs::path lines = fs::path(a.out) / fmt::format("{}_path.jsonl", loaded.scene.file_stem());
-  std::string text;
+  const fs::path partial = fs::path(lines).concat(".partial");
+  remove_earlier_output(lines, "path file");
+  io::LineFile out(partial);
   std::map<std::string, std::vector<double>> frame_s, psnr;
   std::vector<double> bvh_s;
-  validation::run_path(loaded.scene, run, executor, [&](const json& f) {
-    text += f.dump() + "\n";
-    // Frame 0 builds the BVH; later frames update it, unless the path moves no geometry ("static").
-    if (f["frame"].get<int>() > 0 && f["bvh"] != "static") bvh_s.push_back(f["bvh_update_s"].get<double>());
-    std::string line = fmt::format("frame {:>4}", f["frame"].get<int>());
-    for (const auto& [name, p] : f["pipelines"].items()) {
-      frame_s[name].push_back(p["total_s"].get<double>());
-      const json& m = p["metrics"]["psnr"];
-      if (m.is_number()) psnr[name].push_back(m.get<double>());
-      line += fmt::format("  {} {:.1f} ms {}", name, 1e3 * p["total_s"].get<double>(),
-                          m.is_number() ? fmt::format("{:.2f} dB", m.get<double>()) : std::string("inf dB"));
-    }
-    fmt::print(stderr, "{}\n", line);
-  });
-  io::write_text_atomically(lines, text);
+  try {
+    validation::run_path(loaded.scene, run, executor, [&](const json& f) {
+      out.append(f.dump());
+      // Frame 0 builds the BVH; later frames update it, unless the path moves no geometry ("static").
+      if (f["frame"].get<int>() > 0 && f["bvh"] != "static") bvh_s.push_back(f["bvh_update_s"].get<double>());
+      std::string line = fmt::format("frame {:>4}", f["frame"].get<int>());
+      for (const auto& [name, p] : f["pipelines"].items()) {
+        frame_s[name].push_back(p["total_s"].get<double>());
+        // PSNR is a string ("inf") for a frame identical to the truth.
+        const json& m = p["metrics"]["psnr"];
+        const double db = m.is_number() ? m.get<double>() : std::numeric_limits<double>::infinity();
+        psnr[name].push_back(db);
+        line += fmt::format("  {} {:.1f} ms {} dB", name, 1e3 * p["total_s"].get<double>(), decibels(db));
+      }
+      fmt::print(stderr, "{}\n", line);
+    });
+  } catch (...) {
+    if (out.lines() > 0)
+      fmt::print(stderr, "stereobench: the {} frames finished before the error are in {}\n", out.lines(),
+                 partial.string());
+    throw;
+  }
+  out.finish(lines);
   std::vector<std::string> names;
   for (const auto& entry : frame_s) names.push_back(entry.first);
   const size_t name_w = pipeline_column(names);
   fmt::print("\n{:<{}} {:>14} {:>14} {:>12}\n", "pipeline", name_w, "median ms", "95th pct ms", "median PSNR");
   for (const auto& [name, s] : frame_s)
     fmt::print("{:<{}} {:>14.2f} {:>14.2f} {:>12}\n", name, name_w, 1e3 * median(s), 1e3 * percentile(s, 0.95),
-               psnr[name].empty() ? std::string("inf") : fmt::format("{:.2f}", median(psnr[name])));
+               decibels(median(psnr[name])));
   if (!bvh_s.empty()) fmt::print("BVH {} per frame: median {:.2f} ms\n", a.bvh, 1e3 * median(bvh_s));
   fmt::print("wrote {}\n", lines.string());
 }

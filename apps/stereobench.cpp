@@ -1,6 +1,7 @@
 // stereobench: the command-line tool. Maps subcommands to library calls and errors to exit codes.
 #include <cstdio>
 #include <exception>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -71,6 +72,29 @@ void refuse_folder_as_file(CLI::App& app) {
   for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) refuse_folder_as_file(*sub);
 }
 
+/// Numeric options take decimal numbers only. The parser would also read C's other forms
+/// (0x10 as 16, 0b11, 0o17, digit separators), so a resolution or hash pasted into --vfov or
+/// --repetitions would run silently with another value. "inf" and "nan" pass on to the option's
+/// own range check, which names them.
+void refuse_non_decimal_numbers(CLI::App& app) {
+  static const std::regex integer(R"([+-]?[0-9]+)");
+  static const std::regex real(R"([+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?|[+-]?(inf|infinity|nan))",
+                               std::regex::icase);
+  for (CLI::Option* option : app.get_options()) {
+    const std::string type = option->get_type_name();
+    const bool is_integer = type.starts_with("INT") || type.starts_with("UINT");
+    if (!is_integer && !type.starts_with("FLOAT")) continue;
+    option->check(CLI::Validator(
+        [is_integer](const std::string& value) {
+          return std::regex_match(value, is_integer ? integer : real)
+                     ? std::string()
+                     : fmt::format("'{}' is not a decimal {}", value, is_integer ? "integer" : "number");
+        },
+        "", "decimal"));
+  }
+  for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) refuse_non_decimal_numbers(*sub);
+}
+
 /// When parsing stopped for want of a subcommand: the first word after the commands given that
 /// names none of the next level's, with those names ("" when every word is a command or option).
 std::string unknown_command_message(const CLI::App& app, int argc, char** argv) {
@@ -119,6 +143,7 @@ int main(int argc, char** argv) {
   sb::cli::register_path_command(app);
   refuse_empty_paths(app);
   refuse_folder_as_file(app);
+  refuse_non_decimal_numbers(app);
 
   try {
     app.parse(argc, argv);

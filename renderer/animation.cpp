@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -47,6 +48,16 @@ CameraKey interpolated_key(const std::vector<CameraKey>& keys, const PathPlace& 
 
 bool looks_at_itself(const CameraKey& k) { return glm::length(k.target - k.position) < 1e-9; }
 
+/// The unit vector along `axis`, scaled by its largest component first so that neither a huge
+/// axis (1e300, whose length overflows) nor a tiny one (1e-300, whose square underflows) is lost;
+/// nothing for a zero or non-finite axis.
+std::optional<dvec3> unit_axis(const dvec3& axis) {
+  if (!finite(axis)) return std::nullopt;
+  const double largest = std::max({std::abs(axis.x), std::abs(axis.y), std::abs(axis.z)});
+  if (!(largest > 0.0)) return std::nullopt;
+  return glm::normalize(axis / largest);
+}
+
 }  // namespace
 
 void PathSpec::validate() const {
@@ -84,7 +95,7 @@ void PathSpec::validate() const {
                                    i + 1, i + 2, 100.0 * t));
   }
   if (spin) {
-    if (!finite(spin->axis) || glm::length(spin->axis) < 1e-12)
+    if (!unit_axis(spin->axis))
       throw InputError("the spin axis is zero or not finite; give a direction such as 0,1,0");
     // More than a turn per frame is the same motion as its remainder, and large values would
     // overflow frame x angle.
@@ -119,7 +130,7 @@ void SceneAnimator::apply(int frame) {
     throw InputError(fmt::format("frame {} is outside the path's 0..{}", frame, path_.frames - 1));
   if (turning_.empty()) return;
   const double radians = degrees_to_radians(path_.spin->degrees_per_frame * frame);
-  const dmat3 r = rotation(glm::normalize(path_.spin->axis), radians);
+  const dmat3 r = rotation(*unit_axis(path_.spin->axis), radians);
   for (size_t k = 0; k < turning_.size(); ++k) {
     Mesh& mesh = scene_.meshes[turning_[k]];
     const std::vector<vec3>& p0 = base_positions_[k];
@@ -150,7 +161,10 @@ std::vector<CameraKey> parse_camera_keys(const std::string& text) {
     return v;
   };
   while (std::getline(list, item, ';')) {
-    if (item.empty()) continue;
+    if (item.empty())
+      throw InputError(fmt::format("camera key {} is empty (two ';' in a row?); give "
+                                   "POSITION>TARGET;POSITION>TARGET...",
+                                   keys.size() + 1));
     const size_t arrow = item.find('>');
     if (arrow == std::string::npos)
       throw InputError(fmt::format("camera key {} '{}' is not POSITION>TARGET, e.g. 0,1.6,3>0,1.2,0", keys.size() + 1, item));

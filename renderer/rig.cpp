@@ -241,10 +241,11 @@ StereoRig resolve_rig(const Scene& scene, const RigOverrides& o) {
     require_positive(p.convergence, "convergence", "give the zero-parallax distance in meters");
     p.interaxial = interaxial_from_max_disparity(*o.max_disparity_px, p.convergence, p.vfov, p.height);
   }
-  // A disparity out of range that the scene's extras alone set up (no option gave the interaxial or
-  // the convergence) is named by file and JSON path: the message must not read as if an option were
-  // at fault. Where an option took part, RigParams::validate names the values as options.
-  const bool options_set_rig = o.interaxial || o.max_disparity_px || o.convergence;
+  // A disparity out of range that the scene's extras alone set up (no option gave the interaxial,
+  // the convergence, the field of view or the image height, which all enter it) is named by file
+  // and JSON path: the message must not read as if an option were at fault. Where an option took
+  // part, RigParams::validate names the values.
+  const bool options_set_rig = o.interaxial || o.max_disparity_px || o.convergence || o.vfov || o.height;
   const bool vfov_ok = std::isfinite(p.vfov) && p.vfov > 0.0 && p.vfov < kPi;
   if (!options_set_rig && (scene.rig.interaxial || scene.rig.convergence) && !scene.rig.where.empty() && vfov_ok) {
     try {
@@ -288,10 +289,14 @@ ivec2 parse_resolution(const std::string& text) {
 
 std::string describe(const StereoRig& rig) {
   const RigParams& p = rig.params();
-  return fmt::format("{}x{}, vfov {:.2f} deg, interaxial {:.4f} m, convergence {:.3f} m, "
-                     "f {:.1f} px, max disparity {:.2f} px",
-                     p.width, p.height, radians_to_degrees(p.vfov), p.interaxial, p.convergence,
-                     rig.focal_px(), rig.max_disparity_px());
+  // `decimals` places, or three significant digits for a value those places would show as 0.
+  const auto number = [](double v, int decimals) {
+    return v != 0.0 && std::abs(v) < 0.5 * std::pow(10.0, -decimals) ? fmt::format("{:.3g}", v)
+                                                                     : fmt::format("{:.{}f}", v, decimals);
+  };
+  return fmt::format("{}x{}, vfov {} deg, interaxial {} m, convergence {} m, f {:.1f} px, max disparity {} px",
+                     p.width, p.height, number(radians_to_degrees(p.vfov), 2), number(p.interaxial, 4),
+                     number(p.convergence, 3), rig.focal_px(), number(rig.max_disparity_px(), 2));
 }
 
 }  // namespace sb

@@ -14,6 +14,23 @@ namespace {
 
 json vec_json(const dvec3& v) { return json::array({v.x, v.y, v.z}); }
 
+/// What every frame of a path shares: the path itself (keys, spin, BVH update) and its frame count.
+json animation_json(const PathRun& run) {
+  json keys = json::array();
+  for (const CameraKey& k : run.path.camera_keys)
+    keys.push_back({{"position", vec_json(k.position)}, {"target", vec_json(k.target)}});
+  json spin = nullptr;
+  if (run.path.spin)
+    spin = {{"axis", vec_json(run.path.spin->axis)},
+            {"degrees_per_frame", run.path.spin->degrees_per_frame},
+            {"mesh_prefix", run.path.spin->mesh_prefix},
+            {"pivot", run.path.spin->pivot ? vec_json(*run.path.spin->pivot) : json(nullptr)}};
+  return {{"frames", run.path.frames},
+          {"camera_keys", keys},
+          {"spin", spin},
+          {"bvh_update", run.refit ? "refit" : "rebuild"}};
+}
+
 }  // namespace
 
 void run_path(Scene& scene, const PathRun& run, const Executor& executor,
@@ -21,6 +38,11 @@ void run_path(Scene& scene, const PathRun& run, const Executor& executor,
   SceneAnimator animator(scene, run.path);
   animator.apply(0);
   RenderScene prepared(scene, run.refit);
+  const json animation = animation_json(run);
+  const json scene_json = {{"name", scene.name},
+                           {"path", scene.path},
+                           {"triangles", scene.triangle_count()},
+                           {"lights", scene.lights.size()}};
   for (int frame = 0; frame < animator.frames(); ++frame) {
     const auto t0 = std::chrono::steady_clock::now();
     animator.apply(frame);
@@ -35,16 +57,31 @@ void run_path(Scene& scene, const PathRun& run, const Executor& executor,
     json pipelines = json::object();
     for (const PipelineEntry& entry : run.pipelines) {
       const PipelineValidation v = validate_pipeline(target, entry, entry.options(), executor);
-      pipelines[v.pipeline] = {{"total_s", v.result.timings.total()},
+      pipelines[v.pipeline] = {{"options", v.options.values()},
+                               {"total_s", v.result.timings.total()},
                                {"timings_s", io::timings_to_json(v.result.timings)},
                                {"stage_eyes", io::stage_eyes_to_json(v.result.timings)},
                                {"counters", v.result.counters.snapshot()},
                                {"metrics", to_json(v.whole)},
                                {"hole_fraction", v.holes.hole_fraction},
-                               {"recall", v.holes.scores.recall}};
+                               {"recall", v.holes.scores.recall},
+                               {"precision", v.holes.scores.precision}};
     }
     const double pixels = static_cast<double>(rig.params().width) * rig.params().height;
-    on_frame({{"frame", frame},
+    const TruthRender& truth = target.truth.render;
+    on_frame({{"kind", "stereobench.path_frame"},
+              {"frame", frame},
+              {"frames", animator.frames()},
+              {"scene", scene_json},
+              {"rig", io::rig_to_json(rig)},
+              {"animation", animation},
+              {"truth",
+               {{"provider", truth.provider},
+                {"tool_version", truth.tool_version},
+                {"cached", target.truth.cached},
+                {"cache_key", target.truth.key}}},
+              {"threads", executor.threads()},
+              {"versions", io::versions_json()},
               {"animate_s", animate_s},
               {"bvh_update_s", bvh_s},
               {"bvh", frame == 0 ? "build" : (animator.moves_geometry() ? (run.refit ? "refit" : "rebuild") : "static")},

@@ -29,9 +29,12 @@ struct PathRun {
 };
 
 /// Runs every frame of the path on `scene` (animated in place; left at the last frame) and calls
-/// `on_frame` with each frame's record: frame, animate_s, bvh_update_s, bvh ("refit"/"rebuild"),
-/// camera pose, truth seconds, true disocclusion fraction, and per pipeline total_s, timings_s,
-/// counters and the whole-image metrics (metrics JSON of validation/metrics.hpp).
+/// `on_frame` with each frame's record ("kind": "stereobench.path_frame"): frame and frames, the
+/// scene, the frame's rig, the animation (camera keys, spin, BVH update), the truth's provider,
+/// tool version and cache key, threads and versions; animate_s, bvh_update_s, bvh
+/// ("build"/"refit"/"rebuild"/"static"), camera pose, truth seconds, true disocclusion fraction;
+/// and per pipeline its options, total_s, timings_s, counters, the whole-image metrics (metrics
+/// JSON of validation/metrics.hpp), hole fraction, recall and precision.
 void run_path(Scene& scene, const PathRun& run, const Executor& executor,
               const std::function<void(const nlohmann::json& frame)>& on_frame);
 

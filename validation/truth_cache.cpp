@@ -65,7 +65,7 @@ void TruthCache::prepare(const std::string& provider) const {
   if (const auto why = io::unwritable_folder(folder))
     throw IoError(
         fmt::format("the ground-truth cache {} cannot hold {} renders: {}: {}; give --cache a folder you "
-                    "can write, or --no-cache",
+                    "can write, or --cache '' to render without it",
                     dir_.string(), provider, folder.string(), *why));
 }
 

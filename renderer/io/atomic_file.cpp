@@ -271,6 +271,12 @@ void StagedFiles::add(const fs::path& given, const std::function<void(const fs::
   const fs::path& path = target.path;
   const fs::path parent = path.parent_path();
   std::error_code ec;
+  // The folders of a path as given are made; a link's target is where the link says, and a
+  // missing folder there is not made up (a dangling link to /nowhere/x.json made /nowhere).
+  if (!parent.empty() && path != given && !fs::is_directory(parent, ec))
+    throw IoError(fmt::format("cannot write {}: it is a link to {}, whose folder does not exist; make that folder, "
+                              "or give another path",
+                              given.string(), path.string()));
   if (!parent.empty()) {
     fs::create_directories(parent, ec);
     if (ec)

@@ -138,6 +138,15 @@ TEST(BenchPreset, BadPresetsAndLightCountsExitWith3AndSayWhy) {
       {"bench --scene box-wall --resolution 32x18 --lights 99" + quick, {"--lights 99", "'box-wall'", "has 1 light"}},
       {"render --scene box-wall --resolution 32x18 --lights 99 --out '" + dir.path().string() + "'" + sd,
        {"--lights 99", "'box-wall'", "has 1 light"}},
+      // Numbers in another base than ten would run silently with another value (0x10 is 16).
+      {"bench --scene box-wall --resolution 32x18 --vfov 0x10" + quick, {"--vfov: '0x10' is not a decimal number"}},
+      {"bench --scene box-wall --resolution 32x18 --pipelines plain-rt -n 0x2 -w 0" + sd,
+       {"--repetitions: '0x2' is not a decimal integer"}},
+      // The option at fault is named, also for the baseline and an option without a name.
+      {"bench --scene box-wall --resolution 32x18 --baseline nope" + quick, {"--baseline: unknown pipeline 'nope'"}},
+      {"bench --scene box-wall --resolution 32x18 --option plain-rt.=4" + quick,
+       {"--option plain-rt.=4: name it PIPELINE.OPTION=VALUE"}},
+      {"bench --preset al-hagri-lights --json -" + quick, {"--json - with --preset"}},
   };
   for (const Case& c : cases) {
     const CliRun r = test::run_cli(c.args);

@@ -226,6 +226,13 @@ TEST(Cli, RenderWritesEveryOutputAndBenchPrintsATable) {
   ASSERT_EQ(b.code, 0) << b.out;
   EXPECT_NE(b.out.find("ideal-copy"), std::string::npos) << b.out;
   EXPECT_NE(b.out.find("speed-up"), std::string::npos) << b.out;
+  // --json -: the JSON alone on standard output; the tables go to standard error.
+  const CliRun json_only = test::run_shell("(" + std::string(SB_CLI_PATH) +
+                                           " bench --scene box-wall --pipelines plain-rt --baseline plain-rt -n 1 -w 0"
+                                           " --json -" + common + " 2>/dev/null)");
+  ASSERT_EQ(json_only.code, 0) << json_only.out;
+  EXPECT_EQ(nlohmann::json::parse(json_only.out).at("baseline"), "plain-rt") << json_only.out;
+  EXPECT_FALSE(std::filesystem::exists("-"));
   // 'all' times every registered pipeline, beside a variant named after it.
   const CliRun every =
       run("bench --scene box-wall --pipelines all,bidir-warp:occlusion=ztest --baseline plain-rt -n 1 -w 0" + common);

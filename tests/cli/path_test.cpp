@@ -36,7 +36,20 @@ TEST(PathCommand, FramesWithSpinAndCameraKeys) {
   EXPECT_GT(frames[2]["bvh_update_s"].get<double>(), 0.0);
   EXPECT_EQ(frames[2]["frame"], 2);
   EXPECT_NE(frames[0]["camera"]["position"], frames[2]["camera"]["position"]);
+  // The frames went to a ".partial" file, renamed once the last was in.
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "box-wall_path.jsonl.partial"));
   for (const json& f : frames) {
+    // Each line says what made it: a file from another run, or a cut one, shows as such.
+    EXPECT_EQ(f["kind"], "stereobench.path_frame");
+    EXPECT_EQ(f["frames"], 3);
+    EXPECT_EQ(f["scene"]["name"], "box-wall");
+    EXPECT_EQ(f["rig"]["width"], 96);
+    EXPECT_EQ(f["truth"]["provider"], "full");
+    EXPECT_EQ(f["animation"]["spin"]["degrees_per_frame"], 10.0);
+    EXPECT_EQ(f["animation"]["camera_keys"].size(), 2u);
+    EXPECT_EQ(f["animation"]["bvh_update"], "refit");
+    EXPECT_EQ(f["pipelines"]["repro-rt:discontinuity_px=1e6"]["options"]["discontinuity_px"], "1e6");
+    EXPECT_GT(f["pipelines"]["repro-rt"]["precision"].get<double>(), 0.0);
     EXPECT_EQ(f["pipelines"]["plain-rt"]["metrics"]["psnr"], "inf") << "plain-rt is the built-in ground truth";
     EXPECT_GT(f["pipelines"]["repro-rt"]["total_s"].get<double>(), 0.0);
     // Measured 38.4-43.5 dB over the three frames; below 30 dB the frame's truth or rig is wrong.
@@ -62,6 +75,10 @@ TEST(PathCommand, BadInput) {
   EXPECT_NE(beside_all.out.find("'repro-rt' is one of the pipelines 'all' includes"), std::string::npos)
       << beside_all.out;
   EXPECT_EQ(test::run_cli(args(dir) + " --camera-keys '1,2,3'").code, 3);
+  EXPECT_EQ(test::run_cli(args(dir) + " --camera-keys ''").code, 3);
+  const test::CliRun empty_key = test::run_cli(args(dir) + " --camera-keys '0,1,6>0,0.5,0;;1,1,6>0,0.5,0'");
+  EXPECT_EQ(empty_key.code, 3) << empty_key.out;
+  EXPECT_NE(empty_key.out.find("camera key 2 is empty"), std::string::npos) << empty_key.out;
   EXPECT_EQ(test::run_cli(args(dir) + " --spin-deg 5 --spin-prefix nothing-like-this").code, 3);
   EXPECT_EQ(test::run_cli(args(dir) + " --spin-deg 5 --truth blender").code, 3);
   // An axis with trailing junk, and spin settings without a spin, are refused, not ignored.

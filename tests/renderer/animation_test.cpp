@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "renderer/animation.hpp"
@@ -35,6 +36,22 @@ TEST(Animation, SpinTurnsAboutThePivotWithoutDrift) {
   animator.apply(0);
   EXPECT_EQ(scene.meshes[0].positions, original.meshes[0].positions) << "frame 0 is the scene as loaded";
   EXPECT_THROW(animator.apply(5), InputError);
+
+  // An axis is a direction, whatever its length: one whose length overflows (1e300) or whose
+  // square underflows (1e-300) turns the scene as the unit axis does.
+  for (const double scale : {1e300, 1e-300, 7.0}) {
+    Scene turned = original;
+    PathSpec scaled = path;
+    scaled.spin->axis = dvec3(0.0, scale, 0.0);
+    SceneAnimator a(turned, scaled);
+    a.apply(1);
+    animator.apply(1);
+    EXPECT_EQ(turned.meshes[0].positions, scene.meshes[0].positions) << "axis length " << scale;
+  }
+  path.spin->axis = dvec3(0.0, 0.0, 0.0);
+  EXPECT_THROW(path.validate(), InputError);
+  path.spin->axis = dvec3(0.0, std::numeric_limits<double>::infinity(), 0.0);
+  EXPECT_THROW(path.validate(), InputError);
 }
 
 TEST(Animation, CameraFollowsKeysAndBadPathsAreRejected) {
