@@ -1,17 +1,54 @@
 // The on-disk cache of ground-truth renders.
 #include "validation/truth_cache.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
+
+#include <cerrno>
+#include <cmath>
+
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/image_io.hpp"
 #include "renderer/io/json_text.hpp"
+#include "renderer/io/unique_fd.hpp"
 #include "validation/content_hash.hpp"
 
 namespace sb::validation {
 
 using nlohmann::json;
+
+namespace {
+
+/// An exclusive lock (flock) on the work folder an external tool renders in, held while it
+/// renders: two runs sharing the folder would read each other's passes. A run that finds it held
+/// says so and waits. Where locks are unavailable (ENOLCK), or the folder cannot be opened (the
+/// provider then reports it), nothing is held.
+class WorkFolderLock {
+ public:
+  WorkFolderLock(const std::filesystem::path& dir, const std::string& provider) {
+    if (dir.empty() || provider == "full") return;  // the built-in renderer writes no files
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    fd_.reset(::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+    if (!fd_.valid() || ::flock(fd_.get(), LOCK_EX | LOCK_NB) == 0 || errno != EWOULDBLOCK) return;
+    fmt::print(stderr, "stereobench: another run is rendering a '{}' ground truth in {}; waiting for it\n", provider,
+               dir.string());
+    while (::flock(fd_.get(), LOCK_EX) != 0 && errno == EINTR) {
+    }
+    waited_ = true;
+  }
+  /// Whether another run held the folder first (its render may be the one wanted, now cached).
+  [[nodiscard]] bool waited() const { return waited_; }
+
+ private:
+  io::UniqueFd fd_;
+  bool waited_ = false;
+};
+
+}  // namespace
 
 
 std::string truth_key(const TruthProvider& provider, const TruthRequest& request) {
@@ -30,6 +67,20 @@ std::string truth_key(const TruthProvider& provider, const TruthRequest& request
   return sha.hex();
 }
 
+std::optional<std::string> unusable_samples(const Image& truth) {
+  if (!truth.has_plane(planes::rgb)) return "it has no rgb plane";
+  const float* v = truth.data_f32(planes::rgb);
+  size_t nan = 0, inf = 0, negative = 0;
+  for (size_t i = 0; i < truth.pixel_count() * 3; ++i) {
+    nan += std::isnan(v[i]) ? 1 : 0;
+    inf += std::isinf(v[i]) ? 1 : 0;
+    negative += v[i] < 0.0f ? 1 : 0;
+  }
+  if (nan + inf + negative == 0) return std::nullopt;
+  return fmt::format("{} NaN, {} infinite and {} negative sample(s) of {}", nan, inf, negative,
+                     truth.pixel_count() * 3);
+}
+
 std::filesystem::path TruthCache::image_path(const std::string& provider, const std::string& key) const {
   return dir_ / provider / (key + ".exr");
 }
@@ -45,6 +96,10 @@ std::optional<TruthRender> TruthCache::load(const std::string& provider, const s
     TruthRender r;
     r.right = rgb_plane_only(io::read_exr(exr));
     if (hash_image(r.right) != j.at("image_sha256").get<std::string>()) return std::nullopt;
+    // An entry made for another request (copied or renamed by hand) is no answer to this one.
+    if (j.at("key").get<std::string>() != key || j.at("provider").get<std::string>() != provider ||
+        unusable_samples(r.right))
+      return std::nullopt;
     r.provider = j.at("provider").get<std::string>();
     r.tool_version = j.at("tool_version").get<std::string>();
     r.settings = j.at("settings");
@@ -60,13 +115,22 @@ std::optional<TruthRender> TruthCache::load(const std::string& provider, const s
   }
 }
 
-void TruthCache::prepare(const std::string& provider) const {
+void TruthCache::prepare(const std::string& provider, const std::string& key) const {
   const std::filesystem::path folder = dir_ / provider;
   if (const auto why = io::unwritable_folder(folder))
     throw IoError(
         fmt::format("the ground-truth cache {} cannot hold {} renders: {}: {}; give --cache a folder you "
                     "can write, or --cache '' to render without it",
                     dir_.string(), provider, folder.string(), *why));
+  std::filesystem::path meta = image_path(provider, key);
+  meta.replace_extension(".json");
+  for (const std::filesystem::path& entry : {image_path(provider, key), meta}) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(entry, ec))
+      throw IoError(fmt::format("the ground-truth cache {} cannot store this render: {} is a folder; remove it, or "
+                                "give --cache another folder (--cache '' renders without it)",
+                                dir_.string(), entry.string()));
+  }
 }
 
 void TruthCache::store(const std::string& key, const TruthRender& render) const {
@@ -95,8 +159,22 @@ ResolvedTruth resolve_truth(const TruthProvider& provider, const TruthRequest& r
       return out;
     }
   }
-  if (use_cache) cache->prepare(provider.name());
+  if (use_cache) cache->prepare(provider.name(), out.key);
+  // Two runs may share a work folder (two validations into one --out): the second waits for the
+  // first's render there, and may then find it in the cache.
+  const WorkFolderLock lock(request.work_dir, provider.name());
+  if (use_cache && lock.waited())
+    if (auto hit = cache->load(provider.name(), out.key)) {
+      out.render = std::move(*hit);
+      out.cached = true;
+      return out;
+    }
   out.render = provider.render(request);
+  // A radiance no renderer gives is the tool's failure; it is never stored for later runs.
+  if (const auto bad = unusable_samples(out.render.right))
+    throw ToolError(fmt::format("the '{}' ground truth ({}) has {}; it was not stored in the cache. Look at the "
+                                "tool's output in {}",
+                                provider.name(), out.render.tool_version, *bad, request.work_dir.string()));
   if (use_cache) cache->store(out.key, out.render);
   return out;
 }

@@ -25,16 +25,22 @@ class TruthCache {
   [[nodiscard]] std::filesystem::path image_path(const std::string& provider, const std::string& key) const;
 
   /// The cached render, or nothing when absent. An entry whose image no longer matches its
-  /// recorded hash (edited, truncated) counts as absent and is overwritten by the next store().
+  /// recorded hash (edited, truncated), whose record names another key or provider (copied by
+  /// hand), or whose samples are unusable counts as absent and is overwritten by the next store().
   [[nodiscard]] std::optional<TruthRender> load(const std::string& provider, const std::string& key) const;
   void store(const std::string& key, const TruthRender& render) const;
-  /// Makes the provider's folder and checks that it can be written: called before a render, so
-  /// that an unusable cache fails before the external tool runs, not after. IoError naming it.
-  void prepare(const std::string& provider) const;
+  /// Makes the provider's folder and checks that it can be written and that the entry of `key`
+  /// can be stored there: called before a render, so that an unusable cache fails before the
+  /// external tool runs, not after. IoError naming it.
+  void prepare(const std::string& provider, const std::string& key) const;
 
  private:
   std::filesystem::path dir_;
 };
+
+/// Why a ground-truth image cannot be used (NaN, infinite or negative radiance, counted), or
+/// nothing when every sample is a radiance.
+[[nodiscard]] std::optional<std::string> unusable_samples(const Image& truth);
 
 /// A ground-truth render and where it came from.
 struct ResolvedTruth {
@@ -45,7 +51,9 @@ struct ResolvedTruth {
 
 /// Renders the request with the provider, through the cache when one is given. The `full`
 /// provider is never cached: it is this suite's own renderer, as fast as a pipeline, and must
-/// follow every change to it. ToolError when the provider is unavailable.
+/// follow every change to it. An external render runs under an exclusive lock on the request's
+/// work folder (runs that share one take turns). ToolError when the provider is unavailable or
+/// its image has NaN, infinite or negative samples (which are not stored).
 [[nodiscard]] ResolvedTruth resolve_truth(const TruthProvider& provider, const TruthRequest& request,
                                           const TruthCache* cache);
 

@@ -3,7 +3,12 @@
 // provider is never cached.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <fstream>
+#include <limits>
+#include <optional>
+#include <thread>
 
 #include "renderer/error.hpp"
 #include "renderer/stages/eye_image.hpp"
@@ -35,6 +40,7 @@ class CountingProvider final : public TruthProvider {
     r.right = make_eye_image(request.rig.params().width, request.rig.params().height);
     for (int y = 0; y < r.right.height(); ++y)
       for (int x = 0; x < r.right.width(); ++x) r.right.set_rgb(x, y, {0.25f, 0.5f, float(x) / 64.0f});
+    if (bad_sample) r.right.set_rgb(1, 1, {*bad_sample, 0.5f, 0.5f});
     r.settings = {{"constant", true}};
     r.command = "counting --render";
     r.seconds = 0.5;
@@ -42,6 +48,7 @@ class CountingProvider final : public TruthProvider {
   }
   mutable int renders = 0;
   std::string revision_ = "r1";
+  std::optional<float> bad_sample;  ///< a value the render puts in one sample (NaN, inf, negative)
 
  private:
   std::string name_;
@@ -125,6 +132,118 @@ TEST(TruthCache, DamagedEntryIsRenderedAgain) {
   EXPECT_FALSE(again.cached);
   EXPECT_EQ(provider.renders, 2);
   EXPECT_TRUE(resolve_truth(provider, request, &cache).cached);
+}
+
+TEST(TruthCache, AnEntryMadeForAnotherRequestIsNoHit) {
+  // An entry copied by hand under another key, or from another provider's folder, is rendered
+  // again instead of being passed off as this request's truth.
+  test::ScratchDir dir;
+  const Scene scene = test::load_builtin("box-wall");
+  const RenderScene prepared(scene);
+  const TruthCache cache(dir / "cache");
+  CountingProvider provider;
+  const TruthRequest small{prepared, scene.path, test::rig_at(scene, 64, 36), dir / "work", 1};
+  const TruthRequest large{prepared, scene.path, test::rig_at(scene, 96, 54), dir / "work", 1};
+  const std::string small_key = resolve_truth(provider, small, &cache).key;
+  const std::string large_key = truth_key(provider, large);
+  const auto json_of = [](std::filesystem::path exr) { return exr.replace_extension(".json"); };
+  std::filesystem::copy_file(cache.image_path("counting", small_key), cache.image_path("counting", large_key));
+  std::filesystem::copy_file(json_of(cache.image_path("counting", small_key)),
+                             json_of(cache.image_path("counting", large_key)));
+  const ResolvedTruth large_truth = resolve_truth(provider, large, &cache);
+  EXPECT_FALSE(large_truth.cached);
+  EXPECT_EQ(large_truth.render.right.width(), 96);
+  EXPECT_EQ(provider.renders, 2);
+
+  CountingProvider other("other");
+  const std::string other_key = truth_key(other, small);
+  std::filesystem::create_directories(dir / "cache" / "other");
+  std::filesystem::copy_file(cache.image_path("counting", small_key), cache.image_path("other", other_key));
+  std::filesystem::copy_file(json_of(cache.image_path("counting", small_key)),
+                             json_of(cache.image_path("other", other_key)));
+  EXPECT_FALSE(resolve_truth(other, small, &cache).cached);
+  EXPECT_EQ(other.renders, 1);
+}
+
+/// A provider that leaves a file in the work folder, waits, and reads it back, as an external tool
+/// writes its passes and then reads them: another render in the same folder meanwhile would swap
+/// them.
+class WorkFileProvider final : public TruthProvider {
+ public:
+  std::string name() const override { return "workfile"; }
+  std::string description() const override { return "test provider"; }
+  std::optional<std::string> unavailable_reason() const override { return std::nullopt; }
+  std::string tool_version() const override { return "workfile 1.0"; }
+  std::string revision() const override { return "r1"; }
+  TruthRender render(const TruthRequest& request) const override {
+    const std::string mine = std::to_string(request.rig.params().width);
+    { std::ofstream(request.work_dir / "pass.txt") << mine; }
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    std::string read;
+    std::ifstream(request.work_dir / "pass.txt") >> read;
+    if (read != mine) swapped = true;
+    TruthRender r;
+    r.provider = name();
+    r.tool_version = tool_version();
+    r.right = make_eye_image(request.rig.params().width, request.rig.params().height);
+    return r;
+  }
+  mutable std::atomic<bool> swapped{false};
+};
+
+TEST(TruthCache, RunsSharingAWorkFolderTakeTurns) {
+  test::ScratchDir dir;
+  const Scene scene = test::load_builtin("box-wall");
+  const RenderScene prepared(scene);
+  const TruthCache cache(dir / "cache");
+  WorkFileProvider provider;
+  const TruthRequest a{prepared, scene.path, test::rig_at(scene, 64, 36), dir / "work", 1};
+  const TruthRequest b{prepared, scene.path, test::rig_at(scene, 96, 54), dir / "work", 1};
+  std::thread other([&] { (void)resolve_truth(provider, b, &cache); });
+  const ResolvedTruth mine = resolve_truth(provider, a, &cache);
+  other.join();
+  EXPECT_FALSE(provider.swapped) << "two renders used the work folder at once";
+  EXPECT_EQ(mine.render.right.width(), 64);
+}
+
+TEST(TruthCache, AnImageWithNoRadianceInItIsAToolErrorAndIsNotStored) {
+  test::ScratchDir dir;
+  const Scene scene = test::load_builtin("box-wall");
+  const RenderScene prepared(scene);
+  const TruthCache cache(dir / "cache");
+  const TruthRequest request{prepared, scene.path, test::rig_at(scene, 64, 36), dir / "work", 1};
+  for (const float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(), -0.5f}) {
+    CountingProvider provider;
+    provider.bad_sample = bad;
+    try {
+      (void)resolve_truth(provider, request, &cache);
+      ADD_FAILURE() << bad << " passed";
+    } catch (const ToolError& e) {
+      EXPECT_NE(std::string(e.what()).find("it was not stored in the cache"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(std::filesystem::exists(cache.image_path("counting", truth_key(provider, request)))) << bad;
+  }
+  // The tool mended: rendered and stored.
+  CountingProvider provider;
+  EXPECT_FALSE(resolve_truth(provider, request, &cache).cached);
+  EXPECT_TRUE(resolve_truth(provider, request, &cache).cached);
+}
+
+TEST(TruthCache, AFolderInPlaceOfTheEntryFailsBeforeTheProviderRenders) {
+  test::ScratchDir dir;
+  const Scene scene = test::load_builtin("box-wall");
+  const RenderScene prepared(scene);
+  const TruthCache cache(dir / "cache");
+  CountingProvider provider;
+  const TruthRequest request{prepared, scene.path, test::rig_at(scene, 64, 36), dir / "work", 1};
+  std::filesystem::create_directories(cache.image_path("counting", truth_key(provider, request)));
+  try {
+    (void)resolve_truth(provider, request, &cache);
+    ADD_FAILURE() << "a folder in place of the entry must fail";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("is a folder; remove it"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(provider.renders, 0);
 }
 
 TEST(TruthCache, AnUnusableCacheFailsBeforeTheProviderRenders) {
