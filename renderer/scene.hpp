@@ -109,6 +109,9 @@ struct Scene {
   vec3 background{0.0f};      ///< radiance of rays that miss (scene extras)
   float ambient = 0.0f;       ///< ambient term of DESIGN §3 (scene extras)
   std::vector<std::string> warnings;  ///< unsupported features, each named once
+  /// Nodes of the file with a mesh or light that the loaded glTF scene does not reach (those of
+  /// another scene, or of none): not part of this scene.
+  size_t nodes_not_loaded = 0;
 
   [[nodiscard]] size_t triangle_count() const;
   /// Triangles of zero area (Mesh::zero_area); one pass over every triangle.

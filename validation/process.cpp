@@ -13,11 +13,15 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <sstream>
+#include <deque>
+#include <mutex>
 #include <string_view>
 
 #include <fmt/format.h>
@@ -54,7 +58,41 @@ void open_pipe(io::UniqueFd& read_end, io::UniqueFd& write_end, const std::strin
   }
 }
 
-/// The spawned child until it is reaped: an exception kills its group and reaps it.
+/// The process groups of the children running now, one per slot (0: free), for the handler
+/// below: a stereobench stopped by Ctrl-C, `kill` or a Slurm job's end takes its tools with it
+/// instead of leaving Blender or POV-Ray rendering into a work folder no one reads.
+std::array<std::atomic<pid_t>, 256> g_running{};
+static_assert(std::atomic<pid_t>::is_always_lock_free, "the signal handler needs lock-free slots");
+
+/// SIGINT, SIGTERM, SIGHUP, SIGQUIT: kill every running child's group, then end as the signal's
+/// default action would (the exit status still says which signal it was). Async-signal-safe.
+extern "C" void stop_children_and_end(int sig) {
+  for (std::atomic<pid_t>& slot : g_running)
+    if (const pid_t group = slot.load(); group > 0) ::kill(-group, SIGKILL);
+  ::signal(sig, SIG_DFL);
+  ::raise(sig);  // delivered when the handler returns
+}
+
+/// Installs stop_children_and_end, once, for the signals whose action is still the default (an
+/// ignored one stays ignored, as under nohup; another handler stays).
+void install_stop_handler() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    for (const int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) {
+      struct sigaction current {};
+      if (::sigaction(sig, nullptr, &current) != 0 || (current.sa_flags & SA_SIGINFO) != 0 ||
+          current.sa_handler != SIG_DFL)
+        continue;
+      struct sigaction stop {};
+      stop.sa_handler = stop_children_and_end;
+      sigemptyset(&stop.sa_mask);
+      ::sigaction(sig, &stop, nullptr);
+    }
+  });
+}
+
+/// The spawned child until it is reaped: an exception kills its group and reaps it. While it
+/// runs, its group is listed for stop_children_and_end.
 class ChildGuard {
  public:
   ChildGuard() = default;
@@ -66,7 +104,29 @@ class ChildGuard {
     int status = 0;
     while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
     }
+    forget();
   }
+  /// Takes charge of the child `pid`, the leader of its own process group.
+  void adopt(pid_t pid) {
+    pid_ = pid;
+    for (std::atomic<pid_t>& slot : g_running) {
+      pid_t free = 0;
+      if (slot.compare_exchange_strong(free, pid)) return;
+    }
+  }
+  /// The child is reaped (or lost): it is no longer listed.
+  void forget() {
+    const int saved = errno;
+    for (std::atomic<pid_t>& slot : g_running) {
+      pid_t mine = pid_;
+      if (mine > 0 && slot.compare_exchange_strong(mine, 0)) break;
+    }
+    pid_ = -1;
+    errno = saved;
+  }
+  [[nodiscard]] pid_t pid() const { return pid_; }
+
+ private:
   pid_t pid_ = -1;  ///< the child (and its process group), -1 once reaped
 };
 
@@ -116,10 +176,10 @@ bool is_executable_file(const fs::path& p) {
 bool has_ended(ChildGuard& child, const std::string& program) {
   siginfo_t info{};
   info.si_pid = 0;
-  if (::waitid(P_PID, static_cast<id_t>(child.pid_), &info, WEXITED | WNOHANG | WNOWAIT) != 0) {
+  if (::waitid(P_PID, static_cast<id_t>(child.pid()), &info, WEXITED | WNOHANG | WNOWAIT) != 0) {
     if (errno == EINTR) return false;
-    const pid_t pid = child.pid_;
-    child.pid_ = -1;
+    const pid_t pid = child.pid();
+    child.forget();
     throw ToolError(fmt::format("lost track of {} (pid {}): {}", program, pid, std::strerror(errno)));
   }
   return info.si_pid != 0;
@@ -228,6 +288,7 @@ ProcessResult run_process(const std::vector<std::string>& argv, const ProcessOpt
   const std::string cwd = options.cwd.string();
   if (!cwd.empty()) posix_spawn_file_actions_addchdir_np(fa, cwd.c_str());
 
+  install_stop_handler();
   ChildGuard child;
   const Clock::time_point start = Clock::now();
   pid_t pid = 0;
@@ -235,7 +296,7 @@ ProcessResult run_process(const std::vector<std::string>& argv, const ProcessOpt
   if (spawn_error != 0)
     throw ToolError(fmt::format("cannot start '{}'{}: {}", executable.string(),
                                 cwd.empty() ? "" : fmt::format(" in '{}'", cwd), std::strerror(spawn_error)));
-  child.pid_ = pid;
+  child.adopt(pid);
   for (io::UniqueFd& w : write_ends) w.reset();  // the child holds its own copies: EOF comes when it closes them
   const io::UniqueFd pid_fd(open_pid_fd(pid));
 
@@ -307,11 +368,11 @@ ProcessResult run_process(const std::vector<std::string>& argv, const ProcessOpt
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0) {
     if (errno != EINTR) {
-      child.pid_ = -1;
+      child.forget();
       throw ToolError(fmt::format("lost track of {} (pid {}): {}", program, pid, std::strerror(errno)));
     }
   }
-  child.pid_ = -1;
+  child.forget();
   result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   if (WIFEXITED(status)) {
     result.exit_code = WEXITSTATUS(status);
@@ -351,6 +412,20 @@ std::string format_limit(std::chrono::milliseconds limit) {
   if (ms % 60'000 == 0 && ms >= 60'000) return fmt::format("{} min", ms / 60'000);
   if (ms % 1000 == 0) return fmt::format("{} s", ms / 1000);
   return fmt::format("{:g} s", static_cast<double>(ms) / 1000.0);
+}
+
+std::string quoted_output(const std::string& text, std::size_t count) {
+  std::deque<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.find_first_not_of(" \t") == std::string::npos) continue;
+    lines.push_back(line);
+    if (lines.size() > count) lines.pop_front();
+  }
+  std::string out;
+  for (const std::string& l : lines) out += "\n  | " + l;
+  return out.empty() ? "\n  | (no output)" : out;
 }
 
 }  // namespace sb::validation

@@ -61,6 +61,10 @@ struct ProcessResult {
 /// regular file `<dir>/<name>` along $PATH (empty entries are skipped); nullopt when none.
 [[nodiscard]] std::optional<std::filesystem::path> find_program(const std::string& name);
 
+/// The last `count` non-empty lines of a tool's output, each on a line of its own as "  | LINE",
+/// for quoting at the end of a message ("  | (no output)" when it printed nothing).
+[[nodiscard]] std::string quoted_output(const std::string& text, std::size_t count);
+
 /// The environment variable that sets the time limit of one external ground-truth render.
 inline constexpr const char* kToolTimeoutVariable = "STEREOBENCH_TOOL_TIMEOUT";
 /// The limit without it: 30 minutes. Renders take seconds (Blender 3-24 s, POV-Ray 1-10 s at

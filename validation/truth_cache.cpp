@@ -6,6 +6,8 @@
 
 #include <cerrno>
 #include <cmath>
+#include <mutex>
+#include <set>
 
 #include <fmt/format.h>
 
@@ -47,6 +49,27 @@ class WorkFolderLock {
   io::UniqueFd fd_;
   bool waited_ = false;
 };
+
+/// Says once per scene file and provider, on standard error, that an external tool shows what
+/// this suite's renderer culls: glTF's single-sided materials (doubleSided false, the default)
+/// hide their back faces from camera rays here, while Cycles and POV-Ray draw both sides.
+void note_single_sided(const Scene& scene, const std::string& provider) {
+  if (provider == "full") return;
+  size_t meshes = 0;
+  for (const Mesh& m : scene.meshes)
+    if (m.material >= 0 && !scene.materials[static_cast<size_t>(m.material)].double_sided && m.triangle_count() > 0)
+      ++meshes;
+  if (meshes == 0) return;
+  static std::mutex mutex;
+  static std::set<std::string> said;
+  const std::lock_guard lock(mutex);
+  if (!said.insert(scene.path + "\n" + provider).second) return;
+  fmt::print(stderr,
+             "stereobench: warning: {} mesh(es) of {} use single-sided materials: this suite's renderer hides their "
+             "back faces from the eye, as glTF asks, while the {} ground truth shows them; where an eye sees one, "
+             "the images differ for that reason (mark the materials doubleSided to compare like with like)\n",
+             meshes, scene.path, provider);
+}
 
 }  // namespace
 
@@ -149,6 +172,7 @@ void TruthCache::store(const std::string& key, const TruthRender& render) const 
 ResolvedTruth resolve_truth(const TruthProvider& provider, const TruthRequest& request, const TruthCache* cache) {
   if (auto why = provider.unavailable_reason())
     throw ToolError(fmt::format("ground-truth provider '{}' is unavailable: {}", provider.name(), *why));
+  note_single_sided(request.scene.scene(), provider.name());
   ResolvedTruth out;
   const bool use_cache = cache != nullptr && provider.name() != "full";
   if (use_cache) {

@@ -664,6 +664,14 @@ class Converter {
                    fmt::format("loading {}: {} triangles, {} vertices", file_, triangles, vertices),
                    "use a smaller scene, check the accessors' counts, or run on a machine with more memory");
     for (const Item& item : order) visit(scene, item.node, item.world);
+    // Nodes with meshes or lights that the loaded scene does not reach: in another glTF scene, or
+    // in none. They are not rendered here; a tool that imports the file whole would show them.
+    for (size_t i = 0; i < m_.nodes.size(); ++i)
+      if (!visited[i] && (m_.nodes[i].mesh >= 0 || m_.nodes[i].extensions.count("KHR_lights_punctual") > 0))
+        ++scene.nodes_not_loaded;
+    if (scene.nodes_not_loaded > 0 && m_.scenes.size() <= 1)
+      warn("orphan-nodes", fmt::format("{} node(s) with a mesh or light are in no scene and are not loaded",
+                                       scene.nodes_not_loaded));
   }
 
   /// Whether a primitive's POSITION accessor has neither a bufferView nor sparse values: glTF

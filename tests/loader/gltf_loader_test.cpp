@@ -372,6 +372,32 @@ TEST(GltfLoader, UnsupportedFeaturesAreNamedOnce) {
   EXPECT_TRUE(counted);
 }
 
+TEST(GltfLoader, NodesOutsideTheLoadedSceneAreCounted) {
+  // A tool that imports the file whole (Blender) would render them; the loader says how many.
+  ScratchDir dir("outside");
+  MiniGltf g;
+  g.add_triangle();
+  const int p = g.add_positions({0, 0, 1, 1, 0, 1, 0, 1, 1});
+  const int m = g.add_mesh(json::array({{{"attributes", {{"POSITION", p}}}}}));
+  g.add_node({{"mesh", m}}, false);  // in no scene
+  g.add_node({{"name", "empty"}}, false);  // nothing to render: not counted
+  g.write_gltf(dir / "orphan.gltf");
+  const Scene orphan = io::load_gltf(dir / "orphan.gltf");
+  EXPECT_EQ(orphan.meshes.size(), 1u);
+  EXPECT_EQ(orphan.nodes_not_loaded, 1u);
+  EXPECT_NE(fmt::format("{}", fmt::join(orphan.warnings, "\n")).find("1 node(s) with a mesh or light are in no scene"),
+            std::string::npos);
+  // The same node in a second glTF scene.
+  g.doc["scenes"].push_back({{"nodes", {1}}});
+  g.write_gltf(dir / "two.gltf");
+  const Scene two = io::load_gltf(dir / "two.gltf");
+  EXPECT_EQ(two.nodes_not_loaded, 1u);
+  MiniGltf one;
+  one.add_triangle();
+  one.write_gltf(dir / "one.gltf");
+  EXPECT_EQ(io::load_gltf(dir / "one.gltf").nodes_not_loaded, 0u);
+}
+
 TEST(GltfLoader, AnUnlitSceneIsWarnedAbout) {
   const ScratchDir dir("unlit");
   const auto unlit_warning = [&](const std::function<void(MiniGltf&)>& edit) -> std::string {

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
-#include <deque>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -48,20 +47,6 @@ constexpr double kClipEnd = 1e9;
 /// Lines of Blender's output quoted in an error message.
 constexpr size_t kQuotedLines = 25;
 
-/// The last `count` lines of a text, indented for an error message.
-std::string last_lines(const std::string& text, size_t count) {
-  std::deque<std::string> lines;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    lines.push_back(line);
-    if (lines.size() > count) lines.pop_front();
-  }
-  std::string out;
-  for (const std::string& l : lines) out += "\n  | " + l;
-  return out.empty() ? "\n  | (no output)" : out;
-}
-
 /// Where the Blender executable is, or why it cannot be found.
 struct Located {
   fs::path executable;
@@ -86,16 +71,28 @@ Located locate_blender() {
                           name, origin, kExecutableVariable)};
 }
 
+/// How Blender runs: its output merged, and its Python kept to the system's. Blender looks for a
+/// Python executable on PATH and takes its prefix, so an activated virtual environment or pyenv
+/// shim would replace the modules its glTF importer needs (numpy); PYTHON* variables would do the
+/// same. The child gets the system PATH and none of them.
+ProcessOptions blender_options(std::chrono::milliseconds timeout) {
+  ProcessOptions options;
+  options.stderr_to = ChildOutput::to_stdout;
+  options.timeout = timeout;
+  options.set_env = {{"PATH", "/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin"}};
+  options.unset_env = {"VIRTUAL_ENV", "PYTHONHOME", "PYTHONPATH", "PYTHONSTARTUP", "PYTHONUSERBASE",
+                       "PYTHONSAFEPATH", "CONDA_PREFIX", "PYENV_VERSION"};
+  return options;
+}
+
 /// The first line of `blender --version`, e.g. "Blender 3.4.1", cached per executable.
 std::string query_version(const fs::path& executable) {
   static std::mutex mutex;
   static std::map<std::string, std::string> cache;
   const std::lock_guard lock(mutex);
   if (auto it = cache.find(executable.string()); it != cache.end()) return it->second;
-  ProcessOptions options;
-  options.stderr_to = ChildOutput::to_stdout;
-  options.timeout = kShortCommandTimeout;
-  const ProcessResult r = run_process({executable.string(), "--factory-startup", "--version"}, options);
+  const ProcessResult r =
+      run_process({executable.string(), "--factory-startup", "--version"}, blender_options(kShortCommandTimeout));
   std::istringstream in(r.out);
   std::string version;
   for (std::string line; std::getline(in, line);) {
@@ -114,7 +111,7 @@ std::string query_version(const fs::path& executable) {
                           kExecutableVariable, configured, kExecutableVariable)
             : std::string("check the Blender installation (`ci/install-deps.sh blender`)");
     throw ToolError(fmt::format("'{} --version' failed (it {}){}; {}", executable.string(), r.describe(),
-                                last_lines(r.out, kQuotedLines), remedy));
+                                quoted_output(r.out, kQuotedLines), remedy));
   }
   cache.emplace(executable.string(), version);
   return version;
@@ -133,8 +130,8 @@ nlohmann::json export_lights(const Scene& scene) {
     if (l.type == Light::Type::spot)
       throw InputError(fmt::format(
           "scene {}: spot light {} cannot be exported to Blender: Cycles' spot cone (cosine times smoothstep) "
-          "differs from the KHR_lights_punctual falloff of DESIGN §3; use the `full` or `povray` provider, or "
-          "replace the spot by a point light",
+          "differs from the KHR_lights_punctual falloff of DESIGN §3; use the `full` provider (POV-Ray refuses "
+          "spots too), or replace the spot by a point light",
           scene.path, label));
     const float max_colour = std::max({l.color.x, l.color.y, l.color.z});
     const float min_colour = std::min({l.color.x, l.color.y, l.color.z});
@@ -263,6 +260,14 @@ class BlenderProvider final : public TruthProvider {
       throw InputError(fmt::format("the blender provider imports the scene's glTF file, but '{}' is not a file; "
                                    "render a scene loaded from a .gltf/.glb file",
                                    request.scene_file.string()));
+    // Blender's importer brings in every node of the file; the loaded scene is glTF scene 0 (or
+    // `scene`) alone.
+    if (scene.nodes_not_loaded > 0)
+      throw InputError(fmt::format("the blender provider imports the whole of {}, which has {} node(s) with a mesh "
+                                   "or light outside the scene that is loaded (in another glTF scene, or in none); "
+                                   "Blender would render them too. Remove them from the file, or use the full or "
+                                   "povray provider",
+                                   request.scene_file.string(), scene.nodes_not_loaded));
     std::error_code ec;
     fs::create_directories(request.work_dir, ec);
     if (ec)
@@ -332,22 +337,19 @@ class BlenderProvider final : public TruthProvider {
     text += blender_script_body();
     io::write_text_atomically(script, text);
 
-    ProcessOptions options;
-    options.stderr_to = ChildOutput::to_stdout;
-    options.timeout = limit;
-    const ProcessResult run = run_process(argv, options);
+    const ProcessResult run = run_process(argv, blender_options(limit));
     const fs::path log = work_dir / "blender_output.txt";
     io::write_text_atomically(log, run.out);
     if (run.timed_out)
       throw ToolError(fmt::format("{} did not finish rendering {} within {} and was stopped; {}; the script is kept "
                                   "in {} and the output so far in {}; last lines of the output:{}",
                                   version, request.scene_file.string(), format_limit(limit), tool_timeout_hint(),
-                                  script.string(), log.string(), last_lines(run.out, kQuotedLines)));
+                                  script.string(), log.string(), quoted_output(run.out, kQuotedLines)));
     if (!run.ok())
       throw ToolError(fmt::format("{} {} rendering {}; the script is kept in {} and the full output in {}; "
                                   "last lines of the output:{}",
                                   version, run.describe(), request.scene_file.string(), script.string(), log.string(),
-                                  last_lines(run.out, kQuotedLines)));
+                                  quoted_output(run.out, kQuotedLines)));
 
     // Sum the passes in light order (the order in which our shading adds the lights).
     TruthRender out;
@@ -361,8 +363,17 @@ class BlenderProvider final : public TruthProvider {
         throw ToolError(fmt::format("{} exited normally but wrote no image {}; the script is kept in {}, its "
                                     "output in {}{}",
                                     version, passes[k].string(), script.string(), log.string(),
-                                    last_lines(run.out, kQuotedLines)));
-      const Image pass = io::read_exr(passes[k]);
+                                    quoted_output(run.out, kQuotedLines)));
+      const Image pass = [&] {
+        try {
+          return io::read_exr(passes[k]);
+        } catch (const Error& e) {
+          throw ToolError(fmt::format("{} wrote {} but it cannot be read ({}); the script is kept in {}, its output in "
+                                      "{}{}",
+                                      version, passes[k].string(), e.what(), script.string(), log.string(),
+                                      quoted_output(run.out, kQuotedLines)));
+        }
+      }();
       if (pass.width() != eye.width || pass.height() != eye.height || !pass.has_plane(planes::rgb))
         throw ToolError(fmt::format("{} wrote {} as {}x{} with planes [{}]; expected {}x{} with rgb", version,
                                     passes[k].string(), pass.width(), pass.height(), pass.plane_list(), eye.width,

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
-#include <deque>
 #include <fstream>
 #include <mutex>
 #include <regex>
@@ -68,21 +67,6 @@ std::string quoted(const Command& c) {
   for (const auto& [k, v] : c.options.set_env) out += k + "=" + q(v) + " ";
   out += q(c.executable.string());
   for (const std::string& a : c.args) out += " " + q(a);
-  return out;
-}
-
-/// The last `n` non-empty lines of a text, each indented, for quoting in a message.
-std::string last_lines(const std::string& text, std::size_t n) {
-  std::deque<std::string> lines;
-  std::stringstream in(text);
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    lines.push_back(line);
-    if (lines.size() > n) lines.pop_front();
-  }
-  std::string out;
-  for (const std::string& l : lines) out += "\n    " + l;
   return out;
 }
 
@@ -202,7 +186,7 @@ class PovrayProvider final : public TruthProvider {
           "POV-Ray did not finish rendering '{}' within {} and was stopped; {}; the scene file is kept there, rerun "
           "it with: {}\nlast lines of its output ({}):{}",
           exported.sdl_file.string(), format_limit(limit), tool_timeout_hint(), quoted(cmd), log_file.string(),
-          last_lines(log, kQuotedLines)));
+          quoted_output(log, kQuotedLines)));
     const bool have_image = std::filesystem::is_regular_file(image_file, ec);
     if (!run.ok() || !have_image) {
       std::string failure = "no image written";
@@ -213,7 +197,7 @@ class PovrayProvider final : public TruthProvider {
       throw ToolError(fmt::format(
           "POV-Ray failed ({}) rendering '{}'; the scene file is kept there, rerun it with: {}\nlast lines of its "
           "output ({}):{}",
-          failure, exported.sdl_file.string(), quoted(cmd), log_file.string(), last_lines(log, kQuotedLines)));
+          failure, exported.sdl_file.string(), quoted(cmd), log_file.string(), quoted_output(log, kQuotedLines)));
     }
 
     Image raw;
@@ -291,8 +275,8 @@ class PovrayProvider final : public TruthProvider {
       static const std::regex version_line(R"(POV-Ray (\d+)\.(\d+)(\.\d+)*\S*)");
       std::smatch m;
       if (!std::regex_search(result.out, m, version_line)) {
-        reason_ = fmt::format("'{} --version' did not report a POV-Ray version (it {});{} {}", exe->string(),
-                              result.describe(), last_lines(result.out, 5), kInstallHint);
+        reason_ = fmt::format("'{} --version' did not report a POV-Ray version (it {}); {}; its output:{}",
+                              exe->string(), result.describe(), kInstallHint, quoted_output(result.out, 5));
         return;
       }
       info_.banner = m.str(0);
