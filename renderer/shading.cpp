@@ -109,6 +109,14 @@ float derivative_lod(const RenderScene& scene, const SurfacePoint& p, const vec4
   return lod_from_derivatives(duv, mt.width(), mt.height());
 }
 
+namespace {
+
+/// |n . l| below which a light counts as lying in a triangle's plane: a few hundred times the
+/// rounding of a dot product of unit float vectors (~2e-7), about 0.0006 degrees.
+constexpr float kInPlane = 1e-5f;
+
+}  // namespace
+
 void shade(const RenderScene& scene, std::span<const SurfacePoint> points, std::span<const vec3> albedo,
            std::span<vec3> radiance, ShadeCounts& counts) {
   const Scene& s = scene.scene();
@@ -148,8 +156,11 @@ void shade(const RenderScene& scene, std::span<const SurfacePoint> points, std::
       }
       const float cos_l = glm::dot(p.shading_normal, l);
       if (cos_l <= 0.0f || e <= 0.0f) continue;
-      // Offset the shadow-ray origin to the side of the geometric normal the light is on.
-      const float side = glm::dot(p.geometric_normal, l) >= 0.0f ? 1.0f : -1.0f;
+      // Offset the shadow-ray origin to the side of the geometric normal the light is on. A light
+      // in the plane of the triangle (within kInPlane, the rounding of the dot product) counts as
+      // on the lit side the shading normal found: otherwise rounding would pick the side per
+      // pixel, and an origin pushed inside a closed mesh is shadowed by its far side (speckles).
+      const float side = glm::dot(p.geometric_normal, l) >= -kInPlane ? 1.0f : -1.0f;
       RayQuery& q = rays[active];
       q.origin = p.position + (side * eps) * p.geometric_normal;
       q.dir = l;

@@ -8,6 +8,7 @@
 #include "renderer/scene_geometry.hpp"
 #include "renderer/stages/eye_image.hpp"
 #include "scenes/generators.hpp"
+#include "support/mini_gltf.hpp"
 #include "support/render_support.hpp"
 #include "support/scratch_dir.hpp"
 
@@ -167,6 +168,56 @@ TEST(Shading, BoxShadowBoundaryLiesWhereGeometrySays) {
                             << " of them more than one pixel from the boundary";
     std::printf("%s box shadow: %d shadowed floor pixels, %d boundary disagreements\n", pipeline.c_str(), shadowed, wrong);
   }
+}
+
+TEST(Shading, ALightInAFacesPlaneLightsItEvenly) {
+  // A smooth octahedron (vertex normals along the axes) whose face -x-y+z has the point light in
+  // its plane: the geometric normal is at right angles to the light, the shading normal turned to
+  // it. Rounding must not choose per pixel between an origin outside the mesh (lit) and one
+  // inside it (shadowed by the far faces): the face is shaded smoothly, with no dark speckles.
+  test::ScratchDir dir("inplane");
+  test::MiniGltf g;
+  const std::vector<float> dirs = {1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1};
+  std::vector<float> xyz;
+  for (size_t i = 0; i < dirs.size(); ++i) xyz.push_back(0.5f * dirs[i] + (i % 3 == 2 ? -4.0f : 0.0f));
+  const std::vector<uint32_t> faces = {0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5};
+  const int pos = g.add_positions(xyz);
+  const int nrm = g.add_accessor(g.add_view(dirs), 5126, 6, "VEC3");
+  const int idx = g.add_accessor(g.add_view(faces), 5125, faces.size(), "SCALAR");
+  g.doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.1, 0.1, 1}}, {"metallicFactor", 0}}},
+                         {"doubleSided", true}}};
+  g.add_node({{"mesh", g.add_mesh(nlohmann::json::array(
+                           {{{"attributes", {{"POSITION", pos}, {"NORMAL", nrm}}}, {"indices", idx}, {"material", 0}}}))}});
+  g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+  g.doc["extensions"] = {{"KHR_lights_punctual", {{"lights", {{{"type", "point"}, {"intensity", 20}}}}}}};
+  // In the face's plane -x - y + (z + 4) = 0.5.
+  g.add_node({{"translation", {0.5, 2, -1}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  g.write_gltf(dir / "octahedron.gltf");
+  const Scene scene = io::load_gltf(dir / "octahedron.gltf");
+  const RenderScene rs(scene);
+  const StereoRig rig = test::rig_at(scene, 200, 200);
+  const StereoResult r = test::render_with("plain-rt", rs, rig);
+  const int w = r.left.width(), h = r.left.height();
+  const uint32_t* prim = r.left.data_u32(planes::primid);
+  const float* rgb = r.left.data_f32(planes::rgb);
+  const uint32_t face = 2;  // triangle (1, 3, 4): the face -x-y+z
+  int pixels = 0, speckles = 0;
+  for (int y = 1; y + 1 < h; ++y)
+    for (int x = 1; x + 1 < w; ++x) {
+      const size_t i = static_cast<size_t>(y) * w + x;
+      if (prim[i] != face) continue;
+      ++pixels;
+      // A dark pixel whose four neighbours on the face are all lit.
+      int lit_neighbours = 0, on_face = 0;
+      for (const size_t j : {i - 1, i + 1, i - static_cast<size_t>(w), i + static_cast<size_t>(w)}) {
+        if (prim[j] != face) continue;
+        ++on_face;
+        lit_neighbours += rgb[3 * j] > 0.0f ? 1 : 0;
+      }
+      speckles += rgb[3 * i] == 0.0f && on_face == 4 && lit_neighbours == 4 ? 1 : 0;
+    }
+  EXPECT_GT(pixels, 500) << "the face should be in view";
+  EXPECT_EQ(speckles, 0) << "of " << pixels << " pixels of the face";
 }
 
 }  // namespace
