@@ -85,13 +85,23 @@ TEST(SceneHash, FollowsContentNotNames) {
   EXPECT_NE(hash_scene(a), hash_scene(d));
 }
 
-TEST(TruthCache, RendersOncePerContentAndKeysFollowTheRig) {
+/// A scratch folder, box-wall prepared for rendering, and a cache in the folder.
+class TruthCacheTest : public ::testing::Test {
+ protected:
   test::ScratchDir dir;
   const Scene scene = test::load_builtin("box-wall");
-  const RenderScene prepared(scene);
-  const TruthCache cache(dir / "cache");
+  const RenderScene prepared{scene};
+  const TruthCache cache{dir / "cache"};
+
+  /// A request for the right eye at width x height, working in dir/work.
+  [[nodiscard]] TruthRequest request_at(int width, int height) const {
+    return {prepared, scene.path, test::rig_at(scene, width, height), dir / "work", 1};
+  }
+};
+
+TEST_F(TruthCacheTest, RendersOncePerContentAndKeysFollowTheRig) {
   CountingProvider provider;
-  const TruthRequest request{prepared, scene.path, test::rig_at(scene, 64, 36), dir / "work", 1};
+  const TruthRequest request = request_at(64, 36);
 
   const ResolvedTruth first = resolve_truth(provider, request, &cache);
   EXPECT_FALSE(first.cached);
@@ -115,13 +125,9 @@ TEST(TruthCache, RendersOncePerContentAndKeysFollowTheRig) {
   EXPECT_NE(truth_key(provider, request), first.key) << "a new provider revision must not reuse old renders";
 }
 
-TEST(TruthCache, DamagedEntryIsRenderedAgain) {
-  test::ScratchDir dir;
-  const Scene scene = test::load_builtin("box-wall");
-  const RenderScene prepared(scene);
-  const TruthCache cache(dir / "cache");
+TEST_F(TruthCacheTest, DamagedEntryIsRenderedAgain) {
   CountingProvider provider;
-  const TruthRequest request{prepared, scene.path, test::rig_at(scene, 64, 36), dir / "work", 1};
+  const TruthRequest request = request_at(64, 36);
   const ResolvedTruth first = resolve_truth(provider, request, &cache);
   {
     std::fstream f(cache.image_path("counting", first.key), std::ios::in | std::ios::out | std::ios::binary);
@@ -134,16 +140,12 @@ TEST(TruthCache, DamagedEntryIsRenderedAgain) {
   EXPECT_TRUE(resolve_truth(provider, request, &cache).cached);
 }
 
-TEST(TruthCache, AnEntryMadeForAnotherRequestIsNoHit) {
+TEST_F(TruthCacheTest, AnEntryMadeForAnotherRequestIsNoHit) {
   // An entry copied by hand under another key, or from another provider's folder, is rendered
   // again instead of being passed off as this request's truth.
-  test::ScratchDir dir;
-  const Scene scene = test::load_builtin("box-wall");
-  const RenderScene prepared(scene);
-  const TruthCache cache(dir / "cache");
   CountingProvider provider;
-  const TruthRequest small{prepared, scene.path, test::rig_at(scene, 64, 36), dir / "work", 1};
-  const TruthRequest large{prepared, scene.path, test::rig_at(scene, 96, 54), dir / "work", 1};
+  const TruthRequest small = request_at(64, 36);
+  const TruthRequest large = request_at(96, 54);
   const std::string small_key = resolve_truth(provider, small, &cache).key;
   const std::string large_key = truth_key(provider, large);
   const auto json_of = [](std::filesystem::path exr) { return exr.replace_extension(".json"); };
@@ -191,14 +193,10 @@ class WorkFileProvider final : public TruthProvider {
   mutable std::atomic<bool> swapped{false};
 };
 
-TEST(TruthCache, RunsSharingAWorkFolderTakeTurns) {
-  test::ScratchDir dir;
-  const Scene scene = test::load_builtin("box-wall");
-  const RenderScene prepared(scene);
-  const TruthCache cache(dir / "cache");
+TEST_F(TruthCacheTest, RunsSharingAWorkFolderTakeTurns) {
   WorkFileProvider provider;
-  const TruthRequest a{prepared, scene.path, test::rig_at(scene, 64, 36), dir / "work", 1};
-  const TruthRequest b{prepared, scene.path, test::rig_at(scene, 96, 54), dir / "work", 1};
+  const TruthRequest a = request_at(64, 36);
+  const TruthRequest b = request_at(96, 54);
   std::thread other([&] { (void)resolve_truth(provider, b, &cache); });
   const ResolvedTruth mine = resolve_truth(provider, a, &cache);
   other.join();
@@ -206,12 +204,8 @@ TEST(TruthCache, RunsSharingAWorkFolderTakeTurns) {
   EXPECT_EQ(mine.render.right.width(), 64);
 }
 
-TEST(TruthCache, AnImageWithNoRadianceInItIsAToolErrorAndIsNotStored) {
-  test::ScratchDir dir;
-  const Scene scene = test::load_builtin("box-wall");
-  const RenderScene prepared(scene);
-  const TruthCache cache(dir / "cache");
-  const TruthRequest request{prepared, scene.path, test::rig_at(scene, 64, 36), dir / "work", 1};
+TEST_F(TruthCacheTest, AnImageWithNoRadianceInItIsAToolErrorAndIsNotStored) {
+  const TruthRequest request = request_at(64, 36);
   for (const float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(), -0.5f}) {
     CountingProvider provider;
     provider.bad_sample = bad;
@@ -229,13 +223,9 @@ TEST(TruthCache, AnImageWithNoRadianceInItIsAToolErrorAndIsNotStored) {
   EXPECT_TRUE(resolve_truth(provider, request, &cache).cached);
 }
 
-TEST(TruthCache, AFolderInPlaceOfTheEntryFailsBeforeTheProviderRenders) {
-  test::ScratchDir dir;
-  const Scene scene = test::load_builtin("box-wall");
-  const RenderScene prepared(scene);
-  const TruthCache cache(dir / "cache");
+TEST_F(TruthCacheTest, AFolderInPlaceOfTheEntryFailsBeforeTheProviderRenders) {
   CountingProvider provider;
-  const TruthRequest request{prepared, scene.path, test::rig_at(scene, 64, 36), dir / "work", 1};
+  const TruthRequest request = request_at(64, 36);
   std::filesystem::create_directories(cache.image_path("counting", truth_key(provider, request)));
   try {
     (void)resolve_truth(provider, request, &cache);
@@ -246,17 +236,14 @@ TEST(TruthCache, AFolderInPlaceOfTheEntryFailsBeforeTheProviderRenders) {
   EXPECT_EQ(provider.renders, 0);
 }
 
-TEST(TruthCache, AnUnusableCacheFailsBeforeTheProviderRenders) {
+TEST_F(TruthCacheTest, AnUnusableCacheFailsBeforeTheProviderRenders) {
   // A file where the cache folder should be: the external render would be lost when storing it.
-  test::ScratchDir dir;
   { std::ofstream(dir / "not-a-folder") << "x"; }
-  const Scene scene = test::load_builtin("box-wall");
-  const RenderScene prepared(scene);
-  const TruthCache cache(dir / "not-a-folder");
+  const TruthCache unusable(dir / "not-a-folder");
   CountingProvider provider;
-  const TruthRequest request{prepared, scene.path, test::rig_at(scene, 64, 36), dir / "work", 1};
+  const TruthRequest request = request_at(64, 36);
   try {
-    (void)resolve_truth(provider, request, &cache);
+    (void)resolve_truth(provider, request, &unusable);
     ADD_FAILURE() << "an unusable cache must fail";
   } catch (const IoError& e) {
     EXPECT_NE(std::string(e.what()).find("the ground-truth cache " + (dir / "not-a-folder").string() +
@@ -267,12 +254,8 @@ TEST(TruthCache, AnUnusableCacheFailsBeforeTheProviderRenders) {
   EXPECT_EQ(provider.renders, 0);
 }
 
-TEST(TruthCache, FullProviderIsNeverCachedAndUnavailableProviderIsAToolError) {
-  test::ScratchDir dir;
-  const Scene scene = test::load_builtin("box-wall");
-  const RenderScene prepared(scene);
-  const TruthCache cache(dir / "cache");
-  const TruthRequest request{prepared, scene.path, test::rig_at(scene, 64, 36), dir / "work", 1};
+TEST_F(TruthCacheTest, FullProviderIsNeverCachedAndUnavailableProviderIsAToolError) {
+  const TruthRequest request = request_at(64, 36);
   const auto full = make_truth_provider("full");
   EXPECT_FALSE(resolve_truth(*full, request, &cache).cached);
   EXPECT_FALSE(resolve_truth(*full, request, &cache).cached);
