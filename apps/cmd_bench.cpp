@@ -4,6 +4,9 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -56,7 +59,9 @@ BenchConfig bench_config(const BenchArgs& a, const std::vector<std::string>& def
   const std::vector<PipelineEntry> listed = parse_pipeline_entries(config.pipelines, "--pipelines");
   const PipelineEntry base = [&] {
     try {
-      return parse_pipeline_entry(a.baseline);
+      PipelineEntry entry = parse_pipeline_entry(a.baseline);
+      (void)entry.options();  // the options a variant fixes, checked here to be named as the baseline's
+      return entry;
     } catch (const InputError& e) {
       throw InputError(fmt::format("--baseline: {}", e.what()));
     }
@@ -171,6 +176,8 @@ void run_bench_command(const BenchArgs& a) {
     j["versions"] = io::versions_json();
     if (a.json_out == "-") {
       fmt::print(stdout, "{}\n", j.dump(2));
+      if (std::fflush(stdout) != 0 || std::ferror(stdout) != 0)
+        throw IoError(fmt::format("cannot write the JSON to standard output: {}", std::strerror(errno)));
     } else {
       io::write_text_atomically(a.json_out, j.dump(2) + "\n");
       fmt::print(out, "wrote {}\n", a.json_out);

@@ -160,7 +160,9 @@ void register_path_command(CLI::App& root) {
       "path",
       "Validate pipelines frame by frame along a camera path and/or a rigid animation: per frame the\n"
       "scene moves, its BVH is refit (or rebuilt) and timed, and every pipeline is rendered and\n"
-      "measured against the ground truth. Writes <out>/<scene>_path.jsonl (one line per frame).");
+      "measured against the ground truth. Writes <out>/<scene>_path.jsonl (one line per frame, each\n"
+      "naming its scene, rig, animation and truth; written to <scene>_path.jsonl.partial as frames\n"
+      "finish and renamed after the last).");
   p->add_option("--scene,-s", a->scene, "Scene file (.gltf/.glb) or built-in scene name")->capture_default_str();
   p->add_option("--pipelines,-p", a->pipelines,
                 "Pipelines to run each frame, comma-separated, 'all' for every registered one; a variant "
@@ -170,7 +172,7 @@ void register_path_command(CLI::App& root) {
   p->add_option("--frames,-n", a->frames, "Number of frames")->capture_default_str();
   p->add_option("--camera-keys", a->camera_keys,
                 "Camera key poses POSITION>TARGET;... in meters, e.g. '0,1.6,4>0,1,0;2,1.6,3>0,1,0';\n"
-                "the camera moves linearly between them over the frames (default: the scene's camera)");
+                "the camera moves linearly between them over the frames (without the option: the scene's camera)");
   CLI::Option* spin =
       p->add_option("--spin-deg", a->spin_deg, "Turn meshes by this many degrees per frame (rigid animation)");
   p->add_option("--spin-axis", a->spin_axis, "Axis of the turn, x,y,z")->capture_default_str()->needs(spin);

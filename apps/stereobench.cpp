@@ -1,4 +1,5 @@
 // stereobench: the command-line tool. Maps subcommands to library calls and errors to exit codes.
+#include <cctype>
 #include <cstdio>
 #include <exception>
 #include <regex>
@@ -73,9 +74,9 @@ void refuse_folder_as_file(CLI::App& app) {
 }
 
 /// Numeric options take decimal numbers only. The parser would also read C's other forms
-/// (0x10 as 16, 0b11, 0o17, digit separators), so a resolution or hash pasted into --vfov or
-/// --repetitions would run silently with another value. "inf" and "nan" pass on to the option's
-/// own range check, which names them.
+/// (0x10 as 16, 0b11, 0o17, 010 as octal 8, digit separators), so a resolution or hash pasted
+/// into --vfov or --repetitions would run silently with another value. Leading zeros are dropped
+/// (010 is ten). "inf" and "nan" pass on to the option's own range check, which names them.
 void refuse_non_decimal_numbers(CLI::App& app) {
   static const std::regex integer(R"([+-]?[0-9]+)");
   static const std::regex real(R"([+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?|[+-]?(inf|infinity|nan))",
@@ -84,11 +85,16 @@ void refuse_non_decimal_numbers(CLI::App& app) {
     const std::string type = option->get_type_name();
     const bool is_integer = type.starts_with("INT") || type.starts_with("UINT");
     if (!is_integer && !type.starts_with("FLOAT")) continue;
-    option->check(CLI::Validator(
-        [is_integer](const std::string& value) {
-          return std::regex_match(value, is_integer ? integer : real)
-                     ? std::string()
-                     : fmt::format("'{}' is not a decimal {}", value, is_integer ? "integer" : "number");
+    option->transform(CLI::Validator(
+        [is_integer](std::string& value) {
+          if (!std::regex_match(value, is_integer ? integer : real))
+            return fmt::format("'{}' is not a decimal {}", value, is_integer ? "integer" : "number");
+          const size_t digits = value.find_first_not_of("+-");
+          size_t zeros = digits;
+          while (zeros + 1 < value.size() && value[zeros] == '0' && std::isdigit(static_cast<unsigned char>(value[zeros + 1])))
+            ++zeros;
+          value.erase(digits, zeros - digits);
+          return std::string();
         },
         "", "decimal"));
   }

@@ -28,6 +28,7 @@
 #include "validation/content_hash.hpp"
 #include "validation/metric_images.hpp"
 #include "validation/truth.hpp"
+#include "validation/truth_cache.hpp"
 
 namespace sb::reference {
 
@@ -462,6 +463,7 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
     const RenderScene prepared(scene);
     const validation::TruthRequest request{prepared, p.loaded.file, *p.rig, staged / "work", executor.threads()};
     const validation::TruthRender render = provider->render(request);
+    validation::check_truth_samples(render, request.work_dir, false);  // never stored as a reference
     const Image right = validation::rgb_plane_only(render.right);
     io::write_exr(staged / kImage, right);
     validation::write_png(staged / kPreview, validation::encode_srgb8(right, "the reference"));
@@ -626,7 +628,9 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
   const validation::TruthRequest request{prepared, p.loaded.file, *p.rig, work, executor.threads()};
   Image fresh;
   try {
-    fresh = validation::rgb_plane_only(provider->render(request).right);
+    const validation::TruthRender render = provider->render(request);
+    validation::check_truth_samples(render, request.work_dir, false);
+    fresh = validation::rgb_plane_only(render.right);
   } catch (...) {
     fs::remove_all(work, ec);
     throw;

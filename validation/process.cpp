@@ -101,10 +101,11 @@ class ChildGuard {
   ~ChildGuard() {
     if (pid_ <= 0) return;
     ::kill(-pid_, SIGKILL);
+    unlist();
     int status = 0;
     while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
     }
-    forget();
+    pid_ = -1;
   }
   /// Takes charge of the child `pid`, the leader of its own process group.
   void adopt(pid_t pid) {
@@ -114,15 +115,20 @@ class ChildGuard {
       if (slot.compare_exchange_strong(free, pid)) return;
     }
   }
-  /// The child is reaped (or lost): it is no longer listed.
-  void forget() {
+  /// Takes the child off the list for stop_children_and_end, before it is reaped: once reaped,
+  /// its process group id may name another group.
+  void unlist() {
     const int saved = errno;
     for (std::atomic<pid_t>& slot : g_running) {
       pid_t mine = pid_;
       if (mine > 0 && slot.compare_exchange_strong(mine, 0)) break;
     }
-    pid_ = -1;
     errno = saved;
+  }
+  /// The child is lost (reaped by someone else): it is no longer listed or waited for.
+  void forget() {
+    unlist();
+    pid_ = -1;
   }
   [[nodiscard]] pid_t pid() const { return pid_; }
 
@@ -292,11 +298,18 @@ ProcessResult run_process(const std::vector<std::string>& argv, const ProcessOpt
   ChildGuard child;
   const Clock::time_point start = Clock::now();
   pid_t pid = 0;
+  // The stop signals wait while the child is made and listed: one in between would leave it
+  // running unlisted. (The child's own mask is set empty above.)
+  sigset_t stop_signals, before;
+  sigemptyset(&stop_signals);
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) sigaddset(&stop_signals, sig);
+  ::pthread_sigmask(SIG_BLOCK, &stop_signals, &before);
   const int spawn_error = ::posix_spawn(&pid, executable.c_str(), fa, &setup.attr, args.data(), envp.data());
+  if (spawn_error == 0) child.adopt(pid);
+  ::pthread_sigmask(SIG_SETMASK, &before, nullptr);
   if (spawn_error != 0)
     throw ToolError(fmt::format("cannot start '{}'{}: {}", executable.string(),
                                 cwd.empty() ? "" : fmt::format(" in '{}'", cwd), std::strerror(spawn_error)));
-  child.adopt(pid);
   for (io::UniqueFd& w : write_ends) w.reset();  // the child holds its own copies: EOF comes when it closes them
   const io::UniqueFd pid_fd(open_pid_fd(pid));
 
@@ -364,6 +377,7 @@ ProcessResult run_process(const std::vector<std::string>& argv, const ProcessOpt
 
   // Whatever the child left running in its group goes with it; then the zombie is reaped.
   ::kill(-pid, SIGKILL);
+  child.unlist();
   for (io::UniqueFd& r : read_ends) r.reset();
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0) {
@@ -391,7 +405,7 @@ std::chrono::milliseconds tool_timeout() {
   // At most ten years: beyond that the limit means nothing and milliseconds could overflow.
   constexpr double kMaxSeconds = 10.0 * 365 * 24 * 3600;
   if (end == value || *end != '\0' || errno != 0 || !std::isfinite(seconds) || seconds < 0.0 || seconds > kMaxSeconds ||
-      std::isspace(static_cast<unsigned char>(*value)))
+      std::isspace(static_cast<unsigned char>(*value)) || std::strpbrk(value, "xX") != nullptr)  // decimal only
     throw InputError(fmt::format("{}='{}' is not a time limit: give the seconds one external render may take (e.g. "
                                  "{}=3600), or 0 for no limit; unset it for the default of {}",
                                  kToolTimeoutVariable, value, kToolTimeoutVariable, format_limit(kDefaultToolTimeout)));

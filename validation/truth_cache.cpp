@@ -2,8 +2,8 @@
 #include "validation/truth_cache.hpp"
 
 #include <fcntl.h>
-#include <sys/file.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <mutex>
@@ -24,23 +24,30 @@ using nlohmann::json;
 
 namespace {
 
-/// An exclusive lock (flock) on the work folder an external tool renders in, held while it
-/// renders: two runs sharing the folder would read each other's passes. A run that finds it held
-/// says so and waits. Where locks are unavailable (ENOLCK), or the folder cannot be opened (the
-/// provider then reports it), nothing is held.
+/// An exclusive lock on the work folder an external tool renders in, held while it renders: two
+/// runs sharing the folder would read each other's passes. The lock is an open-file-description
+/// lock on ".stereobench-render.lock" in the folder (fcntl locks also hold on NFS, where a Slurm
+/// sweep's folders may lie). A run that finds it held says so and waits. Where locks are
+/// unavailable, or the lock file cannot be made (the provider then reports the folder), nothing is
+/// held.
 class WorkFolderLock {
  public:
   WorkFolderLock(const std::filesystem::path& dir, const std::string& provider) {
     if (dir.empty() || provider == "full") return;  // the built-in renderer writes no files
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
-    fd_.reset(::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
-    if (!fd_.valid() || ::flock(fd_.get(), LOCK_EX | LOCK_NB) == 0 || errno != EWOULDBLOCK) return;
+    fd_.reset(::open((dir / ".stereobench-render.lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644));
+    if (!fd_.valid()) return;
+    struct flock whole {};
+    whole.l_type = F_WRLCK;
+    whole.l_whence = SEEK_SET;
+    if (::fcntl(fd_.get(), F_OFD_SETLK, &whole) == 0 || (errno != EAGAIN && errno != EACCES)) return;
     fmt::print(stderr, "stereobench: another run is rendering a '{}' ground truth in {}; waiting for it\n", provider,
                dir.string());
-    while (::flock(fd_.get(), LOCK_EX) != 0 && errno == EINTR) {
+    int rc = 0;
+    while ((rc = ::fcntl(fd_.get(), F_OFD_SETLKW, &whole)) != 0 && errno == EINTR) {
     }
-    waited_ = true;
+    waited_ = rc == 0;
   }
   /// Whether another run held the folder first (its render may be the one wanted, now cached).
   [[nodiscard]] bool waited() const { return waited_; }
@@ -102,6 +109,26 @@ std::optional<std::string> unusable_samples(const Image& truth) {
   if (nan + inf + negative == 0) return std::nullopt;
   return fmt::format("{} NaN, {} infinite and {} negative sample(s) of {}", nan, inf, negative,
                      truth.pixel_count() * 3);
+}
+
+void check_truth_samples(const TruthRender& render, const std::filesystem::path& work_dir, bool caching) {
+  const Image& image = render.right;
+  const auto bad = unusable_samples(image);
+  if (!bad) return;
+  const std::string kept = caching ? "; it was not stored in the cache" : "";
+  const float* v = image.has_plane(planes::rgb) ? image.data_f32(planes::rgb) : nullptr;
+  const bool overflow = v != nullptr && std::any_of(v, v + image.pixel_count() * 3, [](float x) { return std::isinf(x); });
+  if (render.provider == "povray" && overflow)
+    throw InputError(fmt::format("the 'povray' ground truth has {}{}: POV-Ray writes half floats, whose largest value "
+                                 "is 65504, and the scene's lights make brighter pixels; scale the light intensities "
+                                 "down, or use the full or blender provider",
+                                 *bad, kept));
+  if (render.provider == "full")
+    throw ToolError(fmt::format("the 'full' ground truth has {}: this suite's renderer produced them; report it with "
+                                "the scene",
+                                *bad));
+  throw ToolError(fmt::format("the '{}' ground truth ({}) has {}{}; look at the tool's output in {}", render.provider,
+                              render.tool_version, *bad, kept, work_dir.string()));
 }
 
 std::filesystem::path TruthCache::image_path(const std::string& provider, const std::string& key) const {
@@ -194,11 +221,8 @@ ResolvedTruth resolve_truth(const TruthProvider& provider, const TruthRequest& r
       return out;
     }
   out.render = provider.render(request);
-  // A radiance no renderer gives is the tool's failure; it is never stored for later runs.
-  if (const auto bad = unusable_samples(out.render.right))
-    throw ToolError(fmt::format("the '{}' ground truth ({}) has {}; it was not stored in the cache. Look at the "
-                                "tool's output in {}",
-                                provider.name(), out.render.tool_version, *bad, request.work_dir.string()));
+  // A radiance no renderer gives is never stored for later runs.
+  check_truth_samples(out.render, request.work_dir, use_cache);
   if (use_cache) cache->store(out.key, out.render);
   return out;
 }

@@ -42,6 +42,11 @@ class TruthCache {
 /// nothing when every sample is a radiance.
 [[nodiscard]] std::optional<std::string> unusable_samples(const Image& truth);
 
+/// Throws when a fresh render's image cannot be used (unusable_samples): InputError for POV-Ray's
+/// half floats overflowing (lights too bright for it), ToolError otherwise, naming the tool's work
+/// folder and, when `caching`, that nothing was stored.
+void check_truth_samples(const TruthRender& render, const std::filesystem::path& work_dir, bool caching);
+
 /// A ground-truth render and where it came from.
 struct ResolvedTruth {
   TruthRender render;
@@ -52,8 +57,8 @@ struct ResolvedTruth {
 /// Renders the request with the provider, through the cache when one is given. The `full`
 /// provider is never cached: it is this suite's own renderer, as fast as a pipeline, and must
 /// follow every change to it. An external render runs under an exclusive lock on the request's
-/// work folder (runs that share one take turns). ToolError when the provider is unavailable or
-/// its image has NaN, infinite or negative samples (which are not stored).
+/// work folder (runs that share one take turns). ToolError when the provider is unavailable;
+/// check_truth_samples' errors for an image with NaN, infinite or negative samples (not stored).
 [[nodiscard]] ResolvedTruth resolve_truth(const TruthProvider& provider, const TruthRequest& request,
                                           const TruthCache* cache);
 

@@ -70,13 +70,15 @@ void remove_stale_temporaries(const fs::path& path) {
   for (fs::directory_iterator it(folder_of(path), ec), end; !ec && it != end; it.increment(ec)) {
     const TemporaryKind kind = temporary_kind(it->path().filename().string(), prefix);
     if (kind == TemporaryKind::none) continue;
-    const UniqueFd fd{::open(it->path().c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK)};
-    if (!fd.valid() || ::flock(fd.get(), LOCK_EX | LOCK_NB) != 0) continue;  // a running write, or not ours
     std::error_code ignored;
+    // A young staging file is not even opened: a lock taken here, between its writer's creation
+    // and its own flock, would make the writer's flock fail and leave its write unlocked.
     if (kind == TemporaryKind::staging) {
       const auto made = fs::last_write_time(it->path(), ignored);
       if (ignored || now - made < std::chrono::minutes(1)) continue;
     }
+    const UniqueFd fd{::open(it->path().c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK)};
+    if (!fd.valid() || ::flock(fd.get(), LOCK_EX | LOCK_NB) != 0) continue;  // a running write, or not ours
     fs::remove(it->path(), ignored);
   }
 }

@@ -2,6 +2,7 @@
 #include "renderer/io/line_file.hpp"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -10,16 +11,30 @@
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
 
 namespace sb::io {
 
 namespace fs = std::filesystem;
 
 LineFile::LineFile(fs::path partial) : path_(std::move(partial)) {
-  fd_.reset(::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
+  fd_.reset(::open(path_.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644));
   if (!fd_.valid())
     throw IoError(fmt::format("cannot write {}: {}; give a folder you can write, or make room there", path_.string(),
                               std::strerror(errno)));
+  if (::flock(fd_.get(), LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK) {
+    fd_.reset();
+    throw InputError(fmt::format("{} is being written by another run; wait for it to end, or give another --out",
+                                 path_.string()));
+  }
+  if (::ftruncate(fd_.get(), 0) != 0)
+    throw IoError(fmt::format("cannot empty {}: {}", path_.string(), std::strerror(errno)));
+}
+
+LineFile::~LineFile() {
+  if (finished_ || lines_ > 0) return;
+  std::error_code ignored;
+  fs::remove(path_, ignored);
 }
 
 void LineFile::append(const std::string& line) {
@@ -38,11 +53,16 @@ void LineFile::append(const std::string& line) {
 void LineFile::finish(const fs::path& final_path) {
   if (::fsync(fd_.get()) != 0)
     throw IoError(fmt::format("cannot flush {} to disk: {}; check free disk space", path_.string(), std::strerror(errno)));
-  fd_.reset();
+  const fs::path target = follow_links(final_path);
   std::error_code ec;
-  fs::rename(path_, final_path, ec);
+  fs::rename(path_, target, ec);
   if (ec)
-    throw IoError(fmt::format("cannot rename {} to {}: {}", path_.string(), final_path.string(), ec.message()));
+    throw IoError(fmt::format("cannot rename {} to {}: {}", path_.string(), target.string(), ec.message()));
+  finished_ = true;
+  fd_.reset();  // the lock goes with the file's last descriptor
+  const fs::path folder = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  const UniqueFd dir(::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+  if (dir.valid()) (void)::fsync(dir.get());  // the rename itself on disk; best effort
 }
 
 }  // namespace sb::io

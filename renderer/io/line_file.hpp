@@ -12,20 +12,28 @@ namespace sb::io {
 
 class LineFile {
  public:
-  /// Creates (or empties) `partial`; IoError naming it when it cannot be made.
+  /// Creates (or empties) `partial` and holds an exclusive lock on it while this object lives:
+  /// InputError when another run holds it (it is writing the same file), IoError naming it when it
+  /// cannot be made.
   explicit LineFile(std::filesystem::path partial);
+  /// Removes the partial file when no line reached it (a run that failed before its first result).
+  ~LineFile();
+  LineFile(const LineFile&) = delete;
+  LineFile& operator=(const LineFile&) = delete;
 
   /// Writes `line` and a newline, whole, before returning; IoError naming the file (a full disk).
   void append(const std::string& line);
   /// Lines appended so far.
   [[nodiscard]] size_t lines() const { return lines_; }
-  /// Flushes the file to disk and renames it to `final_path` (replacing a file there).
+  /// Flushes the file to disk and renames it to `final_path`, replacing a file there; a link at
+  /// `final_path` is followed (the file it names is replaced, the link kept).
   void finish(const std::filesystem::path& final_path);
 
  private:
   std::filesystem::path path_;
   UniqueFd fd_;
   size_t lines_ = 0;
+  bool finished_ = false;
 };
 
 }  // namespace sb::io

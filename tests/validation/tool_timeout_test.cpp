@@ -3,10 +3,13 @@
 // answer `--version` and then sleep play Blender and POV-Ray.
 #include <gtest/gtest.h>
 
+#include <signal.h>
+
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "renderer/error.hpp"
@@ -132,6 +135,48 @@ TEST(ToolTimeout, ValidateExitsWithFourForAHangingTool) {
       test::run_shell(env + "STEREOBENCH_TOOL_TIMEOUT=soon " + std::string(SB_CLI_PATH) + " " + args);
   EXPECT_EQ(bad.code, 3) << bad.out;
   EXPECT_NE(bad.out.find("STEREOBENCH_TOOL_TIMEOUT='soon'"), std::string::npos) << bad.out;
+}
+
+/// Whether process `pid` is still running (a zombie whose parent is gone counts as ended).
+bool running(long pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string text;
+  if (!std::getline(stat, text)) return false;
+  const size_t close = text.rfind(')');
+  return close != std::string::npos && close + 2 < text.size() && text[close + 2] != 'Z';
+}
+
+TEST(ToolStop, StoppingStereobenchStopsTheToolItRuns) {
+  // SIGTERM to stereobench (a job's end, `kill`) or Ctrl-C: the tool is in a process group of its
+  // own, so without stereobench passing it on it would go on rendering into the work folder.
+  const test::ScratchDir dir;
+  const fs::path pid_file = dir / "tool.pid";
+  const fs::path povray = fake_tool(dir, "fake-povray",
+                                    "if [ \"$1\" = --version ]; then echo 'POV-Ray 3.7.0.10'; exit 0; fi\n"
+                                    "echo $$ > " + test::quoted(pid_file) + "\nexec sleep 100\n");
+  // (A shell starts background jobs with SIGINT ignored, which stays ignored: HUP stands in.)
+  for (const char* sig : {"TERM", "HUP"}) {
+    fs::remove(pid_file);
+    const std::string run = "STEREOBENCH_POVRAY=" + test::quoted(povray) + " " + std::string(SB_CLI_PATH) +
+                            " validate --scene lit-plane --resolution 32x18 --threads 1 --pipelines plain-rt "
+                            "--truth povray --no-cache --scenes-dir " +
+                            test::quoted(fs::path(SB_BINARY_DIR) / "Testing" / "scenes-cache") + " --out " +
+                            test::quoted(dir / "out");
+    // The shell waits for the tool's pid file, then signals stereobench alone.
+    const test::CliRun r = test::run_shell("sh -c '" + run + " & sb=$!; n=0; while [ ! -s " + test::quoted(pid_file) +
+                                           " ] && [ $n -lt 600 ]; do sleep 0.05; n=$((n+1)); done; kill -" + sig +
+                                           " $sb; wait $sb; echo exit=$?'");
+    ASSERT_TRUE(fs::exists(pid_file)) << r.out;
+    long pid = 0;
+    std::ifstream(pid_file) >> pid;
+    ASSERT_GT(pid, 0);
+    const auto start = Clock::now();
+    while (running(pid) && seconds_since(start) < 5.0) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    EXPECT_FALSE(running(pid)) << "SIG" << sig << ": the tool (pid " << pid << ") still runs\n" << r.out;
+    EXPECT_NE(r.out.find(std::string("exit=") + (std::string(sig) == "TERM" ? "143" : "129")), std::string::npos)
+        << "stereobench ends as the signal says\n" << r.out;
+    if (running(pid)) ::kill(static_cast<pid_t>(pid), SIGKILL);
+  }
 }
 
 }  // namespace

@@ -71,17 +71,34 @@ Located locate_blender() {
                           name, origin, kExecutableVariable)};
 }
 
-/// How Blender runs: its output merged, and its Python kept to the system's. Blender looks for a
-/// Python executable on PATH and takes its prefix, so an activated virtual environment or pyenv
-/// shim would replace the modules its glTF importer needs (numpy); PYTHON* variables would do the
-/// same. The child gets the system PATH and none of them.
+/// PATH without the folders of Python environments: $VIRTUAL_ENV/bin, $CONDA_PREFIX/bin, pyenv's
+/// shims and any folder beside a pyvenv.cfg (a virtual environment's bin, activated or not). Blender looks for a Python executable on PATH and takes
+/// its prefix, so such a python3 would replace the modules its glTF importer needs (numpy).
+std::string path_without_python_environments() {
+  const char* path = std::getenv("PATH");
+  std::vector<std::string> drop;
+  for (const char* var : {"VIRTUAL_ENV", "CONDA_PREFIX"})
+    if (const char* v = std::getenv(var); v != nullptr && *v != '\0') drop.push_back((fs::path(v) / "bin").string());
+  std::string kept;
+  std::istringstream in(path != nullptr ? path : "");
+  for (std::string dir; std::getline(in, dir, ':');) {
+    std::error_code ec;
+    const bool environment = std::find(drop.begin(), drop.end(), dir) != drop.end() ||
+                             dir.find("/.pyenv/shims") != std::string::npos ||
+                             (!dir.empty() && fs::exists(fs::path(dir).parent_path() / "pyvenv.cfg", ec));
+    if (!environment) kept += (kept.empty() ? "" : ":") + dir;
+  }
+  return kept;
+}
+
+/// How Blender runs: its output merged, its Python kept to the system's (PATH without Python
+/// environments, and none of the variables that point Python elsewhere).
 ProcessOptions blender_options(std::chrono::milliseconds timeout) {
   ProcessOptions options;
   options.stderr_to = ChildOutput::to_stdout;
   options.timeout = timeout;
-  options.set_env = {{"PATH", "/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin"}};
-  options.unset_env = {"VIRTUAL_ENV", "PYTHONHOME", "PYTHONPATH", "PYTHONSTARTUP", "PYTHONUSERBASE",
-                       "PYTHONSAFEPATH", "CONDA_PREFIX", "PYENV_VERSION"};
+  options.set_env = {{"PATH", path_without_python_environments()}};
+  options.unset_env = {"VIRTUAL_ENV", "PYTHONHOME", "PYTHONPATH", "PYTHONSTARTUP", "PYTHONUSERBASE", "CONDA_PREFIX"};
   return options;
 }
 
