@@ -233,6 +233,10 @@ TEST(Cli, RenderWritesEveryOutputAndBenchPrintsATable) {
   ASSERT_EQ(json_only.code, 0) << json_only.out;
   EXPECT_EQ(nlohmann::json::parse(json_only.out).at("baseline"), "plain-rt") << json_only.out;
   EXPECT_FALSE(std::filesystem::exists("-"));
+  // Numbers are decimal: a leading zero does not make an integer octal (010 is ten, not eight).
+  const CliRun zeros = run("bench --scene box-wall --pipelines plain-rt --baseline plain-rt -n 010 -w 00" + common);
+  ASSERT_EQ(zeros.code, 0) << zeros.out;
+  EXPECT_NE(zeros.out.find("0 warm-up + 10 repetitions"), std::string::npos) << zeros.out;
   // 'all' times every registered pipeline, beside a variant named after it.
   const CliRun every =
       run("bench --scene box-wall --pipelines all,bidir-warp:occlusion=ztest --baseline plain-rt -n 1 -w 0" + common);
