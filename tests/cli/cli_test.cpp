@@ -79,7 +79,7 @@ TEST(Cli, BadArgumentsExitWith3AndSayWhy) {
        "--seed: a seed is a whole number from 0 to 18446744073709551615, not -1"},
       {"scenes generate spheres --seed 18446744073709551616 --out '" + dir.path().string() + "'",
        "not 18446744073709551616"},  // 2^64: saturated to 2^64 - 1 before
-      {"scenes generate spheres --seed 1e3 --out '" + dir.path().string() + "'", "not 1e3"},
+      {"scenes generate spheres --seed 1e3 --out '" + dir.path().string() + "'", "--seed: '1e3' is not a decimal integer"},
       // A folder where a file is to be written: refused before the work, not when writing it.
       {"bench --scene " + scene + " --resolution 16x9 --pipelines plain-rt --json '" + dir.path().string() + "'",
        "--json: " + dir.path().string() + " is a folder; give the name of the file to write"},
