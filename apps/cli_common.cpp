@@ -2,7 +2,10 @@
 #include "apps/cli_common.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <optional>
 
@@ -187,6 +190,13 @@ void discard_outputs(std::initializer_list<NamedPath> outputs) noexcept {
 void prepare_output_folder(const std::string& folder, const char* option) {
   if (const auto why = io::unwritable_folder(folder))
     throw IoError(fmt::format("{} {}: {}; give a folder you can write", option, folder, *why));
+}
+
+void print_to_stdout(const std::string& text) {
+  errno = 0;
+  fmt::print(stdout, "{}\n", text);
+  if (std::fflush(stdout) != 0 || std::ferror(stdout) != 0)
+    throw IoError(fmt::format("cannot write to standard output: {}", errno != 0 ? std::strerror(errno) : "write error"));
 }
 
 void prepare_output_file_folder(const std::string& file, const char* option) {

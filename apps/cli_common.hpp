@@ -83,6 +83,11 @@ void remove_earlier_outputs(std::initializer_list<NamedPath> outputs);
 /// regular files only, "" and "-" skipped), so that none is left beside its error.
 void discard_outputs(std::initializer_list<NamedPath> outputs) noexcept;
 
+/// Writes `text` and a newline to standard output and flushes it: IoError (exit 4) when it cannot
+/// take them (a full disk behind a redirection, a closed pipe), so that "--json -" never ends in
+/// success with the JSON lost.
+void print_to_stdout(const std::string& text);
+
 /// The same for the folder of an output file (a --json written after a long benchmark); nothing
 /// for "" (no file), "-" (standard output) or a bare file name (the current folder).
 void prepare_output_file_folder(const std::string& file, const char* option);

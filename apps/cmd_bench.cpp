@@ -4,9 +4,6 @@
 #include <sys/resource.h>
 
 #include <algorithm>
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -175,9 +172,7 @@ void run_bench_command(const BenchArgs& a) {
     j["peak_rss_mib"] = peak_rss_mib();
     j["versions"] = io::versions_json();
     if (a.json_out == "-") {
-      fmt::print(stdout, "{}\n", j.dump(2));
-      if (std::fflush(stdout) != 0 || std::ferror(stdout) != 0)
-        throw IoError(fmt::format("cannot write the JSON to standard output: {}", std::strerror(errno)));
+      print_to_stdout(j.dump(2));
     } else {
       io::write_text_atomically(a.json_out, j.dump(2) + "\n");
       fmt::print(out, "wrote {}\n", a.json_out);

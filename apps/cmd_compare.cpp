@@ -193,7 +193,7 @@ int run_compare(const CompareArgs& a) {
     if (!a.diff.empty()) validation::write_png(a.diff, validation::difference_image(fa.image, fb.image, region));
     if (!a.ssim_map.empty()) validation::write_png(a.ssim_map, validation::ssim_image(ssim, region));
     if (a.json == "-")
-      fmt::print("{}\n", record.dump(2));
+      print_to_stdout(record.dump(2));
     else if (!a.json.empty())
       io::write_text_atomically(a.json, record.dump(2) + "\n");
   } catch (const std::exception&) {

@@ -89,6 +89,11 @@ void run_gate(const GateArgs& a) {
   }
   if (!a.only.empty() || !a.cells.empty())
     throw InputError("--only and --cells select what --update-baseline rewrites; add --update-baseline or drop them");
+  for (const auto& [option, path] : {std::pair{"--junit", &a.junit}, std::pair{"--json", &a.json_out}})
+    if (*path == "-")
+      throw InputError(fmt::format("{} -: the gate writes its report to a file (standard output shows the table); "
+                                   "give a file name",
+                                   option));
   refuse_overwriting({{"--results", &a.results}, {"--config", &a.config}, {"the baseline", &baseline_path}},
                      {{"--junit", &a.junit}, {"--json", &a.json_out}});
   remove_earlier_outputs({{"--junit", &a.junit}, {"--json", &a.json_out}});

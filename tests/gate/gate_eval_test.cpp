@@ -456,6 +456,11 @@ TEST(GateCli, BadInputIsExitThree) {
   EXPECT_EQ(run.code, 3) << run.out;
   EXPECT_NE(run.out.find("typo.toml:2"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("min_pnsr"), std::string::npos) << run.out;
+  // "-" is no report file (it made one named "-").
+  run = run_cli("gate" + config + " --results " + (dir / "pass.jsonl").string() + " --json -");
+  EXPECT_EQ(run.code, 3) << run.out;
+  EXPECT_NE(run.out.find("--json -: the gate writes its report to a file"), std::string::npos) << run.out;
+  EXPECT_FALSE(std::filesystem::exists("-"));
   write_results(dir / "dup.jsonl", {passing_cells()[0], passing_cells()[0]});
   run = run_cli("gate" + config + " --results " + (dir / "dup.jsonl").string());
   EXPECT_EQ(run.code, 3) << run.out;
