@@ -30,6 +30,7 @@
 #include "renderer/image.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/image_io.hpp"
+#include "renderer/io/line_file.hpp"
 
 #include "support/scratch_dir.hpp"
 
@@ -452,6 +453,45 @@ TEST_F(ImageIoTest, FailureInsideWriteAtomicallyLeavesNoFileAndNoTemporary) {
                InputError);
   EXPECT_EQ(entries(), std::vector<std::string>{"out.bin"});
   EXPECT_EQ(read_bytes(file), std::vector<unsigned char>{42});
+}
+
+TEST_F(ImageIoTest, ALineFileIsWholeUnderItsFinalNameOnlyOnceFinished) {
+  // Lines go to the partial file as they come; the final name appears with the last.
+  {
+    io::LineFile lines(path("frames.jsonl.partial"));
+    lines.append("{\"frame\": 0}");
+    lines.append("{\"frame\": 1}");
+    EXPECT_EQ(lines.lines(), 2u);
+    EXPECT_FALSE(fs::exists(path("frames.jsonl")));
+    std::ifstream partial(path("frames.jsonl.partial"));
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(partial), {}), "{\"frame\": 0}\n{\"frame\": 1}\n");
+    // A second writer of the same partial file is refused while the first holds it.
+    EXPECT_THROW(io::LineFile second(path("frames.jsonl.partial")), InputError);
+    lines.finish(path("frames.jsonl"));
+  }
+  EXPECT_EQ(entries(), std::vector<std::string>{"frames.jsonl"});
+
+  // A run that ends before its first line leaves no partial file; one with lines keeps them.
+  { io::LineFile none(path("empty.jsonl.partial")); }
+  EXPECT_FALSE(fs::exists(path("empty.jsonl.partial")));
+  {
+    io::LineFile cut(path("cut.jsonl.partial"));
+    cut.append("{}");
+  }
+  EXPECT_TRUE(fs::exists(path("cut.jsonl.partial")));
+
+  // A link at the final name is followed: the file it names is replaced, the link kept.
+  fs::create_directories(path("real"));
+  std::ofstream(path("real") / "frames.jsonl") << "earlier\n";
+  fs::create_symlink(path("real") / "frames.jsonl", path("linked.jsonl"));
+  {
+    io::LineFile lines(path("linked.jsonl.partial"));
+    lines.append("new");
+    lines.finish(path("linked.jsonl"));
+  }
+  EXPECT_TRUE(fs::is_symlink(path("linked.jsonl")));
+  std::ifstream through(path("linked.jsonl"));
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(through), {}), "new\n");
 }
 
 TEST_F(ImageIoTest, AKilledWritesTemporaryGoesWhenTheFileIsWrittenAgain) {
