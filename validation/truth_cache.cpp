@@ -3,7 +3,6 @@
 
 #include <fcntl.h>
 
-#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <mutex>
@@ -97,28 +96,40 @@ std::string truth_key(const TruthProvider& provider, const TruthRequest& request
   return sha.hex();
 }
 
-std::optional<std::string> unusable_samples(const Image& truth) {
-  if (!truth.has_plane(planes::rgb)) return "it has no rgb plane";
-  const float* v = truth.data_f32(planes::rgb);
-  size_t nan = 0, inf = 0, negative = 0;
-  for (size_t i = 0; i < truth.pixel_count() * 3; ++i) {
-    nan += std::isnan(v[i]) ? 1 : 0;
-    inf += std::isinf(v[i]) ? 1 : 0;
-    negative += v[i] < 0.0f ? 1 : 0;
+namespace {
+
+/// The samples of a ground truth's rgb plane that no radiance has, counted in one pass.
+struct BadSamples {
+  bool has_rgb = false;
+  size_t nan = 0, inf = 0, negative = 0, total = 0;
+
+  explicit BadSamples(const Image& truth) : has_rgb(truth.has_plane(planes::rgb)) {
+    if (!has_rgb) return;
+    const float* v = truth.data_f32(planes::rgb);
+    total = truth.pixel_count() * 3;
+    for (size_t i = 0; i < total; ++i) {
+      nan += std::isnan(v[i]) ? 1 : 0;
+      inf += std::isinf(v[i]) ? 1 : 0;
+      negative += v[i] < 0.0f ? 1 : 0;
+    }
   }
-  if (nan + inf + negative == 0) return std::nullopt;
-  return fmt::format("{} NaN, {} infinite and {} negative sample(s) of {}", nan, inf, negative,
-                     truth.pixel_count() * 3);
-}
+  [[nodiscard]] std::optional<std::string> why() const {
+    if (!has_rgb) return "it has no rgb plane";
+    if (nan + inf + negative == 0) return std::nullopt;
+    return fmt::format("{} NaN, {} infinite and {} negative sample(s) of {}", nan, inf, negative, total);
+  }
+};
+
+}  // namespace
+
+std::optional<std::string> unusable_samples(const Image& truth) { return BadSamples(truth).why(); }
 
 void check_truth_samples(const TruthRender& render, const std::filesystem::path& work_dir, bool caching) {
-  const Image& image = render.right;
-  const auto bad = unusable_samples(image);
+  const BadSamples counts(render.right);
+  const auto bad = counts.why();
   if (!bad) return;
   const std::string kept = caching ? "; it was not stored in the cache" : "";
-  const float* v = image.has_plane(planes::rgb) ? image.data_f32(planes::rgb) : nullptr;
-  const bool overflow = v != nullptr && std::any_of(v, v + image.pixel_count() * 3, [](float x) { return std::isinf(x); });
-  if (render.provider == "povray" && overflow)
+  if (render.provider == "povray" && counts.inf > 0)
     throw InputError(fmt::format("the 'povray' ground truth has {}{}: POV-Ray writes half floats, whose largest value "
                                  "is 65504, and the scene's lights make brighter pixels; scale the light intensities "
                                  "down, or use the full or blender provider",
