@@ -9,6 +9,7 @@
 #include <atomic>
 #include <chrono>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <new>
@@ -370,8 +371,10 @@ std::optional<std::string> unwritable_folder(const fs::path& folder) {
   fs::create_directories(folder, ec);
   if (ec) return fmt::format("cannot create the folder ({})", ec.message());
   if (!fs::is_directory(folder, ec)) return "it is not a folder";
-  const fs::path probe = folder / fmt::format(".stereobench-probe-{}", ::getpid());
-  if (!UniqueFd(::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600)).valid())
+  // A name of its own (mkostemp): threads of one process probe a folder at once (sweep jobs), and
+  // a probe a killed run left behind must not make the folder look unwritable.
+  std::string probe = (folder / ".stereobench-probe-XXXXXX").string();
+  if (!UniqueFd(::mkostemp(probe.data(), O_CLOEXEC)).valid())
     return fmt::format("cannot create a file in it ({})", std::strerror(errno));
   fs::remove(probe, ec);
   return std::nullopt;

@@ -560,6 +560,25 @@ TEST_F(ImageIoTest, ConcurrentWritesOfOneFileNeverRemoveEachOthersTemporaries) {
   EXPECT_EQ(text, std::string(4096, text.front()));
 }
 
+TEST_F(ImageIoTest, AWritableFolderIsWritableToThreadsProbingAtOnceAndDespiteAnOldProbe) {
+  // Sweep jobs are threads of one process: their probes of one cache folder must not collide.
+  // A probe file a killed run left behind (same name scheme, any pid) does not matter either.
+  std::ofstream(path(".stereobench-probe-" + std::to_string(::getpid()))) << "left behind";
+  constexpr int kProbers = 4;
+  constexpr int kProbes = 200;
+  std::atomic<int> refusals{0};
+  std::vector<std::thread> probers;
+  for (int t = 0; t < kProbers; ++t)
+    probers.emplace_back([&] {
+      for (int i = 0; i < kProbes; ++i)
+        if (io::unwritable_folder(dir_)) ++refusals;
+    });
+  for (std::thread& t : probers) t.join();
+  EXPECT_EQ(refusals.load(), 0);
+  EXPECT_EQ(entries(), std::vector<std::string>{".stereobench-probe-" + std::to_string(::getpid())})
+      << "a probe leaves nothing behind";
+}
+
 TEST_F(ImageIoTest, WritingThroughALinkReplacesItsTargetAndKeepsTheLink) {
   write_bytes(path("target.json"), {1});
   fs::create_symlink("target.json", path("link.json"));
