@@ -403,11 +403,12 @@ void claim_out_folder(const SweepDefinition& d, const SweepRunOptions& options) 
   io::write_text_atomically(marker, mine.dump(2) + "\n");
 }
 
-/// Every cell's rig resolved against its scene, and a path's spin against the scene's meshes, each
-/// scene resolved (a built-in one generated) and loaded once: an impossible rig (a convergence so
-/// near that the disparity exceeds any image) or a spin prefix that matches nothing is refused
-/// before the first cell runs, naming the definition and the cell, instead of stopping the sweep
-/// when that cell comes.
+/// Every cell's rig resolved against its scene, its scene checked by its ground truth's provider,
+/// and a path's spin against the scene's meshes, each scene resolved (a built-in one generated)
+/// and loaded once: an impossible rig (a convergence so near that the disparity exceeds any
+/// image), a scene the truth cannot render (a spot light for POV-Ray) or a spin prefix that
+/// matches nothing is refused before the first cell runs, naming the definition and the cell,
+/// instead of stopping the sweep when that cell comes.
 void check_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, const std::vector<size_t>& todo,
                  const fs::path& scenes_dir) {
   std::map<std::string, fs::path> file_of;  // by scene label
@@ -418,12 +419,24 @@ void check_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, 
     by_file[at->second].push_back(i);
   }
   const std::vector<BenchEntry> entries = bench_config(d).entries();  // as run_cell runs them
+  std::map<std::string, std::unique_ptr<TruthProvider>> providers;
+  for (size_t i : todo) {
+    auto& p = providers[cells[i].truth];
+    if (!p) p = make_truth_provider(cells[i].truth);
+  }
   for (const auto& [file, indices] : by_file) {
     Scene scene = io::load_gltf(file);
+    const std::vector<Light> lights = scene.lights;
     for (size_t i : indices) {
       try {
         const StereoRig rig = resolve_rig(scene, cell_overrides(cells[i]));
         for (const BenchEntry& e : entries) e.entry.check_rig(e.options, rig);
+        // The lights the cell keeps (as SceneCache::get keeps them), for the truth's check.
+        scene.lights.assign(lights.begin(),
+                            lights.begin() + static_cast<std::ptrdiff_t>(std::min(
+                                                 cells[i].lights ? static_cast<size_t>(*cells[i].lights) : lights.size(),
+                                                 lights.size())));
+        providers.at(cells[i].truth)->check_scene(scene, file);
       } catch (const InputError& e) {
         throw InputError(fmt::format("{}: cell {} '{}': {}; fix the definition (no cell has run)", d.file.string(),
                                      cells[i].index, cells[i].id, e.what()));

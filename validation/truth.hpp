@@ -61,8 +61,14 @@ class TruthProvider {
   /// A string that changes whenever the provider's export, settings or calibration change, so
   /// that cached renders made by an older provider are not reused.
   [[nodiscard]] virtual std::string revision() const = 0;
-  /// Renders the right eye. ToolError when the tool is missing or fails (its output quoted),
-  /// InputError for a scene feature the provider cannot export (named).
+  /// InputError naming what of `scene` (loaded from `scene_file`, its lights after any --lights
+  /// selection) this provider cannot render faithfully: a light its tool cannot reproduce, nodes
+  /// its importer would bring in besides the loaded scene. Checked before a cache lookup, so that a
+  /// render an older provider made of such a scene is not served, and by sweeps before any cell
+  /// runs. The default accepts every scene.
+  virtual void check_scene(const Scene& scene, const std::filesystem::path& scene_file) const;
+  /// Renders the right eye (check_scene first). ToolError when the tool is missing or fails (its
+  /// output quoted), InputError for a scene feature the provider cannot export (named).
   [[nodiscard]] virtual TruthRender render(const TruthRequest& request) const = 0;
 };
 

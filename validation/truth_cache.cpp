@@ -210,6 +210,8 @@ void TruthCache::store(const std::string& key, const TruthRender& render) const 
 ResolvedTruth resolve_truth(const TruthProvider& provider, const TruthRequest& request, const TruthCache* cache) {
   if (auto why = provider.unavailable_reason())
     throw ToolError(fmt::format("ground-truth provider '{}' is unavailable: {}", provider.name(), *why));
+  // Before the cache: an entry an older provider rendered of a scene it now refuses is not served.
+  provider.check_scene(request.scene.scene(), request.scene_file);
   note_single_sided(request.scene.scene(), provider.name());
   ResolvedTruth out;
   const bool use_cache = cache != nullptr && provider.name() != "full";

@@ -18,6 +18,8 @@
 #include "renderer/error.hpp"
 #include "renderer/render_scene.hpp"
 #include "scenes/catalog.hpp"
+#include "renderer/io/gltf_loader.hpp"
+#include "support/mini_gltf.hpp"
 #include "support/render_support.hpp"
 #include "support/scoped_env.hpp"
 #include "support/scratch_dir.hpp"
@@ -299,6 +301,34 @@ TEST(BlenderFailure, SpotLightIsAnInputErrorNamingIt) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("spot light 'lamp'"), std::string::npos) << e.what();
   }
+}
+
+TEST(BlenderFailure, NodesOutsideTheLoadedSceneAreAnInputErrorBeforeAnythingRuns) {
+  // Blender's importer would bring in a mesh node that is in no glTF scene (or in another one);
+  // the provider refuses the file in check_scene, which needs no Blender and runs before a cache
+  // lookup (so no render made before the refusal existed is served).
+  auto provider = validation::make_truth_provider("blender");
+  const test::ScratchDir dir;
+  test::MiniGltf g;
+  g.add_triangle();
+  const int p = g.add_positions({0, 0, 1, 1, 0, 1, 0, 1, 1});
+  g.add_node({{"mesh", g.add_mesh(nlohmann::json::array({{{"attributes", {{"POSITION", p}}}}}))}}, false);
+  g.write_gltf(dir / "orphan.gltf");
+  const Scene orphan = io::load_gltf(dir / "orphan.gltf");
+  try {
+    provider->check_scene(orphan, dir / "orphan.gltf");
+    FAIL() << "a file with a node outside the loaded scene must be refused";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find((dir / "orphan.gltf").string() + ", which has 1 node(s)"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("use the full or povray provider"), std::string::npos) << msg;
+  }
+  test::MiniGltf one;
+  one.add_triangle();
+  one.write_gltf(dir / "one.gltf");
+  EXPECT_NO_THROW(provider->check_scene(io::load_gltf(dir / "one.gltf"), dir / "one.gltf"));
+  // The importer needs the file itself.
+  EXPECT_THROW(provider->check_scene(io::load_gltf(dir / "one.gltf"), dir / "missing.gltf"), InputError);
 }
 
 TEST(BlenderProvider, DescribesItself) {

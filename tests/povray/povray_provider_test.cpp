@@ -21,7 +21,9 @@
 #include "renderer/error.hpp"
 #include "renderer/render_scene.hpp"
 #include "scenes/catalog.hpp"
+#include "support/mini_gltf.hpp"
 #include "support/render_support.hpp"
+#include "support/run_cli.hpp"
 #include "support/scoped_env.hpp"
 #include "support/scratch_dir.hpp"
 #include "validation/truth.hpp"
@@ -431,6 +433,33 @@ TEST(PovrayUnsupported, SpotLightIsRefusedByName) {
     EXPECT_NE(msg.find("`full`"), std::string::npos) << msg;
   }
   EXPECT_FALSE(std::filesystem::exists(dir / "work" / "scene.pov"));
+}
+
+TEST(PovrayUnsupported, ASweepCellWithASpotLightIsRefusedBeforeAnyCellRuns) {
+  SB_REQUIRE_POVRAY(povray);
+  // A triangle lit by a point light, then a spot light: the cell keeping the first light can be
+  // rendered, the cell keeping both cannot; the sweep is refused before its first cell, naming it.
+  const test::ScratchDir dir;
+  test::MiniGltf g;
+  g.add_triangle();
+  g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+  g.doc["extensions"]["KHR_lights_punctual"]["lights"] = {
+      {{"name", "bulb"}, {"type", "point"}, {"intensity", 5.0}},
+      {{"name", "stage-spot"}, {"type", "spot"}, {"intensity", 5.0}, {"spot", {{"outerConeAngle", 0.5}}}}};
+  g.add_node({{"translation", {0.0, 0.0, 1.0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  g.add_node({{"translation", {0.0, 0.0, 1.0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}});
+  g.write_gltf(dir / "lit.gltf");
+  std::ofstream(dir / "spot.toml") << "[sweep]\nname = \"spot\"\nscenes = [\"" << (dir / "lit.gltf").string()
+                                   << "\"]\npipelines = [\"plain-rt\"]\nresolutions = [\"32x18\"]\nlights = [1, 2]\n"
+                                      "truths = [\"povray\"]\n[timing]\nrepetitions = 1\nwarmup = 0\n";
+  const test::CliRun r = test::run_cli("sweep run '" + (dir / "spot.toml").string() + "' --out '" +
+                                       (dir / "out").string() + "'");
+  EXPECT_EQ(r.code, 3) << r.out;
+  EXPECT_NE(r.out.find((dir / "spot.toml").string() + ": cell 1 "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("'stage-spot') is a spot light"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("no cell has run"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("[1/2]"), std::string::npos) << "no cell may run: " << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "results.jsonl"));
 }
 
 }  // namespace

@@ -32,7 +32,11 @@ class CountingProvider final : public TruthProvider {
   }
   std::string tool_version() const override { return "counting 1.0"; }
   std::string revision() const override { return revision_; }
+  void check_scene(const Scene& /*scene*/, const std::filesystem::path& /*scene_file*/) const override {
+    if (refusal) throw InputError(*refusal);
+  }
   TruthRender render(const TruthRequest& request) const override {
+    check_scene(request.scene.scene(), request.scene_file);
     ++renders;
     TruthRender r;
     r.provider = name_;
@@ -49,6 +53,7 @@ class CountingProvider final : public TruthProvider {
   mutable int renders = 0;
   std::string revision_ = "r1";
   std::optional<float> bad_sample;  ///< a value the render puts in one sample (NaN, inf, negative)
+  std::optional<std::string> refusal;  ///< check_scene's InputError message, when set
 
  private:
   std::string name_;
@@ -138,6 +143,23 @@ TEST_F(TruthCacheTest, DamagedEntryIsRenderedAgain) {
   EXPECT_FALSE(again.cached);
   EXPECT_EQ(provider.renders, 2);
   EXPECT_TRUE(resolve_truth(provider, request, &cache).cached);
+}
+
+TEST_F(TruthCacheTest, ASceneTheProviderNowRefusesIsNotServedFromTheCache) {
+  // An entry an older provider rendered before it learnt to refuse the scene (Blender with nodes
+  // outside the loaded glTF scene) is not passed off as the truth: the check comes before the lookup.
+  CountingProvider provider;
+  const TruthRequest request = request_at(64, 36);
+  const ResolvedTruth first = resolve_truth(provider, request, &cache);
+  ASSERT_TRUE(std::filesystem::is_regular_file(cache.image_path("counting", first.key)));
+  provider.refusal = "cannot render this scene";
+  try {
+    (void)resolve_truth(provider, request, &cache);
+    ADD_FAILURE() << "a cached render of a refused scene was served";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "cannot render this scene");
+  }
+  EXPECT_EQ(provider.renders, 1);
 }
 
 TEST_F(TruthCacheTest, AnEntryMadeForAnotherRequestIsNoHit) {

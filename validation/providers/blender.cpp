@@ -263,20 +263,12 @@ class BlenderProvider final : public TruthProvider {
   std::string tool_version() const override { return query_version(executable()); }
   std::string revision() const override { return kRevision; }
 
-  TruthRender render(const TruthRequest& request) const override {
-    const auto start = std::chrono::steady_clock::now();
-    const std::chrono::milliseconds limit = tool_timeout();  // InputError for a malformed value
-    const Scene& scene = request.scene.scene();
-    nlohmann::json params;
-    params["lights"] = export_lights(scene);  // InputError for what Cycles cannot reproduce
-    const fs::path blender = executable();
-    const std::string version = query_version(blender);
-    const EyeCamera eye = request.rig.eye(Eye::right);
-
-    if (request.scene_file.empty() || !fs::is_regular_file(request.scene_file))
+  void check_scene(const Scene& scene, const fs::path& scene_file) const override {
+    (void)export_lights(scene);  // InputError for what Cycles cannot reproduce
+    if (scene_file.empty() || !fs::is_regular_file(scene_file))
       throw InputError(fmt::format("the blender provider imports the scene's glTF file, but '{}' is not a file; "
                                    "render a scene loaded from a .gltf/.glb file",
-                                   request.scene_file.string()));
+                                   scene_file.string()));
     // Blender's importer brings in every node of the file; the loaded scene is glTF scene 0 (or
     // `scene`) alone.
     if (scene.nodes_not_loaded > 0)
@@ -284,7 +276,20 @@ class BlenderProvider final : public TruthProvider {
                                    "or light outside the scene that is loaded (in another glTF scene, or in none); "
                                    "Blender would render them too. Remove them from the file, or use the full or "
                                    "povray provider",
-                                   request.scene_file.string(), scene.nodes_not_loaded));
+                                   scene_file.string(), scene.nodes_not_loaded));
+  }
+
+  TruthRender render(const TruthRequest& request) const override {
+    const auto start = std::chrono::steady_clock::now();
+    const std::chrono::milliseconds limit = tool_timeout();  // InputError for a malformed value
+    const Scene& scene = request.scene.scene();
+    check_scene(scene, request.scene_file);
+    nlohmann::json params;
+    params["lights"] = export_lights(scene);
+    const fs::path blender = executable();
+    const std::string version = query_version(blender);
+    const EyeCamera eye = request.rig.eye(Eye::right);
+
     std::error_code ec;
     fs::create_directories(request.work_dir, ec);
     if (ec)

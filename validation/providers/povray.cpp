@@ -120,6 +120,10 @@ class PovrayProvider final : public TruthProvider {
 
   std::string revision() const override { return fmt::format("{}+{}", kProviderRevision, povray::kExportRevision); }
 
+  void check_scene(const Scene& scene, const std::filesystem::path& /*scene_file*/) const override {
+    povray::check_exportable(scene);
+  }
+
   TruthRender render(const TruthRequest& request) const override {
     const auto start = std::chrono::steady_clock::now();
     probe();

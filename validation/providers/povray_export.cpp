@@ -162,10 +162,7 @@ double min_distance_to_scene(const Scene& scene, const dvec3& p) {
   return std::sqrt(best2);
 }
 
-ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::filesystem::path& dir) {
-  ExportResult out;
-
-  // Lights first: an unsupported one is refused before anything is written.
+void check_exportable(const Scene& scene) {
   for (std::size_t i = 0; i < scene.lights.size(); ++i) {
     const Light& light = scene.lights[i];
     if (light.type == Light::Type::spot)
@@ -176,6 +173,11 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
           "leave the light out with --lights",
           scene.name, i, light.name));
   }
+}
+
+ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::filesystem::path& dir) {
+  check_exportable(scene);
+  ExportResult out;
 
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);

@@ -52,11 +52,14 @@ struct ExportResult {
   nlohmann::json settings = nlohmann::json::object();
 };
 
+/// InputError for a scene feature POV-Ray cannot render with the shading of DESIGN §3: a spot
+/// light (named).
+void check_exportable(const Scene& scene);
+
 /// Writes `dir`/scene.pov and the texture files beside it (names relative to `dir`, so that
 /// POV-Ray runs with `dir` as its working folder, the one its I/O restrictions allow). The camera
 /// is `eye` exactly: pixel (i, j) of the render is the ray through EyeCamera pixel centre
-/// (i + 0.5, j + 0.5). InputError for a scene feature POV-Ray cannot render with the shading of
-/// DESIGN §3 (a spot light, named); IoError when a file cannot be written.
+/// (i + 0.5, j + 0.5). InputError as check_exportable, before anything is written; IoError when a file cannot be written.
 [[nodiscard]] ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::filesystem::path& dir);
 
 /// Smallest distance from `p` to any triangle of the scene (infinity for a scene without
