@@ -63,11 +63,9 @@ BenchConfig bench_config(const BenchArgs& a, const std::vector<std::string>& def
       throw InputError(fmt::format("--baseline: {}", e.what()));
     }
   }();
-  const auto same = std::find_if(listed.begin(), listed.end(), [&](const PipelineEntry& e) {
-    return e.pipeline == base.pipeline && e.fixed == base.fixed;
-  });
-  config.baseline = same != listed.end() ? same->name : a.baseline;
-  if (same == listed.end()) config.pipelines.insert(config.pipelines.begin(), config.baseline);
+  const std::optional<std::string> same = find_same_variant(listed, base);
+  config.baseline = same.value_or(a.baseline);
+  if (!same) config.pipelines.insert(config.pipelines.begin(), config.baseline);
   config.repetitions = a.repetitions;
   config.warmup = a.warmup;
   for (const auto& [key, value] : parse_key_values(a.options, "--option")) {

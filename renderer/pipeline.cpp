@@ -135,6 +135,12 @@ std::string entry_file_stem(const std::string& entry) {
   return stem;
 }
 
+std::optional<std::string> find_same_variant(const std::vector<PipelineEntry>& listed, const PipelineEntry& entry) {
+  const auto at = std::find_if(listed.begin(), listed.end(), [&](const PipelineEntry& e) { return e.same_variant(entry); });
+  if (at == listed.end()) return std::nullopt;
+  return at->name;
+}
+
 std::vector<PipelineEntry> parse_pipeline_entries(const std::vector<std::string>& names, const std::string& what) {
   // A caller that places the message itself (a sweep file's line and key) passes no list name.
   const std::string prefix = what.empty() ? "" : what + ": ";
@@ -143,13 +149,10 @@ std::vector<PipelineEntry> parse_pipeline_entries(const std::vector<std::string>
   for (const std::string& name : names) {
     PipelineEntry entry = parse_pipeline_entry(name);
     // One variant under two names (its options in another order) would be rendered and measured
-    // twice. Entries that fix different options are not compared further: options given for the
-    // pipeline (--option, [options.NAME]) apply under each entry's own, so a variant that fixes a
-    // default is a configuration of its own.
-    for (const PipelineEntry& e : entries)
-      if (e.pipeline == entry.pipeline && e.fixed == entry.fixed && e.name != name)
-        throw InputError(fmt::format("{}'{}' and '{}' name the same variant of {}; name it once", prefix, e.name, name,
-                                     entry.pipeline->info().name));
+    // twice.
+    if (const auto same = find_same_variant(entries, entry); same && *same != name)
+      throw InputError(fmt::format("{}'{}' and '{}' name the same variant of {}; name it once", prefix, *same, name,
+                                   entry.pipeline->info().name));
     entries.push_back(std::move(entry));
     const auto [it, fresh] = stems.emplace(entry_file_stem(name), name);
     if (fresh) continue;

@@ -120,7 +120,18 @@ struct PipelineEntry {
   /// The pipeline's check_rig for `options` (made by options()) and `rig`; an InputError about a
   /// variant names the entry.
   void check_rig(const PipelineOptions& options, const StereoRig& rig) const;
+  /// Whether `other` names the same variant: the same pipeline fixing the same options, in
+  /// whatever order either name gives them. Entries that fix different options are different
+  /// variants even where the values are the pipeline's defaults: options given for the pipeline
+  /// (--option, [options.NAME]) apply under each entry's own.
+  [[nodiscard]] bool same_variant(const PipelineEntry& other) const {
+    return pipeline == other.pipeline && fixed == other.fixed;
+  }
 };
+
+/// The name of the entry of `listed` that names the same variant as `entry`, if there is one.
+[[nodiscard]] std::optional<std::string> find_same_variant(const std::vector<PipelineEntry>& listed,
+                                                           const PipelineEntry& entry);
 
 /// Parses an entry: InputError for an unknown pipeline, a part that is not KEY=VALUE, a key fixed
 /// twice, or a name longer than 160 characters (it names files). Option names and values are checked by

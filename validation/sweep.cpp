@@ -467,7 +467,11 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
   if (const toml::node* n = sweep.get("baseline")) {
     d.baseline = string_at(where, *n, "sweep.baseline");
     try {
-      (void)parse_pipeline_entry(d.baseline).options();
+      const PipelineEntry base = parse_pipeline_entry(d.baseline);
+      (void)base.options();
+      // Listed under another spelling of the same variant (its options in another order), the
+      // baseline is that entry, as for `bench --baseline`.
+      if (const auto same = find_same_variant(parse_pipeline_entries(d.pipelines, ""), base)) d.baseline = *same;
     } catch (const InputError& err) {
       where.fail(*n, "sweep.baseline", err.what());
     }

@@ -174,6 +174,14 @@ TEST(SweepDefinition, VariantsRunBesideTheirPipeline) {
   const std::string baseline = error_of("[sweep]\nbaseline = \"plain-rt:tile=0\"\n");
   EXPECT_NE(baseline.find("def.toml:2: sweep.baseline: pipeline entry 'plain-rt:tile=0'"), std::string::npos)
       << baseline;
+  // A baseline listed under another spelling of its variant is that entry (as bench --baseline
+  // takes it); it used to be added a second time and refused as the same variant named twice.
+  const SweepDefinition reordered = parse_sweep(
+      "[sweep]\npipelines = [\"fw-warp:max_crack=1:warp=rows\", \"plain-rt\"]\nbaseline = \"fw-warp:warp=rows:max_crack=1\"\n",
+      "def.toml");
+  EXPECT_EQ(reordered.baseline, "fw-warp:max_crack=1:warp=rows");
+  EXPECT_TRUE(reordered.baseline_listed);
+  EXPECT_EQ(reordered.pipelines, (std::vector<std::string>{"fw-warp:max_crack=1:warp=rows", "plain-rt"}));
 }
 
 TEST(SweepDefinition, BothInteraxialKindsRejected) {
