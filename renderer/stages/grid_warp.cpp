@@ -32,6 +32,7 @@ struct GridVertex {
   int32_t x = 0;  ///< target position, fixed point
   int32_t y = 0;
   float q = 0.0f;     ///< inverse target depth (0 at infinity)
+  float r = 1.0f;     ///< the source clip w over the target clip w (1 / the scaled point's target w)
   float disc = 0.0f;  ///< discontinuity measure, px
   float sx = 0.0f;    ///< source position (pixel coordinates)
   float sy = 0.0f;
@@ -107,6 +108,10 @@ class Reprojector {
     return dvec2((c.x * r + 1.0) * 0.5 * to_w_, (1.0 - c.y * r) * 0.5 * to_h_);
   }
 
+  /// Whether every point has the same target clip w relative to its source clip w (eyes that look
+  /// the same way): a warped triangle then maps onto its source triangle affinely.
+  [[nodiscard]] bool uniform_w() const { return fixed_inv_w_.has_value(); }
+
   /// Source position of lattice column i / row j: pixel centres, and the extra ring outside the
   /// image on its edges.
   [[nodiscard]] double lattice_x(int i) const { return i < 0 ? 0.0 : i >= from_.width ? from_.width : i + 0.5; }
@@ -127,6 +132,7 @@ class Reprojector {
     v.x = static_cast<int32_t>(std::floor(at->x * kSubOne + 0.5));
     v.y = static_cast<int32_t>(std::floor(at->y * kSubOne + 0.5));
     v.q = static_cast<float>(inv_z * inv_w);
+    v.r = static_cast<float>(inv_w);
     // The discontinuity measure: the larger excess opening of the two source gaps beside the vertex.
     const bool inside_row = i >= 0 && i < grid_.width;
     const float left_gap = inside_row && i > 0 ? grid_.excess[p - 1] : 0.0f;
@@ -225,8 +231,13 @@ class GridRasterizer {
  public:
   enum class Detect { off, interpolated, flags };
 
-  GridRasterizer(const WarpTarget& target, const WarpOptions& options)
-      : t_(target), detect_(options.detect_disocclusions), rule_(options.rule), threshold_(options.discontinuity_px) {}
+  /// `affine`: the reprojection keeps every point's clip w in proportion (Reprojector::uniform_w).
+  GridRasterizer(const WarpTarget& target, const WarpOptions& options, bool affine)
+      : t_(target),
+        detect_(options.detect_disocclusions),
+        rule_(options.rule),
+        threshold_(options.discontinuity_px),
+        affine_(affine) {}
 
   /// Rasterizes one grid triangle; `detect` enables disocclusion detection for it.
   void draw(const GridVertex& a, const GridVertex& b, const GridVertex& c, bool detect) {
@@ -264,13 +275,12 @@ class GridRasterizer {
       ey[k] = dx * kSubOne;
     }
     const double inv_area = 1.0 / static_cast<double>(area);
-    const bool perspective = a.q > 0.0f && b.q > 0.0f && c.q > 0.0f;
     Detect mode = Detect::off;
     if (detect && detect_) mode = rule_ == DiscardRule::all_vertices ? Detect::flags : Detect::interpolated;
     for (int y = py0; y <= py1; ++y) {
       int64_t e[3] = {e0[0], e0[1], e0[2]};
       for (int x = px0; x <= px1; ++x) {
-        if (e[0] + bias[0] >= 0 && e[1] + bias[1] >= 0 && e[2] + bias[2] >= 0) fragment(v, e, inv_area, perspective, mode, x, y);
+        if (e[0] + bias[0] >= 0 && e[1] + bias[1] >= 0 && e[2] + bias[2] >= 0) fragment(v, e, inv_area, mode, x, y);
         for (int k = 0; k < 3; ++k) e[k] += ex[k];
       }
       for (int k = 0; k < 3; ++k) e0[k] += ey[k];
@@ -299,12 +309,11 @@ class GridRasterizer {
     const GridVertex* v[3] = {&a, &b, &a};
     const Detect mode = detect && detect_ ? (rule_ == DiscardRule::all_vertices ? Detect::flags : Detect::interpolated)
                                           : Detect::off;
-    const bool perspective = a.q > 0.0f && b.q > 0.0f;
     for (int p = p0; p <= p1; ++p) {
       const int64_t along = int64_t{p} * kSubOne + kSubHalf - a.x;
       // As edge-function weights: b's share of the edge, a's the rest, nothing for the third vertex.
       const int64_t e[3] = {0, int64_t{b.x} - a.x - along, along};
-      fragment(v, e, inv_len, perspective, mode, p, static_cast<int>(row));
+      fragment(v, e, inv_len, mode, p, static_cast<int>(row));
     }
     return true;
   }
@@ -315,16 +324,20 @@ class GridRasterizer {
   uint64_t discarded = 0;
 
  private:
-  void fragment(const GridVertex* const v[3], const int64_t e[3], double inv_area, bool perspective, Detect mode, int x,
-                int y) {
+  void fragment(const GridVertex* const v[3], const int64_t e[3], double inv_area, Detect mode, int x, int y) {
     ++fragments;
-    // The weight of vertex k is the edge function of the opposite edge over the area.
+    // The weight of vertex k is the edge function of the opposite edge over the area: the target
+    // screen's barycentrics, in which the inverse target depth is linear.
     const double l0 = static_cast<double>(e[1]) * inv_area;
     const double l1 = static_cast<double>(e[2]) * inv_area;
     const double l2 = 1.0 - l0 - l1;
+    // The source position of the triangle's plane seen here: the point's world barycentrics are
+    // l_k / w_k (target clip w), and its source position weighs each vertex's by its source clip w,
+    // so vertex k weighs l_k r_k with r_k = source w / target w. Eyes that look the same way give
+    // every point one r: the source position is then affine in the target's (l_k), at any depths.
     double w0 = l0, w1 = l1, w2 = l2;
-    if (perspective) {
-      const double p0 = l0 * v[0]->q, p1 = l1 * v[1]->q, p2 = l2 * v[2]->q;
+    if (!affine_) {
+      const double p0 = l0 * v[0]->r, p1 = l1 * v[1]->r, p2 = l2 * v[2]->r;
       const double inv = 1.0 / (p0 + p1 + p2);
       w0 = p0 * inv;
       w1 = p1 * inv;
@@ -358,6 +371,7 @@ class GridRasterizer {
   bool detect_;
   DiscardRule rule_;
   double threshold_;
+  bool affine_;
 };
 
 /// The warped vertices of one row of cells: lattice rows y0..y1, every column, computed for the
@@ -598,7 +612,7 @@ std::vector<uint8_t> grid_warp(const WarpGrid& grid, const Image& source, const 
   std::vector<WarpStats> row_stats(static_cast<size_t>(grid.cells_y));
   const auto warp_row = [&](int cy, const WarpTarget& buffers) {
     CellRowVertices vertices(grid, reproject, cy);
-    GridRasterizer raster(buffers, options);
+    GridRasterizer raster(buffers, options, reproject.uniform_w());
     for (int cx = 0; cx < grid.cells_x; ++cx) {
       vertices.prepare(cx, cy);
       // A coarse cell is flat in parallax by construction: nothing in it is discarded.
