@@ -117,24 +117,32 @@ void run_gate(const GateArgs& a) {
   validation::GateReport report =
       validation::evaluate_gate(config, results, baseline, validation::registered_reproduce_settings());
   if (!baseline_note.empty()) report.notes.push_back(baseline_note);
-  fmt::print("{}", validation::format_gate_table(report));
-
-  if (!a.junit.empty()) {
-    io::write_text_atomically(a.junit, validation::junit_xml(report, "stereobench gate " + a.results));
-    fmt::print("wrote {}\n", a.junit);
-  }
-  if (!a.json_out.empty()) {
-    const nlohmann::json doc =
-        validation::gate_report_json(report, a.config, a.results, baseline_note.empty() ? baseline_file.string() : "");
+  // The report files first: the table ends in the verdict and its exit code, which stand only once
+  // they are written. Exit 4 leaves neither file: a JUnit file beside a failed run would read as
+  // its verdict.
+  const auto write = [](const char* option, const std::string& path, const std::string& text) {
     try {
-      io::write_text_atomically(a.json_out, doc.dump(2) + "\n");
-    } catch (const IoError&) {
-      // Exit 4 leaves neither output: a JUnit file beside a failed run would read as its verdict.
-      discard_outputs({{"--junit", &a.junit}});
-      throw;
+      io::write_text_atomically(path, text);
+    } catch (const IoError& e) {
+      throw IoError(fmt::format("{}: {}", option, e.what()));
     }
-    fmt::print("wrote {}\n", a.json_out);
+  };
+  try {
+    if (!a.junit.empty()) write("--junit", a.junit, validation::junit_xml(report, "stereobench gate " + a.results));
+    if (!a.json_out.empty())
+      write("--json", a.json_out,
+            validation::gate_report_json(report, a.config, a.results, baseline_note.empty() ? baseline_file.string() : "")
+                    .dump(2) +
+                "\n");
+  } catch (const IoError&) {
+    discard_outputs({{"--junit", &a.junit}, {"--json", &a.json_out}});
+    fmt::print("{}gate: the verdict above does not stand: its report files could not be written (exit 4)\n",
+               validation::format_gate_table(report));
+    throw;
   }
+  fmt::print("{}", validation::format_gate_table(report));
+  if (!a.junit.empty()) fmt::print("wrote {}\n", a.junit);
+  if (!a.json_out.empty()) fmt::print("wrote {}\n", a.json_out);
   if (const int code = validation::exit_code(report.worst); code != 0) throw VerdictExit{code};
 }
 

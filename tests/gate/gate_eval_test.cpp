@@ -516,6 +516,16 @@ TEST(GateCli, BadInputIsExitThree) {
   EXPECT_EQ(run.code, 4) << run.out;
   EXPECT_NE(run.out.find("--json " + (dir / "notafolder" / "gate.json").string()), std::string::npos) << run.out;
   EXPECT_FALSE(std::filesystem::exists(dir / "junit.xml"));
+  // An output whose folder is there but which cannot be written (under /proc) fails only when it is
+  // written: the table's verdict line ("-> PASS (exit 0)") used to end standard output of a run
+  // that exited 4.
+  run = run_cli("gate" + config + " --results " + (dir / "pass.jsonl").string() + " --junit /proc/sb-gate-junit.xml");
+  EXPECT_EQ(run.code, 4) << run.out;
+  EXPECT_NE(run.out.find("gate: the verdict above does not stand: its report files could not be written (exit 4)"),
+            std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("--junit: cannot open /proc/sb-gate-junit.xml"), std::string::npos) << run.out;
+  EXPECT_EQ(run.out.find("wrote /proc"), std::string::npos) << run.out;
   // A folder given as an output is bad input naming it.
   run = run_cli("gate" + config + " --results " + (dir / "pass.jsonl").string() + " --junit " + dir.path().string());
   EXPECT_EQ(run.code, 3) << run.out;
