@@ -376,6 +376,12 @@ void check_out_folders(const SweepRunOptions& options) {
       throw IoError(fmt::format("cannot write into {}: {}; give --out (or --results) a folder you can write",
                                 dir.string(), std::strerror(errno)));
   }
+  // Checked once the folders exist: --results naming --out's folder (or one inside it) is a folder
+  // only from here on.
+  std::error_code ec;
+  if (fs::is_directory(options.results, ec))
+    throw InputError(fmt::format("--results {} is a folder; give the results file (JSON Lines), e.g. {}",
+                                 options.results.string(), (options.results / "results.jsonl").string()));
 }
 
 /// Claims the output folder for this definition before any cell runs: a folder made for another

@@ -497,6 +497,15 @@ TEST(SweepRun, BadDefinitionAndShardAreUsageErrors) {
       << unusable.out;
   EXPECT_EQ(unusable.out.find("[1/6]"), std::string::npos) << "no cell may run: " << unusable.out;
   EXPECT_FALSE(fs::exists(dir / "r.jsonl"));
+  // --results naming --out's folder, which only the run creates, is refused before any cell runs
+  // (the first cell's results used to fail to append).
+  const test::CliRun same = test::run_cli("sweep run " + quoted(dir / "ok.toml") + " --out " + quoted(dir / "both") +
+                                          " --results " + quoted(dir / "both") + " --scenes-dir " +
+                                          quoted(dir / "scenes"));
+  EXPECT_EQ(same.code, 3) << same.out;
+  EXPECT_NE(same.out.find("--results " + (dir / "both").string() + " is a folder"), std::string::npos) << same.out;
+  EXPECT_EQ(same.out.find("[1/6]"), std::string::npos) << "no cell may run: " << same.out;
+  EXPECT_FALSE(fs::exists(dir / "both" / "cells"));
   // A damaged marker (valid JSON, not an object) names no definition: refused as another's, not
   // an internal error.
   fs::create_directories(dir / "marked");
