@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
+#include "renderer/io/gltf_loader.hpp"
 #include "scenes/scene_generator.hpp"
 
 namespace sb::scenes {
@@ -91,6 +92,15 @@ GenerateResult generate(const std::string& name, const GenerateOptions& options,
 
   GltfBuilder builder(name, options.seed, context.params);
   entry.build(context, builder);
+  // Refused before anything is written: no file that nothing could load.
+  if (builder.stats().triangles > io::kMaxSceneTriangles) {
+    std::string given;
+    for (const auto& [key, value] : options.params) given += fmt::format("{}{}={}", given.empty() ? "" : " ", key, value);
+    throw InputError(fmt::format("scene '{}' with {} expands to {} triangles (instances counted), more than the {} a "
+                                 "scene may hold; choose smaller parameters",
+                                 name, given.empty() ? "its default parameters" : given, builder.stats().triangles,
+                                 io::kMaxSceneTriangles));
+  }
 
   GenerateResult result;
   result.path = out_path;

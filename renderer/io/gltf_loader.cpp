@@ -38,9 +38,6 @@ const char* gltf_loader_version() { return "tinygltf 2.7.0"; }
 
 namespace {
 
-/// Hard limit on the triangles one scene may expand to (instancing included).
-constexpr uint64_t kMaxTriangles = 1'500'000'000;
-
 struct GlbParts {
   std::string json_text;
   bool is_glb = false;
@@ -653,9 +650,9 @@ class Converter {
             vertices += view_of(it->second, ppath).count;
         }
       }
-      if (triangles > kMaxTriangles)
+      if (triangles > kMaxSceneTriangles)
         fail(fmt::format("/nodes/{}", ni), fmt::format("the scene expands to more than {} triangles; this is "
-                                                        "beyond what the renderer holds in memory", kMaxTriangles));
+                                                        "beyond what the renderer holds in memory", kMaxSceneTriangles));
       for (auto c = n.children.rbegin(); c != n.children.rend(); ++c) stack.push_back({*c, item.world});
     }
     // Before any mesh is read: an accessor's count alone (without a bufferView its elements are

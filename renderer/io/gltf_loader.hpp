@@ -1,11 +1,15 @@
 // Loads glTF 2.0 scenes (.gltf with external or embedded buffers, .glb) into sb::Scene.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 
 #include "renderer/scene.hpp"
 
 namespace sb::io {
+
+/// The most triangles a scene may expand to (instancing included); load_gltf refuses more.
+inline constexpr uint64_t kMaxSceneTriangles = 1'500'000'000;
 
 struct GltfLoadOptions {
   bool load_textures = true;  ///< decode base colour textures (off: materials keep their factor only)

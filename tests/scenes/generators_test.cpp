@@ -94,6 +94,11 @@ TEST(SceneRegistry, RejectsUnknownAndOutOfRangeParameters) {
   o.params = {{"anything", 1.0}};
   expect_input_error([&] { (void)generate("atrium", o, out); }, {"anything", "none"});
   expect_input_error([&] { (void)generate("lit-plane", {}, dir / "plane.obj"); }, {"plane.obj", ".glb", ".gltf"});
+  // Each parameter in range, together beyond what a scene may hold (the loader would refuse the
+  // file): refused before anything is written. 100000 spheres of 256 x 128 segments.
+  o.params = {{"count", 100000.0}, {"segments", 256.0}};
+  expect_input_error([&] { (void)generate("spheres", o, out); },
+                     {"count=100000 segments=256", "6502400000 triangles", "1500000000"});
   EXPECT_FALSE(fs::exists(out));
 }
 
