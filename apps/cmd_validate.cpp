@@ -90,11 +90,16 @@ void run_validate(const ValidateArgs& a) {
              describe(rig), executor.threads(), provider->name());
 
   const fs::path out = a.out;
-  // The summary of an earlier run goes first: the records this run writes must not sit beside a
-  // summary that looks complete but describes another run, should this one stop on the way.
+  // The summary and the pipelines' records of an earlier run go first: the files this run writes
+  // must not sit beside a summary or record that looks complete but describes another run, should
+  // this one stop on the way.
   const std::string scene_stem = fmt::format("{}_{}", scene.file_stem(), provider->name());
   const fs::path summary = out / fmt::format("{}_summary.json", scene_stem);
+  const auto record_file = [&](const std::string& pipeline) {
+    return out / fmt::format("{}_{}.json", scene_stem, entry_file_stem(pipeline));
+  };
   remove_earlier_output(summary, "summary");
+  for (const PipelineEntry& e : chosen) remove_earlier_output(record_file(e.name), "record");
   const std::optional<validation::TruthCache> cache =
       a.no_cache || a.cache.empty() ? std::nullopt
                                     : std::optional<validation::TruthCache>(validation::TruthCache(a.cache));
@@ -105,31 +110,53 @@ void run_validate(const ValidateArgs& a) {
              target.truth.render.seconds,
              100.0 * double(target.disocclusions.count()) / double(target.truth_srgb8.pixel_count()));
   warn_geometry_before_near_plane(prepared, rig, executor);
-  const json shared_images = validation::write_target_images(out, scene.file_stem(), target, executor);
 
-  const validation::MetricOptions metric_options{a.error_threshold};
-  json records = json::array();
-  std::vector<std::string> names;
-  for (const PipelineEntry& e : chosen) names.push_back(e.name);
-  const size_t name_w = pipeline_column(names);
-  fmt::print("\n{:<{}} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10}\n", "pipeline", name_w, "PSNR dB", "SSIM",
-             "MSE", "err %", "holes %", "recall", "prec.", "time ms");
-  for (size_t i = 0; i < chosen.size(); ++i) {
-    const validation::PipelineValidation v =
-        validation::validate_pipeline(target, chosen[i], options[i], executor, metric_options);
-    const std::string stem = fmt::format("{}_{}", scene_stem, entry_file_stem(v.pipeline));
-    json images = validation::write_pipeline_images(out, stem, target, v, executor);
-    images.update(shared_images);
-    const json record = validation::validation_record(target, v, executor.threads(), images);
-    io::write_text_atomically(out / (stem + ".json"), record.dump(2) + "\n");
-    records.push_back(record);
-    const validation::HoleStatistics& h = v.holes;
-    fmt::print("{:<{}} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10.1f}\n", v.pipeline, name_w,
-               number(v.whole.psnr, "{:.2f}"), number(v.whole.ssim, "{:.4f}"), number(v.whole.mse, "{:.3f}"),
-               number(100.0 * v.whole.error_fraction, "{:.3f}"), number(100.0 * h.hole_fraction, "{:.3f}"),
-               number(h.scores.recall, "{:.4f}"), number(h.scores.precision, "{:.4f}"), v.result.timings.total() * 1e3);
+  // What this run has written, removed should it stop on the way (an image it cannot write, a full
+  // disk): the images shared by the records must not be left beside another run's.
+  std::vector<fs::path> written;
+  const auto remember = [&](const json& files) {
+    for (const auto& [name, path] : files.items()) written.emplace_back(path.get<std::string>());
+  };
+  try {
+    const json shared_images = validation::write_target_images(out, scene.file_stem(), target, executor);
+    remember(shared_images);
+
+    const validation::MetricOptions metric_options{a.error_threshold};
+    json records = json::array();
+    std::vector<std::string> names;
+    for (const PipelineEntry& e : chosen) names.push_back(e.name);
+    const size_t name_w = pipeline_column(names);
+    fmt::print("\n{:<{}} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10}\n", "pipeline", name_w, "PSNR dB", "SSIM",
+               "MSE", "err %", "holes %", "recall", "prec.", "time ms");
+    for (size_t i = 0; i < chosen.size(); ++i) {
+      const validation::PipelineValidation v =
+          validation::validate_pipeline(target, chosen[i], options[i], executor, metric_options);
+      const std::string stem = fmt::format("{}_{}", scene_stem, entry_file_stem(v.pipeline));
+      json images = validation::write_pipeline_images(out, stem, target, v, executor);
+      remember(images);
+      images.update(shared_images);
+      const json record = validation::validation_record(target, v, executor.threads(), images);
+      io::write_text_atomically(record_file(v.pipeline), record.dump(2) + "\n");
+      written.push_back(record_file(v.pipeline));
+      records.push_back(record);
+      const validation::HoleStatistics& h = v.holes;
+      fmt::print("{:<{}} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10.1f}\n", v.pipeline, name_w,
+                 number(v.whole.psnr, "{:.2f}"), number(v.whole.ssim, "{:.4f}"), number(v.whole.mse, "{:.3f}"),
+                 number(100.0 * v.whole.error_fraction, "{:.3f}"), number(100.0 * h.hole_fraction, "{:.3f}"),
+                 number(h.scores.recall, "{:.4f}"), number(h.scores.precision, "{:.4f}"),
+                 v.result.timings.total() * 1e3);
+    }
+    io::write_text_atomically(summary,
+                              json{{"kind", "stereobench.validation_summary"}, {"records", records}}.dump(2) + "\n");
+  } catch (...) {
+    for (const fs::path& p : written) {
+      try {
+        (void)io::remove_output_file(p);
+      } catch (const std::exception&) {  // best effort: the run's own error is the one to report
+      }
+    }
+    throw;
   }
-  io::write_text_atomically(summary, json{{"kind", "stereobench.validation_summary"}, {"records", records}}.dump(2) + "\n");
   fmt::print("\nwrote {} (one record per pipeline beside it, images under {})\n", summary.string(), out.string());
 }
 

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
 #include "renderer/io/image_io.hpp"
 #include "validation/metric_images.hpp"
 
@@ -37,9 +38,22 @@ namespace {
 
 /// Runs the file writers side by side on the executor's threads. A failure cancels the writers
 /// not yet started and is rethrown once the running ones have finished; each writes atomically,
-/// so none leaves a partial file.
-void write_side_by_side(const std::vector<std::function<void()>>& writers, const Executor& executor) {
-  executor.for_each(writers.size(), [&](size_t i) { writers[i](); });
+/// so none leaves a partial file, and every file of `paths` (the set) is then removed.
+void write_side_by_side(const std::vector<std::function<void()>>& writers, const std::vector<std::filesystem::path>& paths,
+                        const Executor& executor) {
+  try {
+    executor.for_each(writers.size(), [&](size_t i) { writers[i](); });
+  } catch (...) {
+    // The set is whole or gone: files of it written beside the one that failed (or left from an
+    // earlier run under the same names) would read as this run's.
+    for (const std::filesystem::path& p : paths) {
+      try {
+        (void)io::remove_output_file(p);
+      } catch (const std::exception&) {  // best effort: the write's own error is the one to report
+      }
+    }
+    throw;
+  }
 }
 
 }  // namespace
@@ -54,11 +68,13 @@ json write_target_images(const std::filesystem::path& dir, const std::string& st
   std::vector<std::function<void()>> writers = {
       [&] { write_png(png, target.truth_srgb8); },
       [&] { write_png(dis, disocclusion_image(target.truth_srgb8, target.disocclusions)); }};
+  std::vector<std::filesystem::path> paths = {png, dis};
   if (options.exr) {
     writers.emplace_back([&] { io::write_exr(exr, target.truth.render.right); });
     files["truth_exr"] = exr.string();
+    paths.push_back(exr);
   }
-  write_side_by_side(writers, executor);
+  write_side_by_side(writers, paths, executor);
   files["truth_png"] = png.string();
   files["true_disocclusions_png"] = dis.string();
   return files;
@@ -75,11 +91,13 @@ json write_pipeline_images(const std::filesystem::path& dir, const std::string& 
       [&] {
         io::write_png_preview(path("holes.png"), hole_overlay(v.result.right, v.hole_mask, target.disocclusions.mask));
       }};
+  std::vector<std::filesystem::path> paths = {path("right.png"), path("diff.png"), path("ssim.png"), path("holes.png")};
   if (options.exr) {
     writers.emplace_back([&] { io::write_exr(path("right.exr"), v.result.right); });
     files["right_exr"] = path("right.exr").string();
+    paths.push_back(path("right.exr"));
   }
-  write_side_by_side(writers, executor);
+  write_side_by_side(writers, paths, executor);
   files["right_png"] = path("right.png").string();
   files["diff_png"] = path("diff.png").string();
   files["ssim_png"] = path("ssim.png").string();

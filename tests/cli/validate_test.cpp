@@ -156,17 +156,22 @@ TEST(Validate, WhatARigForbidsIsRefusedBeforeAnythingRendersAndAStopLeavesNoSumm
             std::string::npos)
       << variant.out;
 
-  // A run that stops after a record is written (here: the second record's path is a folder)
-  // leaves no summary of an earlier run beside its records.
+  // A run that stops after a record is written (here: the second pipeline's right-eye image path
+  // is a folder) leaves neither an earlier run's summary and records nor its own files: the truth
+  // images it shares with the records used to stay beside the earlier run's records, which
+  // described another rig.
   ASSERT_EQ(test::run_cli(base_args(dir) + " --pipelines plain-rt,repro-rt").code, 0);
   ASSERT_TRUE(fs::exists(out / "box-wall_full_summary.json"));
-  fs::remove(out / "box-wall_full_repro-rt.json");
-  fs::create_directories(out / "box-wall_full_repro-rt.json");
-  const test::CliRun stopped = test::run_cli(base_args(dir) + " --pipelines plain-rt,repro-rt");
+  fs::remove(out / "box-wall_full_repro-rt_right.png");
+  fs::create_directories(out / "box-wall_full_repro-rt_right.png");
+  const test::CliRun stopped = test::run_cli(base_args(dir) + " --interaxial 0.3 --pipelines plain-rt,repro-rt");
   EXPECT_EQ(stopped.code, 3) << stopped.out;
-  EXPECT_NE(stopped.out.find("box-wall_full_repro-rt.json is a folder"), std::string::npos) << stopped.out;
-  EXPECT_TRUE(fs::exists(out / "box-wall_full_plain-rt.json"));
-  EXPECT_FALSE(fs::exists(out / "box-wall_full_summary.json")) << "an earlier run's summary beside this run's records";
+  EXPECT_NE(stopped.out.find("box-wall_full_repro-rt_right.png is a folder"), std::string::npos) << stopped.out;
+  for (const char* file : {"box-wall_full_summary.json", "box-wall_full_plain-rt.json", "box-wall_full_repro-rt.json",
+                           "box-wall_truth-full.png", "box-wall_disocclusions.png", "box-wall_full_plain-rt_right.png",
+                           "box-wall_full_plain-rt_diff.png", "box-wall_full_repro-rt_diff.png"})
+    EXPECT_FALSE(fs::exists(out / file)) << file << " stayed beside a run that stopped";
+  EXPECT_TRUE(fs::is_directory(out / "box-wall_full_repro-rt_right.png")) << "a folder is never removed";
 }
 
 TEST(Validate, BadInputAndMissingTools) {
