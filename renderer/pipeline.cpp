@@ -2,6 +2,7 @@
 #include "renderer/pipeline.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <string_view>
 
@@ -133,6 +134,35 @@ std::string entry_file_stem(const std::string& entry) {
     c = c == ':' ? '@' : kept ? c : '_';
   }
   return stem;
+}
+
+namespace {
+
+/// An option value as the pipeline reads it, for comparing spellings: a boolean option's (its
+/// default is true or false) as true/false, a number as the shortest text of its double.
+std::string canonical_value(const PipelineInfo& info, const std::string& key, const std::string& value) {
+  const auto spec = std::find_if(info.options.begin(), info.options.end(), [&](const OptionSpec& o) { return o.name == key; });
+  if (spec != info.options.end() && (spec->default_value == "true" || spec->default_value == "false")) {
+    if (value == "1" || value == "true" || value == "on" || value == "yes") return "true";
+    if (value == "0" || value == "false" || value == "off" || value == "no") return "false";
+    return value;
+  }
+  double number = 0.0;
+  const char* end = value.data() + value.size();
+  const auto [at, ec] = std::from_chars(value.data(), end, number);
+  if (ec == std::errc() && at == end && std::isfinite(number)) return fmt::format("{}", number);
+  return value;
+}
+
+}  // namespace
+
+bool PipelineEntry::same_variant(const PipelineEntry& other) const {
+  if (pipeline != other.pipeline || fixed.size() != other.fixed.size()) return false;
+  for (auto a = fixed.begin(), b = other.fixed.begin(); a != fixed.end(); ++a, ++b)
+    if (a->first != b->first || canonical_value(pipeline->info(), a->first, a->second) !=
+                                    canonical_value(pipeline->info(), b->first, b->second))
+      return false;
+  return true;
 }
 
 std::optional<std::string> find_same_variant(const std::vector<PipelineEntry>& listed, const PipelineEntry& entry) {

@@ -120,13 +120,12 @@ struct PipelineEntry {
   /// The pipeline's check_rig for `options` (made by options()) and `rig`; an InputError about a
   /// variant names the entry.
   void check_rig(const PipelineOptions& options, const StereoRig& rig) const;
-  /// Whether `other` names the same variant: the same pipeline fixing the same options, in
-  /// whatever order either name gives them. Entries that fix different options are different
-  /// variants even where the values are the pipeline's defaults: options given for the pipeline
-  /// (--option, [options.NAME]) apply under each entry's own.
-  [[nodiscard]] bool same_variant(const PipelineEntry& other) const {
-    return pipeline == other.pipeline && fixed == other.fixed;
-  }
+  /// Whether `other` names the same variant: the same pipeline fixing the same options to the same
+  /// values, in whatever order and spelling either name gives them (a boolean as yes/on/1/true, a
+  /// number as 2 or 2.0). Entries that fix different options are different variants even where the
+  /// values are the pipeline's defaults: options given for the pipeline (--option,
+  /// [options.NAME]) apply under each entry's own.
+  [[nodiscard]] bool same_variant(const PipelineEntry& other) const;
 };
 
 /// The name of the entry of `listed` that names the same variant as `entry`, if there is one.

@@ -182,6 +182,12 @@ TEST(SweepDefinition, VariantsRunBesideTheirPipeline) {
   EXPECT_EQ(reordered.baseline, "fw-warp:max_crack=1:warp=rows");
   EXPECT_TRUE(reordered.baseline_listed);
   EXPECT_EQ(reordered.pipelines, (std::vector<std::string>{"fw-warp:max_crack=1:warp=rows", "plain-rt"}));
+  // Different values stay different variants.
+  const SweepDefinition distinct = parse_sweep(
+      "[sweep]\npipelines = [\"rt-atomic:confirm=true\", \"rt-atomic:confirm=false\", \"repro-rt:tile=16\", "
+      "\"repro-rt:tile=32\"]\n",
+      "def.toml");
+  EXPECT_EQ(distinct.pipelines.size(), 5u);  // and the baseline
 }
 
 TEST(SweepDefinition, BothInteraxialKindsRejected) {
@@ -225,6 +231,11 @@ TEST(SweepDefinition, BadValuesRejected) {
       {"[sweep]\npipelines = [\"fw-warp:max_crack=1:warp=rows\", \"fw-warp:warp=rows:max_crack=1\"]\n",
        "def.toml:2: sweep.pipelines: 'fw-warp:max_crack=1:warp=rows' and 'fw-warp:warp=rows:max_crack=1' "
        "name the same variant of fw-warp; name it once"},
+      // So did one under two spellings of a value the pipeline reads alike.
+      {"[sweep]\npipelines = [\"rt-atomic:confirm=yes\", \"rt-atomic:confirm=true\"]\n",
+       "'rt-atomic:confirm=yes' and 'rt-atomic:confirm=true' name the same variant of rt-atomic"},
+      {"[sweep]\npipelines = [\"repro-rt:threshold_arcmin=2\", \"repro-rt:threshold_arcmin=2.0\"]\n",
+       "name the same variant of repro-rt"},
       {"[sweep]\nbaseline = \"nope\"\n", "sweep.baseline"},
       {"[sweep]\ntruths = [\"mitsuba\"]\n", "unknown ground-truth provider 'mitsuba'"},
       {"[sweep]\nname = 3\n", "sweep.name: must be a string, not an integer"},
