@@ -148,6 +148,15 @@ CameraPose SceneAnimator::camera_at(int frame, const CameraPose& base) const {
   return CameraPose::look_at(k.position, k.target);
 }
 
+std::optional<std::string> camera_key_problem(const CameraKey& key) {
+  for (const auto& [what, p] : {std::pair{"position", key.position}, std::pair{"target", key.target}})
+    if (!within_scene_range(p))
+      return fmt::format("its {} ({:g}, {:g}, {:g}) m lies beyond the ±{:g} m a scene may span", what, p.x, p.y, p.z,
+                         kMaxSceneCoordinate);
+  if (key.position == key.target) return "its target equals its position: it has no viewing direction";
+  return std::nullopt;
+}
+
 std::vector<CameraKey> parse_camera_keys(const std::string& text) {
   std::vector<CameraKey> keys;
   std::stringstream list(text);
@@ -169,6 +178,8 @@ std::vector<CameraKey> parse_camera_keys(const std::string& text) {
     if (arrow == std::string::npos)
       throw InputError(fmt::format("camera key {} '{}' is not POSITION>TARGET, e.g. 0,1.6,3>0,1.2,0", keys.size() + 1, item));
     keys.push_back({vec(item.substr(0, arrow), keys.size() + 1), vec(item.substr(arrow + 1), keys.size() + 1)});
+    if (const auto why = camera_key_problem(keys.back()))
+      throw InputError(fmt::format("camera key {} '{}': {}", keys.size(), item, *why));
   }
   if (keys.empty()) throw InputError("no camera key given; give POSITION>TARGET;POSITION>TARGET...");
   return keys;

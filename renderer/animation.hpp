@@ -66,8 +66,13 @@ class SceneAnimator {
   std::vector<std::vector<vec3>> base_positions_, base_normals_;
 };
 
+/// What makes a key pose unusable, if anything: a position or target that is not finite or lies
+/// beyond the ±kMaxSceneCoordinate a scene may span, or a target equal to the position (no
+/// viewing direction).
+[[nodiscard]] std::optional<std::string> camera_key_problem(const CameraKey& key);
+
 /// Parses camera keys "px,py,pz>tx,ty,tz;px,py,pz>tx,ty,tz;..." (meters). InputError naming the
-/// key and what is wrong.
+/// key and what is wrong (camera_key_problem included).
 [[nodiscard]] std::vector<CameraKey> parse_camera_keys(const std::string& text);
 
 }  // namespace sb

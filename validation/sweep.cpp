@@ -308,8 +308,7 @@ void parse_path(const Where& where, const toml::node& node, SweepDefinition& d) 
       const std::vector<double> v =
           numbers_at(where, e, "path.camera_keys", 6, "[0, 1.6, 4, 0, 1, 0] (position, then target, meters)");
       const CameraKey key{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
-      if (key.position == key.target)
-        where.fail(e, "path.camera_keys", "a key pose whose target equals its position has no viewing direction");
+      if (const auto why = camera_key_problem(key)) where.fail(e, "path.camera_keys", fmt::format("a key pose: {}", *why));
       path.camera_keys.push_back(key);
     }
   }

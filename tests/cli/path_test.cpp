@@ -79,6 +79,11 @@ TEST(PathCommand, BadInput) {
   const test::CliRun empty_key = test::run_cli(args(dir) + " --camera-keys '0,1,6>0,0.5,0;;1,1,6>0,0.5,0'");
   EXPECT_EQ(empty_key.code, 3) << empty_key.out;
   EXPECT_NE(empty_key.out.find("camera key 2 is empty"), std::string::npos) << empty_key.out;
+  const test::CliRun far_key = test::run_cli(args(dir) + " --camera-keys '0,1,6>0,0.5,0;1,1,6>0,1e300,0'");
+  EXPECT_EQ(far_key.code, 3) << far_key.out;
+  EXPECT_NE(far_key.out.find("camera key 2 '1,1,6>0,1e300,0': its target (0, 1e+300, 0) m lies beyond"),
+            std::string::npos)
+      << far_key.out;
   EXPECT_EQ(test::run_cli(args(dir) + " --spin-deg 5 --spin-prefix nothing-like-this").code, 3);
   EXPECT_EQ(test::run_cli(args(dir) + " --spin-deg 5 --truth blender").code, 3);
   // An axis with trailing junk, and spin settings without a spin, are refused, not ignored.

@@ -362,7 +362,10 @@ TEST(SweepDefinition, RejectsBadPaths) {
        "def.toml:4: path.camera_keys: must be an array of 6 numbers, e.g. [0, 1.6, 4, 0, 1, 0] (position, then "
        "target, meters), not 5 values"},
       {"[sweep]\n[path]\nframes = 3\ncamera_keys = [[0, 1, 2, 0, 1, 2]]\n",
-       "def.toml:4: path.camera_keys: a key pose whose target equals its position"},
+       "def.toml:4: path.camera_keys: a key pose: its target equals its position"},
+      // Checked when the definition loads (it used to stop the sweep at its first cell, naming no file).
+      {"[sweep]\n[path]\nframes = 2\ncamera_keys = [[1e300, 1, 4, 0, 1, 0]]\n",
+       "def.toml:4: path.camera_keys: a key pose: its position (1e+300, 1, 4) m lies beyond"},
       {"[sweep]\n[path]\nframes = 3\ncamera_keys = []\n", "def.toml:4: path.camera_keys: must be a non-empty array"},
       {"[sweep]\n[path]\nframes = 3\nbvh = \"refresh\"\n", "def.toml:4: path.bvh: 'refresh' is neither"},
       {"[sweep]\n[path]\nframes = 3\n[path.spin]\naxis = [0, 0, 0]\n", "def.toml:5: path.spin.axis: is zero"},
