@@ -398,7 +398,12 @@ void claim_out_folder(const SweepDefinition& d, const SweepRunOptions& options) 
       theirs = io::parse_json(io::read_file(marker));
     } catch (const io::JsonTextError&) {
     }
-    if (!theirs.is_object()) theirs = json::object();  // damaged: it names no definition
+    if (!theirs.is_object() || !theirs.value("sweep", json()).is_string() ||
+        !theirs.value("definition_sha256", json()).is_string() || !theirs.value("definition", json()).is_string())
+      throw InputError(fmt::format("{} holds a damaged sweep marker {} (not the record a sweep writes), so which "
+                                   "sweep's cells are there is unknown; its images could be overwritten: give another "
+                                   "--out, or delete the folder to start over",
+                                   options.out_dir.string(), marker.string()));
     if (theirs.value("sweep", "") == d.name && theirs.value("definition_sha256", "") == d.sha256) return;
     throw InputError(fmt::format(
         "{} holds the cells of sweep '{}' ({}, sha256 {}), not of this definition '{}' ({}, sha256 {}); its images "
