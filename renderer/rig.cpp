@@ -52,6 +52,10 @@ void RigParams::validate() const {
                                  interaxial, kMaxSceneCoordinate));
   require_positive(convergence, "convergence",
                    "give the zero-parallax distance in meters, e.g. 2.0");
+  if (convergence > kMaxSceneCoordinate)
+    throw InputError(fmt::format("convergence {:g} m is beyond the ±{:g} m a scene may span; give the zero-parallax "
+                                 "distance in meters, e.g. 2.0",
+                                 convergence, kMaxSceneCoordinate));
   if (width < 1 || width > kMaxImageSide || height < 1 || height > kMaxImageSide)
     throw InputError(fmt::format("resolution {}x{} is out of range; each side must be 1..{}", width,
                                  height, kMaxImageSide));

@@ -507,8 +507,7 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
                       kMaxDisparityPx);
   if (const toml::node* n = sweep.get("convergence_m"))
     d.convergence_m = positive_axis(where, *n, "sweep.convergence_m",
-                                    "give zero-parallax distances in meters, e.g. 2.0",
-                                    std::numeric_limits<double>::max());
+                                    "give zero-parallax distances in meters, e.g. 2.0", kMaxSceneCoordinate);
   if (const toml::node* n = sweep.get("resolutions")) {
     d.resolutions.clear();
     for (const toml::node* e : axis_entries(where, *n, "sweep.resolutions")) {

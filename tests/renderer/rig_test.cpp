@@ -131,13 +131,15 @@ TEST(Rig, BadParametersAreInputErrors) {
   // Rigs whose rays cannot be set up: an interaxial beyond the span of a scene (1e20 m aborted the
   // ray tracer on NaN rays), a convergence so near that the sensor shift is infinite, a disparity
   // of a billion pixels. The largest accepted ones still render.
-  for (const auto& [e, c] : {std::pair{1e20, 2.0}, std::pair{1.0, 1e-6}, std::pair{0.064, 1e-300}}) {
+  // A convergence beyond that span is refused too (1e308 m printed as a 300-digit number).
+  for (const auto& [e, c] :
+       {std::pair{1e20, 2.0}, std::pair{1.0, 1e-6}, std::pair{0.064, 1e-300}, std::pair{0.064, 1e308}}) {
     try {
       make_rig(e, c);
       ADD_FAILURE() << "e " << e << " c " << c;
     } catch (const InputError& err) {
-      EXPECT_NE(std::string(err.what()).find(e > kMaxSceneCoordinate ? "a scene may span" : "a rig may have"),
-                std::string::npos)
+      const bool beyond_span = e > kMaxSceneCoordinate || c > kMaxSceneCoordinate;
+      EXPECT_NE(std::string(err.what()).find(beyond_span ? "a scene may span" : "a rig may have"), std::string::npos)
           << err.what();
     }
   }
