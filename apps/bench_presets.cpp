@@ -270,7 +270,7 @@ void run_bench_preset(const PresetRun& run, const Executor& executor) {
 
   nlohmann::json out = preset_json(run, executor);
   const auto write_json = [&] {
-    if (!run.json_out.empty()) io::write_text_atomically(run.json_out, out.dump(2) + "\n");
+    if (!run.json_out.empty()) write_option_file("--json", run.json_out, out.dump(2) + "\n");
   };
 
   RowScene current;

@@ -260,7 +260,7 @@ void run_kim_focal(const PresetRun& run, const Executor& executor) {
   out["reference"] = kReference;
   out["metrics_version"] = validation::kMetricsVersion;
   const auto write_json = [&] {
-    if (!run.json_out.empty()) io::write_text_atomically(run.json_out, out.dump(2) + "\n");
+    if (!run.json_out.empty()) write_option_file("--json", run.json_out, out.dump(2) + "\n");
   };
 
   const RenderContext ctx{executor};
@@ -353,7 +353,7 @@ void run_kim_complexity(const PresetRun& run, const Executor& executor) {
   nlohmann::json out = preset_json(run, executor);
   out["memory_usable_share"] = kMemoryUsableShare;
   const auto write_json = [&] {
-    if (!run.json_out.empty()) io::write_text_atomically(run.json_out, out.dump(2) + "\n");
+    if (!run.json_out.empty()) write_option_file("--json", run.json_out, out.dump(2) + "\n");
   };
 
   for (const PresetSeries& series : preset.series) {

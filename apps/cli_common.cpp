@@ -177,6 +177,14 @@ void remove_earlier_outputs(std::initializer_list<NamedPath> outputs) {
   if (first) throw *first;
 }
 
+void write_option_file(const std::string& option, const std::string& path, const std::string& text) {
+  try {
+    io::write_text_atomically(path, text);
+  } catch (const IoError& e) {
+    throw IoError(fmt::format("{}: {}; give {} a path you can write", option, e.what(), option));
+  }
+}
+
 void discard_outputs(std::initializer_list<NamedPath> outputs) noexcept {
   for (const NamedPath& o : outputs) {
     if (o.path->empty() || *o.path == "-") continue;

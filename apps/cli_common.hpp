@@ -83,6 +83,10 @@ void remove_earlier_outputs(std::initializer_list<NamedPath> outputs);
 /// regular files only, "" and "-" skipped), so that none is left beside its error.
 void discard_outputs(std::initializer_list<NamedPath> outputs) noexcept;
 
+/// Writes an output file an option names (io::write_text_atomically); an IoError names the option
+/// and what to do, e.g. "--json: cannot open /proc/x.json: ...; give --json a path you can write".
+void write_option_file(const std::string& option, const std::string& path, const std::string& text);
+
 /// Writes `text` and a newline to standard output and flushes it: IoError (exit 4) when it cannot
 /// take them (a full disk behind a redirection, a closed pipe), so that "--json -" never ends in
 /// success with the JSON lost.

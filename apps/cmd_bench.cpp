@@ -172,7 +172,7 @@ void run_bench_command(const BenchArgs& a) {
     if (a.json_out == "-") {
       print_to_stdout(j.dump(2));
     } else {
-      io::write_text_atomically(a.json_out, j.dump(2) + "\n");
+      write_option_file("--json", a.json_out, j.dump(2) + "\n");
       fmt::print(out, "wrote {}\n", a.json_out);
     }
   }

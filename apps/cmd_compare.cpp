@@ -195,7 +195,7 @@ int run_compare(const CompareArgs& a) {
     if (a.json == "-")
       print_to_stdout(record.dump(2));
     else if (!a.json.empty())
-      io::write_text_atomically(a.json, record.dump(2) + "\n");
+      write_option_file("--json", a.json, record.dump(2) + "\n");
   } catch (const std::exception&) {
     // An output that cannot be written takes the others of this run with it.
     discard_outputs(outputs);

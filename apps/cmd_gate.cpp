@@ -120,20 +120,15 @@ void run_gate(const GateArgs& a) {
   // The report files first: the table ends in the verdict and its exit code, which stand only once
   // they are written. Exit 4 leaves neither file: a JUnit file beside a failed run would read as
   // its verdict.
-  const auto write = [](const char* option, const std::string& path, const std::string& text) {
-    try {
-      io::write_text_atomically(path, text);
-    } catch (const IoError& e) {
-      throw IoError(fmt::format("{}: {}", option, e.what()));
-    }
-  };
   try {
-    if (!a.junit.empty()) write("--junit", a.junit, validation::junit_xml(report, "stereobench gate " + a.results));
+    if (!a.junit.empty())
+      write_option_file("--junit", a.junit, validation::junit_xml(report, "stereobench gate " + a.results));
     if (!a.json_out.empty())
-      write("--json", a.json_out,
-            validation::gate_report_json(report, a.config, a.results, baseline_note.empty() ? baseline_file.string() : "")
-                    .dump(2) +
-                "\n");
+      write_option_file("--json", a.json_out,
+                        validation::gate_report_json(report, a.config, a.results,
+                                                     baseline_note.empty() ? baseline_file.string() : "")
+                                .dump(2) +
+                            "\n");
   } catch (const IoError&) {
     discard_outputs({{"--junit", &a.junit}, {"--json", &a.json_out}});
     fmt::print("{}gate: the verdict above does not stand: its report files could not be written (exit 4)\n",

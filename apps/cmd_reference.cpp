@@ -106,7 +106,7 @@ int run_verify(const ReferenceArgs& a) {
       j.push_back({{"id", r.id}, {"status", reference::to_string(r.status)}, {"detail", r.detail},
                    {"bit_identical", r.bit_identical},
                    {"metrics", r.metrics ? validation::to_json(*r.metrics) : json(nullptr)}});
-    io::write_text_atomically(a.json_out, j.dump(2) + "\n");
+    write_option_file("--json", a.json_out, j.dump(2) + "\n");
   }
   const int code = verdict(results);
   // What to do differs: a failed check is rewritten by update, unless the entry's spec is lost with

@@ -218,7 +218,7 @@ void register_csv(CLI::App& sweep) {
     if (a->out.empty()) {
       fmt::print("{}", text);
     } else {
-      io::write_text_atomically(a->out, text);
+      write_option_file("--out", a->out, text);
       fmt::print(stderr, "wrote {} ({} cells)\n", a->out, r.cells.size());
     }
   });
@@ -244,7 +244,7 @@ void register_collect(CLI::App& sweep) {
       throw InputError(fmt::format("the {} input file(s) hold no finished cell; {} not written (check that the shards "
                                    "ran, and their results paths)",
                                    inputs.size(), a->out));
-    io::write_text_atomically(a->out, results_text(cells));
+    write_option_file("the merged results file", a->out, results_text(cells));
     fmt::print("wrote {}: {} cells from {} files\n", a->out, cells.size(), inputs.size());
   });
 }

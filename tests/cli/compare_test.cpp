@@ -168,6 +168,13 @@ TEST_F(Compare, AStoppedComparisonLeavesNoOutputs) {
   EXPECT_EQ(r.code, 4) << r.out;
   EXPECT_NE(r.out.find("--json " + (path("file") / "v.json").string()), std::string::npos) << r.out;
   none_left("file/v.json");
+  // A file its folder cannot take (under /proc) fails only when written: the error names the option
+  // and what to do, and the pictures go with it.
+  r = compare(ab() + " --diff " + q(path("d.png")) + " --ssim-map " + q(path("s.png")) + " --json /proc/sb-compare.json");
+  EXPECT_EQ(r.code, 4) << r.out;
+  EXPECT_NE(r.out.find("--json: cannot open /proc/sb-compare.json"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("give --json a path you can write"), std::string::npos) << r.out;
+  none_left("v.json");
   // A picture name the run refuses is not its output: the file stays.
   std::ofstream(path("photo.jpg")) << "a photo\n";
   r = compare(ab() + " --diff " + q(path("photo.jpg")));
