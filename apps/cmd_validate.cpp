@@ -42,19 +42,10 @@ struct ValidateArgs {
 };
 
 /// The pipelines named (comma-separated or repeated), "all" for every registered one, variants as
-/// NAME:KEY=VALUE[:KEY=VALUE...]; a name given twice runs once.
+/// NAME:KEY=VALUE[:KEY=VALUE...]; a pipeline named twice (also beside "all") is refused, as bench,
+/// path and sweeps refuse it.
 std::vector<PipelineEntry> chosen_pipelines(const std::vector<std::string>& names) {
-  std::vector<std::string> chosen;
-  const auto add = [&chosen](const std::string& name) {
-    if (std::find(chosen.begin(), chosen.end(), name) == chosen.end()) chosen.push_back(name);
-  };
-  for (const std::string& name : split_list(names, "--pipelines")) {
-    if (name == "all")
-      for (const std::string& n : pipeline_names()) add(n);
-    else
-      add(name);
-  }
-  return parse_pipeline_entries(chosen, "--pipelines");
+  return parse_pipeline_entries(expand_all_pipelines(split_list(names, "--pipelines"), "--pipelines"), "--pipelines");
 }
 
 std::string number(double v, const char* format) {

@@ -45,6 +45,9 @@ std::vector<std::string> expand_all_pipelines(const std::vector<std::string>& na
   const auto listed = [&out](const std::string& name) { return std::find(out.begin(), out.end(), name) != out.end(); };
   for (const std::string& name : names) {
     if (name == "all") {
+      if (all)
+        throw InputError(what.empty() ? "'all' is named twice; name it once"
+                                      : fmt::format("{} names 'all' twice; name it once", what));
       all = true;
       for (const std::string& n : pipeline_names())
         if (!listed(n)) out.push_back(n);

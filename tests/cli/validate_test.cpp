@@ -131,6 +131,11 @@ TEST(Validate, VariantsAreMeasuredBesideTheirPipelineUnderTheirOwnName) {
       {"bidir-warp:max_crack=2:occlusion=ztest,bidir-warp:occlusion=ztest:max_crack=2",
        "'bidir-warp:max_crack=2:occlusion=ztest' and 'bidir-warp:occlusion=ztest:max_crack=2' name the same variant of "
        "bidir-warp; name it once"},
+      // A name given twice, also beside 'all' or as 'all' twice, is refused as bench, path and
+      // sweeps refuse it (validate used to run it once).
+      {"plain-rt,plain-rt", "--pipelines names 'plain-rt' twice"},
+      {"all,plain-rt", "'plain-rt' is one of the pipelines 'all' includes"},
+      {"all,all", "--pipelines names 'all' twice"},
   };
   for (const auto& [entry, message] : bad) {
     const test::CliRun e = test::run_cli(base_args(dir) + " --pipelines '" + entry + "'");

@@ -225,6 +225,7 @@ TEST(SweepDefinition, BadValuesRejected) {
       {"[sweep]\npipelines = [\"repro-rtx\"]\n", "sweep.pipelines"},
       {"[sweep]\npipelines = [\"all\", \"repro-rt\"]\n",
        "sweep.pipelines: 'repro-rt' is one of the pipelines 'all' includes; drop one of them"},
+      {"[sweep]\npipelines = [\"all\", \"all\"]\n", "sweep.pipelines: 'all' is named twice"},
       {"[sweep]\npipelines = []\n",
        "sweep.pipelines: is empty; give at least one value, or leave the key out for its default"},
       // One variant under two names (its options in another order) used to be measured twice.
