@@ -406,6 +406,10 @@ void check_cell_record(const json& line, const std::string& where) {
         require_within(p, where, prefix, std::string("timing.") + t, 0.0, kMax);
       }
       require(p, where, prefix, "timing.repetitions", Kind::integer, true);
+      if (const json* n = find(p, "timing.repetitions"); n != nullptr && n->get<long long>() < 1)
+        throw InputError(fmt::format("{}: field '{}timing.repetitions' is {}, but a timed pipeline ran at least once; "
+                                     "the line is damaged or edited by hand",
+                                     where, prefix, n->dump()));
       require(p, where, prefix, "timing.samples_s", Kind::array, true);
       if (const json* samples = find(p, "timing.samples_s"))
         for (const json& t : *samples)

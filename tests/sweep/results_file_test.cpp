@@ -221,6 +221,11 @@ TEST(ResultsFile, BadLinesAndDuplicatesRejected) {
   expect_refused(short_of_samples,
                  "checked.jsonl:2: field 'pipelines.plain-rt.timing.samples_s' holds 0 time(s) but timing.repetitions "
                  "is 3");
+  // A timed pipeline ran at least once: no repetitions and no samples is no timing.
+  json untimed = cell(1, "b");
+  untimed["pipelines"]["plain-rt"]["timing"]["repetitions"] = 0;
+  untimed["pipelines"]["plain-rt"]["timing"]["samples_s"] = json::array();
+  expect_refused(untimed, "checked.jsonl:2: field 'pipelines.plain-rt.timing.repetitions' is 0, but a timed pipeline");
   // A cell_id that tells another cell than the fields do: the gate would look its baseline and
   // rules up under one cell and read the scene of another.
   json axes = cell(1, "box-wall:size=0.5|e=0.064m|c=default|96x54|lights=all|full");
