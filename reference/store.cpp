@@ -141,6 +141,10 @@ ReferenceSpec spec_from_json(const json& j) {
 /// The spec a provenance (read from `file`) records; InputError naming the file when it is malformed.
 ReferenceSpec spec_in(const json& provenance, const fs::path& file) {
   ReferenceSpec spec;
+  if (!provenance.is_object() || !provenance.contains("spec"))
+    throw InputError(fmt::format("{}: has no field 'spec' (what the reference renders), so it cannot be rendered again; "
+                                 "generate the reference anew (stereobench reference generate)",
+                                 file.string()));
   try {
     spec = spec_from_json(provenance.at("spec"));
   } catch (const json::exception& e) {

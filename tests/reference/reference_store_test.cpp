@@ -169,6 +169,14 @@ TEST(ReferenceStore, DamagedProvenanceIsAFindingNotAStop) {
   EXPECT_EQ(nope.code, 2) << nope.out;
   EXPECT_NE(nope.out.find("corrupt        " + pole), std::string::npos) << nope.out;
   EXPECT_NE(nope.out.find("spec.provider 'nope' is not a ground-truth provider"), std::string::npos) << nope.out;
+  // One without a spec at all says so and what to do (it showed the JSON library's out-of-range text).
+  std::ofstream(dir / "store" / pole / "provenance.json", std::ios::trunc) << "{}\n";
+  const test::CliRun bare = test::run_cli(ref(dir, "verify") + " --no-render " + pole);
+  EXPECT_EQ(bare.code, 2) << bare.out;
+  EXPECT_NE(bare.out.find("provenance.json: has no field 'spec'"), std::string::npos) << bare.out;
+  EXPECT_EQ(bare.out.find("json.exception"), std::string::npos) << bare.out;
+  unknown["spec"]["provider"] = "nope";
+  std::ofstream(dir / "store" / pole / "provenance.json", std::ios::trunc) << unknown.dump(2);
 
   // The verdicts are not written into the store, where they could replace a reference's files.
   const test::CliRun inside = test::run_cli(ref(dir, "verify") + " --no-render --json " +
