@@ -107,13 +107,17 @@ std::pair<Image, Image> ztest_partials(const RenderScene& scene, const StereoRig
 
 }  // namespace
 
-std::vector<OptionSpec> bidir_option_specs() {
+std::vector<OptionSpec> bidir_option_specs(bool traced) {
   return {tile_option_spec(),
-          {"max_crack", "2", "widest run of hole pixels in a row filled by linear interpolation after the composition"},
+          {"max_crack", "2",
+           traced ? "widest run of pixels in a row that crack_depth can make a crack (cracks are traced, not "
+                    "interpolated)"
+                  : "widest run of hole pixels in a row filled by linear interpolation after the composition"},
           {"crack_depth", "1.01",
-           "a run of at most max_crack pixels deeper than this factor times the depth on both sides is a crack "
-           "(a farther surface showing through the warped one) and is filled; 0 turns this off (off under "
-           "occlusion=ztest, where each eye's own pixels are its nearest surfaces)"},
+           std::string("a run of at most max_crack pixels deeper than this factor times the depth on both sides is a "
+                       "crack (a farther surface showing through the warped one) and is ") +
+               (traced ? "traced" : "filled") +
+               "; 0 turns this off (off under occlusion=ztest, where each eye's own pixels are its nearest surfaces)"},
           {"segment", "256", "target-row segment length of the row warp in pixels (the image does not depend on it)"},
           {"occlusion", "none",
            "none: each eye rasterizes only its share (Kim's method as published); ztest: both eyes rasterize every "
@@ -197,8 +201,10 @@ void render_bidirectional(const RenderScene& scene, const StereoRig& rig, const 
       r.counters.set("depth_cracks_left",
                      mark_depth_cracks(r.left, settings.max_crack, settings.crack_depth_ratio, executor));
     }
-    cracks_right = fill_cracks(r.right, settings.max_crack, executor);
-    cracks_left = fill_cracks(r.left, settings.max_crack, executor);
+    // Without interpolation the runs are only counted: every hole stays for the caller.
+    const int fill_width = settings.interpolate_cracks ? settings.max_crack : 0;
+    cracks_right = fill_cracks(r.right, fill_width, executor);
+    cracks_left = fill_cracks(r.left, fill_width, executor);
   }
   r.counters.set("hole_pixels", cracks_right.hole_pixels);
   r.counters.set("hole_pixels_left", cracks_left.hole_pixels);

@@ -19,6 +19,9 @@ struct BidirSettings {
   double crack_depth_ratio = 1.01;  ///< mark_depth_cracks before the fill; 0 = off
   RowWarpOptions warp{256, false};  ///< partial images: only surfaces are warped
   bool keep_partials = false;       ///< add the partial images to the result's extras
+  /// Fill the cracks by linear interpolation (Kim). Off, they stay holes (the depth cracks marked
+  /// as such) for a caller that traces them.
+  bool interpolate_cracks = true;
   /// Kim's §5 remedy for occlusion artifacts (his Fig. 14): both eyes rasterize every triangle
   /// (depth test over the whole scene); each eye shades the pixels whose nearest triangle is in its
   /// share, the background, and the pixels whose nearest triangle went to the other eye but is not
@@ -30,8 +33,9 @@ struct BidirSettings {
   static BidirSettings from(const std::string& pipeline, const PipelineOptions& options);
 };
 
-/// The options both bidirectional pipelines declare.
-[[nodiscard]] std::vector<OptionSpec> bidir_option_specs();
+/// The options both bidirectional pipelines declare; `traced`: the pipeline traces its cracks
+/// instead of interpolating them (the help says so).
+[[nodiscard]] std::vector<OptionSpec> bidir_option_specs(bool traced = false);
 
 /// Renders both eyes of `result` (stages redirect, left_gbuffer, left_shading, right_gbuffer,
 /// right_shading, motion, warp, crack_fill; with ztest the G-buffers come first, then stage ztest,
