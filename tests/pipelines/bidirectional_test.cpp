@@ -133,11 +133,7 @@ TEST(BidirWarpRt, TracesItsCracksSoAVanishingDisparityReproducesTheTruth) {
   // traces them; bidir-warp, Kim's method, still interpolates.
   const Scene scene = test::load_builtin("spheres");
   const RenderScene prepared(scene);
-  RigOverrides o;
-  o.width = 160;
-  o.height = 90;
-  o.max_disparity_px = 1e-3;
-  const StereoRig rig = resolve_rig(scene, o);
+  const StereoRig rig = test::rig_with_disparity(scene, 160, 90, 1e-3);
   const StereoResult truth = test::render_with("plain-rt", prepared, rig, 2);
   const StereoResult traced = test::render_with("bidir-warp-rt", prepared, rig, 2);
   const StereoResult kim = test::render_with("bidir-warp", prepared, rig, 2);

@@ -164,11 +164,7 @@ TEST(GridWarp, AVanishingInteraxialReproducesTheLeftEyeAcrossDepthEdges) {
   for (const char* name : {"box-wall", "temple"}) {
     const Scene scene = test::load_builtin(name);
     const RenderScene prepared(scene);
-    RigOverrides o;
-    o.width = 128;
-    o.height = 72;
-    o.max_disparity_px = 1e-3;
-    const StereoResult r = test::render_with("repro-warp", prepared, resolve_rig(scene, o), 2);
+    const StereoResult r = test::render_with("repro-warp", prepared, test::rig_with_disparity(scene, 128, 72, 1e-3), 2);
     ASSERT_EQ(r.counters.get("grid_cells_subdivided"), 0u) << name;
     float peak = 0.0f, worst = 0.0f;
     const float* left = r.left.data_f32(planes::rgb);

@@ -32,6 +32,15 @@ inline StereoRig rig_at(const Scene& scene, int width, int height, std::optional
   return resolve_rig(scene, o);
 }
 
+/// The scene's rig at width x height with the interaxial given as the disparity at infinity (px).
+inline StereoRig rig_with_disparity(const Scene& scene, int width, int height, double max_disparity_px) {
+  RigOverrides o;
+  o.width = width;
+  o.height = height;
+  o.max_disparity_px = max_disparity_px;
+  return resolve_rig(scene, o);
+}
+
 inline StereoResult render_with(const std::string& pipeline, const RenderScene& scene, const StereoRig& rig,
                                 int threads = 0, const std::map<std::string, std::string>& options = {}) {
   const Pipeline& p = find_pipeline(pipeline);
