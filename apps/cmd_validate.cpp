@@ -140,12 +140,7 @@ void run_validate(const ValidateArgs& a) {
     io::write_text_atomically(summary,
                               json{{"kind", "stereobench.validation_summary"}, {"records", records}}.dump(2) + "\n");
   } catch (...) {
-    for (const fs::path& p : written) {
-      try {
-        (void)io::remove_output_file(p);
-      } catch (const std::exception&) {  // best effort: the run's own error is the one to report
-      }
-    }
+    io::discard_output_files(written);
     throw;
   }
   fmt::print("\nwrote {} (one record per pipeline beside it, images under {})\n", summary.string(), out.string());

@@ -46,12 +46,7 @@ void write_side_by_side(const std::vector<std::function<void()>>& writers, const
   } catch (...) {
     // The set is whole or gone: files of it written beside the one that failed (or left from an
     // earlier run under the same names) would read as this run's.
-    for (const std::filesystem::path& p : paths) {
-      try {
-        (void)io::remove_output_file(p);
-      } catch (const std::exception&) {  // best effort: the write's own error is the one to report
-      }
-    }
+    io::discard_output_files(paths);
     throw;
   }
 }

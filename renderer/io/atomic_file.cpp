@@ -336,6 +336,15 @@ bool remove_output_file(const fs::path& path) {
   return true;
 }
 
+void discard_output_files(std::span<const fs::path> paths) noexcept {
+  for (const fs::path& p : paths) {
+    try {
+      (void)remove_output_file(p);
+    } catch (const std::exception&) {
+    }
+  }
+}
+
 void write_atomically(const fs::path& given, const std::function<void(const fs::path&)>& write) {
   if (staging_path != nullptr && given == *staging_path) {
     write(given);  // the temporary file of a StagedFiles::add, made and locked there

@@ -61,6 +61,10 @@ class StagedFiles {
 /// place. Whether there was one to remove; IoError when it could not be removed.
 bool remove_output_file(const std::filesystem::path& path);
 
+/// remove_output_file for each of the files a run wrote before it failed, best effort: one that
+/// cannot be removed is skipped (the run's own error is the one to report).
+void discard_output_files(std::span<const std::filesystem::path> paths) noexcept;
+
 /// The file a path names, its symbolic links followed (a dangling link gives the file it would
 /// create); `path` itself when it is no link. IoError for a loop of links.
 [[nodiscard]] std::filesystem::path follow_links(const std::filesystem::path& path);
