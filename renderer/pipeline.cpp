@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <optional>
 #include <cmath>
 #include <string_view>
 
@@ -141,14 +142,20 @@ std::string entry_file_stem(const std::string& entry) {
 
 namespace {
 
+/// A boolean option value: 1/true/on/yes or 0/false/off/no; nothing for any other text.
+std::optional<bool> boolean_value(const std::string& v) {
+  if (v == "1" || v == "true" || v == "on" || v == "yes") return true;
+  if (v == "0" || v == "false" || v == "off" || v == "no") return false;
+  return std::nullopt;
+}
+
 /// An option value as the pipeline reads it, for comparing spellings: a boolean option's (its
 /// default is true or false) as true/false, a number as the shortest text of its double.
 std::string canonical_value(const PipelineInfo& info, const std::string& key, const std::string& value) {
   const auto spec = std::find_if(info.options.begin(), info.options.end(), [&](const OptionSpec& o) { return o.name == key; });
   if (spec != info.options.end() && (spec->default_value == "true" || spec->default_value == "false")) {
-    if (value == "1" || value == "true" || value == "on" || value == "yes") return "true";
-    if (value == "0" || value == "false" || value == "off" || value == "no") return "false";
-    return value;
+    const std::optional<bool> b = boolean_value(value);
+    return b ? (*b ? "true" : "false") : value;
   }
   double number = 0.0;
   const char* end = value.data() + value.size();
@@ -239,8 +246,7 @@ int PipelineOptions::get_int(const std::string& name) const {
 
 bool PipelineOptions::get_bool(const std::string& name) const {
   const std::string& v = get(name);
-  if (v == "1" || v == "true" || v == "on" || v == "yes") return true;
-  if (v == "0" || v == "false" || v == "off" || v == "no") return false;
+  if (const std::optional<bool> b = boolean_value(v)) return *b;
   throw InputError(fmt::format("pipeline '{}': option {}={} is not a boolean (true/false)", pipeline_, name, v));
 }
 
