@@ -88,8 +88,14 @@ std::string git_revision(const fs::path& dir) {
   return out;
 }
 
-/// The run folder: the newest unfinished run of this definition version (resumed), else a new one.
-fs::path choose_run_dir(const fs::path& out, const SweepDefinition& d, bool* resumed) {
+/// Whether a history holds a line of run `run_id`.
+bool history_holds(const HistoryFile& history, const std::string& run_id) {
+  return std::any_of(history.runs.begin(), history.runs.end(), [&](const json& r) { return r["run_id"] == run_id; });
+}
+
+/// The run folder: the newest unfinished run of this definition version (resumed), else a new one
+/// whose id neither a folder in `out` nor a line of `history` (which other sweeps may share) has.
+fs::path choose_run_dir(const fs::path& out, const SweepDefinition& d, const HistoryFile& history, bool* resumed) {
   std::vector<std::string> ids;
   std::error_code ec;
   if (fs::is_directory(out, ec))
@@ -121,7 +127,7 @@ fs::path choose_run_dir(const fs::path& out, const SweepDefinition& d, bool* res
   }
   const std::string base = utc_now("%Y%m%dT%H%M%SZ");
   std::string id = base;
-  for (int n = 2; fs::exists(out / id, ec); ++n) id = fmt::format("{}-{}", base, n);
+  for (int n = 2; fs::exists(out / id, ec) || history_holds(history, id); ++n) id = fmt::format("{}-{}", base, n);
   fs::create_directories(out / id, ec);
   if (ec) throw IoError(fmt::format("cannot create the run folder {}: {}", (out / id).string(), ec.message()));
   return out / id;
@@ -184,11 +190,26 @@ void run_nightly(const NightlyArgs& a) {
 
   // 1. The sweep, into the run folder.
   bool resumed = false;
-  const fs::path run_dir = choose_run_dir(out, d, &resumed);
+  const fs::path run_dir = choose_run_dir(out, d, history_before, &resumed);
   const std::string run_id = run_dir.filename().string();
   SweepRunOptions o;
   o.out_dir = run_dir;
   o.results = run_dir / "results.jsonl";
+  // The results file as the history line names it: relative to the history file's folder.
+  const fs::path history_dir = history_file.has_parent_path() ? history_file.parent_path() : fs::path(".");
+  const std::string results_in_history = fs::absolute(o.results)
+                                             .lexically_normal()
+                                             .lexically_relative(fs::absolute(history_dir).lexically_normal())
+                                             .generic_string();
+  // A resumed run whose id a line of another run took meanwhile (a history shared between sweeps)
+  // could not be recorded: stop before the sweep.
+  for (const json& r : history_before.runs)
+    if (r["run_id"] == run_id && r.value("results", "") != results_in_history)
+      throw InputError(fmt::format(
+          "{} already holds a run {} of another results file ({}, sweep '{}'), so this run ({}) cannot be recorded "
+          "there; give this sweep its own --history, or move the unfinished run folder {} away to start a new run",
+          history_file.string(), run_id, r.value("results", "?"), r.value("sweep", "?"), o.results.string(),
+          run_dir.string()));
   o.scenes_dir = a.scenes_dir;
   if (!a.cache.empty()) o.truth_cache = fs::path(a.cache);
   o.definition_label = a.definition;
@@ -234,14 +255,10 @@ void run_nightly(const NightlyArgs& a) {
   run.sweep = d.name;
   run.definition = a.definition;
   run.definition_sha256 = d.sha256;
-  const fs::path history_dir = history_file.has_parent_path() ? history_file.parent_path() : fs::path(".");
-  run.results = fs::absolute(o.results).lexically_normal().lexically_relative(fs::absolute(history_dir).lexically_normal())
-                    .generic_string();
+  run.results = results_in_history;
   std::vector<json> cells;
   for (const GateCell& c : results.cells) cells.push_back(c.record);
-  const bool recorded = std::any_of(history_before.runs.begin(), history_before.runs.end(),
-                                    [&run_id](const json& r) { return r["run_id"] == run_id; });
-  if (recorded)
+  if (history_holds(history_before, run_id))
     fmt::print(stderr, "note: {} already holds run {}; not appended again\n", history_file.string(), run_id);
   else
     append_history(history_file, history_entry(run, cells, gate));
@@ -252,7 +269,14 @@ void run_nightly(const NightlyArgs& a) {
   reports::ReportOptions options;
   options.out_dir = run_dir / "report";
   options.title = fmt::format("stereobench nightly: {} {}", d.name, run.date);
-  options.history = json(history.runs);
+  // The trends are this sweep's: a history shared with other sweeps keeps their runs out.
+  json trend_runs = json::array();
+  for (const json& r : history.runs)
+    if (r.value("sweep", "") == d.name) trend_runs.push_back(r);
+  if (trend_runs.size() < history.runs.size())
+    fmt::print(stderr, "note: the trends leave out {} runs of other sweeps in {}\n",
+               history.runs.size() - trend_runs.size(), history_file.string());
+  options.history = std::move(trend_runs);
   const reports::ReportSummary s = reports::write_report(report_results, options);
   for (const std::string& w : s.warnings) fmt::print(stderr, "warning: {}\n", w);
 

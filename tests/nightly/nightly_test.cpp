@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <functional>
 #include <fstream>
@@ -16,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "renderer/error.hpp"
@@ -380,6 +382,68 @@ TEST(NightlyTest, RunFoldersWithLongSuffixesOrderWithoutOverflow) {
   const test::CliRun r = test::run_cli(nightly_args(dir));
   EXPECT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find(" (new): "), std::string::npos) << "a new run, none resumed: " << r.out;
+}
+
+TEST(NightlyTest, SweepsSharingAHistoryKeepTheirRunsApart) {
+  // Two sweeps, one history: a new run takes an id no line of the history has (it used to take the
+  // other sweep's id of the same second and was silently not recorded), its trends show its own
+  // sweep's runs only, and a resumed run whose id another sweep's line took is refused.
+  test::ScratchDir dir;
+  write_inputs(dir);
+  const std::string history = quoted(dir / "shared.jsonl");
+  const test::CliRun a = test::run_cli(nightly_args(dir) + " --history " + history);
+  ASSERT_EQ(a.code, 0) << a.out;
+  const std::vector<json> lines = json_lines(dir / "shared.jsonl");
+  ASSERT_EQ(lines.size(), 1u);
+  // Lines of another sweep for every second of the next two minutes.
+  std::string others;
+  size_t other_runs = 0;
+  const std::time_t now = std::time(nullptr);
+  for (std::time_t t = now; t < now + 120; ++t) {
+    std::tm utc{};
+    gmtime_r(&t, &utc);
+    std::array<char, 32> id{}, date{};
+    std::strftime(id.data(), id.size(), "%Y%m%dT%H%M%SZ", &utc);
+    std::strftime(date.data(), date.size(), "%Y-%m-%dT%H:%M:%SZ", &utc);
+    if (lines[0]["run_id"] == id.data()) continue;
+    json other = lines[0];
+    other["run_id"] = id.data();
+    other["date"] = date.data();
+    other["sweep"] = "other-sweep";
+    other["results"] = std::string("elsewhere/") + id.data() + "/results.jsonl";
+    others += other.dump() + "\n";
+    ++other_runs;
+  }
+  std::ofstream(dir / "shared.jsonl", std::ios::app) << others;
+
+  std::string b_args = nightly_args(dir) + " --history " + history;
+  b_args.replace(b_args.find(" --out " + quoted(dir / "runs")), (" --out " + quoted(dir / "runs")).size(),
+                 " --out " + quoted(dir / "runs-b"));
+  const test::CliRun b = test::run_cli(b_args);
+  ASSERT_EQ(b.code, 0) << b.out;
+  const std::vector<json> after = json_lines(dir / "shared.jsonl");
+  ASSERT_EQ(after.size(), other_runs + 2) << "the run was recorded";
+  const std::string b_id = after.back()["run_id"].get<std::string>();
+  EXPECT_TRUE(std::regex_match(b_id, std::regex(R"(\d{8}T\d{6}Z-2)"))) << b_id;
+  EXPECT_TRUE(fs::is_directory(dir / "runs-b" / b_id));
+  EXPECT_EQ(after.back()["results"], "runs-b/" + b_id + "/results.jsonl");
+  EXPECT_NE(b.out.find(fmt::format("the trends leave out {} runs of other sweeps", other_runs)), std::string::npos)
+      << b.out;
+  const json trends = embedded_data(dir / "runs-b" / b_id / "report" / "index.html")["history"];
+  ASSERT_EQ(trends.size(), 2u) << trends.dump();
+  for (const json& r : trends) EXPECT_EQ(r["sweep"], "nightly-tiny");
+
+  // An unfinished run folder named as another sweep's recorded run: resuming it is refused before
+  // any cell runs.
+  const std::string taken = after[1]["run_id"].get<std::string>();
+  fs::create_directories(dir / "runs-c" / taken);
+  std::string c_args = b_args;
+  c_args.replace(c_args.find(quoted(dir / "runs-b")), quoted(dir / "runs-b").size(), quoted(dir / "runs-c"));
+  const test::CliRun c = test::run_cli(c_args);
+  EXPECT_EQ(c.code, 3) << c.out;
+  EXPECT_NE(c.out.find("already holds a run " + taken + " of another results file"), std::string::npos) << c.out;
+  EXPECT_FALSE(fs::exists(dir / "runs-c" / taken / "results.jsonl")) << "no cell ran";
+  EXPECT_EQ(json_lines(dir / "shared.jsonl").size(), other_runs + 2);
 }
 
 }  // namespace
