@@ -181,7 +181,12 @@ void write_option_file(const std::string& option, const std::string& path, const
   try {
     io::write_text_atomically(path, text);
   } catch (const IoError& e) {
-    throw IoError(fmt::format("{}: {}; give {} a path you can write", option, e.what(), option));
+    // The advice once: most messages of the writer already say what to do.
+    const std::string what = e.what();
+    const bool advised = what.find("; give ") != std::string::npos || what.find("; make ") != std::string::npos ||
+                         what.find("; check ") != std::string::npos || what.find("; free ") != std::string::npos;
+    throw IoError(advised ? fmt::format("{}: {}", option, what)
+                          : fmt::format("{}: {}; give {} a path you can write", option, what, option));
   }
 }
 

@@ -98,6 +98,10 @@ int run_verify(const ReferenceArgs& a) {
     if (!rel.empty() && *rel.begin() != "..")
       throw InputError(fmt::format("--json {} lies inside the reference store {}; write the verdicts outside it",
                                    a.json_out, store.root().string()));
+    // An earlier run's verdicts must not outlive a run that stops, nor one whose file cannot be
+    // written be found out only after every reference was rendered again.
+    remove_earlier_output(a.json_out, "--json");
+    prepare_output_file_folder(a.json_out, "--json");
   }
   const std::vector<reference::VerifyResult> results = verify_all(a, store);
   if (!a.json_out.empty()) {
@@ -144,14 +148,22 @@ int run_update(const ReferenceArgs& a) {
   if (a.no_render && !a.only_failing)
     throw InputError("--no-render only shapes the check of --only-failing (hashes only); update always renders the "
                      "references it rewrites: add --only-failing, or drop --no-render");
+  if (!std::isinf(a.min_psnr) && !a.only_failing)
+    throw InputError(fmt::format("--min-psnr {} only shapes the check of --only-failing (which references count as "
+                                 "failing); without it every chosen reference is rewritten: add --only-failing, or "
+                                 "drop --min-psnr",
+                                 a.min_psnr));
   const reference::ReferenceStore store(a.store);
   const Executor executor(checked_threads(a.threads));
   std::vector<std::string> targets;
+  // Entries whose check needs a missing tool: the others are still rewritten, then the run exits 4.
+  std::vector<std::string> unchecked;
   if (a.only_failing) {
     for (const reference::VerifyResult& r : verify_all(a, store)) {
       if (r.status == reference::Status::unavailable)
-        throw ToolError(fmt::format("cannot update '{}': {}", r.id, r.detail));
-      if (reference::failed(r.status)) targets.push_back(r.id);
+        unchecked.push_back(fmt::format("{} ({})", r.id, r.detail));
+      else if (reference::failed(r.status))
+        targets.push_back(r.id);
     }
   } else {
     targets = chosen_ids(store, a.ids);
@@ -177,6 +189,10 @@ int run_update(const ReferenceArgs& a) {
                                  "them from; remove each and run `stereobench reference generate` with its "
                                  "scene and rig:\n  {}",
                                  unreadable.size(), fmt::join(unreadable, "\n  ")));
+  if (!unchecked.empty())
+    throw ToolError(fmt::format("{} reference(s) could not be checked, so not updated, because their tool is "
+                                "missing; install it and run the update again:\n  {}",
+                                unchecked.size(), fmt::join(unchecked, "\n  ")));
   return 0;
 }
 

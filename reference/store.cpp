@@ -6,7 +6,9 @@
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <optional>
 #include <regex>
 #include <fcntl.h>
@@ -22,6 +24,7 @@
 #include "renderer/io/unique_fd.hpp"
 #include "renderer/io/render_output.hpp"
 #include "renderer/render_scene.hpp"
+#include "renderer/rig.hpp"
 #include "renderer/text.hpp"
 #include "sb_version.hpp"
 #include "scenes/catalog.hpp"
@@ -48,10 +51,24 @@ json optional_json(const std::optional<T>& v) {
   return v ? json(*v) : json(nullptr);
 }
 
-template <class T>
-std::optional<T> optional_from(const json& j, const char* key) {
+/// An optional count of a spec: absent or null, else an integer in [1, max]; InputError naming the
+/// field ("spec.lights") otherwise (a value the command line could never have given: the provenance
+/// was edited or damaged, and nlohmann's get<int> would truncate 64.7 or wrap 4294967360).
+std::optional<int> optional_count(const json& j, const char* key, const char* field, int max) {
   if (!j.contains(key) || j.at(key).is_null()) return std::nullopt;
-  return j.at(key).get<T>();
+  const json& v = j.at(key);
+  if (!v.is_number_integer() || v.get<double>() < 1.0 || v.get<double>() > max)
+    throw InputError(fmt::format("{} is {}, not a whole number in 1..{}", field, v.dump(), max));
+  return v.get<int>();
+}
+
+/// An optional quantity of a spec: absent or null, else a finite number; InputError naming the field.
+std::optional<double> optional_quantity(const json& j, const char* key, const char* field) {
+  if (!j.contains(key) || j.at(key).is_null()) return std::nullopt;
+  const json& v = j.at(key);
+  if (!v.is_number() || !std::isfinite(v.get<double>()))
+    throw InputError(fmt::format("{} is {}, not a finite number", field, v.dump()));
+  return v.get<double>();
 }
 
 json spec_to_json(const ReferenceSpec& s) {
@@ -126,15 +143,16 @@ std::string brief(const json& j) {
 ReferenceSpec spec_from_json(const json& j) {
   ReferenceSpec s;
   s.scene = j.at("scene").get<std::string>();
-  s.lights = optional_from<int>(j, "lights");
+  s.lights = optional_count(j, "lights", "spec.lights", std::numeric_limits<int>::max());
   s.provider = j.at("provider").get<std::string>();
   const json& r = j.at("rig_overrides");
-  s.rig.interaxial = optional_from<double>(r, "interaxial_m");
-  s.rig.max_disparity_px = optional_from<double>(r, "max_disparity_px");
-  s.rig.convergence = optional_from<double>(r, "convergence_m");
-  s.rig.width = optional_from<int>(r, "width");
-  s.rig.height = optional_from<int>(r, "height");
-  s.rig.vfov = optional_from<double>(r, "vfov_rad");
+  if (!r.is_object()) throw InputError(fmt::format("spec.rig_overrides is {}, not an object", brief(r)));
+  s.rig.interaxial = optional_quantity(r, "interaxial_m", "spec.rig_overrides.interaxial_m");
+  s.rig.max_disparity_px = optional_quantity(r, "max_disparity_px", "spec.rig_overrides.max_disparity_px");
+  s.rig.convergence = optional_quantity(r, "convergence_m", "spec.rig_overrides.convergence_m");
+  s.rig.width = optional_count(r, "width", "spec.rig_overrides.width", kMaxImageSide);
+  s.rig.height = optional_count(r, "height", "spec.rig_overrides.height", kMaxImageSide);
+  s.rig.vfov = optional_quantity(r, "vfov_rad", "spec.rig_overrides.vfov_rad");
   return s;
 }
 
@@ -149,6 +167,9 @@ ReferenceSpec spec_in(const json& provenance, const fs::path& file) {
     spec = spec_from_json(provenance.at("spec"));
   } catch (const json::exception& e) {
     throw InputError(fmt::format("{}: field 'spec' is malformed ({})", file.string(), e.what()));
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}; the provenance is damaged: remove the entry and generate it again",
+                                 file.string(), e.what()));
   }
   const std::vector<std::string> providers = validation::truth_provider_names();
   if (std::find(providers.begin(), providers.end(), spec.provider) == providers.end())
@@ -192,8 +213,41 @@ std::string reference_id(const Scene& scene, const ReferenceSpec& spec, const St
   return id;
 }
 
-/// A working folder of the store, ".ID.KIND-PID-XXXXXX" (KIND new, old or verify), held under an
-/// exclusive lock (flock) while the generate or verify that made it runs: remove_stale_folders
+/// A folder of its own in the temporary folder (TMPDIR, else /tmp), "PREFIX-XXXXXX", removed with
+/// everything in it when the object goes.
+class ScratchFolder {
+ public:
+  explicit ScratchFolder(const std::string& prefix) {
+    std::error_code ec;
+    const fs::path tmp = fs::temp_directory_path(ec);
+    if (ec) {
+      const char* env = std::getenv("TMPDIR");
+      throw IoError(fmt::format("cannot create a scratch folder: the temporary folder {} is not a folder ({}); set "
+                                "TMPDIR to a folder you can write",
+                                env != nullptr ? fmt::format("TMPDIR={}", env) : std::string("/tmp"), ec.message()));
+    }
+    std::string made = (tmp / (prefix + "-XXXXXX")).string();
+    if (::mkdtemp(made.data()) == nullptr) {
+      const int err = errno;
+      throw IoError(fmt::format("cannot create a scratch folder {}: {}; set TMPDIR to a folder you can write",
+                                made, std::strerror(err)));
+    }
+    path_ = made;
+  }
+  ScratchFolder(const ScratchFolder&) = delete;
+  ScratchFolder& operator=(const ScratchFolder&) = delete;
+  ~ScratchFolder() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  [[nodiscard]] const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+/// A working folder of the store, ".ID.KIND-PID-XXXXXX" (KIND new or old; "verify", a kind stores
+/// written by older versions may hold, is cleared up too), held under an exclusive lock (flock) while the generate that made it runs: remove_stale_folders
 /// leaves a locked one alone, whichever process, container or machine holds it.
 struct WorkingFolder {
   fs::path path;
@@ -240,7 +294,7 @@ void make_working_folder(const fs::path& root, const std::string& id, const char
   }
 }
 
-/// Clears up after a generate or verify that was killed (SIGKILL, a job's time limit): its working
+/// Clears up after a generate (or verify) that was killed (SIGKILL, a job's time limit): its working
 /// folders that no lock holds are removed, except an entry moved aside (".ID.old-…") whose id
 /// names no entry any more, which is moved back. Best effort: errors leave folders where they are.
 void remove_stale_folders(const fs::path& root) {
@@ -614,6 +668,25 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
                            prov_file.string(), expected, id, expected);
     return r;
   }
+  // The hash matched, but the file may still be no image of this rig (both replaced together).
+  Image stored;
+  try {
+    stored = validation::rgb_plane_only(io::read_exr(image_file));
+  } catch (const std::exception& e) {
+    r.status = Status::corrupt;
+    r.detail = fmt::format("{} cannot be read ({}); remove {} and make the reference again with `stereobench "
+                           "reference generate`",
+                           image_file.string(), e.what(), (root_ / id).string());
+    return r;
+  }
+  if (stored.width() != p.rig->params().width || stored.height() != p.rig->params().height) {
+    r.status = Status::corrupt;
+    r.detail = fmt::format("{} is {}x{}, but its rig renders {}x{}; remove {} and make the reference again with "
+                           "`stereobench reference generate`",
+                           image_file.string(), stored.width(), stored.height(), p.rig->params().width,
+                           p.rig->params().height, (root_ / id).string());
+    return r;
+  }
   if (!options.rerender) {
     r.detail = "image, scene and rig match their records (not rendered again)";
     return r;
@@ -624,22 +697,14 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
     r.detail = *why;
     return r;
   }
-  const Image stored = validation::rgb_plane_only(io::read_exr(image_file));
   const RenderScene prepared(p.loaded.scene);
-  WorkingFolder working;
-  make_working_folder(root_, id, "verify", working);
-  const fs::path& work = working.path;
-  const validation::TruthRequest request{prepared, p.loaded.file, *p.rig, work, executor.threads()};
-  Image fresh;
-  try {
-    const validation::TruthRender render = provider->render(request);
-    validation::check_truth_samples(render, request.work_dir, false);
-    fresh = validation::rgb_plane_only(render.right);
-  } catch (...) {
-    fs::remove_all(work, ec);
-    throw;
-  }
-  fs::remove_all(work, ec);
+  // The render goes to a scratch folder outside the store: verifying only reads the store, which
+  // may be read-only (a checkout, another user's store).
+  const ScratchFolder work(fmt::format("stereobench-verify-{}", id));
+  const validation::TruthRequest request{prepared, p.loaded.file, *p.rig, work.path(), executor.threads()};
+  const validation::TruthRender render = provider->render(request);
+  validation::check_truth_samples(render, request.work_dir, false);
+  const Image fresh = validation::rgb_plane_only(render.right);
   r.bit_identical = fresh == stored;
   r.metrics = validation::compare_images(validation::encode_srgb8(fresh, "the new render"),
                                          validation::encode_srgb8(stored, "the stored reference"));

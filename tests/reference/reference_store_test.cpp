@@ -207,6 +207,96 @@ TEST(ReferenceStore, DamagedProvenanceIsAFindingNotAStop) {
   EXPECT_NE(negative.out.find("--min-psnr -1 is not a PSNR in dB"), std::string::npos) << negative.out;
 }
 
+TEST(ReferenceStore, VerifyOnlyReadsTheStoreAndLeavesNoEarlierVerdicts) {
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene box-wall --resolution 32x18 --threads 1").code, 0);
+  const std::string box = "box-wall_full_32x18_e64.0mm_c4.08m";
+  // Rendering again writes nothing into the store (it made its scratch folder there, so a
+  // read-only store could not be verified): the folder's modification time stays, and the
+  // scratch folder is the temporary folder's.
+  const auto store_time = fs::last_write_time(dir / "store");
+  const test::CliRun ok = test::run_cli(ref(dir, "verify") + " --json " + quoted(dir / "v.json"));
+  EXPECT_EQ(ok.code, 0) << ok.out;
+  EXPECT_EQ(fs::last_write_time(dir / "store"), store_time) << "verify wrote into the store";
+  std::ofstream(dir / "not-a-folder") << "x\n";
+  ::setenv("TMPDIR", (dir / "not-a-folder").c_str(), 1);
+  const test::CliRun no_tmp = test::run_cli(ref(dir, "verify"));
+  ::unsetenv("TMPDIR");
+  EXPECT_EQ(no_tmp.code, 4) << no_tmp.out;
+  EXPECT_NE(no_tmp.out.find("cannot create a scratch folder"), std::string::npos) << no_tmp.out;
+  EXPECT_NE(no_tmp.out.find("set TMPDIR to a folder you can write"), std::string::npos) << no_tmp.out;
+
+  // A run that stops leaves no verdicts of an earlier run behind (CI would read them as its own).
+  ASSERT_TRUE(fs::exists(dir / "v.json"));
+  const test::CliRun typo = test::run_cli(ref(dir, "verify") + " --json " + quoted(dir / "v.json") + " nosuch");
+  EXPECT_EQ(typo.code, 3) << typo.out;
+  EXPECT_FALSE(fs::exists(dir / "v.json")) << "the earlier verdicts outlived a failed run";
+  // A --json that cannot be written is refused before anything is rendered again.
+  const test::CliRun blocked =
+      test::run_cli(ref(dir, "verify") + " --json " + quoted(dir / "not-a-folder" / "v.json"));
+  EXPECT_EQ(blocked.code, 4) << blocked.out;
+  EXPECT_NE(blocked.out.find("--json"), std::string::npos) << blocked.out;
+  EXPECT_EQ(blocked.out.find(box), std::string::npos) << "verified before the output was checked: " << blocked.out;
+
+  // --min-psnr decides what --only-failing rewrites; without it, it would be ignored.
+  const test::CliRun psnr = test::run_cli(ref(dir, "update") + " --min-psnr 30");
+  EXPECT_EQ(psnr.code, 3) << psnr.out;
+  EXPECT_NE(psnr.out.find("--min-psnr 30 only shapes the check of --only-failing"), std::string::npos) << psnr.out;
+}
+
+TEST(ReferenceStore, ImpossibleSpecValuesAndAnImageOfAnotherSizeAreCorrupt) {
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene box-wall --resolution 32x18 --threads 1").code, 0);
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene thin-pole --resolution 48x32 --threads 1").code, 0);
+  const std::string box = "box-wall_full_32x18_e64.0mm_c4.08m";
+  const std::string pole = "thin-pole_full_48x32_e64.0mm_c2m";
+  const fs::path prov = dir / "store" / box / "provenance.json";
+  const std::string original = test::read_text(prov);
+  // Values no command line gives: each is a damaged provenance naming the field (a negative width
+  // was reported as a changed scene, whose advised update then failed; 32.7 was read as 32).
+  const std::pair<const char*, json> edits[] = {{"width", -32}, {"width", 32.7}, {"width", 4294967328.0},
+                                                {"height", "18"}, {"convergence_m", "inf"}};
+  for (const auto& [field, value] : edits) {
+    json p = json::parse(original);
+    p["spec"]["rig_overrides"][field] = value;
+    std::ofstream(prov, std::ios::trunc) << p.dump(2);
+    const test::CliRun r = test::run_cli(ref(dir, "verify") + " --no-render " + box);
+    EXPECT_EQ(r.code, 2) << field << " " << value << ": " << r.out;
+    EXPECT_NE(r.out.find("corrupt        " + box), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(fmt::format("spec.rig_overrides.{} is {}", field, value.dump())), std::string::npos) << r.out;
+  }
+  json p = json::parse(original);
+  p["spec"]["lights"] = 0;
+  std::ofstream(prov, std::ios::trunc) << p.dump(2);
+  const test::CliRun lights = test::run_cli(ref(dir, "verify") + " --no-render " + box);
+  EXPECT_EQ(lights.code, 2) << lights.out;
+  EXPECT_NE(lights.out.find("spec.lights is 0, not a whole number"), std::string::npos) << lights.out;
+  std::ofstream(prov, std::ios::trunc) << original;
+
+  // Another entry's image with its hash recorded: the hash holds, the size does not (it stopped
+  // the whole verification with a message about resizing images).
+  fs::copy_file(dir / "store" / pole / "right.exr", dir / "store" / box / "right.exr",
+                fs::copy_options::overwrite_existing);
+  json swapped = json::parse(original);
+  swapped["image"]["sha256"] = json::parse(test::read_text(dir / "store" / pole / "provenance.json"))["image"]["sha256"];
+  std::ofstream(prov, std::ios::trunc) << swapped.dump(2);
+  test::CliRun r = test::run_cli(ref(dir, "verify"));
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("right.exr is 48x32, but its rig renders 32x18"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("ok             " + pole), std::string::npos) << "the verification went on: " << r.out;
+  // A file that is no EXR at all, with its own hash recorded.
+  std::ofstream(dir / "store" / box / "right.exr", std::ios::trunc | std::ios::binary) << "not an image\n";
+  const test::CliRun sum = test::run_shell("sha256sum " + quoted(dir / "store" / box / "right.exr"));
+  ASSERT_EQ(sum.code, 0) << sum.out;
+  swapped["image"]["sha256"] = sum.out.substr(0, 64);
+  std::ofstream(prov, std::ios::trunc) << swapped.dump(2);
+  r = test::run_cli(ref(dir, "verify") + " --no-render");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("corrupt        " + box), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("right.exr cannot be read"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("ok             " + pole), std::string::npos) << r.out;
+}
+
 TEST(ReferenceStore, AnEntryThatContradictsItsFolderIsCorrupt) {
   test::ScratchDir dir;
   ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene box-wall --resolution 64x36").code, 0);
@@ -384,6 +474,20 @@ TEST(ReferenceStore, MissingToolIsUnavailableNotAPass) {
             std::string::npos)
       << verify.out;
   EXPECT_EQ(verify.out.find("update --only-failing"), std::string::npos) << "update cannot render without the tool";
+
+  // Updating the failing entries rewrites those whose tool is here and names the others (it
+  // stopped at the first it could not check and rewrote nothing).
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene box-wall --resolution 32x18").code, 0);
+  const std::string full = "box-wall_full_32x18_e64.0mm_c4.08m";
+  damage(dir / "store" / full / "right.exr");
+  ::setenv("STEREOBENCH_POVRAY", "/nonexistent/povray", 1);
+  const test::CliRun update = test::run_cli(ref(dir, "update") + " --only-failing");
+  ::unsetenv("STEREOBENCH_POVRAY");
+  EXPECT_EQ(update.code, 4) << update.out;
+  EXPECT_NE(update.out.find("1 reference(s) rewritten"), std::string::npos) << update.out;
+  EXPECT_NE(update.out.find("1 reference(s) could not be checked, so not updated"), std::string::npos) << update.out;
+  EXPECT_NE(update.out.find("box-wall_povray_32x18"), std::string::npos) << update.out;
+  EXPECT_EQ(test::run_cli(ref(dir, "verify") + " " + full).code, 0) << "the damaged full entry was rewritten";
 }
 
 }  // namespace
