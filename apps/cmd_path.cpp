@@ -83,6 +83,12 @@ void run_path_command(const PathArgs& a) {
     run.path.spin = Spin{parse_axis(a.spin_axis), std::nullopt, *a.spin_deg, a.spin_prefix};
   }
   run.path.validate();
+  // Keys the path cannot reach are said, not passed over.
+  if (run.path.camera_keys.size() > 1 && a.frames == 1)
+    fmt::print(stderr,
+               "warning: with 1 frame the camera stands at the first of the {} camera keys; give --frames {} or more "
+               "to move through them\n",
+               run.path.camera_keys.size(), run.path.camera_keys.size());
   const RigOverrides overrides = a.rig.overrides();
   run.pipelines =
       parse_pipeline_entries(expand_all_pipelines(split_list(a.pipelines, "--pipelines"), "--pipelines"), "--pipelines");
@@ -178,7 +184,9 @@ void register_path_command(CLI::App& root) {
   p->add_option("--spin-axis", a->spin_axis, "Axis of the turn, x,y,z")->capture_default_str()->needs(spin);
   p->add_option("--spin-prefix", a->spin_prefix, "Turn only meshes whose name starts with this (default: all)")
       ->needs(spin);
-  p->add_option("--bvh", a->bvh, "Per-frame BVH update of a moving scene: refit or rebuild")->capture_default_str();
+  p->add_option("--bvh", a->bvh, "Per-frame BVH update of a moving scene (--spin-deg): refit or rebuild")
+      ->capture_default_str()
+      ->needs(spin);
   p->add_option("--threads,-t", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
   p->add_option("--out", a->out, "Output folder")->capture_default_str();
   p->add_option("--cache", a->cache, "Folder of cached external ground-truth renders ('' to disable)")

@@ -93,6 +93,17 @@ TEST(PathCommand, BadInput) {
   const test::CliRun alone = test::run_cli(args(dir) + " --spin-axis 1,0,0");
   EXPECT_EQ(alone.code, 3) << alone.out;
   EXPECT_NE(alone.out.find("--spin-axis requires --spin-deg"), std::string::npos) << alone.out;
+  // Nothing moves without a spin: a BVH update asked for would be recorded but never done.
+  const test::CliRun still = test::run_cli(args(dir) + " --bvh rebuild");
+  EXPECT_EQ(still.code, 3) << still.out;
+  EXPECT_NE(still.out.find("--bvh requires --spin-deg"), std::string::npos) << still.out;
+  // Camera keys beyond the first need frames to move through.
+  const test::CliRun one = test::run_cli(args(dir) + " --frames 1 --pipelines plain-rt --camera-keys "
+                                         "'0,1,6>0,0.5,0;1,1,6>0,0.5,0'");
+  EXPECT_EQ(one.code, 0) << one.out;
+  EXPECT_NE(one.out.find("warning: with 1 frame the camera stands at the first of the 2 camera keys"),
+            std::string::npos)
+      << one.out;
   // Camera keys that swap position and target: the camera would stand on its target at frame 1.
   const test::CliRun cross = test::run_cli(args(dir) + " --frames 3 --camera-keys '0,1,4>0,1,3;0,1,3>0,1,4'");
   EXPECT_EQ(cross.code, 3) << cross.out;
