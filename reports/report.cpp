@@ -53,13 +53,18 @@ json dig(const json& j, std::initializer_list<const char*> keys) {
   return *at;
 }
 
-/// A name safe as one path segment of a copied image.
+/// A name safe as one path segment of a copied image, and distinct for distinct names: letters,
+/// digits and '-' stay, every other byte is written "_HH" (its hex code), so that "repro-rt:x=1"
+/// and "repro-rt_x_1" do not share a folder. The empty name is "_".
 std::string path_segment(const std::string& name) {
-  std::string s = name;
-  for (char& c : s)
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.')) c = '_';
-  if (s.empty() || s == "." || s == "..") s = "_";
-  return s;
+  std::string s;
+  for (const char c : name) {
+    if (std::isalnum(static_cast<unsigned char>(c)) || c == '-')
+      s += c;
+    else
+      s += fmt::format("_{:02X}", static_cast<unsigned char>(c));
+  }
+  return s.empty() ? "_" : s;
 }
 
 /// The metric subset of a region record.
@@ -388,7 +393,12 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
   summary.warnings = results.warnings;
 
   // Images: copied under images/ (or linked), each checked to exist.
-  const fs::path results_dir = results.path.has_parent_path() ? results.path.parent_path() : fs::path(".");
+  // Image paths are relative to the results file itself: a link to it is followed, as the results
+  // writer follows it.
+  fs::path results_file = results.path;
+  std::error_code resolved;
+  if (fs::path real = fs::weakly_canonical(results.path, resolved); !resolved) results_file = std::move(real);
+  const fs::path results_dir = results_file.has_parent_path() ? results_file.parent_path() : fs::path(".");
   const auto image_path = [&](const std::string& rel, const std::string& name) -> std::string {
     const fs::path source = results_dir / rel;
     std::error_code ec;

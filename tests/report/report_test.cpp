@@ -309,5 +309,36 @@ TEST(Report, WarnsOnTornTailAndMissingImagesAndGuardsForeignFolders) {
   EXPECT_TRUE(embedded_data(dir / "leak" / "index.html")["cells"][0]["images"]["left"].is_null());
 }
 
+TEST(Report, ImagesOfEveryPipelineKeepTheirOwnFolderAndALinkedResultsFileFindsThem) {
+  // Two pipeline names that the image folders once mapped alike ("repro-rt:x=1", "repro-rt_x_1"):
+  // each keeps its own right eye. The results file is read through a link in another folder: its
+  // images lie beside the file it links to (all were reported missing).
+  test::ScratchDir dir;
+  const fs::path store = kSource / "reference" / "store";
+  fs::create_directories(dir / "run" / "cells" / "0000");
+  fs::copy_file(store / "box-wall_full_160x90_e64.0mm_c4.08m" / "right.png", dir / "run" / "cells" / "0000" / "a.png");
+  fs::copy_file(store / "box-wall_povray_160x90_e64.0mm_c4.08m" / "right.png", dir / "run" / "cells" / "0000" / "b.png");
+  json line = minimal_line("a", 0);
+  line["pipelines"]["repro-rt:x=1"] = line["pipelines"]["repro-rt"];
+  line["pipelines"]["repro-rt_x_1"] = line["pipelines"]["repro-rt"];
+  line["images"] = {{"pipelines",
+                     {{"repro-rt:x=1", {{"right_png", "cells/0000/a.png"}}},
+                      {"repro-rt_x_1", {{"right_png", "cells/0000/b.png"}}}}}};
+  write_text(dir / "run" / "results.jsonl", line.dump() + "\n");
+  fs::create_directories(dir / "elsewhere");
+  fs::create_symlink(dir / "run" / "results.jsonl", dir / "elsewhere" / "results.jsonl");
+
+  const test::CliRun r =
+      test::run_cli("report " + quoted(dir / "elsewhere" / "results.jsonl") + " --out " + quoted(dir / "out"));
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(r.out.find("is missing"), std::string::npos) << r.out;
+  const json pipelines = embedded_data(dir / "out" / "index.html")["cells"][0]["pipelines"];
+  const std::string a = pipelines["repro-rt:x=1"]["images"]["right"].get<std::string>();
+  const std::string b = pipelines["repro-rt_x_1"]["images"]["right"].get<std::string>();
+  EXPECT_NE(a, b);
+  EXPECT_EQ(test::read_text(dir / "out" / a), test::read_text(dir / "run" / "cells" / "0000" / "a.png")) << a;
+  EXPECT_EQ(test::read_text(dir / "out" / b), test::read_text(dir / "run" / "cells" / "0000" / "b.png")) << b;
+}
+
 }  // namespace
 }  // namespace sb
