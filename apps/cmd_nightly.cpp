@@ -203,6 +203,9 @@ void run_nightly(const NightlyArgs& a) {
                                              .generic_string();
   // A resumed run whose id a line of another run took meanwhile (a history shared between sweeps)
   // could not be recorded: stop before the sweep.
+  const fs::path report_dir = run_dir / "report";
+  const std::string report_name = fmt::format("the run's report folder {}", report_dir.string());
+  reports::check_report_folder(report_dir, report_name);  // written last, checked first
   for (const json& r : history_before.runs)
     if (r["run_id"] == run_id && r.value("results", "") != results_in_history)
       throw InputError(fmt::format(
@@ -267,7 +270,8 @@ void run_nightly(const NightlyArgs& a) {
   // 4. The report with the trends.
   const reports::ResultsFile report_results = reports::read_results_file(o.results);
   reports::ReportOptions options;
-  options.out_dir = run_dir / "report";
+  options.out_dir = report_dir;
+  options.out_name = report_name;
   options.title = fmt::format("stereobench nightly: {} {}", d.name, run.date);
   // The trends are this sweep's: a history shared with other sweeps keeps their runs out.
   json trend_runs = json::array();

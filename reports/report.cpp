@@ -209,18 +209,19 @@ constexpr const char* kReportMarker = ".stereobench-report";
 
 /// Prepares the output folder: new, empty, or an earlier report (finished, or stopped before its
 /// index was written) whose index, assets and images go. A folder holding anything else is refused.
-void prepare_out_dir(const fs::path& out) {
+/// Whether a non-empty folder holds a stereobench report (its marker, or our index.html).
+bool holds_report(const fs::path& out) {
   std::error_code ec;
-  if (fs::exists(out, ec) && !fs::is_directory(out, ec))
-    throw InputError(fmt::format("--out {} is a file; give a folder for the report", out.string()));
+  const fs::path index = out / "index.html";
+  return fs::exists(out / kReportMarker, ec) ||
+         (fs::exists(index, ec) &&
+          io::read_file(index).find(fmt::format("content=\"{}", kGenerator)) != std::string::npos);
+}
+
+void prepare_out_dir(const fs::path& out, const std::string& named) {
+  check_report_folder(out, named);
+  std::error_code ec;
   if (fs::exists(out, ec) && !fs::is_empty(out, ec)) {
-    const fs::path index = out / "index.html";
-    const bool ours = fs::exists(out / kReportMarker, ec) ||
-                      (fs::exists(index, ec) &&
-                       io::read_file(index).find(fmt::format("content=\"{}", kGenerator)) != std::string::npos);
-    if (!ours)
-      throw InputError(fmt::format("--out {} is not empty and holds no stereobench report; give a new or empty folder",
-                                   out.string()));
     // The index first: a folder never holds an index.html whose assets or images are gone.
     for (const char* sub : {"index.html", "assets", "images"}) {
       fs::remove_all(out / sub, ec);
@@ -241,6 +242,14 @@ void copy_atomically(const fs::path& from, const fs::path& to) {
 }
 
 }  // namespace
+
+void check_report_folder(const fs::path& out, const std::string& named) {
+  std::error_code ec;
+  if (fs::exists(out, ec) && !fs::is_directory(out, ec))
+    throw InputError(fmt::format("{} is a file; give a folder for the report", named));
+  if (fs::exists(out, ec) && !fs::is_empty(out, ec) && !holds_report(out))
+    throw InputError(fmt::format("{} is not empty and holds no stereobench report; give a new or empty folder", named));
+}
 
 fs::path report_assets_dir() {
   if (const char* env = std::getenv("STEREOBENCH_REPORT_ASSETS"); env != nullptr && *env != '\0') return env;
@@ -388,7 +397,7 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
   }
 
   const fs::path out = options.out_dir;
-  prepare_out_dir(out);
+  prepare_out_dir(out, options.out_name.empty() ? fmt::format("--out {}", out.string()) : options.out_name);
   ReportSummary summary;
   summary.warnings = results.warnings;
 

@@ -24,6 +24,8 @@ enum class ImageMode {
 
 struct ReportOptions {
   std::filesystem::path out_dir;  ///< written: index.html, assets/, images/ (copy mode)
+  /// How a message names out_dir; empty: "--out DIR", the report command's option.
+  std::string out_name;
   std::string title;              ///< empty: "stereobench report: <sweep>"
   ImageMode images = ImageMode::copy;
   /// Folder holding report.js, report.css, report.html, papers.json and chart.umd.min.js; empty:
@@ -54,6 +56,12 @@ struct ReportSummary {
 /// ToolError naming the first page asset missing from `assets` and how to get it back. write_report
 /// checks this itself; a long run that ends in a report checks it before it starts.
 void check_report_assets(const std::filesystem::path& assets);
+
+/// InputError when `out` cannot take a report: it is a file, or a folder that is not empty and holds
+/// no stereobench report (write_report replaces an earlier report only). `named` names it in the
+/// message ("--out DIR"). write_report checks this itself; a long run that ends in a report checks
+/// it before it starts.
+void check_report_folder(const std::filesystem::path& out, const std::string& named);
 
 /// The paper experiment a sweep reproduces, by its name: "wissmann-table2", "kim-table2",
 /// "kim-table3", "al-hagri" (any "al-hagri-*"), or empty.

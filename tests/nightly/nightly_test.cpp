@@ -384,6 +384,22 @@ TEST(NightlyTest, RunFoldersWithLongSuffixesOrderWithoutOverflow) {
   EXPECT_NE(r.out.find(" (new): "), std::string::npos) << "a new run, none resumed: " << r.out;
 }
 
+TEST(NightlyTest, AReportFolderThatCannotTakeTheReportIsRefusedBeforeTheSweep) {
+  // An unfinished run whose report path is a file: found before any cell runs, named as the run's
+  // report folder (it was found after the sweep and history line, and called nightly's --out).
+  test::ScratchDir dir;
+  write_inputs(dir);
+  const fs::path run = dir / "runs" / "20200101T000000Z";
+  fs::create_directories(run);
+  write_text(run / "report", "not a folder\n");
+  const test::CliRun r = test::run_cli(nightly_args(dir));
+  EXPECT_EQ(r.code, 3) << r.out;
+  EXPECT_NE(r.out.find("the run's report folder " + (run / "report").string() + " is a file"), std::string::npos)
+      << r.out;
+  EXPECT_FALSE(fs::exists(run / "results.jsonl")) << "no cell ran";
+  EXPECT_FALSE(fs::exists(dir / "runs" / "history.jsonl")) << "no run was recorded";
+}
+
 TEST(NightlyTest, SweepsSharingAHistoryKeepTheirRunsApart) {
   // Two sweeps, one history: a new run takes an id no line of the history has (it used to take the
   // other sweep's id of the same second and was silently not recorded), its trends show its own
