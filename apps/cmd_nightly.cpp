@@ -169,8 +169,8 @@ void run_nightly(const NightlyArgs& a) {
   // Read before any cell runs: a malformed history stops the run before it costs anything, and so
   // does a missing report asset (the report is written last).
   const HistoryFile history_before = read_history(history_file);
+  reports::check_report_assets(reports::report_assets_dir());  // before the history's folder is made
   check_history_writable(history_file, !a.history.empty());
-  reports::check_report_assets(reports::report_assets_dir());
   for (const std::string& w : history_before.warnings) fmt::print(stderr, "warning: {}\n", w);
 
   Baseline baseline;

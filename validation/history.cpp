@@ -48,13 +48,14 @@ struct Field {
   const char* key;      ///< in the history line
   const char* pointer;  ///< in a pipeline entry of a results line
   double lo, hi;        ///< the range every median of measurements lies in
+  bool infinite;        ///< whether hi itself is a value (PSNR of identical images); else below it
 };
 constexpr Field kFields[] = {
-    {"psnr", "/validation/metrics/psnr", 0.0, kInf},
-    {"ssim", "/validation/metrics/ssim", -1.0, 1.0},
-    {"hole_fraction", "/validation/holes/hole_fraction", 0.0, 1.0},
-    {"median_s", "/timing/median_s", 0.0, kInf},
-    {"speedup", "/timing/speedup_median", 0.0, kInf},
+    {"psnr", "/validation/metrics/psnr", 0.0, kInf, true},
+    {"ssim", "/validation/metrics/ssim", -1.0, 1.0, true},
+    {"hole_fraction", "/validation/holes/hole_fraction", 0.0, 1.0, true},
+    {"median_s", "/timing/median_s", 0.0, kInf, false},
+    {"speedup", "/timing/speedup_median", 0.0, kInf, false},
 };
 
 /// A count: an integer >= 0.
@@ -130,7 +131,14 @@ void check_history_line(const json& line, const std::string& where) {
   std::tm tm{};
   const std::string date = line["date"].get<std::string>();
   const char* end = ::strptime(date.c_str(), kUtcTimeFormat, &tm);
-  if (end == nullptr || *end != '\0' || date.size() != 20)
+  // strptime takes any day 1..31 of any month: the date must come back from the time it gives.
+  std::tm back{};
+  std::tm copy = tm;
+  const std::time_t t = ::timegm(&copy);
+  const bool real = end != nullptr && ::gmtime_r(&t, &back) != nullptr && back.tm_mday == tm.tm_mday &&
+                    back.tm_mon == tm.tm_mon && back.tm_year == tm.tm_year && back.tm_hour == tm.tm_hour &&
+                    back.tm_min == tm.tm_min && back.tm_sec == tm.tm_sec;
+  if (end == nullptr || *end != '\0' || date.size() != 20 || !real)
     throw bad(fmt::format("\"date\" {} is not a UTC time of the form 2026-01-31T02:00:00Z", line["date"].dump()));
   if (!line.contains("cells") || !is_count(line["cells"])) throw bad("\"cells\" must be a count >= 0");
   if (!line.contains("pipelines") || !line["pipelines"].is_object())
@@ -145,9 +153,9 @@ void check_history_line(const json& line, const std::string& where) {
       const std::optional<double> x = number_of(v);
       if (!x)
         throw bad(fmt::format("pipelines.{}.{} must be a number, \"inf\" or null, not {}", name, f.key, v.dump()));
-      if (!(*x >= f.lo && *x <= f.hi))
-        throw bad(fmt::format("pipelines.{}.{} is {}, outside [{}, {}] where every measurement lies", name, f.key,
-                              v.dump(), f.lo, f.hi));
+      if (!(*x >= f.lo && (f.infinite ? *x <= f.hi : *x < f.hi)))
+        throw bad(fmt::format("pipelines.{}.{} is {}, outside [{}, {}{} where every measurement lies", name, f.key,
+                              v.dump(), f.lo, f.hi, f.infinite ? "]" : ")"));
     }
   }
   const json gate = line.value("gate", json(nullptr));

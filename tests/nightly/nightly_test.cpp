@@ -357,6 +357,9 @@ TEST(NightlyTest, HistoryLinesWithImpossibleValuesAreRefused) {
       {[](json& h) { h["pipelines"]["repro-rt"]["ssim"] = 9.96; }, "pipelines.repro-rt.ssim is 9.96, outside [-1, 1]"},
       {[](json& h) { h["pipelines"]["repro-rt"]["median_s"] = -0.5; }, "pipelines.repro-rt.median_s is -0.5"},
       {[](json& h) { h["pipelines"]["repro-rt"]["cells"] = -1; }, "pipelines.repro-rt.cells must be a count"},
+      {[](json& h) { h["date"] = "2026-02-30T23:00:00Z"; }, "\"date\" \"2026-02-30T23:00:00Z\" is not a UTC time"},
+      {[](json& h) { h["pipelines"]["repro-rt"]["median_s"] = "inf"; }, "pipelines.repro-rt.median_s is \"inf\""},
+      {[](json& h) { h["pipelines"]["repro-rt"]["speedup"] = "inf"; }, "pipelines.repro-rt.speedup is \"inf\""},
   };
   for (const auto& [edit, expect] : cases) {
     json h = good;
