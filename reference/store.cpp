@@ -8,10 +8,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <limits>
 #include <optional>
 #include <regex>
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <sys/file.h>
 #include <unistd.h>
 
@@ -260,6 +262,15 @@ const std::regex& working_name() {
   return pattern;
 }
 
+/// The process's file mode creation mask (umask), read without changing it; 022 where the kernel
+/// does not report it.
+mode_t current_umask() {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("Umask:", 0) == 0) return static_cast<mode_t>(std::strtoul(line.c_str() + 6, nullptr, 8));
+  return 022;
+}
+
 /// Makes a new working folder of `kind` for entry `id`: made (mkdtemp) and locked under a name the
 /// clean-up does not look at, then renamed, so that no other run can find it unlocked.
 void make_working_folder(const fs::path& root, const std::string& id, const char* kind, WorkingFolder& out) {
@@ -272,6 +283,8 @@ void make_working_folder(const fs::path& root, const std::string& id, const char
                               "can write",
                               root.string(), std::strerror(err)));
   }
+  // mkdtemp makes it private (0700); once an entry, it is read like any folder the user makes.
+  (void)::chmod(made.c_str(), 0777 & ~current_umask());
   out.fd.reset(::open(made.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
   // Unlocked, another run's clean-up could take it; only a file system without locks is let be.
   if (!out.fd.valid() || (::flock(out.fd.get(), LOCK_EX | LOCK_NB) != 0 && errno != ENOLCK && errno != EOPNOTSUPP)) {

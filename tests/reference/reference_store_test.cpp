@@ -73,6 +73,9 @@ TEST(ReferenceStore, GenerateWritesImageAndProvenance) {
   EXPECT_EQ(p["date"].get<std::string>().size(), 20u);  // 2026-01-02T03:04:05Z
   // Nothing but complete entries in the store.
   for (const auto& e : fs::directory_iterator(dir / "store")) EXPECT_EQ(e.path().filename().string(), id);
+  // The entry's folder is readable as any folder made under the same umask (it was private, 0700).
+  fs::create_directory(dir / "plain");
+  EXPECT_EQ(fs::status(dir / "store" / id).permissions(), fs::status(dir / "plain").permissions());
 }
 
 TEST(ReferenceStore, VerifyUpdateOnlyFailingAndCorruption) {
