@@ -113,28 +113,40 @@ bool well_formed_rig(const json& rig) {
   return true;
 }
 
-/// A recorded record against one computed now: every value the recorded one holds equal in type,
-/// strings and booleans, numbers within 1e-9 (relative). Keys only the new record has (fields added
-/// to the record since) are not compared.
-bool same_record(const json& recorded, const json& now) {
+/// Where a recorded record and one computed now first differ, as "FIELD: recorded X, now Y"
+/// (FIELD a dotted path below `at`, e.g. "pose.position[1]"), or nothing when they agree: every
+/// value the recorded one holds equal in type, strings and booleans, numbers within 1e-9
+/// (relative). Keys only the new record has (fields added to the record since) are not compared.
+std::optional<std::string> record_difference(const json& recorded, const json& now, const std::string& at = "") {
+  const auto differ = [&] {
+    return fmt::format("{}: recorded {}, now {}", at.empty() ? "the record" : at, recorded.dump(), now.dump());
+  };
   if (recorded.is_number() && now.is_number()) {
     const double x = recorded.get<double>(), y = now.get<double>();
-    return std::fabs(x - y) <= 1e-9 * std::max({1.0, std::fabs(x), std::fabs(y)});
+    if (std::fabs(x - y) <= 1e-9 * std::max({1.0, std::fabs(x), std::fabs(y)})) return std::nullopt;
+    return differ();
   }
-  if (recorded.type() != now.type()) return false;
+  if (recorded.type() != now.type()) return differ();
   if (recorded.is_object()) {
-    for (auto it = recorded.begin(); it != recorded.end(); ++it)
-      if (!now.contains(it.key()) || !same_record(it.value(), now[it.key()])) return false;
-    return true;
+    for (auto it = recorded.begin(); it != recorded.end(); ++it) {
+      const std::string field = at.empty() ? it.key() : at + "." + it.key();
+      if (!now.contains(it.key())) return fmt::format("{}: recorded {}, now absent", field, it.value().dump());
+      if (auto why = record_difference(it.value(), now[it.key()], field)) return why;
+    }
+    return std::nullopt;
   }
   if (recorded.is_array()) {
-    if (recorded.size() != now.size()) return false;
+    if (recorded.size() != now.size()) return differ();
     for (size_t i = 0; i < recorded.size(); ++i)
-      if (!same_record(recorded[i], now[i])) return false;
-    return true;
+      if (auto why = record_difference(recorded[i], now[i], fmt::format("{}[{}]", at, i))) return why;
+    return std::nullopt;
   }
-  return recorded == now;
+  if (recorded == now) return std::nullopt;
+  return differ();
 }
+
+/// Whether a recorded record agrees with one computed now (record_difference).
+bool same_record(const json& recorded, const json& now) { return !record_difference(recorded, now); }
 
 /// A record's JSON cut to 120 characters, for a message.
 std::string brief(const json& j) {
@@ -521,9 +533,9 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
     if (before && well_formed_rig(before_rig) && !same_record(before_rig, rig_now) &&
         !same_record(spec_to_json(*before), spec_to_json(stored)))
       throw InputError(fmt::format(
-          "reference '{}' in {} was made with another rig (recorded {}, now {}; the id gives the interaxial to 0.1 mm "
-          "and the convergence to 3 digits); give this one another --store, or remove {} to replace it",
-          id, root_.string(), brief(before_rig), brief(rig_now), (root_ / id).string()));
+          "reference '{}' in {} was made with another rig ({}; the id gives the interaxial to 0.1 mm and the "
+          "convergence to 3 digits); give this one another --store, or remove {} to replace it",
+          id, root_.string(), record_difference(before_rig, rig_now).value_or("?"), (root_ / id).string()));
   }
   remove_stale_folders(root_);
   WorkingFolder working;
@@ -664,11 +676,11 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
                            brief(recorded_rig));
     return r;
   }
-  if (!same_record(recorded_rig, rig_now)) {
+  if (const std::optional<std::string> why = record_difference(recorded_rig, rig_now)) {
     r.status = Status::scene_changed;
-    r.detail = fmt::format("its spec now resolves to another rig than the recorded one (now {}, recorded {}): the "
-                           "scene's camera or the rig defaults changed; regenerate the entry",
-                           brief(rig_now), brief(recorded_rig));
+    r.detail = fmt::format("its spec now resolves to another rig than the recorded one (rig {}): the scene's camera "
+                           "or the rig defaults changed; regenerate the entry",
+                           *why);
     return r;
   }
   // With scene and rig as recorded, the folder's name is the id its spec gives: a renamed folder
