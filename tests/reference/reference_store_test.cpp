@@ -450,7 +450,18 @@ TEST(ReferenceStore, ChangedSceneIsReported) {
   const fs::path scene = dir / "plane.gltf";
   fs::copy_file(scenes::resolve_scene("lit-plane", kScenes), scene);
   ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene " + quoted(scene) + " --resolution 32x18").code, 0);
-  std::string text = test::read_text(scene);
+  const std::string original = test::read_text(scene);
+  // A moved camera: the scene hash holds, the rig does not, and the field that moved is named.
+  json moved = json::parse(original);
+  for (json& node : moved["nodes"])
+    if (node.contains("camera")) node["translation"] = {0.25, 0.0, 0.0};
+  std::ofstream(scene, std::ios::binary | std::ios::trunc) << moved.dump();
+  const test::CliRun camera = test::run_cli(ref(dir, "verify") + " --no-render");
+  EXPECT_EQ(camera.code, 2) << camera.out;
+  EXPECT_NE(camera.out.find("another rig than the recorded one (rig pose.position[0]: recorded 0"), std::string::npos)
+      << camera.out;
+  std::ofstream(scene, std::ios::binary | std::ios::trunc) << original;
+  std::string text = original;
   const size_t at = text.find("\"intensity\"");
   ASSERT_NE(at, std::string::npos);
   const size_t colon = text.find(':', at);
