@@ -141,6 +141,12 @@ struct FrameUpdate {
   std::string bvh;  ///< "build" (prepared anew at this frame), "refit", "rebuild" or "static"
 };
 
+/// How many of a scene's `in_file` lights a cell keeps: its light count, capped at the scene's (a
+/// count above the scene's keeps all of its lights, and the record says how many), or all of them.
+size_t kept_lights(std::optional<int> lights, size_t in_file) {
+  return lights ? std::min(static_cast<size_t>(*lights), in_file) : in_file;
+}
+
 /// The prepared scene of the worker's current cell, kept while consecutive cells share the file
 /// and light count (cells are ordered scene first), so loading and the BVH build happen once.
 /// With a path, the kept scene is animated from whatever frame it shows to the cell's frame and
@@ -165,8 +171,7 @@ class SceneCache {
         for (const std::string& w : loaded_->warnings) fmt::print(stderr, "warning: {}\n", w);
       file_ = file;
     }
-    // A light count above the scene's keeps all of its lights (the record says how many).
-    const size_t keep = lights ? std::min(static_cast<size_t>(*lights), loaded_->lights.size()) : loaded_->lights.size();
+    const size_t keep = kept_lights(lights, loaded_->lights.size());
     const bool animated = path.has_value() && frame.has_value();
     const bool reusable = prepared_ && used_->lights.size() == keep && animated == (animator_ != nullptr) &&
                           (!animated || refit == refit_);
@@ -421,7 +426,7 @@ void claim_out_folder(const SweepDefinition& d, const SweepRunOptions& options) 
 /// matches nothing is refused before the first cell runs, naming the definition and the cell,
 /// instead of stopping the sweep when that cell comes.
 void check_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, const std::vector<size_t>& todo,
-                 const fs::path& scenes_dir) {
+                 const fs::path& scenes_dir, const std::map<std::string, std::unique_ptr<TruthProvider>>& providers) {
   std::map<std::string, fs::path> file_of;  // by scene label
   std::map<fs::path, std::vector<size_t>> by_file;
   for (size_t i : todo) {
@@ -430,11 +435,6 @@ void check_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, 
     by_file[at->second].push_back(i);
   }
   const std::vector<BenchEntry> entries = bench_config(d).entries();  // as run_cell runs them
-  std::map<std::string, std::unique_ptr<TruthProvider>> providers;
-  for (size_t i : todo) {
-    auto& p = providers[cells[i].truth];
-    if (!p) p = make_truth_provider(cells[i].truth);
-  }
   for (const auto& [file, indices] : by_file) {
     Scene scene = io::load_gltf(file);
     const std::vector<Light> lights = scene.lights;
@@ -444,9 +444,7 @@ void check_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, 
         for (const BenchEntry& e : entries) e.entry.check_rig(e.options, rig);
         // The lights the cell keeps (as SceneCache::get keeps them), for the truth's check.
         scene.lights.assign(lights.begin(),
-                            lights.begin() + static_cast<std::ptrdiff_t>(std::min(
-                                                 cells[i].lights ? static_cast<size_t>(*cells[i].lights) : lights.size(),
-                                                 lights.size())));
+                            lights.begin() + static_cast<std::ptrdiff_t>(kept_lights(cells[i].lights, lights.size())));
         providers.at(cells[i].truth)->check_scene(scene, file);
       } catch (const InputError& e) {
         throw InputError(fmt::format("{}: cell {} '{}': {}; fix the definition (no cell has run)", d.file.string(),
@@ -468,15 +466,17 @@ void check_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, 
 
 void prepare_sweep(const SweepDefinition& d, const std::vector<SweepCell>& cells, const std::vector<size_t>& todo,
                    const SweepRunOptions& options) {
-  std::set<std::string> truths;
-  for (size_t i : todo) truths.insert(cells[i].truth);
-  for (const std::string& name : truths) {
-    const std::unique_ptr<TruthProvider> provider = make_truth_provider(name);
+  // One provider per truth the cells to run name, each available.
+  std::map<std::string, std::unique_ptr<TruthProvider>> providers;
+  for (size_t i : todo) {
+    std::unique_ptr<TruthProvider>& provider = providers[cells[i].truth];
+    if (provider) continue;
+    provider = make_truth_provider(cells[i].truth);
     if (auto why = provider->unavailable_reason())
-      throw ToolError(fmt::format("{}: truth '{}' is unavailable: {}", d.file.string(), name, *why));
+      throw ToolError(fmt::format("{}: truth '{}' is unavailable: {}", d.file.string(), cells[i].truth, *why));
   }
   check_out_folders(options);
-  check_cells(d, cells, todo, options.scenes_dir);
+  check_cells(d, cells, todo, options.scenes_dir, providers);
   claim_out_folder(d, options);
 }
 
