@@ -214,6 +214,15 @@ class Checker {
         for (size_t i = 0; i < a->size(); ++i) string((*a)[i], fmt::format("/{}/{}", key, i));
       }
 
+    // The top-level arrays first: an index into one that is not an array would read as an index
+    // past its end.
+    for (const char* key : {"accessors", "animations", "buffers", "bufferViews", "cameras", "images", "materials",
+                            "meshes", "nodes", "samplers", "scenes", "skins", "textures"})
+      if (const json* a = member(doc_, key, "")) require_array(*a, std::string("/") + key);
+    if (const json* ext = find(doc_, "extensions"))
+      if (const json* khr = find(*ext, "KHR_lights_punctual"))
+        if (const json* lights = find(*khr, "lights")) require_array(*lights, "/extensions/KHR_lights_punctual/lights");
+
     opt_index(doc_, "scene", "", "scenes");
     each(doc_, "scenes", "", [&](const json& s, const std::string& p) {
       if (const json* nodes = member(s, "nodes", p)) {

@@ -272,6 +272,14 @@ std::vector<BadCase> corpus() {
   c.push_back({"image_absolute_path", "a.gltf", edited([](MiniGltf& g) { g.doc["images"] = json::array({{{"uri", "/etc/hostname"}}}); }),
                "/images/0/uri: '/etc/hostname' is an absolute path"});
   c.push_back({"missing_image_file", "a.gltf", edited([](MiniGltf& g) { g.doc["images"] = json::array({{{"uri", "nope.png"}}}); }), "/images/0/uri: referenced file"});
+  // A top-level array of another type is named as such (it read as an index past its end).
+  c.push_back({"buffers_not_an_array", "a.gltf", edited([](MiniGltf& g) { g.doc["buffers"] = json{{"a", g.doc["buffers"][0]}}; }),
+               "/buffers: expected a JSON array, found object"});
+  c.push_back({"accessors_not_an_array", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"] = 5; }),
+               "/accessors: expected a JSON array, found number"});
+  c.push_back({"lights_not_an_array", "a.gltf",
+               edited([](MiniGltf& g) { g.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::object(); }),
+               "/extensions/KHR_lights_punctual/lights: expected a JSON array"});
   return c;
 }
 
