@@ -80,6 +80,7 @@ void run_render(const RenderArgs& a) {
   // replaced by it.
   const std::string stem = fmt::format("{}_{}", scene.file_stem(), entry_file_stem(entry.name));
   std::vector<fs::path> outputs = io::render_file_names(a.out, stem).all();
+  io::check_no_folder_at(outputs, "give another --out");  // before the render, not after it
   std::error_code ec;
   for (fs::directory_iterator it(a.out, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();

@@ -137,11 +137,22 @@ RenderFiles render_file_names(const std::filesystem::path& dir, const std::strin
   return f;
 }
 
+void check_no_folder_at(const std::vector<fs::path>& files, const std::string& where) {
+  for (const fs::path& file : files) {
+    std::error_code ec;
+    if (fs::is_directory(file, ec))
+      throw IoError(fmt::format("cannot write {}: a folder of that name is in the way; remove it or {}",
+                                file.string(), where));
+  }
+}
+
 RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::string& stem,
                                  const StereoResult& result, const json& record, const Image* holes_overlay) {
   check_extra_names(result);
   RenderFiles f = render_file_names(dir, stem);
   if (!holes_overlay) f.holes_png.reset();
+  for (const auto& [name, image] : result.extras) f.extras.push_back(dir / (stem + "_" + name + ".png"));
+  check_no_folder_at(f.all(), "write to another folder");
   // Every file is made whole under its temporary name first, and only then are all renamed into
   // place, the stats JSON last (it marks a complete set): a failure on the way (a full disk) leaves
   // an earlier render's set as it was. Should a rename fail after others, the stats JSON is
@@ -154,10 +165,7 @@ RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::st
   pngs.emplace_back(f.anaglyph_png, &anaglyph);
   pngs.emplace_back(f.side_by_side_png, &sbs);
   if (holes_overlay) pngs.emplace_back(*f.holes_png, holes_overlay);
-  for (const auto& [name, image] : result.extras) {
-    f.extras.push_back(dir / (stem + "_" + name + ".png"));
-    pngs.emplace_back(f.extras.back(), &image);
-  }
+  for (size_t k = 0; k < result.extras.size(); ++k) pngs.emplace_back(f.extras[k], &result.extras[k].second);
   // The set's file names go into the stats JSON: the next render of this stem removes those of
   // this set it does not write again (a diagnostic image an option asked for).
   json stats = record;

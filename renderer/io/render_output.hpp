@@ -49,6 +49,11 @@ struct RenderFiles {
 /// and <stem>_holes.png (holes_png set); extras are named by write_render_outputs.
 [[nodiscard]] RenderFiles render_file_names(const std::filesystem::path& dir, const std::string& stem);
 
+/// IoError (exit 4) when a folder stands where one of `files` is to be written: the names are
+/// generated, so the way out is to remove the folder or write elsewhere (`where` says how, e.g.
+/// "give another --out").
+void check_no_folder_at(const std::vector<std::filesystem::path>& files, const std::string& where);
+
 /// Writes every output of a run as one set (io::StagedFiles: all made whole, then all renamed
 /// into place, the stats JSON last, which lists the set's files; the earlier set's files of the
 /// stem that this one does not write are then removed) and returns their paths: with

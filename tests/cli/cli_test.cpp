@@ -185,23 +185,36 @@ TEST(Cli, RenderWritesEveryOutputAndBenchPrintsATable) {
   EXPECT_GT(j.at("counters").at("shadow_rays").get<uint64_t>(), 0u);
   EXPECT_EQ(j.at("rig").at("width").get<int>(), 64);
 
-  // A render that stops while writing (here: the side-by-side image's path is a folder) places
-  // none of its files: every file is made whole before any takes its name, so the earlier render's
-  // set stays as it was (it used to lose its stats and the files the new render wrote first), and
-  // no temporary file is left.
+  // A render that stops while writing (here: the side-by-side image's path is a link into a folder
+  // that does not exist) places none of its files: every file is made whole before any takes its
+  // name, so the earlier render's set stays as it was (it used to lose its stats and the files the
+  // new render wrote first), and no temporary file is left.
   const std::string stem = "box-wall_plain-raster";
   std::filesystem::remove(dir / (stem + "_sbs.png"));
-  std::filesystem::create_directories(dir / (stem + "_sbs.png"));
+  std::filesystem::create_symlink(dir / "nowhere" / "sbs.png", dir / (stem + "_sbs.png"));
   std::map<std::string, std::string> before;
   for (const char* suffix : {".exr", "_left.png", "_right.png", "_anaglyph.png", "_stats.json"})
     before[suffix] = test::read_text(dir / (stem + suffix));
-  const CliRun stopped = run("render --scene box-wall --pipeline plain-raster --out '" + dir.path().string() +
-                             "' --scenes-dir '" + (dir / "scenes").string() + "' --resolution 48x27");
-  EXPECT_EQ(stopped.code, 3) << stopped.out;
-  EXPECT_NE(stopped.out.find(stem + "_sbs.png is a folder"), std::string::npos) << stopped.out;
+  const std::string again = "render --scene box-wall --pipeline plain-raster --out '" + dir.path().string() +
+                            "' --scenes-dir '" + (dir / "scenes").string() + "' --resolution 48x27";
+  const CliRun stopped = run(again);
+  EXPECT_EQ(stopped.code, 4) << stopped.out;
+  EXPECT_NE(stopped.out.find(stem + "_sbs.png: it is a link to"), std::string::npos) << stopped.out;
   for (const auto& [suffix, text] : before) EXPECT_EQ(test::read_text(dir / (stem + suffix)), text) << suffix;
   for (const auto& entry : std::filesystem::directory_iterator(dir.path()))
     EXPECT_NE(entry.path().filename().string()[0], '.') << entry.path();
+  std::filesystem::remove(dir / (stem + "_sbs.png"));
+  // A folder where an output goes is found before the render (exit 4: the names are generated,
+  // none was given; it was exit 3, "give the name of the file to write", after the render).
+  std::filesystem::create_directories(dir / (stem + "_sbs.png"));
+  const CliRun blocked = run(again);
+  EXPECT_EQ(blocked.code, 4) << blocked.out;
+  EXPECT_NE(blocked.out.find("cannot write " + (dir / (stem + "_sbs.png")).string() +
+                             ": a folder of that name is in the way; remove it or give another --out"),
+            std::string::npos)
+      << blocked.out;
+  EXPECT_EQ(blocked.out.find("plain-raster on box-wall"), std::string::npos) << "rendered first: " << blocked.out;
+  for (const auto& [suffix, text] : before) EXPECT_EQ(test::read_text(dir / (stem + suffix)), text) << suffix;
   std::filesystem::remove(dir / (stem + "_sbs.png"));
 
   // A diagnostic image an option asked for goes with the next render of the stem that does not
