@@ -1,9 +1,12 @@
 // stereobench: the command-line tool. Maps subcommands to library calls and errors to exit codes.
 #include <cctype>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <regex>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -123,6 +126,17 @@ std::string unknown_command_message(const CLI::App& app, int argc, char** argv) 
   return "";
 }
 
+/// The exit code once standard output has taken everything printed: `code`, or 4 with a message
+/// when it could not (a full disk behind a redirection, a closed pipe), so that output that never
+/// arrived does not end in success.
+int after_flushing_stdout(int code) {
+  errno = 0;
+  if (std::fflush(stdout) == 0 && std::ferror(stdout) == 0) return code;
+  std::fprintf(stderr, "stereobench: error: cannot write to standard output: %s; check where it goes (a full disk, "
+               "a closed pipe)\n", errno != 0 ? std::strerror(errno) : "write error");
+  return static_cast<int>(sb::ExitCode::environment);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -154,7 +168,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const sb::cli::VerdictExit& verdict) {
-    return verdict.code;
+    return after_flushing_stdout(verdict.code);
   } catch (const CLI::Success& e) {
     return app.exit(e);  // --help, --version
   } catch (const CLI::ParseError& e) {
@@ -169,9 +183,14 @@ int main(int argc, char** argv) {
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "stereobench: error: out of memory; try a smaller scene or resolution\n");
     return static_cast<int>(sb::ExitCode::environment);
+  } catch (const std::system_error& e) {
+    // What the operating system refused, e.g. printing to a full disk ("cannot write to file").
+    std::fprintf(stderr, "stereobench: error: %s; check where the output goes (a full disk, a closed pipe)\n",
+                 e.what());
+    return static_cast<int>(sb::ExitCode::environment);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "stereobench: internal error: %s\n", e.what());
     return static_cast<int>(sb::ExitCode::environment);
   }
-  return 0;
+  return after_flushing_stdout(0);
 }

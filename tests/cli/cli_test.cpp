@@ -25,6 +25,19 @@ using test::CliRun;
 
 CliRun run(const std::string& args) { return test::run_cli(args); }
 
+TEST(Cli, OutputStandardOutputCannotTakeIsAnIoError) {
+  // Standard output on a full disk: the commands whose output is their result exit 4 saying so
+  // (they exited 0 with nothing written, or 4 as an "internal error").
+  ASSERT_TRUE(std::filesystem::exists("/dev/full")) << "the test writes to /dev/full";
+  const std::string cache = (std::filesystem::path(SB_BINARY_DIR) / "Testing" / "scenes-cache").string();
+  for (const std::string command : {"scenes list", "scenes info box-wall --scenes-dir '" + cache + "'", "pipelines"}) {
+    const CliRun r = test::run_shell("{ " + std::string(SB_CLI_PATH) + " " + command + " >/dev/full; }");
+    EXPECT_EQ(r.code, 4) << command << ": " << r.out;
+    EXPECT_NE(r.out.find("stereobench: error: cannot write to"), std::string::npos) << command << ": " << r.out;
+    EXPECT_EQ(r.out.find("internal error"), std::string::npos) << command << ": " << r.out;
+  }
+}
+
 TEST(Cli, VersionAndHelp) {
   const CliRun v = run("--version");
   EXPECT_EQ(v.code, 0);
