@@ -88,6 +88,16 @@ void run_preset_command(const BenchArgs& a) {
     throw InputError("--json - with --preset: the file is rewritten after every row; give a file name");
   run.overrides = a.rig.overrides();
   run.config = bench_config(a, preset_pipelines(*run.preset));
+  // The JSON is rewritten after every row: it must not be a scene file a row reads (or its stamp,
+  // whose loss has the scene generated again).
+  for (const PresetSeries& series : run.preset->series)
+    for (size_t i = 0; i < series.rows.size() && (a.preset_rows == 0 || i < static_cast<size_t>(a.preset_rows)); ++i) {
+      const PresetRow& row = series.rows[i];
+      for (const std::filesystem::path& file : scenes::builtin_files(row.scene, row.scene_params, a.scenes_dir)) {
+        const std::string name = file.string();
+        refuse_overwriting({{"a scene file of the preset", &name}}, {{"--json", &a.json_out}});
+      }
+    }
   remove_earlier_output(a.json_out, "--json");
   run.rows_per_series = a.preset_rows;
   run.scenes_dir = a.scenes_dir;
@@ -103,8 +113,8 @@ void run_bench_command(const BenchArgs& a) {
   const BenchConfig config = bench_config(a, pipeline_names());
   const Executor executor(checked_threads(a.threads));
   const scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
-  const std::string scene_file = loaded.file.string();
-  refuse_overwriting({{"the scene file", &scene_file}}, {{"--json", &a.json_out}});
+  const std::string scene_file = loaded.file.string(), stamp = scene_file + ".stamp";
+  refuse_overwriting({{"the scene file", &scene_file}, {"the scene file's stamp", &stamp}}, {{"--json", &a.json_out}});
   // From here the run's own --json, or none: an earlier one is not left to be read as this run's.
   remove_earlier_output(a.json_out, "--json");
   const Scene& scene = loaded.scene;

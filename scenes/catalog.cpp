@@ -139,6 +139,12 @@ fs::path resolve_builtin(const std::string& name, const std::map<std::string, do
   return r.path;
 }
 
+std::vector<fs::path> builtin_files(const std::string& name, const std::map<std::string, double>& params,
+                                    const fs::path& scenes_dir) {
+  const fs::path path = scenes_dir / variant_file_name(find_generator(name), 1, params);
+  return {path, stamp_path(path)};
+}
+
 LoadedScene load_scene(const std::string& spec, const std::filesystem::path& scenes_dir, std::optional<int> lights) {
   LoadedScene out;
   out.file = resolve_scene(spec, scenes_dir);

@@ -6,6 +6,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "renderer/scene.hpp"
 #include "scenes/generators.hpp"
@@ -43,6 +44,12 @@ GenerateResult generate_builtin(const std::string& name, const std::filesystem::
 [[nodiscard]] std::filesystem::path resolve_builtin(const std::string& name,
                                                     const std::map<std::string, double>& params,
                                                     const std::filesystem::path& scenes_dir);
+
+/// The files resolve_builtin(name, params, scenes_dir) reads and writes, without generating
+/// anything: the scene file and the stamp beside it (for a check that an output does not name them).
+[[nodiscard]] std::vector<std::filesystem::path> builtin_files(const std::string& name,
+                                                               const std::map<std::string, double>& params,
+                                                               const std::filesystem::path& scenes_dir);
 
 /// A scene loaded for rendering, with what the command line chose of it.
 struct LoadedScene {

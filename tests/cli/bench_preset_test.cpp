@@ -133,6 +133,15 @@ TEST(BenchPreset, BadPresetsAndLightCountsExitWith3AndSayWhy) {
        {"kim-focal compares every right eye with plain-raster's", "add plain-raster to --pipelines"}},
       {"bench --preset kim-complexity --pipelines plain-raster -n 1 -w 0" + sd, {"add bidir-warp to --pipelines"}},
       {"bench --preset-rows 1 --scene box-wall" + quick, {"--preset-rows needs --preset"}},
+      // The JSON rewritten after every row would replace a scene file a row reads, or its stamp.
+      {"bench --preset kim-focal --preset-rows 1 -n 1 -w 0 --json '" + (dir / "scenes" / "atrium.glb").string() + "'" + sd,
+       {"--json " + (dir / "scenes" / "atrium.glb").string() + " names the same file as a scene file of the preset"}},
+      {"bench --preset al-hagri-lights --preset-rows 1" + quick + " --json '" +
+           (dir / "scenes" / "dragon_lights-10.glb.stamp").string() + "'",
+       {"names the same file as a scene file of the preset"}},
+      {"bench --scene box-wall --resolution 32x18 --json '" + (dir / "scenes" / "box-wall.gltf.stamp").string() + "'" +
+           quick,
+       {"names the same file as the scene file's stamp"}},
       {"bench --preset al-hagri-lights --pipelines plain-rt,warp-drive" + sd, {"unknown pipeline 'warp-drive'"}},
       {"bench --scene box-wall --resolution 32x18 --lights 0" + quick, {"--lights 0", "'box-wall'", "has 1 light", "1..1"}},
       {"bench --scene box-wall --resolution 32x18 --lights 99" + quick, {"--lights 99", "'box-wall'", "has 1 light"}},
