@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <optional>
 
 #include <fmt/format.h>
@@ -177,17 +178,21 @@ void remove_earlier_outputs(std::initializer_list<NamedPath> outputs) {
   if (first) throw *first;
 }
 
-void write_option_file(const std::string& option, const std::string& path, const std::string& text) {
+void write_for_option(const std::string& option, const std::function<void()>& write) {
   try {
-    io::write_text_atomically(path, text);
+    write();
   } catch (const IoError& e) {
-    // The advice once: most messages of the writer already say what to do.
+    // The advice once: most messages of the writers already say what to do.
     const std::string what = e.what();
     const bool advised = what.find("; give ") != std::string::npos || what.find("; make ") != std::string::npos ||
                          what.find("; check ") != std::string::npos || what.find("; free ") != std::string::npos;
     throw IoError(advised ? fmt::format("{}: {}", option, what)
                           : fmt::format("{}: {}; give {} a path you can write", option, what, option));
   }
+}
+
+void write_option_file(const std::string& option, const std::string& path, const std::string& text) {
+  write_for_option(option, [&] { io::write_text_atomically(path, text); });
 }
 
 void discard_outputs(std::initializer_list<NamedPath> outputs) noexcept {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <initializer_list>
 #include <map>
 #include <optional>
@@ -83,8 +84,12 @@ void remove_earlier_outputs(std::initializer_list<NamedPath> outputs);
 /// regular files only, "" and "-" skipped), so that none is left beside its error.
 void discard_outputs(std::initializer_list<NamedPath> outputs) noexcept;
 
-/// Writes an output file an option names (io::write_text_atomically); an IoError names the option
-/// and what to do, e.g. "--json: cannot open /proc/x.json: ...; give --json a path you can write".
+/// Runs `write`, which writes the output file an option names; an IoError it throws is given the
+/// option's name and what to do, e.g. "--json: cannot open /proc/x.json: ...; give --json a path
+/// you can write".
+void write_for_option(const std::string& option, const std::function<void()>& write);
+
+/// Writes an output file an option names (io::write_text_atomically, through write_for_option).
 void write_option_file(const std::string& option, const std::string& path, const std::string& text);
 
 /// Writes `text` and a newline to standard output and flushes it: IoError (exit 4) when it cannot

@@ -190,8 +190,12 @@ int run_compare(const CompareArgs& a) {
 
   try {
     // Pictures first, so that a failing comparison still leaves them to look at.
-    if (!a.diff.empty()) validation::write_png(a.diff, validation::difference_image(fa.image, fb.image, region));
-    if (!a.ssim_map.empty()) validation::write_png(a.ssim_map, validation::ssim_image(ssim, region));
+    if (!a.diff.empty())
+      write_for_option("--diff", [&] {
+        validation::write_png(a.diff, validation::difference_image(fa.image, fb.image, region));
+      });
+    if (!a.ssim_map.empty())
+      write_for_option("--ssim-map", [&] { validation::write_png(a.ssim_map, validation::ssim_image(ssim, region)); });
     if (a.json == "-")
       print_to_stdout(record.dump(2));
     else if (!a.json.empty())

@@ -175,6 +175,13 @@ TEST_F(Compare, AStoppedComparisonLeavesNoOutputs) {
   EXPECT_NE(r.out.find("--json: cannot open /proc/sb-compare.json"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("give --json a path you can write"), std::string::npos) << r.out;
   for (const char* name : {"d.png", "s.png"}) EXPECT_FALSE(fs::exists(path(name))) << name;
+  // So do the pictures' options (their errors named neither the option nor what to do).
+  for (const char* option : {"--diff", "--ssim-map"}) {
+    r = compare(ab() + " " + option + " /proc/sb-compare.png");
+    EXPECT_EQ(r.code, 4) << r.out;
+    EXPECT_NE(r.out.find(std::string(option) + ": cannot open /proc/sb-compare.png"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(std::string("give ") + option + " a path you can write"), std::string::npos) << r.out;
+  }
   // A picture name the run refuses is not its output: the file stays.
   std::ofstream(path("photo.jpg")) << "a photo\n";
   r = compare(ab() + " --diff " + q(path("photo.jpg")));
