@@ -13,9 +13,10 @@
 
 namespace sb {
 
-/// The whole of `text` as a finite decimal number, or nothing (partial parses, NaN, infinities and
-/// hexadecimal such as 0x10, which the C library would accept, fail).
+/// The whole of `text` as a finite decimal number, or nothing (partial parses, NaN, infinities,
+/// hexadecimal such as 0x10 and leading blanks, which the C library would accept, fail).
 [[nodiscard]] inline std::optional<double> parse_finite(const std::string& text) {
+  if (text.empty() || std::isspace(static_cast<unsigned char>(text.front())) != 0) return std::nullopt;
   if (text.find_first_of("xX") != std::string::npos) return std::nullopt;
   size_t used = 0;
   double v = 0.0;

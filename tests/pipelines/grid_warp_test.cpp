@@ -322,7 +322,9 @@ TEST(GridWarp, OptionsAreChecked) {
   const StereoRig rig = test::rig_at(scene, 64, 36);
   for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
            {"threshold_arcmin", "0"}, {"threshold_arcmin", "-1"}, {"discontinuity_px", "0"},
-           {"discard", "sometimes"}, {"occluding_edge_px", "-1"}, {"tile", "2"}})
+           {"discard", "sometimes"}, {"occluding_edge_px", "-1"}, {"tile", "2"},
+           // Blanks around a number: the trailing one was refused, the leading one read as 3.
+           {"threshold_arcmin", " 3"}, {"threshold_arcmin", "3 "}, {"tile", " 16"}})
     EXPECT_THROW((void)test::render_with("repro-rt", prepared, rig, 1, {{key, value}}), InputError) << key << "=" << value;
   EXPECT_THROW((void)test::render_with("repro-warp", prepared, rig, 1, {{"discontinuity_px", "0.1"}}), InputError);
 }
