@@ -128,7 +128,11 @@ void print_focal_tables(const PresetSeries& series, const std::vector<FocalRow>&
   for (const FocalRow& r : rows) {
     std::string line = fmt::format("{:<{}}", r.value, first);
     for (const auto& [name, m] : r.quality)
-      line += fmt::format("  {:>{}}", fmt::format("{:.4f}/{}", m.ssim, psnr_text(m.psnr)), std::max<size_t>(14, name.size()));
+      // SSIM is undefined below its 11x11 window (NaN), as compare says.
+      line += fmt::format("  {:>{}}",
+                          fmt::format("{}/{}", std::isnan(m.ssim) ? "undefined" : fmt::format("{:.4f}", m.ssim),
+                                      psnr_text(m.psnr)),
+                          std::max<size_t>(14, name.size()));
     fmt::print("{}\n", line);
   }
   // Times of the same rows.

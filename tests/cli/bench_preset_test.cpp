@@ -309,6 +309,16 @@ TEST(BenchOptions, VariantsRunBesideTheirPipelineWithTheirOwnOptions) {
 
 // ---- Kim's presets ----
 
+TEST(BenchPresetKim, AnSsimBelowItsWindowIsPrintedAsUndefined) {
+  // 8x8 is below SSIM's 11x11 window: the table says so, as compare does (it printed "nan").
+  test::ScratchDir dir("kimsmall");
+  const CliRun r = test::run_cli("bench --preset kim-focal --preset-rows 1 --resolution 8x8 --pipelines "
+                                 "plain-raster,bidir-warp -n 1 -w 0 --scenes-dir '" + (dir / "scenes").string() + "'");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("undefined/"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("nan"), std::string::npos) << r.out;
+}
+
 TEST(BenchPresetKim, FocalComparesEveryMethodWithPlainRasterAtThreeDistances) {
   test::ScratchDir dir("kimfocal");
   const CliRun r = test::run_cli("bench --preset kim-focal --resolution 160x90 --repetitions 1 --warmup 0 --scenes-dir '" +
