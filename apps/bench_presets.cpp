@@ -241,6 +241,35 @@ nlohmann::json preset_json(const PresetRun& run, const Executor& executor) {
           {"versions", io::versions_json()}};
 }
 
+void check_series_rigs(const PresetRun& run, const PresetSeries& series, size_t rows, const fs::path& loaded,
+                       const Scene& scene, RowRig rig_of) {
+  const std::vector<BenchEntry> entries = run.config.entries();
+  for (size_t i = 0; i < rows; ++i) {
+    const PresetRow& row = series.rows[i];
+    if (scenes::builtin_files(row.scene, row.scene_params, run.scenes_dir).front() != loaded) continue;
+    try {
+      const StereoRig rig = rig_of(scene, run, row);
+      for (const BenchEntry& e : entries) e.entry.check_rig(e.options, rig);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}, row {} = {}: {} (no row of the series has run)", series.name, series.swept,
+                                   row.value, e.what()));
+    }
+  }
+}
+
+namespace {
+
+/// An Al-Hagri row's rig: its image size and disparity, the rest as the command line left it.
+StereoRig speed_row_rig(const Scene& scene, const PresetRun& run, const PresetRow& row) {
+  RigOverrides overrides = run.overrides;
+  overrides.width = row.width;
+  overrides.height = row.height;
+  overrides.max_disparity_px = row.max_disparity_px;
+  return resolve_rig(scene, overrides);
+}
+
+}  // namespace
+
 void run_bench_preset(const PresetRun& run, const Executor& executor) {
   const BenchPreset& preset = *run.preset;
   run.config.validate();  // before any scene is generated or loaded
@@ -294,11 +323,8 @@ void run_bench_preset(const PresetRun& run, const Executor& executor) {
         print_table_header(layout, series.swept, run.config.pipelines);
         header_printed = true;
       }
-      RigOverrides overrides = run.overrides;
-      overrides.width = row.width;
-      overrides.height = row.height;
-      overrides.max_disparity_px = row.max_disparity_px;
-      const StereoRig rig = resolve_rig(scene, overrides);
+      if (i == 0) check_series_rigs(run, series, n, path, scene, speed_row_rig);
+      const StereoRig rig = speed_row_rig(scene, run, row);
       const BenchResult r = run_bench(prepared, rig, run.config, executor);
       print_table_row(layout, row.value, r);
 

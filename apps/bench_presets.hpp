@@ -92,6 +92,17 @@ struct PresetRun {
 /// Runs every series, printing one table per series (a row as soon as it is measured).
 void run_bench_preset(const PresetRun& run, const Executor& executor);
 
+/// The rig of one row of a preset on its scene.
+using RowRig = StereoRig (*)(const Scene& scene, const PresetRun& run, const PresetRow& row);
+
+/// Before a series' first row runs: every row of the first `rows` of `series` whose scene is the
+/// file `loaded` (the scene just loaded for the first row) has its rig checked by every timed
+/// pipeline (PipelineEntry::check_rig), so that a rig a pipeline refuses (rt-buffer's depth
+/// beyond its bound at a small field of view, say) stops the series before it measures anything,
+/// not after its earlier rows. InputError naming the row.
+void check_series_rigs(const PresetRun& run, const PresetSeries& series, size_t rows, const std::filesystem::path& loaded,
+                       const Scene& scene, RowRig rig_of);
+
 // ---- Kim's tables (apps/bench_presets_kim.cpp) ----
 
 /// kim-focal: the atrium at 960x540, e = 64 mm, convergence 6 m, 2 m and 0.3 m (Kim's focal

@@ -287,6 +287,7 @@ void run_kim_focal(const PresetRun& run, const Executor& executor) {
       if (i == 0)
         fmt::print("\n{}: {} ({} triangles, {} lights), {}\n", series.name, scene->name, scene->triangle_count(),
                    scene->lights.size(), series.fixed);
+      if (i == 0) check_series_rigs(run, series, n, path, *scene, row_rig);
       const StereoRig rig = row_rig(*scene, run, row);
       fmt::print("{} = {}: {}\n", series.swept, row.value, describe(rig));
       std::fflush(stdout);

@@ -317,6 +317,18 @@ TEST(BenchPresetKim, AnSsimBelowItsWindowIsPrintedAsUndefined) {
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("undefined/"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("nan"), std::string::npos) << r.out;
+  // A later row's rig that a pipeline refuses (at this field of view the second distance needs a
+  // buffer deeper than rt-buffer's bound) stops the series before its first row runs: it stopped
+  // after the first, whose table was never printed.
+  const CliRun deep = test::run_cli("bench --preset kim-focal --preset-rows 2 --resolution 8x8 --vfov 0.00458 "
+                                    "--pipelines plain-raster,rt-buffer -n 1 -w 0 --scenes-dir '" +
+                                    (dir / "scenes").string() + "' --json '" + (dir / "deep.json").string() + "'");
+  EXPECT_EQ(deep.code, 3) << deep.out;
+  EXPECT_NE(deep.out.find("atrium by focal distance, row DF mm = 2000: rt-buffer: the default depth"),
+            std::string::npos)
+      << deep.out;
+  EXPECT_NE(deep.out.find("(no row of the series has run)"), std::string::npos) << deep.out;
+  EXPECT_EQ(deep.out.find("DF mm = 6000:"), std::string::npos) << "the first row ran: " << deep.out;
 }
 
 TEST(BenchPresetKim, FocalComparesEveryMethodWithPlainRasterAtThreeDistances) {
