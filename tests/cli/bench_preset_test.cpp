@@ -317,6 +317,10 @@ TEST(BenchPresetKim, AnSsimBelowItsWindowIsPrintedAsUndefined) {
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("undefined/"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("nan"), std::string::npos) << r.out;
+}
+
+TEST(BenchPresetKim, ARowARigRefusesStopsTheSeriesBeforeItsFirstRow) {
+  test::ScratchDir dir("kimdeep");
   // A later row's rig that a pipeline refuses (at this field of view the second distance needs a
   // buffer deeper than rt-buffer's bound) stops the series before its first row runs: it stopped
   // after the first, whose table was never printed.
