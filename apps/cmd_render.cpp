@@ -67,7 +67,13 @@ void run_render(const RenderArgs& a) {
                                  a.pipeline));
   const PipelineEntry entry = parse_pipeline_entry(a.pipeline);
   const Pipeline& pipeline = *entry.pipeline;
-  const PipelineOptions options = entry.options(parse_key_values(a.options, "--option"));
+  const std::map<std::string, std::string> given = parse_key_values(a.options, "--option");
+  // One pipeline, one value per option: a variant's own value and another by --option contradict.
+  for (const auto& [key, value] : given)
+    if (const auto it = entry.fixed.find(key); it != entry.fixed.end() && it->second != value)
+      throw InputError(fmt::format("--option {}={}: the variant {} fixes {}={}; give the option once", key, value,
+                                   entry.name, key, it->second));
+  const PipelineOptions options = entry.options(given);
   const Executor executor(checked_threads(a.threads));
   prepare_output_folder(a.out, "--out");
   const scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
@@ -138,7 +144,8 @@ void register_render_command(CLI::App& root) {
                 "NAME:KEY=VALUE[:KEY=VALUE...] (files are named NAME@KEY=VALUE...)")
       ->capture_default_str();
   r->add_option("--option,-o", a->options,
-                "Pipeline option NAME=VALUE (see `stereobench pipelines`); a variant's own options win");
+                "Pipeline option NAME=VALUE (see `stereobench pipelines`); one a variant's name fixes may not be given "
+                "another value");
   r->add_option("--threads,-t", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
   r->add_option("--out", a->out, "Output folder")->capture_default_str();
   add_lights_option(*r, a->lights);

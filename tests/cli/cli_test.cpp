@@ -457,6 +457,9 @@ TEST(Cli, RenderAndBenchRejectBadArguments) {
       {"render --scene box-wall --pipeline all" + common, "`stereobench validate` or `stereobench bench`"},
       {"render --scene box-wall --pipeline plain-raster --option tile=3" + common, "tile=3 is out of range"},
       {"render --scene box-wall --pipeline plain-raster --option tiles=32" + common, "has no option 'tiles'"},
+      // The variant's value and another by --option contradict (the option was ignored in silence).
+      {"render --scene box-wall --pipeline bidir-warp:occlusion=ztest --option occlusion=none" + common,
+       "--option occlusion=none: the variant bidir-warp:occlusion=ztest fixes occlusion=ztest; give the option once"},
       {"render --scene box-wall --pipeline plain-raster:tile=3" + common,
        "pipeline entry 'plain-raster:tile=3': plain-raster: option tile=3 is out of range"},
       {"render --scene box-wall --pipeline plain-rt --threads -1" + common, "--threads -1 is out of range"},
