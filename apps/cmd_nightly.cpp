@@ -201,11 +201,11 @@ void run_nightly(const NightlyArgs& a) {
                                              .lexically_normal()
                                              .lexically_relative(fs::absolute(history_dir).lexically_normal())
                                              .generic_string();
-  // A resumed run whose id a line of another run took meanwhile (a history shared between sweeps)
-  // could not be recorded: stop before the sweep.
   const fs::path report_dir = run_dir / "report";
   const std::string report_name = fmt::format("the run's report folder {}", report_dir.string());
   reports::check_report_folder(report_dir, report_name);  // written last, checked first
+  // A resumed run whose id a line of another run took meanwhile (a history shared between sweeps)
+  // could not be recorded: stop before the sweep.
   for (const json& r : history_before.runs)
     if (r["run_id"] == run_id && r.value("results", "") != results_in_history)
       throw InputError(fmt::format(

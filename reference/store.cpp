@@ -261,8 +261,9 @@ class ScratchFolder {
 };
 
 /// A working folder of the store, ".ID.KIND-PID-XXXXXX" (KIND new or old; "verify", a kind stores
-/// written by older versions may hold, is cleared up too), held under an exclusive lock (flock) while the generate that made it runs: remove_stale_folders
-/// leaves a locked one alone, whichever process, container or machine holds it.
+/// written by older versions may hold, is cleared up too), held under an exclusive lock (flock)
+/// while the generate that made it runs: remove_stale_folders leaves a locked one alone, whichever
+/// process, container or machine holds it.
 struct WorkingFolder {
   fs::path path;
   io::UniqueFd fd;

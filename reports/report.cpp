@@ -207,8 +207,6 @@ std::string fill_template(const std::string& text, const std::map<std::string, s
 /// disk, a kill) is recognised as ours and replaced by the next run, although it has no index.
 constexpr const char* kReportMarker = ".stereobench-report";
 
-/// Prepares the output folder: new, empty, or an earlier report (finished, or stopped before its
-/// index was written) whose index, assets and images go. A folder holding anything else is refused.
 /// Whether a non-empty folder holds a stereobench report (its marker, or our index.html).
 bool holds_report(const fs::path& out) {
   std::error_code ec;
@@ -218,6 +216,9 @@ bool holds_report(const fs::path& out) {
           io::read_file(index).find(fmt::format("content=\"{}", kGenerator)) != std::string::npos);
 }
 
+/// Prepares the output folder: new, empty, or an earlier report (finished, or stopped before its
+/// index was written) whose index, assets and images go. A folder holding anything else is refused
+/// (check_report_folder, naming it as `named`).
 void prepare_out_dir(const fs::path& out, const std::string& named) {
   check_report_folder(out, named);
   std::error_code ec;

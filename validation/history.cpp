@@ -48,7 +48,7 @@ struct Field {
   const char* key;      ///< in the history line
   const char* pointer;  ///< in a pipeline entry of a results line
   double lo, hi;        ///< the range every median of measurements lies in
-  bool infinite;        ///< whether hi itself is a value (PSNR of identical images); else below it
+  bool hi_included;     ///< whether hi itself is a value (SSIM 1, the infinite PSNR of identical images)
 };
 constexpr Field kFields[] = {
     {"psnr", "/validation/metrics/psnr", 0.0, kInf, true},
@@ -153,9 +153,9 @@ void check_history_line(const json& line, const std::string& where) {
       const std::optional<double> x = number_of(v);
       if (!x)
         throw bad(fmt::format("pipelines.{}.{} must be a number, \"inf\" or null, not {}", name, f.key, v.dump()));
-      if (!(*x >= f.lo && (f.infinite ? *x <= f.hi : *x < f.hi)))
+      if (!(*x >= f.lo && (f.hi_included ? *x <= f.hi : *x < f.hi)))
         throw bad(fmt::format("pipelines.{}.{} is {}, outside [{}, {}{} where every measurement lies", name, f.key,
-                              v.dump(), f.lo, f.hi, f.infinite ? "]" : ")"));
+                              v.dump(), f.lo, f.hi, f.hi_included ? "]" : ")"));
     }
   }
   const json gate = line.value("gate", json(nullptr));
