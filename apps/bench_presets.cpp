@@ -241,6 +241,10 @@ nlohmann::json preset_json(const PresetRun& run, const Executor& executor) {
           {"versions", io::versions_json()}};
 }
 
+size_t rows_to_run(const PresetSeries& series, int rows_per_series) {
+  return rows_per_series > 0 ? std::min(series.rows.size(), static_cast<size_t>(rows_per_series)) : series.rows.size();
+}
+
 void check_series_rigs(const PresetRun& run, const PresetSeries& series, size_t rows, const fs::path& loaded,
                        const Scene& scene, RowRig rig_of) {
   const std::vector<BenchEntry> entries = run.config.entries();
@@ -281,11 +285,8 @@ void run_bench_preset(const PresetRun& run, const Executor& executor) {
     run_kim_complexity(run, executor);
     return;
   }
-  const auto rows_of = [&run](const PresetSeries& s) {
-    return run.rows_per_series > 0 ? std::min(s.rows.size(), static_cast<size_t>(run.rows_per_series)) : s.rows.size();
-  };
   size_t total_rows = 0;
-  for (const PresetSeries& s : preset.series) total_rows += rows_of(s);
+  for (const PresetSeries& s : preset.series) total_rows += rows_to_run(s, run.rows_per_series);
 
   std::string pipelines;
   for (const std::string& p : run.config.pipelines) pipelines += (pipelines.empty() ? "" : ", ") + p;
@@ -304,7 +305,7 @@ void run_bench_preset(const PresetRun& run, const Executor& executor) {
 
   RowScene current;
   for (const PresetSeries& series : preset.series) {
-    const size_t n = rows_of(series);
+    const size_t n = rows_to_run(series, run.rows_per_series);
     if (n == 0) continue;
     const TableLayout layout = table_layout(series, run.config.pipelines);
     bool header_printed = false;

@@ -89,6 +89,10 @@ struct PresetRun {
   std::string json_out;      ///< rewritten after every row; empty = none
 };
 
+/// How many rows of `series` a run takes: the first `rows_per_series` (PresetRun's), or all of
+/// them for 0.
+[[nodiscard]] size_t rows_to_run(const PresetSeries& series, int rows_per_series);
+
 /// Runs every series, printing one table per series (a row as soon as it is measured).
 void run_bench_preset(const PresetRun& run, const Executor& executor);
 

@@ -69,9 +69,6 @@ bool contains(const std::vector<std::string>& items, const std::string& name) {
   return std::find(items.begin(), items.end(), name) != items.end();
 }
 
-size_t rows_to_run(const PresetRun& run, const PresetSeries& s) {
-  return run.rows_per_series > 0 ? std::min(s.rows.size(), static_cast<size_t>(run.rows_per_series)) : s.rows.size();
-}
 
 /// The rig of a Kim row: the preset's interaxial and convergence, the row's image size unless
 /// --resolution replaced it, and what else the command line left open (--vfov, --convergence).
@@ -272,7 +269,7 @@ void run_kim_focal(const PresetRun& run, const Executor& executor) {
   std::unique_ptr<Scene> scene;
   std::unique_ptr<RenderScene> prepared;
   for (const PresetSeries& series : preset.series) {
-    const size_t n = rows_to_run(run, series);
+    const size_t n = rows_to_run(series, run.rows_per_series);
     std::vector<FocalRow> measured;
     for (size_t i = 0; i < n; ++i) {
       const PresetRow& row = series.rows[i];
@@ -362,7 +359,7 @@ void run_kim_complexity(const PresetRun& run, const Executor& executor) {
   };
 
   for (const PresetSeries& series : preset.series) {
-    const size_t n = rows_to_run(run, series);
+    const size_t n = rows_to_run(series, run.rows_per_series);
     if (n == 0) continue;
     fmt::print("\n{}: {}\n", series.name, series.fixed);
     bool header_printed = false;

@@ -91,7 +91,7 @@ void run_preset_command(const BenchArgs& a) {
   // The JSON is rewritten after every row: it must not be a scene file a row reads (or its stamp,
   // whose loss has the scene generated again).
   for (const PresetSeries& series : run.preset->series)
-    for (size_t i = 0; i < series.rows.size() && (a.preset_rows == 0 || i < static_cast<size_t>(a.preset_rows)); ++i) {
+    for (size_t i = 0; i < rows_to_run(series, a.preset_rows); ++i) {
       const PresetRow& row = series.rows[i];
       for (const std::filesystem::path& file : scenes::builtin_files(row.scene, row.scene_params, a.scenes_dir)) {
         const std::string name = file.string();
