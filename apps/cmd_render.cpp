@@ -32,6 +32,7 @@ struct RenderArgs {
   std::string out = "out/render";
   int threads = 0;
   std::optional<int> lights;
+  std::vector<std::string> stereo{"anaglyph", "sbs"};
   RigCli rig;
 };
 
@@ -74,6 +75,7 @@ void run_render(const RenderArgs& a) {
       throw InputError(fmt::format("--option {}={}: the variant {} fixes {}={}; give the option once", key, value,
                                    entry.name, key, it->second));
   const PipelineOptions options = entry.options(given);
+  const io::StereoViews views = io::StereoViews::from_names(split_list(a.stereo, "--stereo"), "--stereo");
   const Executor executor(checked_threads(a.threads));
   prepare_output_folder(a.out, "--out");
   const scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
@@ -85,7 +87,7 @@ void run_render(const RenderArgs& a) {
   // or a diagnostic <stem>_NAME.png already there), by name or through a link either way, would be
   // replaced by it.
   const std::string stem = fmt::format("{}_{}", scene.file_stem(), entry_file_stem(entry.name));
-  std::vector<fs::path> outputs = io::render_file_names(a.out, stem).all();
+  std::vector<fs::path> outputs = io::render_file_names(a.out, stem, views).all();
   io::check_no_folder_at(outputs, "give another --out");  // before the render, not after it
   std::error_code ec;
   for (fs::directory_iterator it(a.out, ec), end; !ec && it != end; it.increment(ec)) {
@@ -109,7 +111,7 @@ void run_render(const RenderArgs& a) {
   record["scene"]["lights"] = scene.lights.size();
   record["scene"]["lights_in_file"] = lights_in_file;
   const io::RenderFiles files =
-      io::write_render_outputs(a.out, stem, result, record, holes ? &holes->overlay : nullptr);
+      io::write_render_outputs(a.out, stem, result, record, holes ? &holes->overlay : nullptr, views);
   fmt::print("{} on {} ({} triangles, {}), {}, {} threads\n", entry.name, scene.name, scene.triangle_count(),
              describe_lights(scene.lights.size(), lights_in_file), describe(rig), executor.threads());
   fmt::print("  {:<22} {:>10.2f} ms ({:.1f} MiB)\n", "bvh build (once)", prepared.bvh_build_seconds() * 1e3,
@@ -148,6 +150,11 @@ void register_render_command(CLI::App& root) {
                 "another value");
   r->add_option("--threads,-t", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
   r->add_option("--out", a->out, "Output folder")->capture_default_str();
+  r->add_option("--stereo", a->stereo,
+                "Viewable stereo images to write beside the eyes, comma-separated or repeated: anaglyph (Dubois\n"
+                "red-cyan, <stem>_anaglyph.png), sbs (side by side, left eye on the left, <stem>_sbs.png), ou\n"
+                "(over/under, left eye on top, <stem>_ou.png); none for none")
+      ->capture_default_str();
   add_lights_option(*r, a->lights);
   add_scenes_dir_option(*r, a->scenes_dir);
   a->rig.add_to(*r);

@@ -76,8 +76,32 @@ json holes_to_json(const HoleAnalysis& a) {
           {"analysis_s", a.seconds}};
 }
 
+StereoViews StereoViews::from_names(const std::vector<std::string>& names, const std::string& option) {
+  StereoViews v{false, false, false};
+  if (names.size() == 1 && names.front() == "none") return v;
+  std::vector<std::string> seen;
+  for (const std::string& name : names) {
+    if (name == "none")
+      throw InputError(fmt::format("{} none: 'none' writes no stereo image and stands alone; drop it or the other "
+                                   "names",
+                                   option));
+    if (std::find(seen.begin(), seen.end(), name) != seen.end())
+      throw InputError(fmt::format("{}: '{}' is named twice; name each stereo image once", option, name));
+    seen.push_back(name);
+    bool* flag = name == "anaglyph" ? &v.anaglyph : name == "sbs" ? &v.side_by_side : name == "ou" ? &v.over_under : nullptr;
+    if (flag == nullptr)
+      throw InputError(fmt::format("{} {}: not a stereo image; give anaglyph (Dubois red-cyan), sbs (side by side), "
+                                   "ou (over/under), several of them comma-separated, or none",
+                                   option, name));
+    *flag = true;
+  }
+  return v;
+}
+
 std::vector<std::filesystem::path> RenderFiles::all() const {
-  std::vector<std::filesystem::path> files{exr, left_png, right_png, anaglyph_png, side_by_side_png};
+  std::vector<std::filesystem::path> files{exr, left_png, right_png};
+  for (const auto* view : {&anaglyph_png, &side_by_side_png, &over_under_png})
+    if (*view) files.push_back(**view);
   if (holes_png) files.push_back(*holes_png);
   files.insert(files.end(), extras.begin(), extras.end());
   files.push_back(stats_json);
@@ -88,7 +112,8 @@ namespace {
 
 /// InputError unless every extra's name makes a file name of its own beside the standard outputs.
 void check_extra_names(const StereoResult& result) {
-  static constexpr std::array<std::string_view, 6> reserved = {"left", "right", "anaglyph", "sbs", "stats", "holes"};
+  static constexpr std::array<std::string_view, 7> reserved = {"left",  "right", "anaglyph", "sbs",
+                                                                "ou",    "stats", "holes"};
   for (size_t i = 0; i < result.extras.size(); ++i) {
     const std::string& name = result.extras[i].first;
     const bool valid = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
@@ -96,7 +121,7 @@ void check_extra_names(const StereoResult& result) {
     });
     if (!valid || std::find(reserved.begin(), reserved.end(), name) != reserved.end())
       throw InputError(fmt::format("a pipeline returned a diagnostic image named '{}'; names must be lowercase "
-                                   "letters, digits and '_', and not one of left, right, anaglyph, sbs, stats, holes",
+                                   "letters, digits and '_', and not one of left, right, anaglyph, sbs, ou, stats, holes",
                                    name));
     for (size_t k = 0; k < i; ++k)
       if (result.extras[k].first == name)
@@ -125,13 +150,14 @@ std::vector<std::string> earlier_files(const fs::path& stats_json, const std::st
 
 }  // namespace
 
-RenderFiles render_file_names(const std::filesystem::path& dir, const std::string& stem) {
+RenderFiles render_file_names(const std::filesystem::path& dir, const std::string& stem, const StereoViews& views) {
   RenderFiles f;
   f.exr = dir / (stem + ".exr");
   f.left_png = dir / (stem + "_left.png");
   f.right_png = dir / (stem + "_right.png");
-  f.anaglyph_png = dir / (stem + "_anaglyph.png");
-  f.side_by_side_png = dir / (stem + "_sbs.png");
+  if (views.anaglyph) f.anaglyph_png = dir / (stem + "_anaglyph.png");
+  if (views.side_by_side) f.side_by_side_png = dir / (stem + "_sbs.png");
+  if (views.over_under) f.over_under_png = dir / (stem + "_ou.png");
   f.holes_png = dir / (stem + "_holes.png");
   f.stats_json = dir / (stem + "_stats.json");
   return f;
@@ -147,9 +173,10 @@ void check_no_folder_at(const std::vector<fs::path>& files, const std::string& w
 }
 
 RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::string& stem,
-                                 const StereoResult& result, const json& record, const Image* holes_overlay) {
+                                 const StereoResult& result, const json& record, const Image* holes_overlay,
+                                 const StereoViews& views) {
   check_extra_names(result);
-  RenderFiles f = render_file_names(dir, stem);
+  RenderFiles f = render_file_names(dir, stem, views);
   if (!holes_overlay) f.holes_png.reset();
   for (const auto& [name, image] : result.extras) f.extras.push_back(dir / (stem + "_" + name + ".png"));
   check_no_folder_at(f.all(), "write to another folder");
@@ -160,10 +187,12 @@ RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::st
   ImageMetadata meta;
   meta["stereobench/record"] = record.dump();
   std::vector<std::pair<fs::path, const Image*>> pngs{{f.left_png, &result.left}, {f.right_png, &result.right}};
-  const Image anaglyph = anaglyph_dubois(result.left, result.right);
-  const Image sbs = side_by_side(result.left, result.right);
-  pngs.emplace_back(f.anaglyph_png, &anaglyph);
-  pngs.emplace_back(f.side_by_side_png, &sbs);
+  const std::pair<const std::optional<fs::path>*, Image (*)(const Image&, const Image&)> view_makers[] = {
+      {&f.anaglyph_png, &anaglyph_dubois}, {&f.side_by_side_png, &side_by_side}, {&f.over_under_png, &over_under}};
+  std::vector<Image> views_made;
+  views_made.reserve(std::size(view_makers));
+  for (const auto& [file, make] : view_makers)
+    if (*file) pngs.emplace_back(**file, &views_made.emplace_back(make(result.left, result.right)));
   if (holes_overlay) pngs.emplace_back(*f.holes_png, holes_overlay);
   for (size_t k = 0; k < result.extras.size(); ++k) pngs.emplace_back(f.extras[k], &result.extras[k].second);
   // The set's file names go into the stats JSON: the next render of this stem removes those of

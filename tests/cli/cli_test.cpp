@@ -2,6 +2,7 @@
 // message that says what was wrong.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <cstdio>
@@ -12,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "renderer/io/image_io.hpp"
 #include "renderer/pipeline.hpp"
 
 #include "support/mini_gltf.hpp"
@@ -275,6 +277,53 @@ TEST(Cli, RenderWritesEveryOutputAndBenchPrintsATable) {
   const CliRun l = run("pipelines");
   EXPECT_EQ(l.code, 0);
   for (const char* name : {"plain-rt", "plain-raster", "ideal-copy"}) EXPECT_NE(l.out.find(name), std::string::npos);
+}
+
+TEST(Cli, RenderWritesTheStereoImagesAskedFor) {
+  test::ScratchDir dir("stereo_views");
+  const std::string stem = "box-wall_plain-raster";
+  const std::string render = "render --scene box-wall --pipeline plain-raster --resolution 64x36 --out '" +
+                             dir.path().string() + "' --scenes-dir '" + (dir / "scenes").string() + "'";
+  const auto written = [&] {
+    std::map<std::string, bool> w;
+    for (const char* view : {"anaglyph", "sbs", "ou"})
+      w[view] = std::filesystem::exists(dir / (stem + "_" + view + ".png"));
+    return w;
+  };
+  ASSERT_EQ(run(render).code, 0);
+  EXPECT_EQ(written(), (std::map<std::string, bool>{{"anaglyph", true}, {"sbs", true}, {"ou", false}}));
+
+  // Over/under: the left eye on top of the right, twice the height. The earlier set's stereo
+  // images that this render does not write go with it (its stats JSON lists the set).
+  const CliRun ou = run(render + " --stereo ou");
+  ASSERT_EQ(ou.code, 0) << ou.out;
+  EXPECT_NE(ou.out.find(stem + "_ou.png"), std::string::npos) << ou.out;
+  EXPECT_EQ(written(), (std::map<std::string, bool>{{"anaglyph", false}, {"sbs", false}, {"ou", true}}));
+  const io::DecodedImage stacked = io::read_image(dir / (stem + "_ou.png"));
+  const io::DecodedImage left = io::read_image(dir / (stem + "_left.png"));
+  const io::DecodedImage right = io::read_image(dir / (stem + "_right.png"));
+  ASSERT_EQ(stacked.width, 64);
+  ASSERT_EQ(stacked.height, 72);
+  const size_t half = left.values.size();
+  ASSERT_EQ(stacked.values.size(), 2 * half);
+  EXPECT_TRUE(std::equal(left.values.begin(), left.values.end(), stacked.values.begin())) << "left eye on top";
+  EXPECT_TRUE(std::equal(right.values.begin(), right.values.end(), stacked.values.begin() + static_cast<long>(half)))
+      << "right eye below";
+
+  ASSERT_EQ(run(render + " --stereo sbs --stereo anaglyph,ou").code, 0);
+  EXPECT_EQ(written(), (std::map<std::string, bool>{{"anaglyph", true}, {"sbs", true}, {"ou", true}}));
+  ASSERT_EQ(run(render + " --stereo none").code, 0);
+  EXPECT_EQ(written(), (std::map<std::string, bool>{{"anaglyph", false}, {"sbs", false}, {"ou", false}}));
+
+  for (const auto& [value, says] : std::map<std::string, std::string>{
+           {"stereo", "--stereo stereo: not a stereo image; give anaglyph (Dubois red-cyan), sbs"},
+           {"none,sbs", "--stereo none: 'none' writes no stereo image and stands alone"},
+           {"ou,ou", "--stereo: 'ou' is named twice"}}) {
+    const CliRun bad = run(render + " --stereo " + value);
+    EXPECT_EQ(bad.code, 3) << value << ": " << bad.out;
+    EXPECT_NE(bad.out.find(says), std::string::npos) << value << ": " << bad.out;
+    EXPECT_EQ(bad.out.find("plain-raster on box-wall"), std::string::npos) << "rendered first: " << bad.out;
+  }
 }
 
 TEST(Cli, ASceneNameNeverLeadsOutputsOutOfTheOutputFolder) {
