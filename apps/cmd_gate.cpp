@@ -65,7 +65,8 @@ void run_update(const GateArgs& a, const fs::path& file) {
     fmt::print(stderr,
                "warning: {} of the {} stored entr{} hold{} fewer than the {} timing samples the rank test needs "
                "({}; the fewest: {}): every time check against {} will warn \"not enough repetitions\" and never "
-               "pass or fail; run the sweep with --repetitions {} or more (5 is better) and update again\n",
+               "pass or fail; set repetitions = {} or more in the [timing] table of the sweep's definition, "
+               "run the sweep again and update\n",
                short_entries, changes.size(), changes.size() == 1 ? "y" : "ies", short_entries == 1 ? "s" : "",
                min_repetitions,
                has_config ? fmt::format("[regression] min_repetitions in {}", a.config)

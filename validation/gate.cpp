@@ -589,8 +589,9 @@ std::string reproduce_command(const GateCell& cell, const std::string& pipeline,
     scene = validation["scene"]["path"].get<std::string>();
   add("--scene", scene);
   add("--pipelines", pipeline);
+  const std::string baseline = rec.value("baseline", json()).is_string() ? rec["baseline"].get<std::string>() : pipeline;
   if (timing) {
-    add("--baseline", rec.value("baseline", json()).is_string() ? rec["baseline"].get<std::string>() : pipeline);
+    add("--baseline", baseline);
     const json& t = entry.value("timing", json::object());
     if (const auto n = num(t, "repetitions"); n && *n >= 1)
       add("--repetitions", fmt::format("{}", static_cast<int>(*n)));
@@ -622,25 +623,34 @@ std::string reproduce_command(const GateCell& cell, const std::string& pipeline,
   }
   if (const auto t = num(validation.value("metrics", json::object()), "error_threshold"); !timing && t && *t != 2.0)
     add("--error-threshold", fmt::format("{}", static_cast<int>(*t)));
-  const json& options = validation.value("options", json::object());
-  if (options.is_object()) {
+  // The options that differ from the pipeline's defaults. validate applies --option NAME=VALUE to
+  // the pipelines it measures; bench times the baseline beside the pipeline and takes
+  // PIPELINE.NAME=VALUE, so it is given the baseline's options as well.
+  const auto add_options = [&](const std::string& name, bool qualified) {
+    const json& entry_options =
+        rec["pipelines"].value(name, json::object()).value("validation", json::object()).value("options", json::object());
+    if (!entry_options.is_object()) return;
+    const std::string base = entry_pipeline_name(name);
     // A variant's name already fixes its own options.
-    const auto defaults = settings.pipeline_defaults.find(entry_pipeline_name(pipeline));
+    const auto defaults = settings.pipeline_defaults.find(base);
     std::map<std::string, std::string> fixed;
     try {
-      fixed = entry_fixed_options(pipeline);
+      fixed = entry_fixed_options(name);
     } catch (const InputError&) {  // not an entry this build reads: every option is written
     }
-    for (const auto& [key, value] : options.items()) {
+    for (const auto& [key, value] : entry_options.items()) {
       const std::string v = value.is_string() ? value.get<std::string>() : value.dump();
       if (const auto f = fixed.find(key); f != fixed.end() && f->second == v) continue;
       if (defaults != settings.pipeline_defaults.end()) {
         const auto d = defaults->second.find(key);
         if (d != defaults->second.end() && d->second == v) continue;
       }
-      add("--option", key + "=" + v);
+      add("--option", (qualified ? base + "." : "") + key + "=" + v);
     }
-  }
+  };
+  add_options(pipeline, timing);
+  if (timing && baseline != pipeline && entry_pipeline_name(baseline) != entry_pipeline_name(pipeline))
+    add_options(baseline, true);
   return join_args(args);
 }
 
@@ -924,7 +934,7 @@ std::string format_gate_table(const GateReport& report) {
                          c.cell_id, cell_w, c.pipeline, pipe_w, c.check, check_w, value_text(c.check, c.measured),
                          lim ? fmt::format("{} {}", at_least ? ">=" : "<=", value_text(c.check, *lim)) : "-");
       out << "        " << c.message << "\n";
-      if (c.verdict == Verdict::fail) out << "        reproduce: " << c.reproduce << "\n";
+      if (!c.reproduce.empty()) out << "        reproduce: " << c.reproduce << "\n";
     }
   for (const auto& [key, n] : skip_reasons(report.checks))
     out << fmt::format("SKIP    {} x{}: {}\n", key.first, n, key.second);

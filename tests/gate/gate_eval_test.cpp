@@ -348,6 +348,10 @@ TEST(GateEval, BaselineUpdateTouchesOnlyWhatIsNamed) {
                          (dir / "gate.toml").string() + "; the fewest: 1)"),
             std::string::npos)
       << run.out;
+  // The way out names where repetitions are set (sweep run has no --repetitions option).
+  EXPECT_NE(run.out.find("set repetitions = 5 or more in the [timing] table of the sweep's definition"),
+            std::string::npos)
+      << run.out;
 }
 
 TEST(GateCli, ExitCodesAndOutputs) {
@@ -633,6 +637,52 @@ TEST(GateEval, TimesAreReproducedByBenchAndTheBaselineHasNoSpeedupCheck) {
   // plain-rt is the cell's baseline: its speed-up over itself is 1, so the rule does not apply.
   EXPECT_EQ(find_check(r, "plain-rt", "speedup"), nullptr);
   EXPECT_NE(find_check(r, "plain-rt", "psnr"), nullptr);
+}
+
+TEST(GateEval, BenchCommandsNameThePipelineOfEachOptionAndRun) {
+  // bench takes PIPELINE.NAME=VALUE (it times the baseline beside the pipeline): a bare NAME=VALUE
+  // made the command exit 3. The baseline's own options go with it; validate keeps NAME=VALUE.
+  json cell = fake_cell(0, 0.064, {{"plain-raster", 90, 1.0, 0, 0, 1, 1.0}, {"repro-rt"}});
+  cell["baseline"] = "plain-raster";
+  cell["cell"]["resolution"] = "64x36";  // small enough to run the command below
+  cell["cell_id"] = "box-wall|e=0.064m|c=default|64x36|lights=all|full";
+  cell["cell_count"] = 1;
+  cell["threads"] = 1;
+  cell["pipelines"]["repro-rt"]["validation"]["options"] = {{"threshold_arcmin", "2"}, {"tile", "64"}};
+  const std::string config = kConfig + "[[rule]]\npipeline = \"repro-rt\"\nwarn_speedup = 5\nwarn_psnr = 50\n";
+  const auto evaluate_cell = [&] {
+    return validation::evaluate_gate(validation::parse_gate_config(config, "test.toml"),
+                                     validation::gate_results({cell}, {}, "results.jsonl"), {},
+                                     validation::registered_reproduce_settings());
+  };
+  validation::GateReport r = evaluate_cell();
+  const validation::GateCheck* speedup = find_check(r, "repro-rt", "speedup");
+  ASSERT_NE(speedup, nullptr);
+  EXPECT_EQ(speedup->verdict, Verdict::warn) << speedup->message;
+  EXPECT_NE(speedup->reproduce.find("--option repro-rt.threshold_arcmin=2"), std::string::npos) << speedup->reproduce;
+  EXPECT_EQ(speedup->reproduce.find("tile"), std::string::npos) << "at its default: " << speedup->reproduce;
+  const validation::GateCheck* psnr = find_check(r, "repro-rt", "psnr");
+  ASSERT_NE(psnr, nullptr);
+  EXPECT_NE(psnr->reproduce.find("--option threshold_arcmin=2"), std::string::npos) << psnr->reproduce;
+
+  // The baseline's options, named by the baseline.
+  cell["pipelines"]["plain-raster"]["validation"]["options"] = {{"tile", "8"}};
+  r = evaluate_cell();
+  speedup = find_check(r, "repro-rt", "speedup");
+  ASSERT_NE(speedup, nullptr);
+  EXPECT_NE(speedup->reproduce.find("--option repro-rt.threshold_arcmin=2 --option plain-raster.tile=8"),
+            std::string::npos)
+      << speedup->reproduce;
+
+  // The terminal shows a warned check's command too, and the command runs.
+  const std::string table = validation::format_gate_table(r);
+  EXPECT_NE(table.find("reproduce: " + speedup->reproduce), std::string::npos) << table;
+  ScratchDir dir("gate_bench_reproduce");
+  std::string command = speedup->reproduce.substr(std::string("stereobench ").size());
+  command += " --scenes-dir " + quoted(dir / "scenes");
+  const CliRun run = run_cli(command);
+  EXPECT_EQ(run.code, 0) << command << "\n" << run.out;
+  EXPECT_NE(run.out.find("speed-up"), std::string::npos) << run.out;
 }
 
 TEST(GateEval, AWarningLevelBeyondTheFailureLevelInForceIsNoted) {
