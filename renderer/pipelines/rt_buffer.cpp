@@ -73,7 +73,10 @@ class RtBuffer final : public Pipeline {
             const int32_t target = reprojector.target(x, static_cast<int>(y), depth[y * w + x]);
             if (target == kNoSource) continue;
             int32_t& entry = row[static_cast<size_t>(target) * slots + static_cast<size_t>(x) % slots];
-            collisions[y] += entry != kNoSource ? 1 : 0;  // more writes than t: Lemma 1's bound exceeded
+            // A collision: a source t or more columns before reached the same pixel (t is below
+            // Lemma 1's span). In source order the larger x replaces it, so the maximum survives;
+            // the thesis's racing per-pixel writes could lose it.
+            collisions[y] += entry != kNoSource ? 1 : 0;
             entry = x;
           }
         }

@@ -18,36 +18,60 @@ double x_ndc(const EyeCamera& eye, const dvec3& p) {
   return 2.0 * s.x / eye.width - 1.0;
 }
 
-}  // namespace
-
-double frustum_visibility(const EyeCamera& eye, const dvec3& v0, const dvec3& v1, const dvec3& v2) {
+/// Eq. (1) from the x_ndc of the three vertices (NaN: at or behind the eye's plane).
+double frustum_from_ndc(double x0, double x1, double x2) {
   double largest = 0.0;
-  for (const dvec3* v : {&v0, &v1, &v2}) {
-    const double x = x_ndc(eye, *v);
+  for (const double x : {x0, x1, x2}) {
     if (std::isnan(x)) return 0.0;
     largest = std::max(largest, std::abs(x));
   }
   return largest <= 1.0 ? 1.0 : 1.0 / largest;
 }
 
+/// A triangle's (unnormalized) normal, its length and its centroid: what eq. (3) needs of it.
+struct TriangleFacing {
+  dvec3 n;
+  double area2;
+  dvec3 centroid;
+  TriangleFacing(const dvec3& v0, const dvec3& v1, const dvec3& v2)
+      : n(glm::cross(v1 - v0, v2 - v0)), area2(glm::length(n)), centroid((v0 + v1 + v2) / 3.0) {}
+
+  /// Eq. (3) (eq. (4) when single-sided) for an eye at `origin`.
+  [[nodiscard]] double visibility(const dvec3& origin, bool single_sided) const {
+    const dvec3 to_eye = origin - centroid;
+    const double distance = glm::length(to_eye);
+    if (area2 == 0.0 || distance == 0.0) return 0.0;
+    const double cosine = glm::dot(n, to_eye) / (area2 * distance);
+    return single_sided ? cosine : std::abs(cosine);
+  }
+};
+
+/// The redirection from the vertices' x_ndc in each eye ({x0, x1, x2}) and their positions.
+uint8_t redirect_from(const EyeCamera& left, const EyeCamera& right, const double (&xl)[3], const double (&xr)[3],
+                      const dvec3& v0, const dvec3& v1, const dvec3& v2, bool single_sided) {
+  const double fl = frustum_from_ndc(xl[0], xl[1], xl[2]), fr = frustum_from_ndc(xr[0], xr[1], xr[2]);
+  if (fl != fr) return fl > fr ? kRedirectLeft : kRedirectRight;
+  const TriangleFacing facing(v0, v1, v2);
+  const double bl = facing.visibility(left.origin, single_sided), br = facing.visibility(right.origin, single_sided);
+  if (bl != br) return bl > br ? kRedirectLeft : kRedirectRight;
+  return kRedirectBoth;
+}
+
+}  // namespace
+
+double frustum_visibility(const EyeCamera& eye, const dvec3& v0, const dvec3& v1, const dvec3& v2) {
+  return frustum_from_ndc(x_ndc(eye, v0), x_ndc(eye, v1), x_ndc(eye, v2));
+}
+
 double facing_visibility(const EyeCamera& eye, const dvec3& v0, const dvec3& v1, const dvec3& v2, bool single_sided) {
-  const dvec3 n = glm::cross(v1 - v0, v2 - v0);
-  const double area2 = glm::length(n);
-  const dvec3 to_eye = eye.origin - (v0 + v1 + v2) / 3.0;
-  const double distance = glm::length(to_eye);
-  if (area2 == 0.0 || distance == 0.0) return 0.0;
-  const double cosine = glm::dot(n, to_eye) / (area2 * distance);
-  return single_sided ? cosine : std::abs(cosine);
+  return TriangleFacing(v0, v1, v2).visibility(eye.origin, single_sided);
 }
 
 uint8_t redirect(const EyeCamera& left, const EyeCamera& right, const dvec3& v0, const dvec3& v1, const dvec3& v2,
                  bool single_sided) {
-  const double fl = frustum_visibility(left, v0, v1, v2), fr = frustum_visibility(right, v0, v1, v2);
-  if (fl != fr) return fl > fr ? kRedirectLeft : kRedirectRight;
-  const double bl = facing_visibility(left, v0, v1, v2, single_sided);
-  const double br = facing_visibility(right, v0, v1, v2, single_sided);
-  if (bl != br) return bl > br ? kRedirectLeft : kRedirectRight;
-  return kRedirectBoth;
+  const double xl[3] = {x_ndc(left, v0), x_ndc(left, v1), x_ndc(left, v2)};
+  const double xr[3] = {x_ndc(right, v0), x_ndc(right, v1), x_ndc(right, v2)};
+  return redirect_from(left, right, xl, xr, v0, v1, v2, single_sided);
 }
 
 std::vector<uint8_t> redirect_triangles(const SceneGeometry& geometry, const StereoRig& rig, const Executor& executor,
@@ -56,21 +80,38 @@ std::vector<uint8_t> redirect_triangles(const SceneGeometry& geometry, const Ste
   const EyeCamera left = rig.eye(Eye::left), right = rig.eye(Eye::right);
   std::vector<uint8_t> bits(geometry.triangle_count(), 0);
   std::atomic<uint64_t> n_left{0}, n_right{0}, n_both{0};
-  executor.for_each(scene.meshes.size(), [&](size_t m) {
+  // Mesh by mesh, each in parallel: every vertex projected into both eyes once (a vertex is shared
+  // by about six triangles, which projected it each, a mesh to a task), then every triangle
+  // compared from its vertices' projections. The decisions are those of redirect().
+  std::vector<double> ndc;
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
     const Mesh& mesh = scene.meshes[m];
     const bool single_sided = geometry.single_sided[m] != 0;
-    uint64_t l = 0, r = 0, b = 0;
-    for (size_t t = 0; t < mesh.triangle_count(); ++t) {
-      const dvec3 v0(mesh.positions[mesh.indices[3 * t]]), v1(mesh.positions[mesh.indices[3 * t + 1]]),
-          v2(mesh.positions[mesh.indices[3 * t + 2]]);
-      const uint8_t to = redirect(left, right, v0, v1, v2, single_sided);
-      bits[geometry.first_triangle[m] + t] = to;
-      (to == kRedirectBoth ? b : to == kRedirectLeft ? l : r)++;
-    }
-    n_left += l;
-    n_right += r;
-    n_both += b;
-  });
+    const size_t vertices = mesh.positions.size();
+    ndc.resize(2 * vertices);
+    executor.for_range(vertices, 4096, [&](size_t begin, size_t end) {
+      for (size_t v = begin; v < end; ++v) {
+        const dvec3 p(mesh.positions[v]);
+        ndc[2 * v] = x_ndc(left, p);
+        ndc[2 * v + 1] = x_ndc(right, p);
+      }
+    });
+    executor.for_range(mesh.triangle_count(), 4096, [&](size_t begin, size_t end) {
+      uint64_t l = 0, r = 0, b = 0;
+      for (size_t t = begin; t < end; ++t) {
+        const uint32_t i0 = mesh.indices[3 * t], i1 = mesh.indices[3 * t + 1], i2 = mesh.indices[3 * t + 2];
+        const double xl[3] = {ndc[2 * i0], ndc[2 * i1], ndc[2 * i2]};
+        const double xr[3] = {ndc[2 * i0 + 1], ndc[2 * i1 + 1], ndc[2 * i2 + 1]};
+        const uint8_t to = redirect_from(left, right, xl, xr, dvec3(mesh.positions[i0]), dvec3(mesh.positions[i1]),
+                                         dvec3(mesh.positions[i2]), single_sided);
+        bits[geometry.first_triangle[m] + t] = to;
+        (to == kRedirectBoth ? b : to == kRedirectLeft ? l : r)++;
+      }
+      n_left += l;
+      n_right += r;
+      n_both += b;
+    });
+  }
   counts = {n_left, n_right, n_both};
   return bits;
 }

@@ -2,6 +2,7 @@
 #include "renderer/stages/scanline_reprojection.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <vector>
 
 namespace sb {
@@ -19,7 +20,12 @@ void reproject_row(const PixelReprojector& reprojector, const float* left_depth,
   std::vector<uint8_t> bad(static_cast<size_t>(width), 0);
   int32_t old_r = -1;
   for (int x = 0; x < width; ++x) {
-    const int32_t r = reprojector.target(x, y, left_depth[static_cast<size_t>(y) * width + x]);
+    const float depth = left_depth[static_cast<size_t>(y) * width + x];
+    const int32_t r = reprojector.target(x, y, depth);
+    // A background pixel is not reprojected, so the reprojections on either side of it come from
+    // pixels that are not adjacent: what lies between them is missed, not a bad gap (the thesis
+    // calls a gap bad when two horizontally adjacent pixels reproject to nonadjacent positions).
+    if (!(depth > 0.0f) || !std::isfinite(depth)) old_r = -1;
     if (r == kNoSource) continue;
     // A jump of more than one pixel after an earlier reprojection leaves a gap: its pixels are NoHit,
     // whatever reached them before.
@@ -86,6 +92,8 @@ void scanline_band(const RenderScene& scene, const PixelReprojector& reprojector
     reproject_row(reprojector, depth, w, y, source, counts);
     for (int x = 0; x < w; ++x) {
       const size_t p = static_cast<size_t>(y) * w + x;
+      // Algorithm 1 computes a Hit pixel's colour again for the right camera; with diffuse
+      // materials (the thesis's, and ours) that is the left pixel's, so it is copied.
       if (source[static_cast<size_t>(x)] == kNoSource)
         no_hit.push_back(static_cast<uint32_t>(p));
       else

@@ -159,6 +159,23 @@ TEST(ThinPole, GapBesideThePoleIsRetracedNotSmeared) {
   }
 }
 
+TEST(ScanlineCounts, ABadGapLiesBetweenReprojectionsOfAdjacentPixels) {
+  // At a disparity of a thousandth of a pixel every surface pixel reprojects onto its own column:
+  // no two adjacent pixels land apart, so nothing is a bad gap. The sky between spheres is not
+  // reprojected; its columns are missed. (They were counted bad: the gap test bridged the sky,
+  // 3600 of 160x90's pixels.) At 0.3 px rounding opens real gaps of one column.
+  const Scene scene = test::load_builtin("spheres");
+  const RenderScene prepared(scene);
+  for (const std::string pipeline : {"rt-adelson", "rt-es-isler"}) {
+    const StereoResult still = test::render_with(pipeline, prepared, rig_with_disparity(scene, 160, 90, 0.001));
+    EXPECT_EQ(still.counters.get("bad"), 0u) << pipeline;
+    EXPECT_GT(still.counters.get("missed"), 1000u) << pipeline << ": the sky is missed";
+    const StereoResult moving = test::render_with(pipeline, prepared, rig_with_disparity(scene, 160, 90, 0.3));
+    EXPECT_GT(moving.counters.get("bad"), 0u) << pipeline;
+    EXPECT_LT(moving.counters.get("bad"), 200u) << pipeline;
+  }
+}
+
 TEST(PrimaryRays, SameBitsAsPrimaryRayAndDepthRaysEndAtTheirDepth) {
   // Off-axis eyes of an odd-sized image.
   const Scene scene = test::load_builtin("spheres");
