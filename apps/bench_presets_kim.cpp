@@ -224,10 +224,12 @@ BenchPreset kim_complexity_preset() {
   p.name = "kim-complexity";
   p.summary =
       "Kim's Table 3: the complexity scene with 1e5, 1e6, 1e7 and 1e8 triangles at 1920x1080 (FHD), e = 64 mm; median "
-      "rendering and warping time per pipeline, peak memory per row, and the crossover where bidir-warp beats "
+      "rendering and warping time of each of its methods (plain-raster, bidir-warp, bw-warp, fw-warp), peak memory per "
+      "row, and the crossover where bidir-warp beats "
       "plain-raster. A row that would not fit in the memory left is skipped with the reason.";
   p.kind = PresetKind::complexity;
-  p.pipelines = {kReference, kBidirectional};
+  // Table 3's four methods: 2-Pass, Ours, and the one-directional BW and FW baselines.
+  p.pipelines = {kReference, kBidirectional, "bw-warp", "fw-warp"};
   p.baseline = kReference;
   p.fixed_options = {"--scene", "--interaxial", "--max-disparity", "--lights"};
   p.resolution_open = true;

@@ -430,7 +430,7 @@ TEST(SweepDefinition, ShippedDefinitionsLoad) {
       {"nightly.toml", 6 * 3 * 2, n_pipelines + 1},     // 6 scenes × 3 disparities × 2 resolutions; and a variant
       {"presets/wissmann-table2.toml", 3 * 2, 5},       // 3 scenes × HD, 4K
       {"presets/kim-table2.toml", 3, 6},                // 3 focal distances
-      {"presets/kim-table3.toml", 3, 2},                // 3 triangle counts
+      {"presets/kim-table3.toml", 3, 4},                // 3 triangle counts; Table 3's four methods
       {"presets/al-hagri-dimensions.toml", 6 * 27, 6},  // 6 scenes × 200..1500 step 50
       {"presets/al-hagri-interaxial.toml", 10, 6},      // 10..100 px
       {"presets/al-hagri-lights.toml", 10, 6},          // 1..10 lights
