@@ -33,8 +33,8 @@ class RtBuffer final : public Pipeline {
     // turns that into 36.63 dB (measured at 320x180), the lowest of them. Hence 36 dB.
     static const PipelineInfo i{
         "rt-buffer", "Al-Hagri 2012", "3.1.2.1, 3.3.1 (Algorithms 2-3)",
-        "per-pixel parallel reprojection into a w x h x t buffer (max source x wins), length-restricted validation "
-        "rays, missed and blocked pixels traced",
+        "per-pixel reprojection into a w x h x t buffer, rows in parallel (max source x wins), length-restricted "
+        "validation rays, missed and blocked pixels traced",
         buffer_option_specs(), 200.0, 36.0,
         [](const PipelineOptions& o) {
           (void)ValidationSettings::from("rt-buffer", o);
