@@ -38,7 +38,7 @@ struct TruthRender {
   /// (the provider's calibration constants already applied), W x H of the rig.
   Image right;
   std::string provider;      ///< "full", "blender", "povray"
-  std::string tool_version;  ///< e.g. "stereobench 0.4.0", "Blender 3.4.1", "POV-Ray 3.7.0.10"
+  std::string tool_version;  ///< e.g. "stereobench 0.1.0", "Blender 3.4.1", "POV-Ray 3.7.0.10"
   /// The settings the tool was run with and the calibration constants applied (recorded in
   /// results and provenance files).
   nlohmann::json settings = nlohmann::json::object();

@@ -1,4 +1,4 @@
-// Measuring a pipeline's right eye against ground truth.
+// Measuring a pipeline's right eye against ground truth (and a synthesized left eye against plain-rt's).
 #include "validation/validate.hpp"
 
 #include <chrono>
@@ -8,6 +8,7 @@
 #include "renderer/error.hpp"
 #include "renderer/io/render_output.hpp"
 #include "renderer/memory.hpp"
+#include "renderer/stages/trace.hpp"
 
 namespace sb::validation {
 
@@ -73,6 +74,25 @@ PipelineValidation validate_pipeline(const ValidationTarget& target, const Pipel
   v.whole = metrics[0];
   for (size_t r = 0; r < std::size(kRegionNames); ++r) v.regions.emplace_back(kRegionNames[r], metrics[r + 1]);
   v.holes = hole_statistics(right, v.result.counters, target.disocclusions);
+  // A left eye the pipeline did not render whole is measured too (against plain-rt's left eye).
+  const uint32_t* left_source = v.result.left.data_u32(planes::source);
+  for (size_t i = 0; i < v.result.left.pixel_count(); ++i)
+    v.left_synthesized += left_source[i] != static_cast<uint32_t>(Source::rasterized) &&
+                                  left_source[i] != static_cast<uint32_t>(Source::traced)
+                              ? 1
+                              : 0;
+  if (v.left_synthesized > 0) {
+    LeftReference& reference = *target.left;
+    std::call_once(reference.once, [&] {
+      const auto traced = std::chrono::steady_clock::now();
+      TraceCounts counts;
+      reference.srgb8 =
+          encode_srgb8(traced_eye(target.scene, target.rig.eye(Eye::left), executor, counts), "plain-rt's left eye");
+      reference.seconds = seconds_since(traced);
+    });
+    v.left = compare_images(encode_srgb8(v.result.left, fmt::format("{}'s left eye", v.pipeline)), reference.srgb8,
+                            nullptr, metric_options);
+  }
   v.seconds_metrics = seconds_since(start);
   return v;
 }
@@ -100,6 +120,10 @@ json validation_record(const ValidationTarget& target, const PipelineValidation&
           {"metrics", to_json(v.whole)},
           {"regions", regions},
           {"holes", to_json(v.holes)},
+          {"left_eye", v.left ? json{{"reference", "plain-rt"},
+                                     {"synthesized_pixels", v.left_synthesized},
+                                     {"metrics", to_json(*v.left)}}
+                              : json(nullptr)},
           {"timings_s", io::timings_to_json(v.result.timings)},
           {"stage_eyes", io::stage_eyes_to_json(v.result.timings)},
           {"total_s", v.result.timings.total()},

@@ -1,9 +1,12 @@
 // One validation: a pipeline's right eye measured against a ground-truth right eye (DESIGN §6) —
 // metrics over the whole image and per region, hole statistics against the true disocclusions,
-// and the result record. `stereobench validate` runs it per pipeline; sweeps run it per cell.
+// the left eye too where the pipeline synthesized part of it, and the result record. `stereobench validate` runs it per pipeline; sweeps run it per cell.
 #pragma once
 
 #include <filesystem>
+#include <memory>
+#include <mutex>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -19,6 +22,15 @@
 
 namespace sb::validation {
 
+/// The left eye a pipeline that synthesizes part of its left eye is measured against: this
+/// suite's ray tracer's, plain-rt's, traced once per target when first needed (whatever provider
+/// gives the right eye's truth: the external ones render the right eye only).
+struct LeftReference {
+  std::once_flag once;
+  Srgb8Image srgb8;
+  double seconds = 0.0;
+};
+
 /// What every pipeline of one (scene, rig, provider) is measured against, prepared once.
 struct ValidationTarget {
   const RenderScene& scene;
@@ -27,6 +39,7 @@ struct ValidationTarget {
   Srgb8Image truth_srgb8;
   TrueDisocclusions disocclusions;
   double disocclusion_seconds = 0.0;
+  std::shared_ptr<LeftReference> left = std::make_shared<LeftReference>();
 };
 
 /// Renders (or loads from the cache) the ground truth and computes the true disocclusions.
@@ -54,6 +67,11 @@ struct PipelineValidation {
   HoleStatistics holes;
   SsimMap ssim;
   double seconds_metrics = 0.0;  ///< time to measure (not part of the pipeline's timings)
+  /// Left-eye pixels the pipeline did not render itself (tagged other than rasterized or traced:
+  /// bidir-warp's, warped in from the right eye's share, filled or left as holes).
+  uint64_t left_synthesized = 0;
+  /// With left_synthesized > 0: the left eye's metrics against plain-rt's left eye.
+  std::optional<ImageMetrics> left;
 };
 
 /// Renders an entry (a pipeline or a variant of one) and measures its right eye, recorded under

@@ -97,6 +97,35 @@ TEST(Validate, PipelineOptionsApplyAndAreChecked) {
   EXPECT_NE(undeclared.out.find("discontinuity_px"), std::string::npos) << undeclared.out;
 }
 
+TEST(Validate, ALeftEyeSynthesizedInPartIsMeasuredAgainstPlainRtsLeftEye) {
+  test::ScratchDir dir;
+  const test::CliRun r = test::run_cli(base_args(dir) + " --pipelines plain-raster,repro-rt,bidir-warp");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("left eyes synthesized in part, against plain-rt's left eye:"), std::string::npos) << r.out;
+  const fs::path out = dir / "out";
+  // Left eyes the pipelines render themselves are not measured.
+  for (const char* own : {"plain-raster", "repro-rt"})
+    EXPECT_TRUE(json::parse(test::read_text(out / ("box-wall_full_" + std::string(own) + ".json")))["left_eye"].is_null())
+        << own;
+  const json bidir = json::parse(test::read_text(out / "box-wall_full_bidir-warp.json"))["left_eye"];
+  ASSERT_TRUE(bidir.is_object()) << bidir;
+  EXPECT_EQ(bidir["reference"], "plain-rt");
+  EXPECT_GT(bidir["synthesized_pixels"].get<uint64_t>(), 0u);
+  EXPECT_LT(bidir["synthesized_pixels"].get<uint64_t>(), 160u * 90u);
+  // The same numbers as comparing the two left eyes of the renders' EXRs by hand.
+  const std::string common = " --scene box-wall --resolution 160x90 --stereo none --out '" + (dir / "eyes").string() +
+                             "' --scenes-dir '" + (fs::path(SB_BINARY_DIR) / "Testing" / "scenes-cache").string() + "'";
+  ASSERT_EQ(test::run_cli("render --pipeline bidir-warp" + common).code, 0);
+  ASSERT_EQ(test::run_cli("render --pipeline plain-rt" + common).code, 0);
+  const test::CliRun c = test::run_cli("compare --eye left " + test::quoted(dir / "eyes" / "box-wall_bidir-warp.exr") +
+                                       " " + test::quoted(dir / "eyes" / "box-wall_plain-rt.exr") + " --json " +
+                                       test::quoted(dir / "compare.json"));
+  ASSERT_LE(c.code, 2) << c.out;
+  const json by_hand = json::parse(test::read_text(dir / "compare.json"));
+  EXPECT_NEAR(bidir["metrics"]["mse"].get<double>(), by_hand["metrics"]["mse"].get<double>(), 1e-9) << by_hand;
+  EXPECT_NEAR(bidir["metrics"]["ssim"].get<double>(), by_hand["metrics"]["ssim"].get<double>(), 1e-9) << by_hand;
+}
+
 TEST(Validate, VariantsAreMeasuredBesideTheirPipelineUnderTheirOwnName) {
   test::ScratchDir dir;
   const test::CliRun r =
