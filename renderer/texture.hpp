@@ -97,7 +97,10 @@ class MipTexture {
                                           const vec2& uv1, const vec2& uv2, int width, int height);
 
 /// Ray-cone LOD (Akenine-Möller et al., Ray Tracing Gems ch. 20): triangle constant + log2(cone width at the
-/// hit) - log2(|cos| of the angle between the ray and the surface normal).
+/// hit) - log2(|cos| of the angle between the ray and the surface normal). Wißmann et al.'s eq. 3,
+/// which cites the chapter, prints 0.5 log2 for the second term; the triangle constant (their
+/// eq. 4) is already half the log of an area ratio, a length scale, and the cone's width is a
+/// length, so the chapter's log2 is kept (0.5 log2 would pick a coarser level the wider the cone).
 ///
 /// Conventions: cone_width is the full width W (not the radius) in world units, abs_cos_theta is
 /// |n . d| for unit n and d; both are used as absolute values. The result is raw (+-inf or NaN for

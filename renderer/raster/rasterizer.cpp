@@ -117,7 +117,10 @@ class TileRaster {
 
   /// Writes the winners' depth, id, perspective-correct barycentrics and UV derivatives. The
   /// barycentric planes come from the original triangle's projected vertices, once per run of
-  /// pixels with the same winner.
+  /// pixels with the same winner. The derivatives are the exact ones of the winner's plane at the
+  /// pixel, not a GPU's finite differences over a 2x2 quad (DESIGN §3, Wißmann §3.4): the same
+  /// quantity without the quad's error, and defined at a pixel whose quad neighbours show other
+  /// triangles.
   void resolve(const raster::SetupInputs& in, GBuffer& g) const {
     const SceneGeometry& geometry = *in.geometry;
     const Scene& scene = *geometry.scene;

@@ -98,8 +98,9 @@ enum class DiscardRule : uint8_t {
 
 /// Options of the warp.
 struct WarpOptions {
-  /// Discard fragments whose interpolated discontinuity measure exceeds `discontinuity_px`
-  /// (disocclusion detection); off, the rubber sheets stay.
+  /// Disocclusion detection: discard fragments by `rule` (default: of grid triangles whose vertices
+  /// all exceed `discontinuity_px`; the paper's rule interpolates the measure); off, the rubber
+  /// sheets stay.
   bool detect_disocclusions = true;
   /// Threshold (pixels) on the vertex measure: the larger excess opening of the two source-row
   /// gaps beside the vertex, where the gap between neighbours x and x+1 is the disparity
@@ -159,8 +160,9 @@ struct WarpStats {
                                              const Executor& executor, Image& target, WarpStats& stats);
 
 /// The grid drawn over the source radiance for viewing (the paper's Fig. 4): the image darkened,
-/// cells that exceed the parallax threshold tinted red, cells subdivided as their neighbours tinted
-/// orange (both at native resolution), and the two triangles of every coarse cell outlined.
+/// cells that exceed the parallax threshold tinted red, the other subdivided cells (the flagged
+/// cells' neighbours, and cells where a disocclusion gap opens) tinted orange (both at native
+/// resolution), and the two triangles of every coarse cell outlined.
 [[nodiscard]] Image grid_overlay(const WarpGrid& grid, const Image& source);
 
 }  // namespace sb
