@@ -129,7 +129,11 @@ json validation_record(const ValidationTarget& target, const PipelineValidation&
           {"total_s", v.result.timings.total()},
           {"counters", counters},
           {"threads", threads},
-          {"analysis_s", {{"metrics", v.seconds_metrics}, {"true_disocclusions", target.disocclusion_seconds}}},
+          {"analysis_s", v.left ? json{{"metrics", v.seconds_metrics},
+                                       {"true_disocclusions", target.disocclusion_seconds},
+                                       {"left_reference", target.left->seconds}}
+                                : json{{"metrics", v.seconds_metrics},
+                                       {"true_disocclusions", target.disocclusion_seconds}}},
           {"versions", io::versions_json()},
           {"images", images}};
 }
