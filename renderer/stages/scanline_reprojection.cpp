@@ -23,8 +23,9 @@ void reproject_row(const PixelReprojector& reprojector, const float* left_depth,
     const float depth = left_depth[static_cast<size_t>(y) * width + x];
     const int32_t r = reprojector.target(x, y, depth);
     // A background pixel is not reprojected, so the reprojections on either side of it come from
-    // pixels that are not adjacent: what lies between them is missed, not a bad gap (the thesis
-    // calls a gap bad when two horizontally adjacent pixels reproject to nonadjacent positions).
+    // pixels that are not adjacent: the columns between them are not a bad gap (the thesis calls a
+    // gap bad when two horizontally adjacent pixels reproject to nonadjacent positions) and are not
+    // cleared; those no reprojection reached are missed.
     if (!(depth > 0.0f) || !std::isfinite(depth)) old_r = -1;
     if (r == kNoSource) continue;
     // A jump of more than one pixel after an earlier reprojection leaves a gap: its pixels are NoHit,
