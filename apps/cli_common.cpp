@@ -27,7 +27,7 @@ void RigCli::add_to(CLI::App& app) {
                  "Give the interaxial as the disparity at infinity in pixels, f_px*e/c")
       ->group(g)
       ->excludes("--interaxial");
-  app.add_option("--convergence,-c", convergence, "Zero-parallax distance in meters (default: the scene camera's, else 2.0)")->group(g);
+  app.add_option("--convergence,-c", convergence, "Zero-parallax distance in meters (default: the scene camera's; for a scene without a camera, the distance that frames it)")->group(g);
   app.add_option("--resolution,-r", resolution, "Image size per eye: WxH, hd (1920x1080), 4k, 720p, qhd, 8k")
       ->group(g);
   app.add_option("--vfov", vfov_deg, "Vertical field of view in degrees (default: the scene camera's)")->group(g);

@@ -100,7 +100,8 @@ class MipTexture {
 /// hit) - log2(|cos| of the angle between the ray and the surface normal). Wißmann et al.'s eq. 3,
 /// which cites the chapter, prints 0.5 log2 for the second term; the triangle constant (their
 /// eq. 4) is already half the log of an area ratio, a length scale, and the cone's width is a
-/// length, so the chapter's log2 is kept (0.5 log2 would pick a coarser level the wider the cone).
+/// length, so the chapter's log2 is kept (with 0.5 log2 the level would depend on the world's
+/// unit of length).
 ///
 /// Conventions: cone_width is the full width W (not the radius) in world units, abs_cos_theta is
 /// |n . d| for unit n and d; both are used as absolute values. The result is raw (+-inf or NaN for

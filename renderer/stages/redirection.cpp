@@ -80,15 +80,14 @@ std::vector<uint8_t> redirect_triangles(const SceneGeometry& geometry, const Ste
   const EyeCamera left = rig.eye(Eye::left), right = rig.eye(Eye::right);
   std::vector<uint8_t> bits(geometry.triangle_count(), 0);
   std::atomic<uint64_t> n_left{0}, n_right{0}, n_both{0};
-  // Mesh by mesh, each in parallel: every vertex projected into both eyes once (a vertex is shared
-  // by about six triangles, which projected it each, a mesh to a task), then every triangle
-  // compared from its vertices' projections. The decisions are those of redirect().
-  std::vector<double> ndc;
-  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+  // Meshes in parallel, and a large mesh's vertices and triangles in parallel within it: every
+  // vertex projected into both eyes once (a vertex is shared by about six triangles), then every
+  // triangle compared from its vertices' projections. The decisions are those of redirect().
+  executor.for_each(scene.meshes.size(), [&](size_t m) {
     const Mesh& mesh = scene.meshes[m];
     const bool single_sided = geometry.single_sided[m] != 0;
     const size_t vertices = mesh.positions.size();
-    ndc.resize(2 * vertices);
+    std::vector<double> ndc(2 * vertices);
     executor.for_range(vertices, 4096, [&](size_t begin, size_t end) {
       for (size_t v = begin; v < end; ++v) {
         const dvec3 p(mesh.positions[v]);
@@ -111,7 +110,7 @@ std::vector<uint8_t> redirect_triangles(const SceneGeometry& geometry, const Ste
       n_right += r;
       n_both += b;
     });
-  }
+  });
   counts = {n_left, n_right, n_both};
   return bits;
 }

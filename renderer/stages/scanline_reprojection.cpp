@@ -19,22 +19,23 @@ void reproject_row(const PixelReprojector& reprojector, const float* left_depth,
   source.assign(static_cast<size_t>(width), kNoSource);
   std::vector<uint8_t> bad(static_cast<size_t>(width), 0);
   int32_t old_r = -1;
+  // Whether a background pixel came since the last reprojection.
+  bool background_between = false;
   for (int x = 0; x < width; ++x) {
     const float depth = left_depth[static_cast<size_t>(y) * width + x];
     const int32_t r = reprojector.target(x, y, depth);
-    // A background pixel is not reprojected, so the reprojections on either side of it come from
-    // pixels that are not adjacent: the columns between them are not a bad gap (the thesis calls a
-    // gap bad when two horizontally adjacent pixels reproject to nonadjacent positions) and are not
-    // cleared; those no reprojection reached are missed.
-    if (!(depth > 0.0f) || !std::isfinite(depth)) old_r = -1;
+    if (!(depth > 0.0f) || !std::isfinite(depth)) background_between = true;
     if (r == kNoSource) continue;
     // A jump of more than one pixel after an earlier reprojection leaves a gap: its pixels are NoHit,
-    // whatever reached them before.
+    // whatever reached them before. The thesis calls the gap bad when the two reprojections come
+    // from horizontally adjacent pixels; across a background pixel (not reprojected here) they do
+    // not, and the gap's pixels count as missed.
     if (old_r >= 0 && r - old_r > 1)
       for (int32_t k = old_r + 1; k < r; ++k) {
         source[static_cast<size_t>(k)] = kNoSource;
-        bad[static_cast<size_t>(k)] = 1;
+        if (!background_between) bad[static_cast<size_t>(k)] = 1;
       }
+    background_between = false;
     // Later pixels (larger source x) overwrite: the nearer surface for a right eye to the right.
     if (source[static_cast<size_t>(r)] != kNoSource) ++counts.overlapped;
     source[static_cast<size_t>(r)] = x;

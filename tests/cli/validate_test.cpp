@@ -99,7 +99,7 @@ TEST(Validate, PipelineOptionsApplyAndAreChecked) {
 
 TEST(Validate, ALeftEyeSynthesizedInPartIsMeasuredAgainstPlainRtsLeftEye) {
   test::ScratchDir dir;
-  const test::CliRun r = test::run_cli(base_args(dir) + " --pipelines plain-raster,repro-rt,bidir-warp");
+  const test::CliRun r = test::run_cli(base_args(dir) + " --pipelines plain-raster,repro-rt,bidir-warp,bidir-warp-rt");
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("left eyes synthesized in part, against plain-rt's left eye:"), std::string::npos) << r.out;
   const fs::path out = dir / "out";
@@ -107,7 +107,12 @@ TEST(Validate, ALeftEyeSynthesizedInPartIsMeasuredAgainstPlainRtsLeftEye) {
   for (const char* own : {"plain-raster", "repro-rt"})
     EXPECT_TRUE(json::parse(test::read_text(out / ("box-wall_full_" + std::string(own) + ".json")))["left_eye"].is_null())
         << own;
+  // bidir-warp-rt traces its holes: a left eye closer to plain-rt's than bidir-warp's.
+  const json traced = json::parse(test::read_text(out / "box-wall_full_bidir-warp-rt.json"))["left_eye"];
+  ASSERT_TRUE(traced.is_object()) << traced;
   const json bidir = json::parse(test::read_text(out / "box-wall_full_bidir-warp.json"))["left_eye"];
+  ASSERT_TRUE(bidir.is_object()) << bidir;
+  EXPECT_LE(traced["metrics"]["mse"].get<double>(), bidir["metrics"]["mse"].get<double>());
   ASSERT_TRUE(bidir.is_object()) << bidir;
   EXPECT_EQ(bidir["reference"], "plain-rt");
   EXPECT_GT(bidir["synthesized_pixels"].get<uint64_t>(), 0u);

@@ -2,6 +2,8 @@
 // eyes on exact ties; and the rasterizer's triangle mask that renders an eye's share.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "renderer/raster/rasterizer.hpp"
 #include "renderer/stages/redirection.hpp"
 #include "support/render_support.hpp"
@@ -81,6 +83,41 @@ TEST(Redirection, EachEyeRasterizesOnlyItsShare) {
       if (prim == kNoPrimitiveId) continue;
       ASSERT_NE(bits[prim] & o.triangle_bit, 0) << "triangle " << prim;
     }
+  }
+}
+
+TEST(Redirection, EveryTriangleOfAManyMeshSceneAsRedirectDecidesAtAnyThreadCount) {
+  // The scene's pass projects each vertex once and compares triangles from the stored
+  // projections, meshes and triangles in parallel: each decision must be redirect()'s for that
+  // triangle alone. spheres: 1000 meshes whose vertices are shared by about six triangles each;
+  // the close convergence puts triangles across both frusta's edges.
+  const Scene scene = test::load_builtin("spheres");
+  const RenderScene prepared(scene);
+  const StereoRig rig = test::rig_at(scene, 160, 90, 3.0);
+  const EyeCamera left = rig.eye(Eye::left), right = rig.eye(Eye::right);
+  const SceneGeometry& geometry = prepared.geometry();
+  std::vector<uint8_t> expected(geometry.triangle_count());
+  size_t by_frustum = 0;
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+      const dvec3 v0(mesh.positions[mesh.indices[3 * t]]), v1(mesh.positions[mesh.indices[3 * t + 1]]),
+          v2(mesh.positions[mesh.indices[3 * t + 2]]);
+      expected[geometry.first_triangle[m] + t] = redirect(left, right, v0, v1, v2, geometry.single_sided[m] != 0);
+      by_frustum += frustum_visibility(left, v0, v1, v2) != frustum_visibility(right, v0, v1, v2) ? 1 : 0;
+    }
+  }
+  EXPECT_GT(by_frustum, 0u) << "some triangles decided by the frustum comparison";
+  for (const int threads : {1, 2, 3}) {
+    RedirectionCounts counts;
+    const std::vector<uint8_t> bits = redirect_triangles(geometry, rig, Executor(threads), counts);
+    ASSERT_EQ(bits.size(), expected.size());
+    size_t differ = 0;
+    for (size_t i = 0; i < bits.size(); ++i) differ += bits[i] != expected[i] ? 1 : 0;
+    EXPECT_EQ(differ, 0u) << threads << " threads";
+    EXPECT_EQ(counts.left, static_cast<uint64_t>(std::count(expected.begin(), expected.end(), kRedirectLeft)));
+    EXPECT_EQ(counts.right, static_cast<uint64_t>(std::count(expected.begin(), expected.end(), kRedirectRight)));
+    EXPECT_EQ(counts.both, static_cast<uint64_t>(std::count(expected.begin(), expected.end(), kRedirectBoth)));
   }
 }
 
