@@ -250,7 +250,7 @@ void check_series_rigs(const PresetRun& run, const PresetSeries& series, size_t 
   const std::vector<BenchEntry> entries = run.config.entries();
   for (size_t i = 0; i < rows; ++i) {
     const PresetRow& row = series.rows[i];
-    if (scenes::builtin_files(row.scene, row.scene_params, run.scenes_dir).front() != loaded) continue;
+    if (scenes::builtin_path(row.scene, row.scene_params, run.scenes_dir) != loaded) continue;
     try {
       const StereoRig rig = rig_of(scene, run, row);
       for (const BenchEntry& e : entries) e.entry.check_rig(e.options, rig);

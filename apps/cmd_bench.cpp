@@ -93,10 +93,10 @@ void run_preset_command(const BenchArgs& a) {
   for (const PresetSeries& series : run.preset->series)
     for (size_t i = 0; i < rows_to_run(series, a.preset_rows); ++i) {
       const PresetRow& row = series.rows[i];
-      for (const std::filesystem::path& file : scenes::builtin_files(row.scene, row.scene_params, a.scenes_dir)) {
-        const std::string name = file.string();
-        refuse_overwriting({{"a scene file of the preset", &name}}, {{"--json", &a.json_out}});
-      }
+      const std::filesystem::path path = scenes::builtin_path(row.scene, row.scene_params, a.scenes_dir);
+      const std::string file = path.string(), stamp = scenes::stamp_path(path).string();
+      refuse_overwriting({{"a scene file of the preset", &file}, {"a scene file's stamp", &stamp}},
+                         {{"--json", &a.json_out}});
     }
   remove_earlier_output(a.json_out, "--json");
   run.rows_per_series = a.preset_rows;
@@ -113,7 +113,7 @@ void run_bench_command(const BenchArgs& a) {
   const BenchConfig config = bench_config(a, pipeline_names());
   const Executor executor(checked_threads(a.threads));
   const scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
-  const std::string scene_file = loaded.file.string(), stamp = scene_file + ".stamp";
+  const std::string scene_file = loaded.file.string(), stamp = scenes::stamp_path(loaded.file).string();
   refuse_overwriting({{"the scene file", &scene_file}, {"the scene file's stamp", &stamp}}, {{"--json", &a.json_out}});
   // From here the run's own --json, or none: an earlier one is not left to be read as this run's.
   remove_earlier_output(a.json_out, "--json");

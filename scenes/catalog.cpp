@@ -18,9 +18,9 @@ namespace sb::scenes {
 
 namespace fs = std::filesystem;
 
-namespace {
-
 fs::path stamp_path(const fs::path& scene) { return fs::path(scene.string() + ".stamp"); }
+
+namespace {
 
 std::string format_value(double v) {
   return v == std::floor(v) && std::fabs(v) < 1e15 ? fmt::format("{:.0f}", v) : fmt::format("{:g}", v);
@@ -129,7 +129,7 @@ fs::path resolve_builtin(const std::string& name, const std::map<std::string, do
                          const fs::path& scenes_dir) {
   if (params.empty()) return resolve_scene(name, scenes_dir);
   const GeneratorInfo& info = find_generator(name);
-  const fs::path path = scenes_dir / variant_file_name(info, 1, params);
+  const fs::path path = builtin_path(name, params, scenes_dir);
   const std::string stamp = stamp_text(info.name, params);
   if (cached(path, stamp)) return path;
   GenerateOptions options;
@@ -139,10 +139,9 @@ fs::path resolve_builtin(const std::string& name, const std::map<std::string, do
   return r.path;
 }
 
-std::vector<fs::path> builtin_files(const std::string& name, const std::map<std::string, double>& params,
-                                    const fs::path& scenes_dir) {
-  const fs::path path = scenes_dir / variant_file_name(find_generator(name), 1, params);
-  return {path, stamp_path(path)};
+fs::path builtin_path(const std::string& name, const std::map<std::string, double>& params,
+                      const fs::path& scenes_dir) {
+  return scenes_dir / variant_file_name(find_generator(name), 1, params);
 }
 
 LoadedScene load_scene(const std::string& spec, const std::filesystem::path& scenes_dir, std::optional<int> lights) {

@@ -45,11 +45,13 @@ GenerateResult generate_builtin(const std::string& name, const std::filesystem::
                                                     const std::map<std::string, double>& params,
                                                     const std::filesystem::path& scenes_dir);
 
-/// The files resolve_builtin(name, params, scenes_dir) reads and writes, without generating
-/// anything: the scene file and the stamp beside it (for a check that an output does not name them).
-[[nodiscard]] std::vector<std::filesystem::path> builtin_files(const std::string& name,
-                                                               const std::map<std::string, double>& params,
-                                                               const std::filesystem::path& scenes_dir);
+/// The file resolve_builtin(name, params, scenes_dir) reads or generates, without generating it.
+[[nodiscard]] std::filesystem::path builtin_path(const std::string& name, const std::map<std::string, double>& params,
+                                                 const std::filesystem::path& scenes_dir);
+
+/// The stamp beside a generated scene file, which says what generated it (a scene file without
+/// its stamp is generated again).
+[[nodiscard]] std::filesystem::path stamp_path(const std::filesystem::path& scene);
 
 /// A scene loaded for rendering, with what the command line chose of it.
 struct LoadedScene {

@@ -138,7 +138,7 @@ TEST(BenchPreset, BadPresetsAndLightCountsExitWith3AndSayWhy) {
        {"--json " + (dir / "scenes" / "atrium.glb").string() + " names the same file as a scene file of the preset"}},
       {"bench --preset al-hagri-lights --preset-rows 1" + quick + " --json '" +
            (dir / "scenes" / "dragon_lights-10.glb.stamp").string() + "'",
-       {"names the same file as a scene file of the preset"}},
+       {"names the same file as a scene file's stamp"}},
       {"bench --scene box-wall --resolution 32x18 --json '" + (dir / "scenes" / "box-wall.gltf.stamp").string() + "'" +
            quick,
        {"names the same file as the scene file's stamp"}},
