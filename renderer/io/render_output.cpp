@@ -76,32 +76,50 @@ json holes_to_json(const HoleAnalysis& a) {
           {"analysis_s", a.seconds}};
 }
 
+namespace {
+
+/// A stereo image a render can write: its name (in --stereo, and its file <stem>_<name>.png), the
+/// StereoViews flag that asks for it, where RenderFiles keeps its path, and how it is made.
+struct StereoView {
+  std::string_view name;
+  bool StereoViews::*asked;
+  std::optional<fs::path> RenderFiles::*file;
+  Image (*make)(const Image& left, const Image& right);
+};
+
+const StereoView kStereoViews[] = {
+    {"anaglyph", &StereoViews::anaglyph, &RenderFiles::anaglyph_png, &anaglyph_dubois},
+    {"sbs", &StereoViews::side_by_side, &RenderFiles::side_by_side_png, &side_by_side},
+    {"ou", &StereoViews::over_under, &RenderFiles::over_under_png, &over_under},
+};
+
+}  // namespace
+
 StereoViews StereoViews::from_names(const std::vector<std::string>& names, const std::string& option) {
   StereoViews v{false, false, false};
   if (names.size() == 1 && names.front() == "none") return v;
-  std::vector<std::string> seen;
   for (const std::string& name : names) {
     if (name == "none")
       throw InputError(fmt::format("{} none: 'none' writes no stereo image and stands alone; drop it or the other "
                                    "names",
                                    option));
-    if (std::find(seen.begin(), seen.end(), name) != seen.end())
-      throw InputError(fmt::format("{}: '{}' is named twice; name each stereo image once", option, name));
-    seen.push_back(name);
-    bool* flag = name == "anaglyph" ? &v.anaglyph : name == "sbs" ? &v.side_by_side : name == "ou" ? &v.over_under : nullptr;
-    if (flag == nullptr)
+    const auto view = std::find_if(std::begin(kStereoViews), std::end(kStereoViews),
+                                   [&](const StereoView& s) { return s.name == name; });
+    if (view == std::end(kStereoViews))
       throw InputError(fmt::format("{} {}: not a stereo image; give anaglyph (Dubois red-cyan), sbs (side by side), "
                                    "ou (over/under), several of them comma-separated, or none",
                                    option, name));
-    *flag = true;
+    if (v.*view->asked)
+      throw InputError(fmt::format("{}: '{}' is named twice; name each stereo image once", option, name));
+    v.*view->asked = true;
   }
   return v;
 }
 
 std::vector<std::filesystem::path> RenderFiles::all() const {
   std::vector<std::filesystem::path> files{exr, left_png, right_png};
-  for (const auto* view : {&anaglyph_png, &side_by_side_png, &over_under_png})
-    if (*view) files.push_back(**view);
+  for (const StereoView& view : kStereoViews)
+    if (this->*view.file) files.push_back(*(this->*view.file));
   if (holes_png) files.push_back(*holes_png);
   files.insert(files.end(), extras.begin(), extras.end());
   files.push_back(stats_json);
@@ -155,9 +173,8 @@ RenderFiles render_file_names(const std::filesystem::path& dir, const std::strin
   f.exr = dir / (stem + ".exr");
   f.left_png = dir / (stem + "_left.png");
   f.right_png = dir / (stem + "_right.png");
-  if (views.anaglyph) f.anaglyph_png = dir / (stem + "_anaglyph.png");
-  if (views.side_by_side) f.side_by_side_png = dir / (stem + "_sbs.png");
-  if (views.over_under) f.over_under_png = dir / (stem + "_ou.png");
+  for (const StereoView& view : kStereoViews)
+    if (views.*view.asked) f.*view.file = dir / (stem + "_" + std::string(view.name) + ".png");
   f.holes_png = dir / (stem + "_holes.png");
   f.stats_json = dir / (stem + "_stats.json");
   return f;
@@ -187,12 +204,10 @@ RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::st
   ImageMetadata meta;
   meta["stereobench/record"] = record.dump();
   std::vector<std::pair<fs::path, const Image*>> pngs{{f.left_png, &result.left}, {f.right_png, &result.right}};
-  const std::pair<const std::optional<fs::path>*, Image (*)(const Image&, const Image&)> view_makers[] = {
-      {&f.anaglyph_png, &anaglyph_dubois}, {&f.side_by_side_png, &side_by_side}, {&f.over_under_png, &over_under}};
   std::vector<Image> views_made;
-  views_made.reserve(std::size(view_makers));
-  for (const auto& [file, make] : view_makers)
-    if (*file) pngs.emplace_back(**file, &views_made.emplace_back(make(result.left, result.right)));
+  views_made.reserve(std::size(kStereoViews));  // the pointers into it stay valid
+  for (const StereoView& view : kStereoViews)
+    if (f.*view.file) pngs.emplace_back(*(f.*view.file), &views_made.emplace_back(view.make(result.left, result.right)));
   if (holes_overlay) pngs.emplace_back(*f.holes_png, holes_overlay);
   for (size_t k = 0; k < result.extras.size(); ++k) pngs.emplace_back(f.extras[k], &result.extras[k].second);
   // The set's file names go into the stats JSON: the next render of this stem removes those of
