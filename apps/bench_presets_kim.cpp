@@ -69,7 +69,6 @@ bool contains(const std::vector<std::string>& items, const std::string& name) {
   return std::find(items.begin(), items.end(), name) != items.end();
 }
 
-
 /// The rig of a Kim row: the preset's interaxial and convergence, the row's image size unless
 /// --resolution replaced it, and what else the command line left open (--vfov, --convergence).
 StereoRig row_rig(const Scene& scene, const PresetRun& run, const PresetRow& row) {

@@ -27,6 +27,9 @@ namespace sb {
 /// No reprojection reached the pixel (or the source pixel saw nothing).
 inline constexpr int32_t kNoSource = -1;
 
+/// Whether a left pixel's linear depth is the background's (a miss), which is not reprojected.
+[[nodiscard]] inline bool is_miss(float depth) { return !(depth > 0.0f) || !std::isfinite(depth); }
+
 /// Where left-eye hits land in the right eye.
 class PixelReprojector {
  public:
@@ -38,7 +41,7 @@ class PixelReprojector {
   /// With the rig's parallel, equally shifted eyes the projection moves by the disparity
   /// f·e·(1/c − 1/z) along the row, so the column is target_column(x, disparity) of the row warp.
   [[nodiscard]] int32_t target(int x, int /*y*/, float depth) const {
-    if (!(depth > 0.0f) || !std::isfinite(depth)) return kNoSource;
+    if (is_miss(depth)) return kNoSource;
     const int column = target_column(x, motion_(depth));
     return column >= 0 && column < width_ ? column : kNoSource;
   }

@@ -2,7 +2,6 @@
 #include "renderer/stages/scanline_reprojection.hpp"
 
 #include <chrono>
-#include <cmath>
 #include <vector>
 
 namespace sb {
@@ -24,7 +23,7 @@ void reproject_row(const PixelReprojector& reprojector, const float* left_depth,
   for (int x = 0; x < width; ++x) {
     const float depth = left_depth[static_cast<size_t>(y) * width + x];
     const int32_t r = reprojector.target(x, y, depth);
-    if (!(depth > 0.0f) || !std::isfinite(depth)) background_between = true;
+    background_between |= is_miss(depth);
     if (r == kNoSource) continue;
     // A jump of more than one pixel after an earlier reprojection leaves a gap: its pixels are NoHit,
     // whatever reached them before. The thesis calls the gap bad when the two reprojections come
