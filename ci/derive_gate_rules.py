@@ -9,6 +9,7 @@ build it was derived from and fails on a clear regression:
 
   PSNR      fail 2 dB, warn 1 dB below the lowest (inf: fail below 80 dB)
   SSIM      fail 0.3 x (1 - lowest) (at least 0.005), warn half that, below the lowest
+            (both also for the left eye where a pipeline synthesizes part of it: validation.left_eye)
   recall    fail 0.5 x (1 - lowest) (at least 0.005), warn half that, below the lowest; unchecked
             where the lowest is under 0.5 (ideal-copy and repro-warp trace no holes)
   fractions (error pixels, holes): fail 1.25 x highest + 0.002, warn 1.12 x highest + 0.001
@@ -76,8 +77,10 @@ def main(paths):
         for name, p in rec["pipelines"].items():
             v = p.get("validation", {})
             m, h = v.get("metrics", {}), v.get("holes", {})
+            lm = (v.get("left_eye") or {}).get("metrics", {})
             got = worst[(name, scene, e)]
             for key, val in (("psnr", m.get("psnr")), ("ssim", m.get("ssim")),
+                             ("left_psnr", lm.get("psnr")), ("left_ssim", lm.get("ssim")),
                              ("error_fraction", m.get("error_fraction")),
                              ("hole_fraction", h.get("hole_fraction")),
                              ("recall", (h.get("not_reprojected") or {}).get("recall")),
@@ -85,7 +88,7 @@ def main(paths):
                              ("right_share", p.get("timing", {}).get("right_over_left_median"))):
                 if isinstance(val, (int, float)):
                     got[key].append(float(val))
-                elif val == "inf" or (key == "psnr" and val is None and m):
+                elif val == "inf" or (key == "psnr" and val is None and m) or (key == "left_psnr" and val is None and lm):
                     got[key].append(math.inf)
     if not worst:
         sys.exit("derive_gate_rules: no sweep cell records in " + ", ".join(paths))
@@ -106,19 +109,21 @@ def main(paths):
     for (name, scene, e) in sorted(worst, key=lambda k: (k[1], k[2], k[0])):
         got = worst[(name, scene, e)]
         t, note = {}, []
-        if got["psnr"]:
-            lo, hi = min(got["psnr"]), max(got["psnr"])
-            if math.isinf(lo):
-                t["min_psnr"] = 80
-            else:
-                t["min_psnr"] = fmt(floor_to(lo - 2.0, 0.1), 1)
-                t["warn_psnr"] = fmt(floor_to(lo - 1.0, 0.1), 1)
-            note.append(f"PSNR {lo:.2f}..{hi:.2f}" if not math.isinf(hi) else f"PSNR {lo:.2f}..inf")
-        if got["ssim"]:
-            lo = min(got["ssim"])
-            t["min_ssim"] = fmt(floor_to(lo - max(0.005, 0.3 * (1 - lo)), 0.001), 3)
-            t["warn_ssim"] = fmt(floor_to(lo - max(0.0025, 0.15 * (1 - lo)), 0.001), 3)
-            note.append(f"SSIM {lo:.4f}..{max(got['ssim']):.4f}")
+        for eye in ("", "left_"):
+            what = "left " if eye else ""
+            if got[eye + "psnr"]:
+                lo, hi = min(got[eye + "psnr"]), max(got[eye + "psnr"])
+                if math.isinf(lo):
+                    t["min_" + eye + "psnr"] = 80
+                else:
+                    t["min_" + eye + "psnr"] = fmt(floor_to(lo - 2.0, 0.1), 1)
+                    t["warn_" + eye + "psnr"] = fmt(floor_to(lo - 1.0, 0.1), 1)
+                note.append(f"{what}PSNR {lo:.2f}..{hi:.2f}" if not math.isinf(hi) else f"{what}PSNR {lo:.2f}..inf")
+            if got[eye + "ssim"]:
+                lo = min(got[eye + "ssim"])
+                t["min_" + eye + "ssim"] = fmt(floor_to(lo - max(0.005, 0.3 * (1 - lo)), 0.001), 3)
+                t["warn_" + eye + "ssim"] = fmt(floor_to(lo - max(0.0025, 0.15 * (1 - lo)), 0.001), 3)
+                note.append(f"{what}SSIM {lo:.4f}..{max(got[eye + 'ssim']):.4f}")
         for key in ("error_fraction", "hole_fraction"):
             if got[key]:
                 hi = max(got[key])

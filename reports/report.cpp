@@ -102,6 +102,18 @@ json pipeline_summary(const json& p, const json& baseline_total) {
            {"recall", dig(v, {"holes", "not_reprojected", "recall"})},
            {"precision", dig(v, {"holes", "not_reprojected", "precision"})},
            {"true_disocclusion_fraction", dig(v, {"holes", "true_disocclusions", "fraction"})}};
+  // A left eye synthesized in part (bidir-warp's), measured against plain-rt's left eye; null for a
+  // left eye the pipeline renders whole.
+  const json left = get_or_null(v, "left_eye");
+  const json left_pixels = dig(left, {"metrics", "pixels"});
+  const json synthesized = get_or_null(left, "synthesized_pixels");
+  out["left_psnr"] = dig(left, {"metrics", "psnr"});
+  out["left_ssim"] = dig(left, {"metrics", "ssim"});
+  out["left_mse"] = dig(left, {"metrics", "mse"});
+  out["left_synthesized_fraction"] =
+      synthesized.is_number() && left_pixels.is_number() && left_pixels.get<double>() > 0.0
+          ? json(synthesized.get<double>() / left_pixels.get<double>())
+          : json(nullptr);
   json regions = json::object();
   if (v.contains("regions") && v["regions"].is_object())
     for (const auto& [name, r] : v["regions"].items()) regions[name] = region_summary(r);

@@ -219,7 +219,7 @@ bool timed_check(std::string_view check) {
 std::string value_text(const std::string& check, double v) {
   if (std::isnan(v)) return "-";
   if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  if (check == "psnr") return fmt::format("{:.2f} dB", v);
+  if (check == "psnr" || check == "left_psnr") return fmt::format("{:.2f} dB", v);
   if (check == "speedup") return fmt::format("{:.2f}x", v);
   if (check == "right_share") return fmt::format("{:.1f} %", 100.0 * v);
   if (check == kRegressionCheck) return fmt::format("{:+.1f} %", 100.0 * v);
@@ -815,6 +815,10 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
         check.fail_limit = limit(mc.fail_key);
         check.warn_limit = limit(mc.warn_key);
         if (!check.fail_limit && !check.warn_limit) continue;
+        if (mc.applies_unless_null != nullptr) {
+          const json::json_pointer scope(mc.applies_unless_null);
+          if (entry.contains(scope) && entry.at(scope).is_null()) continue;
+        }
         const std::optional<double> value = record_number(entry, mc.pointer, where + ": pipelines." + pipeline);
         check.measured = value ? *value : kNaN;
         if (!value || std::isnan(*value)) {

@@ -38,6 +38,10 @@ struct MetricCheck {
   const char* pointer;  ///< JSON pointer into the pipeline entry of a results line
   const char* label;    ///< what the number is, for messages ("PSNR")
   double largest = std::numeric_limits<double>::infinity();  ///< the largest value the metric takes
+  /// A JSON pointer into the pipeline entry, or null: where the entry holds null there, the check
+  /// does not apply to it (no check is made, none is listed): a pipeline that renders its left eye
+  /// whole has `validation.left_eye` null, and nothing of its left eye to measure.
+  const char* applies_unless_null = nullptr;
 };
 
 /// Every threshold check, in report order. The time regression is separate (RegressionSettings).
@@ -50,6 +54,10 @@ inline constexpr MetricCheck kMetricChecks[] = {
      "hole fraction", 1.0},
     {"disocclusion_recall", "min_recall", "warn_recall", Direction::at_least,
      "/validation/holes/not_reprojected/recall", "disocclusion recall", 1.0},
+    {"left_psnr", "min_left_psnr", "warn_left_psnr", Direction::at_least, "/validation/left_eye/metrics/psnr",
+     "left eye's PSNR", std::numeric_limits<double>::infinity(), "/validation/left_eye"},
+    {"left_ssim", "min_left_ssim", "warn_left_ssim", Direction::at_least, "/validation/left_eye/metrics/ssim",
+     "left eye's SSIM", 1.0, "/validation/left_eye"},
     {"speedup", "min_speedup", "warn_speedup", Direction::at_least, "/timing/speedup_median", "median speed-up"},
     {"right_share", "max_right_share", "warn_right_share", Direction::at_most, "/timing/right_over_left_median",
      "right eye's time over the left eye's"},

@@ -337,13 +337,37 @@
     { text: 'Right / left %', title: 'Time of the stages that serve the right eye over those that serve the left (the sweep: median over repetitions of each repetition’s ratio); — where no stage serves the left eye alone', key: 'right_over_left', digits: 1, scale: 100 },
   ];
 
+  /** A row per pipeline of `ps`: its name, how many cells `has` it in, and the median of each column over those. */
+  function pipelineRows(ps, columns, has) {
+    return ps.map((p) => {
+      const own = cells.filter((c) => has(c, p));
+      return { cells: [{ text: p, th: true }, { text: String(own.length), num: true },
+        ...columns.map((m) => ({ text: fmt(median(own.map((c) => field(c, p, m.key))), m.digits, m.scale), num: true }))] };
+    });
+  }
+
+  /** A row per cell and pipeline of `ps` that `has` it there: the cell (a link to its viewer, once
+   * per cell), the pipeline, and each column's value. */
+  function cellPipelineRows(ps, columns, has) {
+    const rows = [];
+    cells.forEach((c, i) => {
+      const present = ps.filter((p) => has(c, p));
+      present.forEach((p, j) => {
+        const row = { cls: j === 0 ? 'group-start' : null, cells: [] };
+        if (j === 0)
+          row.cells.push({ th: true, rowspan: present.length, node: el('a', { href: `#${cellAnchor(i)}` }, cellShort(c, i)),
+            title: cellLabel(c) });
+        row.cells.push({ text: p });
+        for (const m of columns) row.cells.push({ text: fmt(field(c, p, m.key), m.digits, m.scale), num: true });
+        rows.push(row);
+      });
+    });
+    return rows;
+  }
+
   function summarySection() {
     const header = [{ text: 'Pipeline' }, { text: 'Cells' }, ...metricColumns];
-    const rows = pipelines.map((p) => {
-      const own = cells.filter((c) => rec(c, p));
-      return { cells: [{ text: p, th: true }, { text: String(own.length), num: true },
-        ...metricColumns.map((m) => ({ text: fmt(median(own.map((c) => field(c, p, m.key))), m.digits, m.scale), num: true }))] };
-    });
+    const rows = pipelineRows(pipelines, metricColumns, (c, p) => rec(c, p) !== null);
     const node = el('section', { 'aria-labelledby': 'summary-h' }, el('h2', { id: 'summary-h' }, 'Summary per pipeline'),
       table(`Medians over the cells of the sweep (${cells.length}). PSNR is ∞ where the right eye equals the ground truth; — marks a value the cell does not have.`,
         header, rows));
@@ -433,21 +457,30 @@
       caption: 'Median time per frame of each pipeline along the camera path.' });
   }
 
+  const leftColumns = [
+    { text: 'Left synthesized %', title: 'Share of the left eye\'s pixels the pipeline did not render for the left eye (warped in from the right eye, filled)', key: 'left_synthesized_fraction', digits: 2, scale: 100 },
+    { text: 'Left PSNR dB', title: 'The whole left eye against plain-rt\'s ray-traced left eye, 8-bit sRGB', key: 'left_psnr', digits: 2 },
+    { text: 'Left SSIM', title: 'Structural similarity of the left eye against plain-rt\'s left eye', key: 'left_ssim', digits: 4 },
+    { text: 'Left MSE', title: 'Mean squared error of the left eye over 0–255 RGB', key: 'left_mse', digits: 3 },
+  ];
+
+  /** Pipelines that synthesize part of their left eye too (bidir-warp): the left eye measured. */
+  function leftEyeSection() {
+    const measured = (c, p) => field(c, p, 'left_psnr') !== null && field(c, p, 'left_psnr') !== undefined;
+    const own = pipelines.filter((p) => cells.some((c) => measured(c, p)));
+    if (!own.length) return null;
+    const summary = pipelineRows(own, leftColumns, measured);
+    const rows = cellPipelineRows(own, leftColumns, measured);
+    const node = el('section', { 'aria-labelledby': 'left-eyes-h' }, el('h2', { id: 'left-eyes-h' }, 'Left eyes synthesized in part'),
+      el('p', { class: 'note' }, 'These pipelines render only part of the left eye themselves and warp the rest in from the right eye, so the left eye is measured too: against plain-rt\'s ray-traced left eye, whichever ground truth gave the right eye\'s. Every other pipeline renders its left eye whole.'),
+      table(`Medians per pipeline over the cells that measured a left eye.`, [{ text: 'Pipeline' }, { text: 'Cells' }, ...leftColumns], summary),
+      table('Every measured left eye. The cell link opens its image viewer.', [{ text: 'Cell' }, { text: 'Pipeline' }, ...leftColumns], rows));
+    return { id: 'left-eyes', title: 'Left eyes', node };
+  }
+
   function cellTableSection() {
     const header = [{ text: 'Cell' }, { text: 'Pipeline' }, ...metricColumns];
-    const rows = [];
-    cells.forEach((c, i) => {
-      const present = pipelines.filter((p) => rec(c, p));
-      present.forEach((p, j) => {
-        const row = { cls: j === 0 ? 'group-start' : null, cells: [] };
-        if (j === 0)
-          row.cells.push({ th: true, rowspan: present.length, node: el('a', { href: `#${cellAnchor(i)}` }, cellShort(c, i)),
-            title: cellLabel(c) });
-        row.cells.push({ text: p });
-        for (const m of metricColumns) row.cells.push({ text: fmt(field(c, p, m.key), m.digits, m.scale), num: true });
-        rows.push(row);
-      });
-    });
+    const rows = cellPipelineRows(pipelines, metricColumns, (c, p) => rec(c, p) !== null);
     const node = el('section', { 'aria-labelledby': 'cells-h' }, el('h2', { id: 'cells-h' }, 'Cells × pipelines'),
       table('Every pipeline in every cell. The cell link opens its image viewer; hover it for the cell\'s axes.', header, rows));
     return { id: 'cells', title: 'Cells × pipelines', node };
@@ -754,7 +787,9 @@
       stopFlicker();
       const r = rec(cell, pipeline);
       const imgs = r.images;
-      metrics.textContent = `PSNR ${fmt(r.psnr, 2)} dB · SSIM ${fmt(r.ssim, 4)} · MSE ${fmt(r.mse, 3)} · holes ${fmt(r.hole_fraction, 2, 100)} % · ${fmt(r.time_s, 2, 1000)} ms · ${fmt(r.speedup, 2)}×`;
+      const left = r.left_psnr !== null && r.left_psnr !== undefined
+        ? ` · left eye PSNR ${fmt(r.left_psnr, 2)} dB, SSIM ${fmt(r.left_ssim, 4)} (${fmt(r.left_synthesized_fraction, 1, 100)} % synthesized)` : '';
+      metrics.textContent = `PSNR ${fmt(r.psnr, 2)} dB · SSIM ${fmt(r.ssim, 4)} · MSE ${fmt(r.mse, 3)} · holes ${fmt(r.hole_fraction, 2, 100)} % · ${fmt(r.time_s, 2, 1000)} ms · ${fmt(r.speedup, 2)}×${left}`;
       const content = {
         sbs: [el('div', { class: 'pair' }, figure(cell.images.left, 'Left eye', 'Left eye'),
           figure(imgs.right, `Right eye by ${pipeline}`, `Right eye by ${pipeline}`))],
@@ -871,7 +906,7 @@
 
   // Sections in page order; each returns {id, title, node} or null when the data has nothing for it.
   const sections = [overviewSection, summarySection, paperSection, chartsSection, trendsSection, cellTableSection,
-    viewerSection];
+    leftEyeSection, viewerSection];
   const main = document.getElementById('main');
   const toc = el('ul');
   for (const make of sections) {

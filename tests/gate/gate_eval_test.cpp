@@ -126,6 +126,40 @@ TEST(GateEval, RightEyeShareOfTheLeft) {
                InputError);
 }
 
+TEST(GateEval, ALeftEyeSynthesizedInPartIsCheckedWhereItWasMeasured) {
+  const std::string config = kConfig + "min_left_psnr = 30\nwarn_left_psnr = 33\nmin_left_ssim = 0.95\n";
+  std::vector<json> cells = passing_cells();
+  // repro-rt of cell 0 as a left eye warped in part (as bidir-warp's is), plain-rt's rendered whole
+  // (left_eye null), and cell 1's repro-rt from a record written before left eyes were measured.
+  auto& measured = cells[0]["pipelines"]["repro-rt"]["validation"];
+  cells[0]["pipelines"]["plain-rt"]["validation"]["left_eye"] = nullptr;
+  cells[1]["pipelines"]["plain-rt"]["validation"]["left_eye"] = nullptr;
+  for (const auto& [psnr, verdict] : std::vector<std::pair<double, Verdict>>{
+           {40.0, Verdict::pass}, {33.0, Verdict::pass}, {31.0, Verdict::warn}, {29.9, Verdict::fail}}) {
+    measured["left_eye"] = {{"reference", "plain-rt"}, {"synthesized_pixels", 100}, {"metrics", {{"psnr", psnr}, {"ssim", 0.99}}}};
+    const validation::GateReport r = evaluate(cells, {}, config);
+    const validation::GateCheck* c = find_check(r, "repro-rt", "left_psnr");
+    ASSERT_NE(c, nullptr);
+    EXPECT_EQ(c->verdict, verdict) << psnr << ": " << c->message;
+    EXPECT_DOUBLE_EQ(c->measured, psnr);
+    EXPECT_EQ(find_check(r, "repro-rt", "left_ssim")->verdict, Verdict::pass);
+    // A left eye rendered whole has nothing to check: no check, not a skip.
+    EXPECT_EQ(find_check(r, "plain-rt", "left_psnr"), nullptr);
+    EXPECT_EQ(find_check(r, "plain-rt", "left_psnr", 1), nullptr);
+    EXPECT_EQ(find_check(r, "repro-rt", "left_psnr", 1)->verdict, Verdict::skip) << "absent: an older record";
+  }
+  validation::GateReport r = evaluate(cells, {}, config);
+  EXPECT_NE(find_check(r, "repro-rt", "left_psnr")->message.find("left eye's PSNR 29.90 dB is below the minimum 30.00 dB"),
+            std::string::npos)
+      << find_check(r, "repro-rt", "left_psnr")->message;
+  EXPECT_EQ(find_check(r, "repro-rt", "left_psnr")->reproduce.rfind("stereobench validate ", 0), 0u)
+      << "validate prints the left eye's measure";
+  measured["left_eye"]["metrics"]["ssim"] = 0.94;
+  r = evaluate(cells, {}, config);
+  EXPECT_EQ(find_check(r, "repro-rt", "left_ssim")->verdict, Verdict::fail);
+  EXPECT_THROW((void)validation::parse_gate_config(kConfig + "min_left_ssim = 1.5\n", "g.toml"), InputError);
+}
+
 TEST(GateEval, WarnLevelsAndEveryMetric) {
   std::vector<json> cells = passing_cells();
   // PSNR 33 dB: above the 30 dB failure level, below the 35 dB warning level.

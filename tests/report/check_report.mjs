@@ -1,6 +1,7 @@
 // Checks a `stereobench report` page in headless Debian Chromium, opened from disk (file://):
 // no console error, page error, failed request or network request; one summary row per pipeline
-// and one cell-table row per (cell, pipeline); every chart canvas has data drawn inside its plot
+// and one cell-table row per (cell, pipeline); a left-eyes row per measured left eye (bidir-warp's),
+// with its PSNR; every chart canvas has data drawn inside its plot
 // area; in every cell and for every pipeline each viewer image loads, each mode button shows its
 // own view (all pipelines of the first cell, the first pipeline of the others), the slider follows
 // a drag, flicker alternates, the anaglyph is composed exactly; with a history (nightly runs), the
@@ -112,6 +113,32 @@ try {
     const wrong = cellShares.filter(([pipeline, text], i) => !expected[i] || expected[i][0] !== pipeline || !shown(expected[i][1], text));
     if (wrong.length) problems.push(`cells table: right / left shown wrongly in ${wrong.length} row(s), e.g. ${JSON.stringify(wrong[0])}`);
   }
+  // Left eyes synthesized in part: a section exactly when some record measured one, with a summary
+  // row per such pipeline and a row per measured (cell, pipeline) showing its left PSNR.
+  const hasLeft = (p) => p && p.left_psnr !== null && p.left_psnr !== undefined;
+  const leftPipelines = data.pipelines.filter((p) => data.cells.some((c) => hasLeft(c.pipelines[p])));
+  const leftTables = await page.locator('#left-eyes table').count();
+  if (!leftPipelines.length) {
+    if (leftTables !== 0) problems.push('left eyes section shown, but no record measured a left eye');
+  } else if (leftTables !== 2) {
+    problems.push(`left eyes section: ${leftTables} tables for ${leftPipelines.length} pipeline(s) with a measured left eye`);
+  } else {
+    const rows = await page.evaluate(() => [...document.querySelectorAll('#left-eyes table')].map((t) =>
+      [...t.querySelectorAll('tbody tr')].map((tr) => [...tr.children].map((x) => x.textContent))));
+    if (rows[0].length !== leftPipelines.length)
+      problems.push(`left eyes summary: ${rows[0].length} rows for ${leftPipelines.length} pipelines`);
+    const expected = data.cells.flatMap((c) => leftPipelines.filter((p) => hasLeft(c.pipelines[p]))
+      .map((p) => [p, c.pipelines[p].left_psnr]));
+    if (rows[1].length !== expected.length) problems.push(`left eyes table: ${rows[1].length} rows for ${expected.length} measured left eyes`);
+    expected.forEach(([p, psnr], i) => {
+      const row = rows[1][i] || [];
+      const at = row.indexOf(p);  // the pipeline cell; the left PSNR two columns on
+      const want = psnr === 'inf' ? '∞' : Number(psnr).toFixed(2);
+      if (at < 0 || row[at + 2] !== want) problems.push(`left eyes table row ${i + 1}: ${JSON.stringify(row)}, expected ${p} with left PSNR ${want}`);
+    });
+    report.left_eye_rows = rows[1].length;
+  }
+
   const bodyText = await page.evaluate(() => document.body.innerText);
   for (const bad of ['NaN', 'undefined', 'Infinity', '[object Object]'])
     if (bodyText.includes(bad)) problems.push(`the page text contains "${bad}"`);

@@ -125,6 +125,16 @@ TEST(Report, SmokeSweepReportsPassTheBrowserCheck) {
     EXPECT_EQ(cell.at("pipelines").at("repro-rt").at("right_over_left"), measured);
     EXPECT_TRUE(cell.at("pipelines").at("bidir-warp").at("right_over_left").is_null()) << "bidir-warp's stages serve both eyes";
     EXPECT_EQ(cell["pipelines"]["repro-rt"]["psnr"], lines[i]["pipelines"]["repro-rt"]["validation"]["metrics"]["psnr"]);
+    // bidir-warp synthesizes part of its left eye: the report carries its measure; repro-rt
+    // renders its left eye whole and carries none.
+    const json& left = lines[i].at("pipelines").at("bidir-warp").at("validation").at("left_eye");
+    ASSERT_TRUE(left.is_object());
+    EXPECT_EQ(cell["pipelines"]["bidir-warp"]["left_psnr"], left["metrics"]["psnr"]);
+    EXPECT_EQ(cell["pipelines"]["bidir-warp"]["left_ssim"], left["metrics"]["ssim"]);
+    EXPECT_DOUBLE_EQ(cell["pipelines"]["bidir-warp"]["left_synthesized_fraction"].get<double>(),
+                     left["synthesized_pixels"].get<double>() / left["metrics"]["pixels"].get<double>());
+    EXPECT_TRUE(cell["pipelines"]["repro-rt"]["left_psnr"].is_null());
+    EXPECT_TRUE(cell["pipelines"]["repro-rt"]["left_synthesized_fraction"].is_null());
     for (const auto& [key, path] : cell["images"].items()) {
       ASSERT_TRUE(path.is_string()) << key;
       EXPECT_TRUE(fs::exists(dir / "report" / path.get<std::string>())) << path;
