@@ -588,6 +588,23 @@
       });
     }
     node.append(table('Rendering and warping time (ms) by triangle count: the paper\'s Table 3 beside this sweep (medians over cells).', header, rows));
+    const fw = paper.forward_warp;
+    if (!fw) return;
+    // Table 1 is at FHD; the warp works in image space, so every triangle count's cells count.
+    const fhd = cells.filter((c) => c.width === 1920 && c.height === 1080);
+    const over = fhd.length ? fhd : cells;
+    const warpRows = fw.methods.map((m) => {
+      const mine = over.filter((c) => rec(c, m.pipeline)).map((c) => {
+        const stages = field(c, m.pipeline, 'stages_s') || {};
+        const parts = m.stages.map((s) => num(stages[s]));
+        return parts.some((x) => x === null) ? null : parts.reduce((a, b) => a + b, 0);
+      });
+      return { cells: [{ th: true, text: `${m.paper_name} (${m.pipeline})` }, { num: true, cls: 'paper', text: fmt(m.ms, 3) },
+        { text: m.stages.join(' + ') }, { num: true, text: fmt(median(mine), 3, 1000) }, { num: true, text: String(mine.filter((x) => x !== null).length) }] };
+    });
+    node.append(el('p', { class: 'note' }, fw.note),
+      table(`${fw.title}, beside this sweep (${fhd.length ? '1920×1080 cells' : 'all cells: the sweep has no 1920×1080 cell'}).`,
+        [{ text: 'Method' }, { text: 'Paper ms', cls: 'paper' }, { text: 'Our stages' }, { text: 'Ours ms' }, { text: 'Cells' }], warpRows));
   }
 
   function alHagri(paper, node) {

@@ -146,6 +146,20 @@ try {
     const paperRows = await page.locator('#paper tbody tr').count();
     if (paperRows === 0) problems.push(`paper section ${data.paper.experiment}: no table rows`);
     report.paper_rows = paperRows;
+    // Kim's Table 1 (forward warping time): a row per method, with our time where the sweep ran it.
+    if (data.paper.forward_warp) {
+      const rows = await page.evaluate(() => {
+        const tables = [...document.querySelectorAll('#paper table')];
+        return [...tables[tables.length - 1].querySelectorAll('tbody tr')].map((tr) => [...tr.children].map((x) => x.textContent));
+      });
+      const methods = data.paper.forward_warp.methods;
+      if (rows.length !== methods.length) problems.push(`forward warping table: ${rows.length} rows for ${methods.length} methods`);
+      methods.forEach((m, i) => {
+        const ran = data.cells.some((c) => c.pipelines[m.pipeline]);
+        const ours = (rows[i] || [])[3];
+        if (ran && !/^\d+\.\d{3}$/.test(ours || '')) problems.push(`forward warping table: ${m.pipeline} shows "${ours}"`);
+      });
+    }
   }
 
   // Charts: data drawn inside each plot area.
