@@ -345,6 +345,11 @@ json report_data(const ResultsFile& results, const std::string& title, const jso
                          {"diff", image(get_or_null(pimgs, "diff_png"), base + "diff.png")},
                          {"ssim", image(get_or_null(pimgs, "ssim_png"), base + "ssim.png")},
                          {"holes", image(get_or_null(pimgs, "holes_png"), base + "holes.png")}};
+      // A left eye synthesized in part: the pipeline's own, and its difference to plain-rt's.
+      if (pimgs.is_object() && pimgs.contains("left_png")) {
+        s["images"]["left"] = image(pimgs["left_png"], base + "left.png");
+        s["images"]["left_diff"] = image(get_or_null(pimgs, "left_diff_png"), base + "left_diff.png");
+      }
       per[name] = std::move(s);
     }
     entry["pipelines"] = std::move(per);

@@ -92,8 +92,8 @@ PipelineValidation validate_pipeline(const ValidationTarget& target, const Pipel
       reference.seconds = seconds_since(traced);
       tracing = reference.seconds;
     });
-    v.left = compare_images(encode_srgb8(v.result.left, fmt::format("{}'s left eye", v.pipeline)), reference.srgb8,
-                            nullptr, metric_options);
+    v.left_srgb8 = encode_srgb8(v.result.left, fmt::format("{}'s left eye", v.pipeline));
+    v.left = compare_images(v.left_srgb8, reference.srgb8, nullptr, metric_options);
   }
   v.seconds_metrics = seconds_since(start) - tracing;
   return v;

@@ -70,8 +70,10 @@ struct PipelineValidation {
   /// Left-eye pixels the pipeline did not render itself (tagged other than rasterized or traced:
   /// bidir-warp's, warped in from the right eye's share, filled or left as holes).
   uint64_t left_synthesized = 0;
-  /// With left_synthesized > 0: the left eye's metrics against plain-rt's left eye.
+  /// With left_synthesized > 0: the left eye's metrics against plain-rt's left eye, and the left
+  /// eye in sRGB (empty otherwise).
   std::optional<ImageMetrics> left;
+  Srgb8Image left_srgb8;
 };
 
 /// Renders an entry (a pipeline or a variant of one) and measures its right eye, recorded under

@@ -87,6 +87,16 @@ json write_pipeline_images(const std::filesystem::path& dir, const std::string& 
         io::write_png_preview(path("holes.png"), hole_overlay(v.result.right, v.hole_mask, target.disocclusions.mask));
       }};
   std::vector<std::filesystem::path> paths = {path("right.png"), path("diff.png"), path("ssim.png"), path("holes.png")};
+  // A left eye synthesized in part (measured against plain-rt's): the pipeline's own left eye and
+  // its difference to plain-rt's.
+  if (v.left) {
+    writers.emplace_back([&] { write_png(path("left.png"), v.left_srgb8); });
+    writers.emplace_back([&] { write_png(path("left_diff.png"), difference_image(v.left_srgb8, target.left->srgb8)); });
+    paths.push_back(path("left.png"));
+    paths.push_back(path("left_diff.png"));
+    files["left_png"] = path("left.png").string();
+    files["left_diff_png"] = path("left_diff.png").string();
+  }
   if (options.exr) {
     writers.emplace_back([&] { io::write_exr(path("right.exr"), v.result.right); });
     files["right_exr"] = path("right.exr").string();

@@ -33,7 +33,8 @@ nlohmann::json write_target_images(const std::filesystem::path& dir, const std::
 /// Writes a pipeline's images under `dir`: <stem>_right.exr (every AOV; unless options.exr is
 /// false) and _right.png, _diff.png (difference heat map), _ssim.png (SSIM map) and _holes.png
 /// (hole mask against the true disocclusions: green found, red missed, blue flagged needlessly),
-/// side by side on the executor's threads. Returns {name: path}; on failure none of these files is
+/// and for a left eye synthesized in part (v.left) _left.png and _left_diff.png (its difference to
+/// plain-rt's left eye), side by side on the executor's threads. Returns {name: path}; on failure none of these files is
 /// left (an earlier run's included).
 nlohmann::json write_pipeline_images(const std::filesystem::path& dir, const std::string& stem,
                                      const ValidationTarget& target, const PipelineValidation& v,

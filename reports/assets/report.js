@@ -792,7 +792,7 @@
     function anaglyphView(imgs) {
       const canvas = el('canvas', { role: 'img', 'aria-label': `Red-cyan anaglyph: left eye and the right eye by ${pipeline}` });
       const note = el('figcaption', {}, 'Red-cyan anaglyph (red: left eye; cyan: right eye by the pipeline). Composing…');
-      Promise.all([loadImage(cell.images.left), loadImage(imgs.right)]).then(([left, right]) => {
+      Promise.all([loadImage(imgs.left || cell.images.left), loadImage(imgs.right)]).then(([left, right]) => {
         if (!left || !right) { note.textContent = 'The anaglyph needs the left eye and the pipeline\'s right eye; the results lack one.'; return; }
         drawAnaglyph(canvas, left, right);
         note.textContent = `Red-cyan anaglyph (red: left eye; cyan: right eye by ${pipeline}).`;
@@ -808,7 +808,9 @@
         ? ` · left eye PSNR ${fmt(r.left_psnr, 2)} dB, SSIM ${fmt(r.left_ssim, 4)} (${fmt(r.left_synthesized_fraction, 1, 100)} % synthesized)` : '';
       metrics.textContent = `PSNR ${fmt(r.psnr, 2)} dB · SSIM ${fmt(r.ssim, 4)} · MSE ${fmt(r.mse, 3)} · holes ${fmt(r.hole_fraction, 2, 100)} % · ${fmt(r.time_s, 2, 1000)} ms · ${fmt(r.speedup, 2)}×${left}`;
       const content = {
-        sbs: [el('div', { class: 'pair' }, figure(cell.images.left, 'Left eye', 'Left eye'),
+        sbs: [el('div', { class: 'pair' },
+          imgs.left ? figure(imgs.left, `Left eye by ${pipeline}`, `Left eye by ${pipeline} (${fmt(r.left_synthesized_fraction, 1, 100)} % synthesized)`)
+            : figure(cell.images.left, 'Left eye', 'Left eye'),
           figure(imgs.right, `Right eye by ${pipeline}`, `Right eye by ${pipeline}`))],
         slider: sliderView(imgs),
         flicker: [el('figure', { class: 'single' }, picture(imgs.right, `Right eye by ${pipeline}`), el('figcaption', {}, `Now: ${pipeline}`)),
@@ -817,7 +819,9 @@
         holes: holesView(imgs),
         diff: [el('div', { class: 'pair' },
           figure(imgs.diff, `Difference heat map of ${pipeline}`, 'Difference: black 0, violet 1 code, red about 15, pale yellow 255 (largest channel, log scale)'),
-          figure(imgs.ssim, `SSIM map of ${pipeline}`, 'SSIM map: white 1, dark low; grey border without a value'))],
+          figure(imgs.ssim, `SSIM map of ${pipeline}`, 'SSIM map: white 1, dark low; grey border without a value')),
+          ...(imgs.left ? [el('div', { class: 'pair' },
+            figure(imgs.left_diff, `Left-eye difference heat map of ${pipeline}`, 'Left eye against plain-rt\'s ray-traced left eye, same scale'))] : [])],
       };
       views.replaceChildren(...modes.map((m) => el('div', { class: 'view', 'data-view': m.id, hidden: m.id !== mode }, content[m.id])));
       if (mode === 'flicker') startFlicker();

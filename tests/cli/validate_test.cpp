@@ -129,6 +129,14 @@ TEST(Validate, ALeftEyeSynthesizedInPartIsMeasuredAgainstPlainRtsLeftEye) {
   const json by_hand = json::parse(test::read_text(dir / "compare.json"));
   EXPECT_NEAR(bidir["metrics"]["mse"].get<double>(), by_hand["metrics"]["mse"].get<double>(), 1e-9) << by_hand;
   EXPECT_NEAR(bidir["metrics"]["ssim"].get<double>(), by_hand["metrics"]["ssim"].get<double>(), 1e-9) << by_hand;
+  // Its own left eye and that eye's difference image are written beside the right eye's; a
+  // pipeline that renders its left eye whole has neither.
+  const json images = json::parse(test::read_text(out / "box-wall_full_bidir-warp.json"))["images"];
+  EXPECT_EQ(images["left_png"], (out / "box-wall_full_bidir-warp_left.png").string());
+  EXPECT_EQ(images["left_diff_png"], (out / "box-wall_full_bidir-warp_left_diff.png").string());
+  for (const char* key : {"left_png", "left_diff_png"}) EXPECT_TRUE(fs::exists(images[key].get<std::string>())) << key;
+  EXPECT_FALSE(json::parse(test::read_text(out / "box-wall_full_repro-rt.json"))["images"].contains("left_png"));
+  EXPECT_FALSE(fs::exists(out / "box-wall_full_repro-rt_left.png"));
 }
 
 TEST(Validate, VariantsAreMeasuredBesideTheirPipelineUnderTheirOwnName) {

@@ -305,6 +305,10 @@ try {
       const imgs = await cell.evaluate((d) => [...d.querySelectorAll('img')].map((i) => ({ src: i.getAttribute('src'), w: i.naturalWidth, alt: i.alt })));
       // Side by side 2, slider 2, flicker 1, hole overlay 2, difference 2.
       if (imgs.length < 9) problems.push(`cell ${ci + 1}, ${pipeline}: ${imgs.length} images in the viewer, expected 9`);
+      // A pipeline with its own left eye (synthesized in part) shows it and its difference image.
+      const own = data.cells[ci].pipelines[pipeline].images;
+      for (const key of own.left ? ['left', 'left_diff'] : [])
+        if (!imgs.some((i) => decodeURIComponent(i.src || '') === own[key])) problems.push(`cell ${ci + 1}, ${pipeline}: its ${key} image ${own[key]} is not in the viewer`);
       for (const i of imgs) {
         if (!(i.w > 0)) problems.push(`cell ${ci + 1}, ${pipeline}: image ${i.src} did not load`);
         if (!i.alt) problems.push(`cell ${ci + 1}, ${pipeline}: image ${i.src} has no alt text`);
@@ -372,7 +376,7 @@ try {
           ctx.drawImage(img, 0, 0);
           return ctx.getImageData(0, 0, cv.width, cv.height).data;
         };
-        const left = await pixels(c.images.left);
+        const left = await pixels(c.pipelines[p].images.left || c.images.left);
         const right = await pixels(c.pipelines[p].images.right);
         const canvas = d.querySelector('[data-view="anaglyph"] canvas');
         const got = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height).data;

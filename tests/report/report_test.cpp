@@ -90,9 +90,15 @@ TEST(Report, SmokeSweepReportsPassTheBrowserCheck) {
   const test::CliRun r = test::run_cli("report " + quoted(sweep / "shuffled.jsonl") + " --out " + quoted(dir / "report"));
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("shuffled.jsonl:3: unterminated last line"), std::string::npos) << r.out;
-  // Per cell: left eye, truth, disocclusions, and four images per pipeline.
+  // Per cell: left eye, truth, disocclusions, and four images per pipeline; two more (its own left
+  // eye and that eye's difference image) per pipeline that synthesizes part of its left eye.
+  size_t left_images = 0;
+  for (const json& line : lines)
+    for (const auto& [name, files] : line["images"]["pipelines"].items()) left_images += files.contains("left_png") ? 2 : 0;
+  EXPECT_EQ(left_images, 2 * 2 * 3u) << "bidir-warp, bidir-warp-rt and the z-test variant in both cells";
   const std::string counts = std::to_string(lines.size()) + " cell(s) x " + std::to_string(pipeline_count) +
-                             " pipeline(s), " + std::to_string(lines.size() * (3 + 4 * pipeline_count)) + " image(s) copied";
+                             " pipeline(s), " + std::to_string(lines.size() * (3 + 4 * pipeline_count) + left_images) +
+                             " image(s) copied";
   EXPECT_NE(r.out.find(counts), std::string::npos) << r.out;
   // The terminal summary's last column: the right eye's share of the left, - where stages serve both eyes.
   EXPECT_NE(r.out.find("right/left %"), std::string::npos) << r.out;
@@ -134,6 +140,9 @@ TEST(Report, SmokeSweepReportsPassTheBrowserCheck) {
     EXPECT_DOUBLE_EQ(cell["pipelines"]["bidir-warp"]["left_synthesized_fraction"].get<double>(),
                      left["synthesized_pixels"].get<double>() / left["metrics"]["pixels"].get<double>());
     EXPECT_TRUE(cell["pipelines"]["repro-rt"]["left_psnr"].is_null());
+    EXPECT_TRUE(cell["pipelines"]["bidir-warp"]["images"]["left"].is_string());
+    EXPECT_TRUE(cell["pipelines"]["bidir-warp"]["images"]["left_diff"].is_string());
+    EXPECT_FALSE(cell["pipelines"]["repro-rt"]["images"].contains("left")) << "repro-rt's left eye is the cell's";
     EXPECT_TRUE(cell["pipelines"]["repro-rt"]["left_synthesized_fraction"].is_null());
     for (const auto& [key, path] : cell["images"].items()) {
       ASSERT_TRUE(path.is_string()) << key;
