@@ -88,7 +88,7 @@ def main(paths):
                              ("right_share", p.get("timing", {}).get("right_over_left_median"))):
                 if isinstance(val, (int, float)):
                     got[key].append(float(val))
-                elif val == "inf" or (key == "psnr" and val is None and m) or (key == "left_psnr" and val is None and lm):
+                elif val == "inf" or (key == "psnr" and val is None and m):
                     got[key].append(math.inf)
     if not worst:
         sys.exit("derive_gate_rules: no sweep cell records in " + ", ".join(paths))

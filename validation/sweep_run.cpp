@@ -310,10 +310,8 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
       images["pipelines"][name] = files;
       record_images = files;
       record_images.update(target_images);
-      // The cell's left eye is the baseline's (its own left_png where it wrote one already).
-      if (name == d.baseline)
-        images["left_png"] =
-            files.contains("left_png") ? files["left_png"] : json(relative_to(write_left_image(cell_dir, stem, v), results_dir));
+      // The cell's left eye: the baseline's, or plain-rt's where the baseline synthesized part of it.
+      if (name == d.baseline) images["left_png"] = relative_to(write_left_image(cell_dir, stem, target, v), results_dir);
     }
     pipelines[name]["validation"] = validation_record(target, v, executor.threads(), record_images);
   }

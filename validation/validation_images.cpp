@@ -86,16 +86,19 @@ json write_pipeline_images(const std::filesystem::path& dir, const std::string& 
       [&] {
         io::write_png_preview(path("holes.png"), hole_overlay(v.result.right, v.hole_mask, target.disocclusions.mask));
       }};
-  std::vector<std::filesystem::path> paths = {path("right.png"), path("diff.png"), path("ssim.png"), path("holes.png")};
   // A left eye synthesized in part (measured against plain-rt's): the pipeline's own left eye and
-  // its difference to plain-rt's.
+  // its difference to plain-rt's. They belong to the set either way: an earlier run's under these
+  // names go on failure, and when this pipeline renders its left eye whole.
+  const std::vector<std::filesystem::path> left_files = {path("left.png"), path("left_diff.png")};
+  std::vector<std::filesystem::path> paths = {path("right.png"), path("diff.png"), path("ssim.png"), path("holes.png"),
+                                              left_files[0], left_files[1]};
   if (v.left) {
-    writers.emplace_back([&] { write_png(path("left.png"), v.left_srgb8); });
-    writers.emplace_back([&] { write_png(path("left_diff.png"), difference_image(v.left_srgb8, target.left->srgb8)); });
-    paths.push_back(path("left.png"));
-    paths.push_back(path("left_diff.png"));
-    files["left_png"] = path("left.png").string();
-    files["left_diff_png"] = path("left_diff.png").string();
+    writers.emplace_back([&] { write_png(left_files[0], v.left_srgb8); });
+    writers.emplace_back([&] { write_png(left_files[1], difference_image(v.left_srgb8, target.left->srgb8)); });
+    files["left_png"] = left_files[0].string();
+    files["left_diff_png"] = left_files[1].string();
+  } else {
+    io::discard_output_files(left_files);
   }
   if (options.exr) {
     writers.emplace_back([&] { io::write_exr(path("right.exr"), v.result.right); });
@@ -111,7 +114,14 @@ json write_pipeline_images(const std::filesystem::path& dir, const std::string& 
 }
 
 std::filesystem::path write_left_image(const std::filesystem::path& dir, const std::string& stem,
-                                       const PipelineValidation& v) {
+                                       const ValidationTarget& target, const PipelineValidation& v) {
+  // A left eye the pipeline synthesized in part would show its warping errors beside every other
+  // pipeline's right eye: plain-rt's traced left eye (the one it was measured against) stands in.
+  if (v.left) {
+    const std::filesystem::path png = dir / "left-eye_plain-rt.png";  // no <entry>_<suffix> name
+    write_png(png, target.left->srgb8);
+    return png;
+  }
   const std::filesystem::path png = dir / fmt::format("{}_left.png", stem);
   write_png(png, encode_srgb8(v.result.left, fmt::format("{}'s left eye", v.pipeline)));
   return png;

@@ -40,9 +40,11 @@ nlohmann::json write_pipeline_images(const std::filesystem::path& dir, const std
                                      const ValidationTarget& target, const PipelineValidation& v,
                                      const Executor& executor, const ImageFileOptions& options = {});
 
-/// Writes the pipeline's left eye as <stem>_left.png (sRGB), e.g. for anaglyph and side-by-side
-/// views of a right eye. Returns its path.
+/// Writes the left eye shown beside every pipeline's right eye (anaglyph and side-by-side views):
+/// the pipeline's own as <stem>_left.png (sRGB), or, where it synthesized part of it (v.left),
+/// plain-rt's traced left eye, which it was measured against, as left-eye_plain-rt.png. Returns
+/// its path.
 std::filesystem::path write_left_image(const std::filesystem::path& dir, const std::string& stem,
-                                       const PipelineValidation& v);
+                                       const ValidationTarget& target, const PipelineValidation& v);
 
 }  // namespace sb::validation

@@ -464,9 +464,14 @@
     { text: 'Left MSE', title: 'Mean squared error of the left eye over 0–255 RGB', key: 'left_mse', digits: 3 },
   ];
 
+  /** Whether a pipeline record measured its left eye (one synthesized in part, as bidir-warp's). */
+  function hasLeftEye(r) {
+    return !!r && r.left_synthesized_fraction !== null && r.left_synthesized_fraction !== undefined;
+  }
+
   /** Pipelines that synthesize part of their left eye too (bidir-warp): the left eye measured. */
   function leftEyeSection() {
-    const measured = (c, p) => field(c, p, 'left_psnr') !== null && field(c, p, 'left_psnr') !== undefined;
+    const measured = (c, p) => hasLeftEye(rec(c, p));
     const own = pipelines.filter((p) => cells.some((c) => measured(c, p)));
     if (!own.length) return null;
     const summary = pipelineRows(own, leftColumns, measured);
@@ -804,7 +809,7 @@
       stopFlicker();
       const r = rec(cell, pipeline);
       const imgs = r.images;
-      const left = r.left_psnr !== null && r.left_psnr !== undefined
+      const left = hasLeftEye(r)
         ? ` · left eye PSNR ${fmt(r.left_psnr, 2)} dB, SSIM ${fmt(r.left_ssim, 4)} (${fmt(r.left_synthesized_fraction, 1, 100)} % synthesized)` : '';
       metrics.textContent = `PSNR ${fmt(r.psnr, 2)} dB · SSIM ${fmt(r.ssim, 4)} · MSE ${fmt(r.mse, 3)} · holes ${fmt(r.hole_fraction, 2, 100)} % · ${fmt(r.time_s, 2, 1000)} ms · ${fmt(r.speedup, 2)}×${left}`;
       const content = {

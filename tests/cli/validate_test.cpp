@@ -135,6 +135,16 @@ TEST(Validate, ALeftEyeSynthesizedInPartIsMeasuredAgainstPlainRtsLeftEye) {
   EXPECT_EQ(images["left_png"], (out / "box-wall_full_bidir-warp_left.png").string());
   EXPECT_EQ(images["left_diff_png"], (out / "box-wall_full_bidir-warp_left_diff.png").string());
   for (const char* key : {"left_png", "left_diff_png"}) EXPECT_TRUE(fs::exists(images[key].get<std::string>())) << key;
+  // The left eye written is the render's own left eye (identical pixels), and its difference map is
+  // the left eye's, not the right eye's.
+  const auto psnr_of = [&](const std::string& a, const std::string& b, const char* name) {
+    const fs::path report = dir / (std::string(name) + ".json");
+    const test::CliRun run = test::run_cli("compare " + test::quoted(a) + " " + test::quoted(b) + " --json " + test::quoted(report));
+    EXPECT_LE(run.code, 2) << run.out;
+    return json::parse(test::read_text(report))["metrics"]["psnr"];
+  };
+  EXPECT_EQ(psnr_of(images["left_png"], (dir / "eyes" / "box-wall_bidir-warp_left.png").string(), "left"), "inf");
+  EXPECT_NE(psnr_of(images["left_diff_png"], images["diff_png"], "diffs"), "inf");
   EXPECT_FALSE(json::parse(test::read_text(out / "box-wall_full_repro-rt.json"))["images"].contains("left_png"));
   EXPECT_FALSE(fs::exists(out / "box-wall_full_repro-rt_left.png"));
 }

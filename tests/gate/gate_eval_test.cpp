@@ -127,7 +127,10 @@ TEST(GateEval, RightEyeShareOfTheLeft) {
 }
 
 TEST(GateEval, ALeftEyeSynthesizedInPartIsCheckedWhereItWasMeasured) {
-  const std::string config = kConfig + "min_left_psnr = 30\nwarn_left_psnr = 33\nmin_left_ssim = 0.95\n";
+  // Limits for every pipeline (a rule after kConfig's repro-rt rule), so that plain-rt's null left
+  // eye is where the check is left out, not a missing limit.
+  const std::string config =
+      kConfig + "[[rule]]\npipeline = \"*\"\nmin_left_psnr = 30\nwarn_left_psnr = 33\nmin_left_ssim = 0.95\n";
   std::vector<json> cells = passing_cells();
   // repro-rt of cell 0 as a left eye warped in part (as bidir-warp's is), plain-rt's rendered whole
   // (left_eye null), and cell 1's repro-rt from a record written before left eyes were measured.
@@ -157,6 +160,10 @@ TEST(GateEval, ALeftEyeSynthesizedInPartIsCheckedWhereItWasMeasured) {
   measured["left_eye"]["metrics"]["ssim"] = 0.94;
   r = evaluate(cells, {}, config);
   EXPECT_EQ(find_check(r, "repro-rt", "left_ssim")->verdict, Verdict::fail);
+  // Without its left_eye field at all (an older record), plain-rt's check is made and skipped.
+  cells[0]["pipelines"]["plain-rt"]["validation"].erase("left_eye");
+  r = evaluate(cells, {}, config);
+  EXPECT_EQ(find_check(r, "plain-rt", "left_psnr")->verdict, Verdict::skip);
   EXPECT_THROW((void)validation::parse_gate_config(kConfig + "min_left_ssim = 1.5\n", "g.toml"), InputError);
 }
 

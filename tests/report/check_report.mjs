@@ -115,7 +115,7 @@ try {
   }
   // Left eyes synthesized in part: a section exactly when some record measured one, with a summary
   // row per such pipeline and a row per measured (cell, pipeline) showing its left PSNR.
-  const hasLeft = (p) => p && p.left_psnr !== null && p.left_psnr !== undefined;
+  const hasLeft = (p) => p && p.left_synthesized_fraction !== null && p.left_synthesized_fraction !== undefined;
   const leftPipelines = data.pipelines.filter((p) => data.cells.some((c) => hasLeft(c.pipelines[p])));
   const leftTables = await page.locator('#left-eyes table').count();
   if (!leftPipelines.length) {
@@ -133,7 +133,7 @@ try {
     expected.forEach(([p, psnr], i) => {
       const row = rows[1][i] || [];
       const at = row.indexOf(p);  // the pipeline cell; the left PSNR two columns on
-      const want = psnr === 'inf' ? '∞' : Number(psnr).toFixed(2);
+      const want = psnr === 'inf' ? '∞' : psnr === null ? '—' : Number(psnr).toFixed(2);
       if (at < 0 || row[at + 2] !== want) problems.push(`left eyes table row ${i + 1}: ${JSON.stringify(row)}, expected ${p} with left PSNR ${want}`);
     });
     report.left_eye_rows = rows[1].length;

@@ -332,27 +332,30 @@ TEST(SweepRun, SmokeSweepRunsAndEveryLineIsWellFormed) {
   EXPECT_NE(cells[0]["rig"]["interaxial_m"], cells[1]["rig"]["interaxial_m"]);
 }
 
-TEST(SweepRun, VariantsAreValidatedAndTimedUnderTheirOwnName) {
-  test::ScratchDir dir;
-  const fs::path def = dir / "variants.toml";
-  std::ofstream(def) << R"([sweep]
-name = "variants"
-scenes = ["box-wall"]
-pipelines = ["plain-raster", "bidir-warp", "bidir-warp:occlusion=ztest"]
-baseline = "plain-raster"
-resolutions = ["96x54"]
-[options.bidir-warp]
-max_crack = 3
-[timing]
-repetitions = 1
-warmup = 0
-)";
+/// Runs a one-cell sweep (box-wall at 96x54, one repetition, no warm-up) with `sweep_keys` in its
+/// [sweep] table and `tables` after it into dir/out, and returns its cell; the test fails (and the
+/// cell is null) where it does not run.
+json run_one_cell(const test::ScratchDir& dir, const std::string& sweep_keys, const std::string& tables = "") {
+  const fs::path def = dir / "one-cell.toml";
+  std::ofstream(def) << "[sweep]\nscenes = [\"box-wall\"]\nresolutions = [\"96x54\"]\n"
+                     << sweep_keys << "[timing]\nrepetitions = 1\nwarmup = 0\n" << tables;
   const test::CliRun r = test::run_cli("sweep run " + quoted(def) + " --out " + quoted(dir / "out") + " --scenes-dir " +
                                        quoted(dir / "scenes"));
-  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(r.code, 0) << r.out;
+  if (r.code != 0) return nullptr;
   const std::vector<json> cells = validation::read_results(dir / "out" / "results.jsonl").cells;
-  ASSERT_EQ(cells.size(), 1u);
-  const json& c = cells[0];
+  EXPECT_EQ(cells.size(), 1u);
+  return cells.size() == 1 ? cells[0] : json(nullptr);
+}
+
+TEST(SweepRun, VariantsAreValidatedAndTimedUnderTheirOwnName) {
+  test::ScratchDir dir;
+  const json c = run_one_cell(dir, R"(name = "variants"
+pipelines = ["plain-raster", "bidir-warp", "bidir-warp:occlusion=ztest"]
+baseline = "plain-raster"
+)",
+                              "[options.bidir-warp]\nmax_crack = 3\n");
+  ASSERT_TRUE(c.is_object());
   ASSERT_EQ(c["pipelines"].size(), 3u);
   const json& plain = c["pipelines"]["bidir-warp"];
   const json& ztest = c["pipelines"]["bidir-warp:occlusion=ztest"];
@@ -365,6 +368,33 @@ warmup = 0
   const std::string right = c["images"]["pipelines"]["bidir-warp:occlusion=ztest"]["right_png"];
   EXPECT_EQ(fs::path(right).filename(), "bidir-warp@occlusion=ztest_right.png");
   EXPECT_TRUE(fs::exists(dir / "out" / right));
+}
+
+TEST(SweepRun, ABaselineThatSynthesizesItsLeftEyeShowsPlainRtsBesideEveryRightEye) {
+  test::ScratchDir dir;
+  const json cell = run_one_cell(dir, R"(name = "bidir-baseline"
+pipelines = ["bidir-warp", "repro-rt"]
+baseline = "bidir-warp"
+)");
+  ASSERT_TRUE(cell.is_object());
+  const json& images = cell["images"];
+  // The cell's left eye is plain-rt's traced one; bidir-warp's own goes with its images.
+  const std::string left = images["left_png"];
+  EXPECT_EQ(fs::path(left).filename(), "left-eye_plain-rt.png");
+  const std::string own = images["pipelines"]["bidir-warp"]["left_png"];
+  EXPECT_EQ(fs::path(own).filename(), "bidir-warp_left.png");
+  EXPECT_FALSE(images["pipelines"]["repro-rt"].contains("left_png"));
+  const test::CliRun render = test::run_cli("render --pipeline plain-rt --scene box-wall --resolution 96x54 --stereo none --out " +
+                                            quoted(dir / "eyes") + " --scenes-dir " + quoted(dir / "scenes"));
+  ASSERT_EQ(render.code, 0) << render.out;
+  const auto psnr_of = [&](const fs::path& a, const fs::path& b) {
+    const fs::path report = dir / "compare.json";
+    const test::CliRun c = test::run_cli("compare " + quoted(a) + " " + quoted(b) + " --json " + quoted(report));
+    EXPECT_LE(c.code, 2) << c.out;
+    return json::parse(test::read_text(report))["metrics"]["psnr"];
+  };
+  EXPECT_EQ(psnr_of(dir / "out" / left, dir / "eyes" / "box-wall_plain-rt_left.png"), "inf");
+  EXPECT_NE(psnr_of(dir / "out" / own, dir / "eyes" / "box-wall_plain-rt_left.png"), "inf");
 }
 
 /// Three frames of the box turning about the vertical through its centre, 64x36, two pipelines.
