@@ -109,6 +109,11 @@ TEST(Report, SmokeSweepReportsPassTheBrowserCheck) {
     return row.substr(row.find_last_of(' ') + 1);
   };
   EXPECT_EQ(last_column("bidir-warp"), "-") << r.out;
+  // The left eyes synthesized in part, in a table of their own.
+  const size_t left_table = r.out.find("(left eyes synthesized in part, against plain-rt's left eye)");
+  ASSERT_NE(left_table, std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\nbidir-warp-rt ", left_table), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("\nrepro-rt ", left_table), std::string::npos) << r.out;
   EXPECT_NE(last_column("repro-rt").find_first_of("0123456789"), std::string::npos) << r.out;
 
   // The embedded data: cells in cell order, infinite PSNR kept as "inf", the sweep's timing, images copied.
