@@ -428,6 +428,7 @@ TEST(SweepDefinition, ShippedDefinitionsLoad) {
   } shipped[] = {
       {"smoke.toml", 2, n_pipelines + 1},               // spheres × 2 interaxial; every pipeline and a variant
       {"nightly.toml", 6 * 3 * 2, n_pipelines + 1},     // 6 scenes × 3 disparities × 2 resolutions; and a variant
+      {"full.toml", 10 * 3 * 3 * 3 * 3, n_pipelines + 1},  // 10 scenes × 3 e × 3 c × 3 resolutions × 3 truths
       {"presets/wissmann-table2.toml", 3 * 2, 5},       // 3 scenes × HD, 4K
       {"presets/kim-table2.toml", 3, 6},                // 3 focal distances
       {"presets/kim-table3.toml", 3, 4},                // 3 triangle counts; Table 3's four methods
