@@ -37,9 +37,10 @@ struct PathArgs {
   int frames = 10;
   std::optional<std::string> camera_keys;
   std::optional<double> spin_deg;
+  bool gltf_animation = false;
   std::string spin_axis = "0,1,0";
   std::string spin_prefix;
-  std::string bvh = "refit";
+  std::string bvh;  // empty: refit, and not given
   std::optional<int> lights;
   RigCli rig;
 };
@@ -70,11 +71,19 @@ double percentile(std::vector<double> v, double q) {
 }
 
 void run_path_command(const PathArgs& a) {
-  if (a.bvh != "refit" && a.bvh != "rebuild")
-    throw InputError(fmt::format("--bvh '{}' is neither refit nor rebuild", a.bvh));
+  // Nothing moves without a spin or an animation: a BVH update asked for would never be done.
+  if (!a.bvh.empty() && !a.spin_deg && !a.gltf_animation)
+    throw InputError("--bvh requires --spin-deg or --gltf-animation (nothing else moves the scene's meshes)");
+  const std::string bvh = a.bvh.empty() ? "refit" : a.bvh;
+  if (bvh != "refit" && bvh != "rebuild")
+    throw InputError(fmt::format("--bvh '{}' is neither refit nor rebuild", bvh));
   validation::PathRun run;
   run.path.frames = a.frames;
   if (a.camera_keys) run.path.camera_keys = parse_camera_keys(*a.camera_keys);
+  run.path.gltf_animation = a.gltf_animation;
+  if (a.gltf_animation && a.truth == "blender")
+    throw InputError("--gltf-animation with --truth blender: Blender renders the scene file at rest, not as it moves "
+                     "along the path; use --truth full or povray");
   if (a.spin_deg) {
     // Blender imports the scene file, which does not turn; full and povray render the moved scene.
     if (a.truth == "blender")
@@ -108,12 +117,15 @@ void run_path_command(const PathArgs& a) {
   const validation::TruthCache cache(a.cache);
   run.cache = a.cache.empty() ? nullptr : &cache;
   run.work_dir = fs::path(a.out) / "work";
-  run.refit = a.bvh == "refit";
+  run.refit = bvh == "refit";
 
   fmt::print("path on {} ({} triangles): {} frames, {}{}; {}, truth {}\n", loaded.scene.name,
              loaded.scene.triangle_count(), a.frames,
              run.path.camera_keys.empty() ? "the scene's camera" : fmt::format("{} camera key{}", run.path.camera_keys.size(), run.path.camera_keys.size() == 1 ? "" : "s"),
-             a.spin_deg ? fmt::format(", meshes turning {} deg per frame (BVH {})", *a.spin_deg, a.bvh) : "",
+             a.spin_deg ? fmt::format(", meshes turning {} deg per frame (BVH {})", *a.spin_deg, bvh)
+             : a.gltf_animation ? fmt::format(", the scene's glTF animation from {:g} s to {:g} s (BVH {})",
+                                              loaded.scene.animation.start(), loaded.scene.animation.end(), bvh)
+                                : "",
              describe(rig), provider->name());
   // The frames go to <stem>_path.jsonl.partial as they finish, renamed to the final name when
   // the last is in: a run stopped on the way leaves the frames it finished under a name that says
@@ -154,7 +166,7 @@ void run_path_command(const PathArgs& a) {
   for (const auto& [name, s] : frame_s)
     fmt::print("{:<{}} {:>14.2f} {:>14.2f} {:>12}\n", name, name_w, 1e3 * median(s), 1e3 * percentile(s, 0.95),
                decibels(median(psnr[name])));
-  if (!bvh_s.empty()) fmt::print("BVH {} per frame: median {:.2f} ms\n", a.bvh, 1e3 * median(bvh_s));
+  if (!bvh_s.empty()) fmt::print("BVH {} per frame: median {:.2f} ms\n", bvh, 1e3 * median(bvh_s));
   fmt::print("wrote {}\n", lines.string());
 }
 
@@ -184,9 +196,12 @@ void register_path_command(CLI::App& root) {
   p->add_option("--spin-axis", a->spin_axis, "Axis of the turn, x,y,z")->capture_default_str()->needs(spin);
   p->add_option("--spin-prefix", a->spin_prefix, "Turn only meshes whose name starts with this (default: all)")
       ->needs(spin);
-  p->add_option("--bvh", a->bvh, "Per-frame BVH update of a moving scene (--spin-deg): refit or rebuild")
-      ->capture_default_str()
-      ->needs(spin);
+  p->add_flag("--gltf-animation", a->gltf_animation,
+                                  "Play the scene file's own node animations over the frames, from their first key time "
+                                  "to their last:\nanimated meshes move with their nodes, an animated scene camera moves "
+                                  "the rig (not with --camera-keys or --spin-deg)");
+  p->add_option("--bvh", a->bvh,
+                "Per-frame BVH update of a moving scene (--spin-deg, --gltf-animation): refit (default) or rebuild");
   p->add_option("--threads,-t", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
   p->add_option("--out", a->out, "Output folder")->capture_default_str();
   p->add_option("--cache", a->cache, "Folder of cached external ground-truth renders ('' to disable)")

@@ -94,6 +94,9 @@ void PathSpec::validate() const {
                                    "between two frames; move a target or add a key between them",
                                    i + 1, i + 2, 100.0 * t));
   }
+  if (gltf_animation && (!camera_keys.empty() || spin))
+    throw InputError(fmt::format("a path plays the scene's glTF animation or {}, not both; drop one",
+                                 spin ? "a spin" : "camera keys"));
   if (spin) {
     if (!unit_axis(spin->axis))
       throw InputError("the spin axis is zero or not finite; give a direction such as 0,1,0");
@@ -109,6 +112,27 @@ void PathSpec::validate() const {
 
 SceneAnimator::SceneAnimator(Scene& scene, const PathSpec& path) : scene_(scene), path_(path) {
   path_.validate();
+  if (path_.gltf_animation) {
+    const NodeAnimation& a = scene.animation;
+    if (a.empty())
+      throw InputError(fmt::format("scene '{}' has no glTF node animation (translation, rotation or scale channels) "
+                                   "to play along the path; give camera keys or a spin instead",
+                                   scene.name));
+    for (size_t m = 0; m < scene.meshes.size(); ++m) {
+      const Mesh& mesh = scene.meshes[m];
+      if (!a.moves(mesh.node)) continue;
+      turning_.push_back(m);
+      base_positions_.push_back(mesh.positions);
+      base_normals_.push_back(mesh.normals);
+      rest_inverse_.push_back(glm::inverse(a.rest_world(mesh.node)));
+    }
+    if (!scene.cameras.empty() && a.moves(scene.cameras.front().node)) camera_node_ = scene.cameras.front().node;
+    if (turning_.empty() && camera_node_ < 0)
+      throw InputError(fmt::format("the glTF animation of scene '{}' moves none of its meshes and not its camera "
+                                   "(its channels target other nodes); nothing would change along the path",
+                                   scene.name));
+    return;
+  }
   if (!path_.spin) return;
   Bounds3 bounds;
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
@@ -129,6 +153,25 @@ void SceneAnimator::apply(int frame) {
   if (frame < 0 || frame >= path_.frames)
     throw InputError(fmt::format("frame {} is outside the path's 0..{}", frame, path_.frames - 1));
   if (turning_.empty()) return;
+  if (path_.gltf_animation) {
+    const double t = time_of(frame);
+    for (size_t k = 0; k < turning_.size(); ++k) {
+      Mesh& mesh = scene_.meshes[turning_[k]];
+      // The node's motion since rest, applied to the rest positions (normals by its inverse
+      // transpose; rigid motion and scale).
+      const dmat4 d = scene_.animation.world(mesh.node, t) * rest_inverse_[k];
+      const dmat3 n = glm::transpose(glm::inverse(dmat3(d)));
+      const std::vector<vec3>& p0 = base_positions_[k];
+      for (size_t i = 0; i < p0.size(); ++i) mesh.positions[i] = vec3(dvec3(d * dvec4(dvec3(p0[i]), 1.0)));
+      const std::vector<vec3>& n0 = base_normals_[k];
+      for (size_t i = 0; i < n0.size(); ++i) {
+        const dvec3 v = n * dvec3(n0[i]);
+        const double len = glm::length(v);
+        mesh.normals[i] = len > 0.0 ? vec3(v / len) : n0[i];
+      }
+    }
+    return;
+  }
   const double radians = degrees_to_radians(path_.spin->degrees_per_frame * frame);
   const dmat3 r = rotation(*unit_axis(path_.spin->axis), radians);
   for (size_t k = 0; k < turning_.size(); ++k) {
@@ -140,7 +183,14 @@ void SceneAnimator::apply(int frame) {
   }
 }
 
+double SceneAnimator::time_of(int frame) const {
+  if (!path_.gltf_animation) return 0.0;
+  const double start = scene_.animation.start(), end = scene_.animation.end();
+  return path_.frames == 1 ? start : start + (end - start) * frame / static_cast<double>(path_.frames - 1);
+}
+
 CameraPose SceneAnimator::camera_at(int frame, const CameraPose& base) const {
+  if (camera_node_ >= 0) return CameraPose::from_matrix(scene_.animation.world(camera_node_, time_of(frame)));
   const std::vector<CameraKey>& keys = path_.camera_keys;
   if (keys.empty()) return base;
   if (keys.size() == 1 || path_.frames == 1) return CameraPose::look_at(keys.front().position, keys.front().target);

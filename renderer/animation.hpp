@@ -31,39 +31,50 @@ struct Spin {
 
 /// A path of `frames` frames: the camera along `camera_keys` (none: the rig's own pose; one: that
 /// pose; more: piecewise linear in position and target, the keys spread evenly over the frames,
-/// the first at frame 0 and the last at frame frames-1) and an optional spin.
+/// the first at frame 0 and the last at frame frames-1) and an optional spin; or, with
+/// `gltf_animation`, the scene file's own node animations (Scene::animation) played from their
+/// first key time to their last, spread evenly over the frames: the meshes of animated nodes move
+/// rigidly with their nodes, and an animated scene camera moves the rig.
 struct PathSpec {
   int frames = 1;
   std::vector<CameraKey> camera_keys;
   std::optional<Spin> spin;
+  bool gltf_animation = false;
 
   /// InputError naming the field: frames outside 1..100000, a key whose target equals its
-  /// position, a zero spin axis, a non-finite angle.
+  /// position, a zero spin axis, a non-finite angle, gltf_animation with camera keys or a spin.
   void validate() const;
 };
 
-/// Applies the frames of a path to a scene. Keeps the scene's frame-0 positions and normals of
-/// the turning meshes, so frame k is always R(k * angle) applied to frame 0 (no drift).
+/// Applies the frames of a path to a scene. Keeps the scene's frame-0 (for a glTF animation: rest)
+/// positions and normals of the moving meshes, so frame k is always computed from those (no drift).
 class SceneAnimator {
  public:
-  /// InputError when the spin's prefix matches no mesh.
+  /// InputError when the spin's prefix matches no mesh, or gltf_animation is asked of a scene
+  /// without node animations.
   SceneAnimator(Scene& scene, const PathSpec& path);
 
   [[nodiscard]] int frames() const { return path_.frames; }
   [[nodiscard]] bool moves_geometry() const { return !turning_.empty(); }
+  /// The meshes that move along the path (turning, or on animated nodes).
   [[nodiscard]] size_t turning_meshes() const { return turning_.size(); }
+  /// The animation time of `frame` (seconds; 0 without gltf_animation).
+  [[nodiscard]] double time_of(int frame) const;
 
-  /// Sets the turning meshes' positions and normals to those of `frame` (0 <= frame < frames()).
+  /// Sets the moving meshes' positions and normals to those of `frame` (0 <= frame < frames()).
   void apply(int frame);
-  /// The centre camera pose at `frame`; `base` when the path has no camera keys.
+  /// The centre camera pose at `frame`; `base` when the path has no camera keys and no animated
+  /// scene camera.
   [[nodiscard]] CameraPose camera_at(int frame, const CameraPose& base) const;
 
  private:
   Scene& scene_;
   PathSpec path_;
   dvec3 pivot_{0.0};
-  std::vector<size_t> turning_;  ///< indices of the turning meshes
+  std::vector<size_t> turning_;  ///< indices of the moving meshes
   std::vector<std::vector<vec3>> base_positions_, base_normals_;
+  std::vector<dmat4> rest_inverse_;  ///< per moving mesh (glTF animation): its node's rest world, inverted
+  int camera_node_ = -1;             ///< the scene camera's node when the animation moves it
 };
 
 /// What makes a key pose unusable, if anything: a position or target that is not finite or lies

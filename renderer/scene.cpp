@@ -1,11 +1,121 @@
 // Scene summaries.
 #include "renderer/scene.hpp"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
 
 namespace sb {
+
+namespace {
+
+/// The index k of the key interval [times[k], times[k+1]] holding t, and t's fraction u of it;
+/// t outside the keys clamps to the first or the last key (k = n - 1, u = 0 for the last).
+std::pair<size_t, double> key_interval(const std::vector<double>& times, double t) {
+  const size_t n = times.size();
+  if (n == 1 || t <= times.front()) return {0, 0.0};
+  if (t >= times.back()) return {n - 1, 0.0};
+  const size_t k = static_cast<size_t>(std::upper_bound(times.begin(), times.end(), t) - times.begin()) - 1;
+  return {k, (t - times[k]) / (times[k + 1] - times[k])};
+}
+
+/// Component c of key k's value (for a cubic spline: of its value, between the tangents).
+double key_value(const NodeAnimation::Channel& ch, size_t k, int width, int c) {
+  const size_t per_key = ch.interpolation == NodeAnimation::Interpolation::cubic_spline ? 3 : 1;
+  const size_t slot = per_key == 3 ? 1 : 0;
+  return ch.values[(k * per_key + slot) * static_cast<size_t>(width) + static_cast<size_t>(c)];
+}
+
+/// A channel's value at time t (glTF 2.0 §3.11 "Animations" and Appendix C: linear with slerp for
+/// rotations, step, cubic Hermite spline), `width` numbers.
+std::vector<double> sample(const NodeAnimation::Channel& ch, double t, int width) {
+  const auto [k, u] = key_interval(ch.times, t);
+  std::vector<double> out(static_cast<size_t>(width));
+  const bool last = k + 1 >= ch.times.size() || u == 0.0;
+  for (int c = 0; c < width; ++c) out[static_cast<size_t>(c)] = key_value(ch, k, width, c);
+  if (last || ch.interpolation == NodeAnimation::Interpolation::step) return out;
+  if (ch.interpolation == NodeAnimation::Interpolation::linear) {
+    if (ch.property == NodeAnimation::Property::rotation) {
+      const dquat a(key_value(ch, k, 4, 3), key_value(ch, k, 4, 0), key_value(ch, k, 4, 1), key_value(ch, k, 4, 2));
+      const dquat b(key_value(ch, k + 1, 4, 3), key_value(ch, k + 1, 4, 0), key_value(ch, k + 1, 4, 1),
+                    key_value(ch, k + 1, 4, 2));
+      const dquat q = glm::slerp(a, glm::dot(a, b) < 0.0 ? -b : b, u);  // the shorter way round
+      return {q.x, q.y, q.z, q.w};
+    }
+    for (int c = 0; c < width; ++c)
+      out[static_cast<size_t>(c)] += u * (key_value(ch, k + 1, width, c) - out[static_cast<size_t>(c)]);
+    return out;
+  }
+  // Cubic spline: per key the in-tangent a, the value v and the out-tangent b.
+  const double td = ch.times[k + 1] - ch.times[k];
+  const double u2 = u * u, u3 = u2 * u;
+  const auto at = [&](size_t key, size_t slot, int c) {
+    return ch.values[(key * 3 + slot) * static_cast<size_t>(width) + static_cast<size_t>(c)];
+  };
+  for (int c = 0; c < width; ++c)
+    out[static_cast<size_t>(c)] = (2 * u3 - 3 * u2 + 1) * at(k, 1, c) + (u3 - 2 * u2 + u) * td * at(k, 2, c) +
+                                  (-2 * u3 + 3 * u2) * at(k + 1, 1, c) + (u3 - u2) * td * at(k + 1, 0, c);
+  return out;
+}
+
+}  // namespace
+
+double NodeAnimation::start() const {
+  double t = channels.empty() ? 0.0 : channels.front().times.front();
+  for (const Channel& c : channels) t = std::min(t, c.times.front());
+  return t;
+}
+
+double NodeAnimation::end() const {
+  double t = channels.empty() ? 0.0 : channels.front().times.back();
+  for (const Channel& c : channels) t = std::max(t, c.times.back());
+  return t;
+}
+
+bool NodeAnimation::moves(int node) const {
+  for (int n = node; n >= 0 && static_cast<size_t>(n) < parent.size(); n = parent[static_cast<size_t>(n)])
+    for (const Channel& c : channels)
+      if (c.node == n) return true;
+  return false;
+}
+
+dmat4 NodeAnimation::local_at(int node, const double* time) const {
+  Local l = local[static_cast<size_t>(node)];
+  if (l.matrix) return *l.matrix;
+  if (time != nullptr)
+    for (const Channel& c : channels) {
+      if (c.node != node) continue;
+      if (c.property == Property::rotation) {
+        const std::vector<double> v = sample(c, *time, 4);
+        const dquat q(v[3], v[0], v[1], v[2]);
+        const double len = glm::length(q);
+        l.rotation = len > 0.0 ? q / len : dquat(1.0, 0.0, 0.0, 0.0);
+      } else {
+        const std::vector<double> v = sample(c, *time, 3);
+        (c.property == Property::translation ? l.translation : l.scale) = dvec3(v[0], v[1], v[2]);
+      }
+    }
+  dmat4 t(1.0), s(1.0);
+  t[3] = dvec4(l.translation, 1.0);
+  s[0][0] = l.scale.x;
+  s[1][1] = l.scale.y;
+  s[2][2] = l.scale.z;
+  return t * dmat4(glm::mat3_cast(l.rotation)) * s;
+}
+
+dmat4 NodeAnimation::world(int node, double time) const {
+  dmat4 w(1.0);
+  for (int n = node; n >= 0; n = parent[static_cast<size_t>(n)]) w = local_at(n, &time) * w;
+  return w;
+}
+
+dmat4 NodeAnimation::rest_world(int node) const {
+  dmat4 w(1.0);
+  for (int n = node; n >= 0; n = parent[static_cast<size_t>(n)]) w = local_at(n, nullptr) * w;
+  return w;
+}
 
 size_t Scene::triangle_count() const {
   size_t n = 0;

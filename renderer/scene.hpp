@@ -96,6 +96,50 @@ struct RigDefaults {
   std::string where;  ///< JSON path of the extras they came from ("/nodes/4/extras/stereobench"), or empty
 };
 
+/// The glTF node animations of a scene (translation, rotation and scale channels) with the node
+/// hierarchy they move: a node's world transform at any time, for camera paths and rigid node
+/// animation (renderer/animation.hpp). Meshes and cameras are stored at rest (the nodes' own TRS).
+struct NodeAnimation {
+  /// A node's local transform at rest: TRS, or a matrix (glTF forbids animating a node with one).
+  struct Local {
+    dvec3 translation{0.0};
+    dquat rotation{1.0, 0.0, 0.0, 0.0};  ///< glm order (w, x, y, z), unit length
+    dvec3 scale{1.0};
+    std::optional<dmat4> matrix;
+  };
+  enum class Property { translation, rotation, scale };
+  enum class Interpolation { linear, step, cubic_spline };
+  /// One channel: a property of a node keyed over time.
+  struct Channel {
+    int node = -1;
+    Property property = Property::translation;
+    Interpolation interpolation = Interpolation::linear;
+    std::vector<double> times;   ///< strictly increasing, seconds
+    /// Per key: the value (3 numbers, 4 for a rotation x, y, z, w); for a cubic spline the in-tangent,
+    /// the value and the out-tangent, in that order.
+    std::vector<double> values;
+    std::string where;  ///< JSON path ("/animations/0/channels/1")
+  };
+
+  std::vector<int> parent;    ///< per glTF node: its parent, -1 for a root
+  std::vector<Local> local;   ///< per glTF node: its rest transform
+  std::vector<Channel> channels;
+
+  [[nodiscard]] bool empty() const { return channels.empty(); }
+  /// The first and the last key time over every channel (0, 0 when there is none).
+  [[nodiscard]] double start() const;
+  [[nodiscard]] double end() const;
+  /// Whether `node` or one of its ancestors is animated.
+  [[nodiscard]] bool moves(int node) const;
+  /// The node's world transform at `time` (before the first key: the first; after the last: the
+  /// last, as glTF clamps), and at rest (rest_world).
+  [[nodiscard]] dmat4 world(int node, double time) const;
+  [[nodiscard]] dmat4 rest_world(int node) const;
+
+ private:
+  [[nodiscard]] dmat4 local_at(int node, const double* time) const;
+};
+
 /// A loaded scene.
 struct Scene {
   std::string path;  ///< file it came from
@@ -109,6 +153,7 @@ struct Scene {
   vec3 background{0.0f};      ///< radiance of rays that miss (scene extras)
   float ambient = 0.0f;       ///< ambient term of DESIGN §3 (scene extras)
   std::vector<std::string> warnings;  ///< unsupported features, each named once
+  NodeAnimation animation;            ///< glTF node animations, played along a path only
   /// Nodes of the file with a mesh or light that the loaded glTF scene does not reach (those of
   /// another scene, or of none): not part of this scene.
   size_t nodes_not_loaded = 0;

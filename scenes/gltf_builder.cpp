@@ -333,8 +333,27 @@ int GltfBuilder::add_directional_light(const std::string& name, const vec3& dire
   return add_light_node(name, light, t, parent);
 }
 
-void GltfBuilder::set_camera(const std::string& name, const CameraPose& pose, double yfov, double znear, double zfar,
-                             const RigDefaults& rig) {
+int GltfBuilder::add_animation_channel(int node, const std::string& property, std::span<const float> times,
+                                       std::span<const float> values, const std::string& interpolation) {
+  const size_t width = property == "rotation" ? 4 : 3;
+  const size_t per_key = interpolation == "CUBICSPLINE" ? 3 : 1;
+  if (node < 0 || static_cast<size_t>(node) >= nodes_.size() || times.empty() ||
+      values.size() != times.size() * width * per_key)
+    throw std::logic_error(fmt::format("glTF builder: animation of node {} ({}) has {} values for {} keys", node,
+                                       property, values.size(), times.size()));
+  const auto [lo, hi] = std::minmax_element(times.begin(), times.end());
+  const int input = add_accessor(add_buffer_view(times.data(), times.size_bytes(), 0), kFloat, times.size(), "SCALAR",
+                                 json::array({static_cast<double>(*lo)}), json::array({static_cast<double>(*hi)}));
+  const int output = add_accessor(add_buffer_view(values.data(), values.size_bytes(), 0), kFloat,
+                                  values.size() / width, width == 4 ? "VEC4" : "VEC3");
+  animation_samplers_.push_back({{"input", input}, {"output", output}, {"interpolation", interpolation}});
+  animation_channels_.push_back(
+      {{"sampler", animation_samplers_.size() - 1}, {"target", {{"node", node}, {"path", property}}}});
+  return static_cast<int>(animation_channels_.size()) - 1;
+}
+
+int GltfBuilder::set_camera(const std::string& name, const CameraPose& pose, double yfov, double znear, double zfar,
+                            const RigDefaults& rig) {
   if (!cameras_.empty()) throw std::logic_error("glTF builder: the scene camera is set twice");
   json perspective = {{"yfov", yfov}, {"znear", znear}};
   if (zfar > znear) perspective["zfar"] = zfar;
@@ -353,6 +372,7 @@ void GltfBuilder::set_camera(const std::string& name, const CameraPose& pose, do
   json& n = nodes_[static_cast<size_t>(node)];
   n["camera"] = 0;
   n["extras"] = {{"stereobench", std::move(sbx)}};
+  return node;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -383,6 +403,9 @@ json GltfBuilder::document() const {
   put("accessors", accessors_);
   put("bufferViews", buffer_views_);
   put("cameras", cameras_);
+  if (!animation_channels_.empty())
+    doc["animations"] = json::array(
+        {{{"name", "animation"}, {"channels", animation_channels_}, {"samplers", animation_samplers_}}});
   if (!textures_.empty())
     doc["samplers"] = json::array({{{"magFilter", kLinear}, {"minFilter", kLinearMipmapLinear}, {"wrapS", kRepeat},
                                     {"wrapT", kRepeat}}});

@@ -96,8 +96,14 @@ class GltfBuilder {
 
   /// The scene's default camera: a node at the pose with a perspective camera (`yfov` radians,
   /// aspect from the rig size) and `extras.stereobench` {interaxial, convergence, width, height}.
-  void set_camera(const std::string& name, const CameraPose& pose, double yfov, double znear, double zfar,
-                  const RigDefaults& rig);
+  /// Returns the camera's node.
+  int set_camera(const std::string& name, const CameraPose& pose, double yfov, double znear, double zfar,
+                 const RigDefaults& rig);
+  /// Keys one property of a node in the scene's animation: `property` "translation", "scale"
+  /// (3 floats per key) or "rotation" (x, y, z, w per key); `interpolation` "LINEAR", "STEP" or
+  /// "CUBICSPLINE" (then in-tangent, value and out-tangent per key). Returns the channel's index.
+  int add_animation_channel(int node, const std::string& property, std::span<const float> times,
+                            std::span<const float> values, const std::string& interpolation = "LINEAR");
   /// Radiance of rays that miss (scene extras).
   void set_background(const vec3& rgb) { background_ = rgb; }
   /// The ambient term of DESIGN §3 (scene extras).
@@ -147,6 +153,8 @@ class GltfBuilder {
   nlohmann::json nodes_ = nlohmann::json::array();
   nlohmann::json lights_ = nlohmann::json::array();
   nlohmann::json cameras_ = nlohmann::json::array();
+  nlohmann::json animation_channels_ = nlohmann::json::array();
+  nlohmann::json animation_samplers_ = nlohmann::json::array();
   std::vector<int> roots_;
   std::vector<Geometry> geometries_;
   std::vector<MeshCounts> mesh_counts_;

@@ -28,6 +28,7 @@ json animation_json(const PathRun& run) {
   return {{"frames", run.path.frames},
           {"camera_keys", keys},
           {"spin", spin},
+          {"gltf_animation", run.path.gltf_animation},
           {"bvh_update", run.refit ? "refit" : "rebuild"}};
 }
 
@@ -83,6 +84,7 @@ void run_path(Scene& scene, const PathRun& run, const Executor& executor,
               {"threads", executor.threads()},
               {"versions", io::versions_json()},
               {"animate_s", animate_s},
+              {"animation_time_s", run.path.gltf_animation ? json(animator.time_of(frame)) : json(nullptr)},
               {"bvh_update_s", bvh_s},
               {"bvh", frame == 0 ? "build" : (animator.moves_geometry() ? (run.refit ? "refit" : "rebuild") : "static")},
               {"camera", {{"position", vec_json(pose.position)}, {"back", vec_json(pose.back)}}},

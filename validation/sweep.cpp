@@ -258,7 +258,7 @@ std::string option_text(const Where& where, const toml::node& node, const std::s
 }
 
 const std::vector<std::string> kTopKeys = {"sweep", "timing", "options", "output", "path", "gate"};
-const std::vector<std::string> kPathKeys = {"frames", "camera_keys", "spin", "bvh"};
+const std::vector<std::string> kPathKeys = {"frames", "camera_keys", "spin", "gltf_animation", "bvh"};
 const std::vector<std::string> kSpinKeys = {"axis", "degrees_per_frame", "pivot", "mesh_prefix"};
 const std::vector<std::string> kSweepKeys = {"name",          "description",      "scenes",        "pipelines",
                                              "baseline",      "interaxial_m",     "max_disparity_px",
@@ -330,6 +330,7 @@ void parse_path(const Where& where, const toml::node& node, SweepDefinition& d) 
     if (const toml::node* v = spin.get("mesh_prefix")) s.mesh_prefix = string_at(where, *v, "path.spin.mesh_prefix");
     path.spin = s;
   }
+  if (const toml::node* v = table.get("gltf_animation")) path.gltf_animation = bool_at(where, *v, "path.gltf_animation");
   if (const toml::node* v = table.get("bvh")) {
     const std::string bvh = string_at(where, *v, "path.bvh");
     if (bvh != "refit" && bvh != "rebuild")
@@ -343,13 +344,13 @@ void parse_path(const Where& where, const toml::node& node, SweepDefinition& d) 
   }
   // Blender imports the scene file, which does not move (the full and povray truths render the
   // scene as animated in memory): a spin cannot use it.
-  if (path.spin)
+  if (path.spin || path.gltf_animation)
     for (const std::string& truth : d.truths)
       if (truth == "blender")
-        where.fail(node, "path.spin",
-                   fmt::format("truth '{}' renders the scene file, which does not turn; a spinning path needs "
-                               "truths \"full\" or \"povray\"",
-                               truth));
+        where.fail(node, path.spin ? "path.spin" : "path.gltf_animation",
+                   fmt::format("truth '{}' renders the scene file at rest, not as it moves along the path; a path "
+                               "with {} needs truths \"full\" or \"povray\"",
+                               truth, path.spin ? "a spin" : "the glTF animation"));
   d.path = path;
 }
 

@@ -368,6 +368,25 @@ class Checker {
         fail(p, "image has neither 'uri' nor 'bufferView'");
     });
 
+    each(doc_, "animations", "", [&](const json& a, const std::string& p) {
+      const json* samplers = member(a, "samplers", p, true);
+      require_array(*samplers, p + "/samplers");
+      each(a, "samplers", p, [&](const json& s, const std::string& sp) {
+        opt_index(s, "input", sp, "accessors", true);
+        opt_index(s, "output", sp, "accessors", true);
+        opt_string(s, "interpolation", sp);
+      });
+      require_array(*member(a, "channels", p, true), p + "/channels");
+      each(a, "channels", p, [&](const json& c, const std::string& cp) {
+        const uint64_t sampler = integer(*member(c, "sampler", cp, true), cp + "/sampler");
+        if (sampler >= samplers->size())
+          fail(cp + "/sampler", fmt::format("refers to sampler {} but the animation has {}", sampler, samplers->size()));
+        const json& target = require_object(*member(c, "target", cp, true), cp + "/target");
+        opt_index(target, "node", cp + "/target", "nodes");
+        opt_string(target, "path", cp + "/target", true);
+      });
+    });
+
     each(doc_, "samplers", "", [&](const json& s, const std::string& p) {
       for (const char* k : {"magFilter", "minFilter", "wrapS", "wrapT"}) opt_integer(s, k, p);
     });

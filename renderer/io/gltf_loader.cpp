@@ -369,7 +369,7 @@ class Converter {
                                    "area (its vertices coincide or lie on one line), so nothing can be seen; check "
                                    "the primitives' indices and POSITION accessors, or pick another scene",
                                    file_, scene.triangle_count()));
-    if (!m_.animations.empty()) warn("animations", fmt::format("{} animation(s) are not played; the scene is rendered at rest", m_.animations.size()));
+    convert_animations(scene);
     if (!m_.skins.empty()) warn("skins", fmt::format("{} skin(s) ignored: meshes render in their bind pose", m_.skins.size()));
     for (const auto& [key, count] : warning_counts_)
       scene.warnings.push_back(count > 1 ? fmt::format("{} ({} occurrences)", warning_text_[key], count)
@@ -605,6 +605,89 @@ class Converter {
       s[2][2] = n.scale[2];
     }
     return t * r * s;
+  }
+
+  /// The file's node animations (translation, rotation, scale channels of the loaded scene's
+  /// nodes) and the node hierarchy they move, for paths (renderer/animation.hpp); a still render
+  /// shows the nodes at rest. Morph-target weights are reported as unsupported.
+  void convert_animations(Scene& scene) {
+    if (m_.animations.empty()) return;
+    NodeAnimation& a = scene.animation;
+    a.parent.assign(m_.nodes.size(), -1);
+    a.local.resize(m_.nodes.size());
+    for (size_t i = 0; i < m_.nodes.size(); ++i) {
+      const tinygltf::Node& n = m_.nodes[i];
+      for (int c : n.children)
+        if (c >= 0 && static_cast<size_t>(c) < m_.nodes.size()) a.parent[static_cast<size_t>(c)] = static_cast<int>(i);
+      NodeAnimation::Local& l = a.local[i];
+      if (n.matrix.size() == 16) {
+        l.matrix = local_matrix(n);
+        continue;
+      }
+      if (n.translation.size() == 3) l.translation = dvec3(n.translation[0], n.translation[1], n.translation[2]);
+      if (n.rotation.size() == 4) {
+        const dquat q(n.rotation[3], n.rotation[0], n.rotation[1], n.rotation[2]);
+        if (glm::length(q) > 0.0) l.rotation = q / glm::length(q);
+      }
+      if (n.scale.size() == 3) l.scale = dvec3(n.scale[0], n.scale[1], n.scale[2]);
+    }
+    size_t weights = 0;
+    for (size_t ai = 0; ai < m_.animations.size(); ++ai) {
+      const tinygltf::Animation& anim = m_.animations[ai];
+      for (size_t ci = 0; ci < anim.channels.size(); ++ci) {
+        const tinygltf::AnimationChannel& gc = anim.channels[ci];
+        const std::string cpath = fmt::format("/animations/{}/channels/{}", ai, ci);
+        if (gc.target_path == "weights") {
+          ++weights;
+          continue;
+        }
+        if (gc.target_node < 0) continue;  // glTF allows a channel without a node: it animates nothing
+        if (static_cast<size_t>(gc.target_node) >= m_.nodes.size())
+          fail(cpath + "/target/node", fmt::format("node {} does not exist (the file has {} nodes)", gc.target_node,
+                                                   m_.nodes.size()));
+        NodeAnimation::Channel ch;
+        ch.node = gc.target_node;
+        ch.where = cpath;
+        int width = 3;
+        if (gc.target_path == "translation") ch.property = NodeAnimation::Property::translation;
+        else if (gc.target_path == "scale") ch.property = NodeAnimation::Property::scale;
+        else if (gc.target_path == "rotation") ch.property = NodeAnimation::Property::rotation, width = 4;
+        else fail(cpath + "/target/path", fmt::format("'{}' is not translation, rotation, scale or weights", gc.target_path));
+        if (a.local[static_cast<size_t>(ch.node)].matrix)
+          fail(cpath + "/target/node", fmt::format("node {} has a matrix, and glTF allows animating only a node "
+                                                   "given by translation, rotation and scale", ch.node));
+        if (gc.sampler < 0 || static_cast<size_t>(gc.sampler) >= anim.samplers.size())
+          fail(cpath + "/sampler", fmt::format("sampler {} does not exist (animation {} has {})", gc.sampler, ai,
+                                               anim.samplers.size()));
+        const tinygltf::AnimationSampler& gs = anim.samplers[static_cast<size_t>(gc.sampler)];
+        const std::string spath = fmt::format("/animations/{}/samplers/{}", ai, gc.sampler);
+        if (gs.interpolation == "STEP") ch.interpolation = NodeAnimation::Interpolation::step;
+        else if (gs.interpolation == "CUBICSPLINE") ch.interpolation = NodeAnimation::Interpolation::cubic_spline;
+        else if (gs.interpolation.empty() || gs.interpolation == "LINEAR") ch.interpolation = NodeAnimation::Interpolation::linear;
+        else fail(spath + "/interpolation", fmt::format("'{}' is not LINEAR, STEP or CUBICSPLINE", gs.interpolation));
+        const std::vector<float> times = read_floats(gs.input, 1, spath + "/input");
+        const std::vector<float> values = read_floats(gs.output, width, spath + "/output");
+        if (times.empty()) fail(spath + "/input", "the sampler has no keyframe");
+        for (size_t k = 0; k < times.size(); ++k) {
+          if (times[k] < 0.0f) fail(spath + "/input", fmt::format("key time {} is negative", times[k]));
+          if (k > 0 && !(times[k] > times[k - 1]))
+            fail(spath + "/input", fmt::format("key times must increase: {} follows {}", times[k], times[k - 1]));
+        }
+        const size_t per_key = ch.interpolation == NodeAnimation::Interpolation::cubic_spline ? 3 : 1;
+        if (values.size() != times.size() * per_key * static_cast<size_t>(width))
+          fail(spath + "/output", fmt::format("{} values for {} key times ({} per key expected)", values.size() / width,
+                                              times.size(), per_key));
+        ch.times.assign(times.begin(), times.end());
+        ch.values.assign(values.begin(), values.end());
+        a.channels.push_back(std::move(ch));
+      }
+    }
+    if (weights > 0) warn("animation-weights", fmt::format("{} morph-target weight channel(s) ignored", weights));
+    if (!a.channels.empty())
+      scene.warnings.push_back(fmt::format("{} animation(s) with {} node channel(s): a still image shows the nodes at rest; "
+                                        "a path plays them (`stereobench path --gltf-animation`, a sweep's "
+                                        "[path] gltf_animation = true)",
+                                        m_.animations.size(), a.channels.size()));
   }
 
   /// Walks the scene's node forest iteratively (deep or cyclic hierarchies cannot overflow the stack).

@@ -79,6 +79,22 @@ std::vector<BadCase> corpus() {
                "/nodes/0/matrix: its last row (elements 3, 7, 11 and 15; glTF matrices are column-major) is (0, 0, 0, 0), not (0, 0, 0, 1)"});
   c.push_back({"matrix_projective_row", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["matrix"] = {1, 0, 0, 0.5, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; }),
                "/nodes/0/matrix: its last row (elements 3, 7, 11 and 15; glTF matrices are column-major) is (0.5, 0, 0, 1)"});
+  // Node animations: structure and references checked before any is read.
+  const json channel0 = {{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}};
+  c.push_back({"animation_channels_not_array", "a.gltf", edited([](MiniGltf& g) { g.doc["animations"] = {{{"channels", 5}, {"samplers", json::array()}}}; }),
+               "/animations/0/channels: expected a JSON array"});
+  c.push_back({"animation_sampler_out_of_range", "a.gltf", edited([channel0](MiniGltf& g) { g.doc["animations"] = {{{"channels", json::array({channel0})}, {"samplers", json::array()}}}; }),
+               "/animations/0/channels/0/sampler: refers to sampler 0 but the animation has 0"});
+  c.push_back({"animation_input_out_of_range", "a.gltf", edited([channel0](MiniGltf& g) { g.doc["animations"] = {{{"channels", json::array({channel0})}, {"samplers", {{{"input", 9}, {"output", 0}}}}}}; }),
+               "/animations/0/samplers/0/input: refers to accessors[9]"});
+  c.push_back({"animation_input_not_scalar", "a.gltf", edited([channel0](MiniGltf& g) { g.doc["animations"] = {{{"channels", json::array({channel0})}, {"samplers", {{{"input", 0}, {"output", 0}}}}}}; }),
+               "/animations/0/samplers/0/input: accessor 0 has type VEC3, but SCALAR is needed here"});
+  c.push_back({"animation_target_node_out_of_range", "a.gltf", edited([channel0](MiniGltf& g) {
+                 json ch = channel0;
+                 ch["target"]["node"] = 5;
+                 g.doc["animations"] = {{{"channels", json::array({ch})}, {"samplers", {{{"input", 0}, {"output", 0}}}}}};
+               }),
+               "/animations/0/channels/0/target/node: refers to nodes[5]"});
   c.push_back({"primitives_not_array", "a.gltf", edited([](MiniGltf& g) { g.doc["meshes"][0]["primitives"] = json::object(); }), "/meshes/0/primitives: expected a JSON array"});
   c.push_back({"attributes_missing", "a.gltf", edited([](MiniGltf& g) { g.doc["meshes"][0]["primitives"][0].erase("attributes"); }), "/meshes/0/primitives/0/attributes: required"});
   c.push_back({"no_position", "a.gltf", edited([](MiniGltf& g) { g.doc["meshes"][0]["primitives"][0]["attributes"] = json::object(); }), "/meshes/0/primitives/0/attributes: primitive has no POSITION"});

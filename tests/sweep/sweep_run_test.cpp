@@ -15,6 +15,7 @@
 #include <sstream>
 #include <thread>
 
+#include "scenes/gltf_builder.hpp"
 #include "support/run_cli.hpp"
 #include "support/scratch_dir.hpp"
 #include "validation/results_file.hpp"
@@ -395,6 +396,35 @@ baseline = "bidir-warp"
   };
   EXPECT_EQ(psnr_of(dir / "out" / left, dir / "eyes" / "box-wall_plain-rt_left.png"), "inf");
   EXPECT_NE(psnr_of(dir / "out" / own, dir / "eyes" / "box-wall_plain-rt_left.png"), "inf");
+}
+
+TEST(SweepRun, AGltfAnimationPlaysAlongThePath) {
+  test::ScratchDir dir;
+  // One box keyed 1 m along +X over 3 s before a still wall; the camera stays.
+  scenes::GltfBuilder b("keyed-box", 1);
+  const int grey = b.add_material("grey", vec3(0.6f));
+  const int box = b.add_node("box", b.add_mesh("box", scenes::make_box(vec3(-0.3f), vec3(0.3f)), grey));
+  b.add_node("wall", b.add_mesh("wall", scenes::make_box(vec3(-3.0f, -1.0f, -2.2f), vec3(3.0f, 2.0f, -2.0f)), grey));
+  b.add_point_light("lamp", vec3(0.0f, 2.0f, 3.0f), vec3(1.0f), 15.0f);
+  b.set_camera("camera", CameraPose::look_at(dvec3(0.0, 0.0, 4.0), dvec3(0.0)), 0.8, 0.05, 0.0, RigDefaults{});
+  const std::vector<float> times = {0.0f, 3.0f}, keys = {0, 0, 0, 1, 0, 0};
+  b.add_animation_channel(box, "translation", times, keys);
+  b.write(dir / "keyed.gltf");
+  std::ofstream(dir / "keyed.toml") << "[sweep]\nscenes = [\"keyed.gltf\"]\npipelines = [\"repro-rt\"]\n"
+                                       "resolutions = [\"96x54\"]\n[timing]\nrepetitions = 1\nwarmup = 0\n"
+                                       "[path]\nframes = 2\ngltf_animation = true\n";
+  const test::CliRun r = test::run_cli("sweep run " + quoted(dir / "keyed.toml") + " --out " + quoted(dir / "out"));
+  ASSERT_EQ(r.code, 0) << r.out;
+  const std::vector<json> cells = validation::read_results(dir / "out" / "results.jsonl").cells;
+  ASSERT_EQ(cells.size(), 2u);
+  for (int f = 0; f < 2; ++f) {
+    const json& a = cells[static_cast<size_t>(f)]["animation"];
+    EXPECT_DOUBLE_EQ(a["animation_time_s"].get<double>(), 3.0 * f) << "frames spread over the keys' 0..3 s";
+    EXPECT_EQ(a["turning_meshes"], 1) << "the box moves, the wall does not";
+  }
+  EXPECT_NE(test::read_text(dir / "out" / cells[0]["images"]["truth_png"].get<std::string>()),
+            test::read_text(dir / "out" / cells[1]["images"]["truth_png"].get<std::string>()))
+      << "the box moved between the frames";
 }
 
 /// Three frames of the box turning about the vertical through its centre, 64x36, two pipelines.
