@@ -5,6 +5,7 @@
 #include <cmath>
 #include <optional>
 #include <sstream>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -118,19 +119,29 @@ SceneAnimator::SceneAnimator(Scene& scene, const PathSpec& path) : scene_(scene)
       throw InputError(fmt::format("scene '{}' has no glTF node animation (translation, rotation or scale channels) "
                                    "to play along the path; give camera keys or a spin instead",
                                    scene.name));
-    for (size_t m = 0; m < scene.meshes.size(); ++m) {
-      const Mesh& mesh = scene.meshes[m];
-      if (!a.moves(mesh.node)) continue;
-      turning_.push_back(m);
-      base_positions_.push_back(mesh.positions);
-      base_normals_.push_back(mesh.normals);
-      rest_inverse_.push_back(glm::inverse(a.rest_world(mesh.node)));
+    std::vector<int> moved;  // the nodes of what moves: meshes, and the camera
+    for (size_t m = 0; m < scene.meshes.size(); ++m)
+      if (!scene.meshes[m].local_positions.empty()) {
+        turning_.push_back(m);
+        moved.push_back(scene.meshes[m].node);
+      }
+    if (!scene.cameras.empty() && a.moves(scene.cameras.front().node)) {
+      camera_node_ = scene.cameras.front().node;
+      moved.push_back(camera_node_);
     }
-    if (!scene.cameras.empty() && a.moves(scene.cameras.front().node)) camera_node_ = scene.cameras.front().node;
-    if (turning_.empty() && camera_node_ < 0)
+    if (moved.empty())
       throw InputError(fmt::format("the glTF animation of scene '{}' moves none of its meshes and not its camera "
-                                   "(its channels target other nodes); nothing would change along the path",
+                                   "(its channels key other nodes); nothing would change along the path",
                                    scene.name));
+    std::tie(start_, end_) = a.time_range(moved);
+    // Every frame's camera has a pose: a scale keyed to 0 would stop the path half-way.
+    if (camera_node_ >= 0)
+      for (int f = 0; f < path_.frames; ++f) try {
+          (void)camera_at(f, CameraPose{});
+        } catch (const InputError& e) {
+          throw InputError(fmt::format("{}: the animated camera (node {}) at frame {} (t = {:g} s): {}", scene.path,
+                                       camera_node_, f, time_of(f), e.what()));
+        }
     return;
   }
   if (!path_.spin) return;
@@ -155,19 +166,26 @@ void SceneAnimator::apply(int frame) {
   if (turning_.empty()) return;
   if (path_.gltf_animation) {
     const double t = time_of(frame);
-    for (size_t k = 0; k < turning_.size(); ++k) {
-      Mesh& mesh = scene_.meshes[turning_[k]];
-      // The node's motion since rest, applied to the rest positions (normals by its inverse
-      // transpose; rigid motion and scale).
-      const dmat4 d = scene_.animation.world(mesh.node, t) * rest_inverse_[k];
-      const dmat3 n = glm::transpose(glm::inverse(dmat3(d)));
-      const std::vector<vec3>& p0 = base_positions_[k];
-      for (size_t i = 0; i < p0.size(); ++i) mesh.positions[i] = vec3(dvec3(d * dvec4(dvec3(p0[i]), 1.0)));
-      const std::vector<vec3>& n0 = base_normals_[k];
-      for (size_t i = 0; i < n0.size(); ++i) {
-        const dvec3 v = n * dvec3(n0[i]);
-        const double len = glm::length(v);
-        mesh.normals[i] = len > 0.0 ? vec3(v / len) : n0[i];
+    for (const size_t m : turning_) {
+      Mesh& mesh = scene_.meshes[m];
+      // The node's world transform at t places its own geometry; normals by its inverse transpose.
+      const dmat4 w = scene_.animation.world(mesh.node, t);
+      const double det = glm::determinant(dmat3(w));
+      for (size_t i = 0; i < mesh.local_positions.size(); ++i)
+        mesh.positions[i] = vec3(dvec3(w * dvec4(dvec3(mesh.local_positions[i]), 1.0)));
+      // A transform scaled to nothing leaves no area to shade: its normals stay as they were.
+      if (det != 0.0 && std::isfinite(det)) {
+        const dmat3 n = glm::transpose(glm::inverse(dmat3(w)));
+        for (size_t i = 0; i < mesh.local_normals.size(); ++i) {
+          const dvec3 v = n * dvec3(mesh.local_normals[i]);
+          const double len = glm::length(v);
+          if (len > 0.0) mesh.normals[i] = vec3(v / len);
+        }
+      }
+      // A mirroring transform reverses the triangles, so that they face the way the file says.
+      if ((det < 0.0) != mesh.mirrored) {
+        for (size_t k = 0; k < mesh.indices.size(); k += 3) std::swap(mesh.indices[k + 1], mesh.indices[k + 2]);
+        mesh.mirrored = det < 0.0;
       }
     }
     return;
@@ -185,8 +203,7 @@ void SceneAnimator::apply(int frame) {
 
 double SceneAnimator::time_of(int frame) const {
   if (!path_.gltf_animation) return 0.0;
-  const double start = scene_.animation.start(), end = scene_.animation.end();
-  return path_.frames == 1 ? start : start + (end - start) * frame / static_cast<double>(path_.frames - 1);
+  return path_.frames == 1 ? start_ : start_ + (end_ - start_) * frame / static_cast<double>(path_.frames - 1);
 }
 
 CameraPose SceneAnimator::camera_at(int frame, const CameraPose& base) const {

@@ -46,8 +46,9 @@ struct PathSpec {
   void validate() const;
 };
 
-/// Applies the frames of a path to a scene. Keeps the scene's frame-0 (for a glTF animation: rest)
-/// positions and normals of the moving meshes, so frame k is always computed from those (no drift).
+/// Applies the frames of a path to a scene. Frame k is always computed from the scene as loaded (a
+/// spin from the frame-0 positions it keeps, a glTF animation from the meshes' node-local
+/// geometry), so it does not depend on the frames before it (no drift).
 class SceneAnimator {
  public:
   /// InputError when the spin's prefix matches no mesh, or gltf_animation is asked of a scene
@@ -73,8 +74,8 @@ class SceneAnimator {
   dvec3 pivot_{0.0};
   std::vector<size_t> turning_;  ///< indices of the moving meshes
   std::vector<std::vector<vec3>> base_positions_, base_normals_;
-  std::vector<dmat4> rest_inverse_;  ///< per moving mesh (glTF animation): its node's rest world, inverted
-  int camera_node_ = -1;             ///< the scene camera's node when the animation moves it
+  int camera_node_ = -1;  ///< the scene camera's node when the glTF animation moves it
+  double start_ = 0.0, end_ = 0.0;  ///< the glTF animation's time range over what it moves
 };
 
 /// What makes a key pose unusable, if anything: a position or target that is not finite or lies

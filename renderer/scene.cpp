@@ -74,6 +74,21 @@ double NodeAnimation::end() const {
   return t;
 }
 
+std::pair<double, double> NodeAnimation::time_range(const std::vector<int>& nodes) const {
+  bool any = false;
+  double lo = 0.0, hi = 0.0;
+  for (const Channel& c : channels) {
+    bool moves_one = false;
+    for (const int node : nodes)
+      for (int n = node; n >= 0 && !moves_one; n = parent[static_cast<size_t>(n)]) moves_one = n == c.node;
+    if (!moves_one) continue;
+    lo = any ? std::min(lo, c.times.front()) : c.times.front();
+    hi = any ? std::max(hi, c.times.back()) : c.times.back();
+    any = true;
+  }
+  return {lo, hi};
+}
+
 bool NodeAnimation::moves(int node) const {
   for (int n = node; n >= 0 && static_cast<size_t>(n) < parent.size(); n = parent[static_cast<size_t>(n)])
     for (const Channel& c : channels)
@@ -81,22 +96,21 @@ bool NodeAnimation::moves(int node) const {
   return false;
 }
 
-dmat4 NodeAnimation::local_at(int node, const double* time) const {
+dmat4 NodeAnimation::local_at(int node, double time) const {
   Local l = local[static_cast<size_t>(node)];
   if (l.matrix) return *l.matrix;
-  if (time != nullptr)
-    for (const Channel& c : channels) {
-      if (c.node != node) continue;
-      if (c.property == Property::rotation) {
-        const std::vector<double> v = sample(c, *time, 4);
-        const dquat q(v[3], v[0], v[1], v[2]);
-        const double len = glm::length(q);
-        l.rotation = len > 0.0 ? q / len : dquat(1.0, 0.0, 0.0, 0.0);
-      } else {
-        const std::vector<double> v = sample(c, *time, 3);
-        (c.property == Property::translation ? l.translation : l.scale) = dvec3(v[0], v[1], v[2]);
-      }
+  for (const Channel& c : channels) {
+    if (c.node != node) continue;
+    if (c.property == Property::rotation) {
+      const std::vector<double> v = sample(c, time, 4);
+      const dquat q(v[3], v[0], v[1], v[2]);
+      const double len = glm::length(q);
+      l.rotation = len > 0.0 ? q / len : dquat(1.0, 0.0, 0.0, 0.0);
+    } else {
+      const std::vector<double> v = sample(c, time, 3);
+      (c.property == Property::translation ? l.translation : l.scale) = dvec3(v[0], v[1], v[2]);
     }
+  }
   dmat4 t(1.0), s(1.0);
   t[3] = dvec4(l.translation, 1.0);
   s[0][0] = l.scale.x;
@@ -107,13 +121,7 @@ dmat4 NodeAnimation::local_at(int node, const double* time) const {
 
 dmat4 NodeAnimation::world(int node, double time) const {
   dmat4 w(1.0);
-  for (int n = node; n >= 0; n = parent[static_cast<size_t>(n)]) w = local_at(n, &time) * w;
-  return w;
-}
-
-dmat4 NodeAnimation::rest_world(int node) const {
-  dmat4 w(1.0);
-  for (int n = node; n >= 0; n = parent[static_cast<size_t>(n)]) w = local_at(n, nullptr) * w;
+  for (int n = node; n >= 0; n = parent[static_cast<size_t>(n)]) w = local_at(n, time) * w;
   return w;
 }
 

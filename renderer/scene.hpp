@@ -6,6 +6,7 @@
 #include <cmath>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "renderer/math.hpp"
@@ -40,6 +41,13 @@ struct Mesh {
   std::vector<vec3> normals;  ///< empty, or one per position (shading normals, world space)
   std::vector<vec2> uvs;      ///< empty, or one per position (the material's TEXCOORD set)
   std::vector<uint32_t> indices;  ///< three per triangle
+  /// For a mesh on an animated node (Scene::animation moves its node): its vertices and normals in
+  /// the node's own space, where the animation's world transform of each frame places them; empty
+  /// otherwise.
+  std::vector<vec3> local_positions, local_normals;
+  /// Whether its triangles are in reversed order, for a world transform that mirrors (negative
+  /// determinant), so that they keep facing the way the file says.
+  bool mirrored = false;
 
   [[nodiscard]] size_t triangle_count() const { return indices.size() / 3; }
   /// Whether triangle t has zero area (its vertices coincide or lie on one line): it covers no
@@ -121,7 +129,7 @@ struct NodeAnimation {
     std::string where;  ///< JSON path ("/animations/0/channels/1")
   };
 
-  std::vector<int> parent;    ///< per glTF node: its parent, -1 for a root
+  std::vector<int> parent;    ///< per glTF node: its parent in the loaded scene, -1 for a root or a node outside it
   std::vector<Local> local;   ///< per glTF node: its rest transform
   std::vector<Channel> channels;
 
@@ -129,15 +137,17 @@ struct NodeAnimation {
   /// The first and the last key time over every channel (0, 0 when there is none).
   [[nodiscard]] double start() const;
   [[nodiscard]] double end() const;
+  /// The first and the last key time over the channels that move one of `nodes` (a channel on the
+  /// node itself or on an ancestor); (0, 0) when none does.
+  [[nodiscard]] std::pair<double, double> time_range(const std::vector<int>& nodes) const;
   /// Whether `node` or one of its ancestors is animated.
   [[nodiscard]] bool moves(int node) const;
   /// The node's world transform at `time` (before the first key: the first; after the last: the
-  /// last, as glTF clamps), and at rest (rest_world).
+  /// last, as glTF clamps).
   [[nodiscard]] dmat4 world(int node, double time) const;
-  [[nodiscard]] dmat4 rest_world(int node) const;
 
  private:
-  [[nodiscard]] dmat4 local_at(int node, const double* time) const;
+  [[nodiscard]] dmat4 local_at(int node, double time) const;
 };
 
 /// A loaded scene.

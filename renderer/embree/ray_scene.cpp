@@ -117,6 +117,12 @@ double RayScene::update() {
     if (!v) throw IoError(fmt::format("Embree has no vertex buffer for mesh '{}' to update", mesh.name));
     std::memcpy(v, mesh.positions.data(), mesh.positions.size() * sizeof(vec3));
     rtcUpdateGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0);
+    // The same triangles, but a mirroring animation reverses their vertex order (Mesh::mirrored).
+    auto* idx = static_cast<uint32_t*>(rtcGetGeometryBufferData(g, RTC_BUFFER_TYPE_INDEX, 0));
+    if (idx && std::memcmp(idx, mesh.indices.data(), mesh.indices.size() * sizeof(uint32_t)) != 0) {
+      std::memcpy(idx, mesh.indices.data(), mesh.indices.size() * sizeof(uint32_t));
+      rtcUpdateGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0);
+    }
     rtcCommitGeometry(g);
   }
   rtcCommitScene(impl_->scene);

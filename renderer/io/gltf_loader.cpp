@@ -369,7 +369,6 @@ class Converter {
                                    "area (its vertices coincide or lie on one line), so nothing can be seen; check "
                                    "the primitives' indices and POSITION accessors, or pick another scene",
                                    file_, scene.triangle_count()));
-    convert_animations(scene);
     if (!m_.skins.empty()) warn("skins", fmt::format("{} skin(s) ignored: meshes render in their bind pose", m_.skins.size()));
     for (const auto& [key, count] : warning_counts_)
       scene.warnings.push_back(count > 1 ? fmt::format("{} ({} occurrences)", warning_text_[key], count)
@@ -613,12 +612,12 @@ class Converter {
   void convert_animations(Scene& scene) {
     if (m_.animations.empty()) return;
     NodeAnimation& a = scene.animation;
-    a.parent.assign(m_.nodes.size(), -1);
+    // The hierarchy as the loaded scene has it (the traversal checked it for cycles): a node
+    // outside it, and what it parents there, does not move anything shown.
+    a.parent = parent_;
     a.local.resize(m_.nodes.size());
     for (size_t i = 0; i < m_.nodes.size(); ++i) {
       const tinygltf::Node& n = m_.nodes[i];
-      for (int c : n.children)
-        if (c >= 0 && static_cast<size_t>(c) < m_.nodes.size()) a.parent[static_cast<size_t>(c)] = static_cast<int>(i);
       NodeAnimation::Local& l = a.local[i];
       if (n.matrix.size() == 16) {
         l.matrix = local_matrix(n);
@@ -631,7 +630,8 @@ class Converter {
       }
       if (n.scale.size() == 3) l.scale = dvec3(n.scale[0], n.scale[1], n.scale[2]);
     }
-    size_t weights = 0;
+    size_t weights = 0, outside = 0;
+    std::map<std::pair<int, int>, std::string> keyed;  // (node, property) -> the channel keying it
     for (size_t ai = 0; ai < m_.animations.size(); ++ai) {
       const tinygltf::Animation& anim = m_.animations[ai];
       for (size_t ci = 0; ci < anim.channels.size(); ++ci) {
@@ -653,6 +653,10 @@ class Converter {
         else if (gc.target_path == "scale") ch.property = NodeAnimation::Property::scale;
         else if (gc.target_path == "rotation") ch.property = NodeAnimation::Property::rotation, width = 4;
         else fail(cpath + "/target/path", fmt::format("'{}' is not translation, rotation, scale or weights", gc.target_path));
+        if (!visited_[static_cast<size_t>(ch.node)]) {  // a node outside the loaded scene moves nothing shown
+          ++outside;
+          continue;
+        }
         if (a.local[static_cast<size_t>(ch.node)].matrix)
           fail(cpath + "/target/node", fmt::format("node {} has a matrix, and glTF allows animating only a node "
                                                    "given by translation, rotation and scale", ch.node));
@@ -665,6 +669,24 @@ class Converter {
         else if (gs.interpolation == "CUBICSPLINE") ch.interpolation = NodeAnimation::Interpolation::cubic_spline;
         else if (gs.interpolation.empty() || gs.interpolation == "LINEAR") ch.interpolation = NodeAnimation::Interpolation::linear;
         else fail(spath + "/interpolation", fmt::format("'{}' is not LINEAR, STEP or CUBICSPLINE", gs.interpolation));
+        // glTF 2.0 §3.11: key times are floats; translation and scale floats; rotations floats or
+        // normalized integers.
+        const tinygltf::Accessor& in = m_.accessors[static_cast<size_t>(gs.input)];
+        const tinygltf::Accessor& out = m_.accessors[static_cast<size_t>(gs.output)];
+        if (in.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT)
+          fail(spath + "/input", fmt::format("accessor {} holds component type {}; key times must be floats (5126)",
+                                             gs.input, in.componentType));
+        const bool float_out = out.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT;
+        const bool normalized_out = out.normalized && out.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+        if (!float_out && !(ch.property == NodeAnimation::Property::rotation && normalized_out))
+          fail(spath + "/output",
+               fmt::format("accessor {} holds component type {}{}; a {} must be floats (5126){}", gs.output,
+                           out.componentType, out.normalized ? " (normalized)" : "", gc.target_path,
+                           ch.property == NodeAnimation::Property::rotation ? " or normalized 8- or 16-bit integers" : ""));
+        // Both are kept as doubles while the file is loaded.
+        require_memory(16 * (uint64_t{in.count} + uint64_t{out.count} * static_cast<uint64_t>(width)),
+                       fmt::format("loading {}: {} ({} keys)", file_, spath, in.count),
+                       "check the sampler's accessor counts, or use a smaller animation");
         const std::vector<float> times = read_floats(gs.input, 1, spath + "/input");
         const std::vector<float> values = read_floats(gs.output, width, spath + "/output");
         if (times.empty()) fail(spath + "/input", "the sampler has no keyframe");
@@ -679,10 +701,19 @@ class Converter {
                                               times.size(), per_key));
         ch.times.assign(times.begin(), times.end());
         ch.values.assign(values.begin(), values.end());
+        const auto [it, first] = keyed.emplace(std::pair(ch.node, static_cast<int>(ch.property)), cpath);
+        if (!first)
+          warn(fmt::format("animation-twice-{}", cpath),
+               fmt::format("{} keys node {}'s {} as {} does; every animation plays at once, and the later channel in "
+                           "file order wins",
+                           cpath, ch.node, gc.target_path, it->second));
         a.channels.push_back(std::move(ch));
       }
     }
     if (weights > 0) warn("animation-weights", fmt::format("{} morph-target weight channel(s) ignored", weights));
+    if (outside > 0)
+      warn("animation-outside", fmt::format("{} animation channel(s) key nodes outside the loaded scene and are not "
+                                            "played", outside));
     if (!a.channels.empty())
       scene.warnings.push_back(fmt::format("{} animation(s) with {} node channel(s): a still image shows the nodes at rest; "
                                         "a path plays them (`stereobench path --gltf-animation`, a sweep's "
@@ -705,8 +736,9 @@ class Converter {
         if (!has_parent[i]) roots.push_back(static_cast<int>(i));
     }
     // Count the triangles the traversal would produce before allocating them.
-    std::vector<int> parent(m_.nodes.size(), -1);
-    std::vector<bool> visited(m_.nodes.size(), false);
+    parent_.assign(m_.nodes.size(), -1);
+    std::vector<bool>& visited = visited_;
+    visited.assign(m_.nodes.size(), false);
     struct Item { int node; dmat4 world; };
     std::vector<Item> stack;
     for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, dmat4(1.0)});
@@ -736,13 +768,18 @@ class Converter {
       if (triangles > kMaxSceneTriangles)
         fail(fmt::format("/nodes/{}", ni), fmt::format("the scene expands to more than {} triangles; this is "
                                                         "beyond what the renderer holds in memory", kMaxSceneTriangles));
-      for (auto c = n.children.rbegin(); c != n.children.rend(); ++c) stack.push_back({*c, item.world});
+      for (auto c = n.children.rbegin(); c != n.children.rend(); ++c) {
+        parent_[static_cast<size_t>(*c)] = item.node;
+        stack.push_back({*c, item.world});
+      }
     }
     // Before any mesh is read: an accessor's count alone (without a bufferView its elements are
     // zeros) can ask for more than the machine holds, which under overcommit ends in the OOM killer.
     require_memory(loaded_mesh_bytes(triangles, vertices),
                    fmt::format("loading {}: {} triangles, {} vertices", file_, triangles, vertices),
                    "use a smaller scene, check the accessors' counts, or run on a machine with more memory");
+    // The animations first: a mesh on an animated node keeps its node-local vertices.
+    convert_animations(scene);
     for (const Item& item : order) visit(scene, item.node, item.world);
     // Nodes with meshes or lights that the loaded scene does not reach: in another glTF scene, or
     // in none. They are not rendered here; a tool that imports the file whole would show them.
@@ -786,6 +823,7 @@ class Converter {
     if (n.camera >= 0) convert_camera(scene, ni, world);
     auto ext = n.extensions.find("KHR_lights_punctual");
     if (ext != n.extensions.end()) {
+      if (scene.animation.moves(ni)) warn("animated-light", "lights on animated nodes stay where they are at rest");
       const int li = ext->second.Get("light").GetNumberAsInt();
       convert_light(scene, li, world);
     }
@@ -822,6 +860,13 @@ class Converter {
       mesh.material = prim.material;
       const std::vector<float> pos = read_floats(pos_it->second, 3, ppath + "/attributes/POSITION");
       const size_t nv = pos.size() / 3;
+      // A mesh that an animation moves keeps its node-local geometry for the frames of a path.
+      const bool animated = scene.animation.moves(ni);
+      if (animated) {
+        mesh.local_positions.resize(nv);
+        for (size_t v = 0; v < nv; ++v) mesh.local_positions[v] = vec3(pos[v * 3], pos[v * 3 + 1], pos[v * 3 + 2]);
+      }
+      mesh.mirrored = flip;
       mesh.positions.resize(nv);
       for (size_t v = 0; v < nv; ++v) {
         const dvec3 p = dvec3(world * dvec4(pos[v * 3], pos[v * 3 + 1], pos[v * 3 + 2], 1.0));
@@ -837,6 +882,10 @@ class Converter {
         if (nrm.size() != pos.size())
           fail(ppath + "/attributes/NORMAL", fmt::format("has {} elements but POSITION has {}", nrm.size() / 3, nv));
         mesh.normals.resize(nv);
+        if (animated) {
+          mesh.local_normals.resize(nv);
+          for (size_t v = 0; v < nv; ++v) mesh.local_normals[v] = vec3(nrm[v * 3], nrm[v * 3 + 1], nrm[v * 3 + 2]);
+        }
         for (size_t v = 0; v < nv; ++v) {
           dvec3 nn = normal_matrix * dvec3(nrm[v * 3], nrm[v * 3 + 1], nrm[v * 3 + 2]);
           const double len = glm::length(nn);
@@ -983,6 +1032,8 @@ class Converter {
   const json& doc_;
   std::string file_;
   GltfLoadOptions options_;
+  std::vector<int> parent_;    ///< per node: its parent as the traversal reached it, -1 for a root or unreached
+  std::vector<bool> visited_;  ///< per node: whether the loaded scene reaches it
   std::map<std::string, int> warning_counts_;
   std::map<std::string, std::string> warning_text_;
 };

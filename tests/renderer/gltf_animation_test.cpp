@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "renderer/animation.hpp"
 #include "renderer/error.hpp"
 #include "renderer/io/gltf_loader.hpp"
@@ -107,46 +109,115 @@ TEST(GltfAnimation, TranslationMovesTheNodeItsChildAndTheCameraOverTheFrames) {
 TEST(GltfAnimation, RotationSlerpsStepHoldsAndCubicSplineFollowsHermite) {
   test::ScratchDir dir;
   AnimatedScene a;
-  // A quarter turn about +Y in 1 s: at 0.5 s the rider (2 m along +X from the mover) is 45° round.
+  // A quarter turn about +Y in 2 s, its end key written as the negated quaternion (the same
+  // rotation: slerp must take the short way): at 0.5 s the rider (2 m along +X from the mover) is
+  // 22.5° round; a normalized linear blend would give 21.6°.
   const float s = static_cast<float>(std::sqrt(0.5));
-  const std::vector<float> times = {0.0f, 1.0f};
-  const std::vector<float> quarter = {0, 0, 0, 1, 0, s, 0, s};
+  const std::vector<float> times = {0.0f, 2.0f};
+  const std::vector<float> quarter = {0, 0, 0, 1, 0, -s, 0, -s};
   a.builder.add_animation_channel(a.mover, "rotation", times, quarter);
   // The still box's scale steps from 1 to 3 at 1 s.
-  const std::vector<float> scales = {1, 1, 1, 3, 3, 3};
-  a.builder.add_animation_channel(a.still, "scale", times, scales, "STEP");
+  const std::vector<float> scales = {1, 1, 1, 3, 3, 3}, scale_times = {0.0f, 1.0f};
+  a.builder.add_animation_channel(a.still, "scale", scale_times, scales, "STEP");
   Scene scene = a.load(dir);
+  PathSpec path;
+  path.frames = 5;
+  path.gltf_animation = true;
+  SceneAnimator animator(scene, path);
+  animator.apply(1);
+  const double angle = 22.5 * std::acos(-1.0) / 180.0;
+  expect_near(centre_of(scene, "rider", a.rider), dvec3(2.0 * std::cos(angle), 0.0, -2.0 * std::sin(angle)), 1e-5,
+              "rider at 22.5 degrees");
+  animator.apply(2);  // 1 s: the scale keys' end, where STEP switches
+  const auto extent = [&] {
+    double x = 0.0;
+    for (const Mesh& m : scene.meshes)
+      if (m.node == a.still)
+        for (const vec3& p : m.positions) x = std::max(x, static_cast<double>(p.x));
+    return x;
+  };
+  // STEP (keys at 0 s and 1 s): until the second key the first value holds, from it the second.
+  animator.apply(1);
+  EXPECT_NEAR(extent(), 0.5, 1e-6) << "the box keeps its 1 m size at 0.5 s";
+  animator.apply(2);
+  EXPECT_NEAR(extent(), 1.5, 1e-5) << "scaled 3x from the second key";
+
+  // Cubic spline over 2 s: in-tangent a, value v, out-tangent b per key, tangents scaled by the
+  // interval. Key 0: v = 0, b = 1 m/s; key 1: a = 2 m/s, v = 2 m (a of key 0 and b of key 1 play
+  // no part). At u = 0.5: 0.125 * 2 s * 1 m/s + 0.5 * 2 m - 0.125 * 2 s * 2 m/s = 0.75 m; at the
+  // last key, its value.
+  test::ScratchDir dir2("cubic");
+  AnimatedScene c;
+  const std::vector<float> spline = {9, 0, 0, 0, 0, 0, 1, 0, 0,   // key 0: a, v, b
+                                     2, 0, 0, 2, 0, 0, 7, 0, 0};  // key 1
+  c.builder.add_animation_channel(c.mover, "translation", times, spline, "CUBICSPLINE");
+  Scene cubic = c.load(dir2);
+  path.frames = 3;
+  SceneAnimator cubic_animator(cubic, path);
+  cubic_animator.apply(1);
+  expect_near(centre_of(cubic, "mover", c.mover), dvec3(0.75, 0.0, 0.0), 1e-5, "Hermite at u = 0.5");
+  cubic_animator.apply(2);
+  expect_near(centre_of(cubic, "mover", c.mover), dvec3(2.0, 0.0, 0.0), 1e-5, "the last key's value");
+}
+
+/// Whether every triangle of the meshes on `node` turns its front (by its vertex order) the way
+/// its vertices' normals point.
+bool triangles_face_their_normals(const Scene& scene, int node) {
+  for (const Mesh& m : scene.meshes) {
+    if (m.node != node) continue;
+    for (size_t t = 0; t < m.indices.size(); t += 3) {
+      const vec3 &p0 = m.positions[m.indices[t]], &p1 = m.positions[m.indices[t + 1]], &p2 = m.positions[m.indices[t + 2]];
+      if (glm::dot(glm::cross(p1 - p0, p2 - p0), m.normals[m.indices[t]]) <= 0.0f) return false;
+    }
+  }
+  return true;
+}
+
+TEST(GltfAnimation, MirroringScaleZeroRestScaleAndTheTimeRangeOfWhatMoves) {
+  test::ScratchDir dir;
+  AnimatedScene a;
+  // The mover mirrors in X from 1 s; the still box pops in from scale 0 at rest to 1 at 2 s.
+  const std::vector<float> step_times = {0.0f, 1.0f}, mirror = {1, 1, 1, -1, 1, 1};
+  a.builder.add_animation_channel(a.mover, "scale", step_times, mirror, "STEP");
+  const std::vector<float> pop_times = {0.0f, 2.0f}, pop = {0, 0, 0, 1, 1, 1};
+  a.builder.add_animation_channel(a.still, "scale", pop_times, pop);
+  // Two channels keying one property: both kept, the later wins, and the load says so.
+  a.builder.add_animation_channel(a.still, "scale", pop_times, pop);
+  Scene scene = a.load(dir);
+  bool said = false;
+  for (const std::string& w : scene.warnings) said |= w.find("the later channel in file order wins") != std::string::npos;
+  EXPECT_TRUE(said);
   PathSpec path;
   path.frames = 3;
   path.gltf_animation = true;
   SceneAnimator animator(scene, path);
-  animator.apply(1);
-  const double r = 2.0 / std::sqrt(2.0);
-  expect_near(centre_of(scene, "rider", a.rider), dvec3(r, 0.0, -r), 1e-5, "rider at 45 degrees");
-  // STEP: half-way the first key's value holds (the box keeps its 1 m size).
-  double extent = 0.0;
-  for (const Mesh& m : scene.meshes)
-    if (m.node == a.still)
-      for (const vec3& p : m.positions) extent = std::max(extent, static_cast<double>(p.x));
-  EXPECT_NEAR(extent, 0.5, 1e-6);
+  EXPECT_DOUBLE_EQ(animator.time_of(2), 2.0);
+  animator.apply(0);
+  EXPECT_TRUE(triangles_face_their_normals(scene, a.mover));
   animator.apply(2);
-  extent = 0.0;
-  for (const Mesh& m : scene.meshes)
-    if (m.node == a.still)
-      for (const vec3& p : m.positions) extent = std::max(extent, static_cast<double>(p.x));
-  EXPECT_NEAR(extent, 1.5, 1e-5) << "scaled 3x at the last key";
+  EXPECT_TRUE(triangles_face_their_normals(scene, a.mover)) << "mirrored, the triangles are reversed";
+  EXPECT_TRUE(triangles_face_their_normals(scene, a.rider)) << "and its child's";
+  expect_near(centre_of(scene, "rider", a.rider), dvec3(-2.0, 0.0, 0.0), 1e-5, "the child mirrored with it");
+  // The popped-in box has its size and lies where its node is.
+  expect_near(centre_of(scene, "still", a.still), dvec3(0.0, 0.0, -3.0), 1e-5, "popped in");
+  EXPECT_TRUE(triangles_face_their_normals(scene, a.still));
+  animator.apply(0);
+  EXPECT_TRUE(triangles_face_their_normals(scene, a.mover)) << "back at frame 0";
 
-  // Cubic spline: in-tangent, value, out-tangent per key. With the out-tangent 4 m/s at the first
-  // key and zero elsewhere, at u = 0.5 of 1 s: 0.5 * 0 + 0.125 * 1 s * 4 m/s + 0.5 * 2 m = 1.5 m.
-  test::ScratchDir dir2("cubic");
+  // A camera scaled to nothing has no pose: refused before the first frame, naming frame and time.
+  test::ScratchDir dir2("camera");
   AnimatedScene c;
-  const std::vector<float> spline = {0, 0, 0, 0, 0, 0, 4, 0, 0,   // key 0: a, v, b
-                                     0, 0, 0, 2, 0, 0, 0, 0, 0};  // key 1
-  c.builder.add_animation_channel(c.mover, "translation", times, spline, "CUBICSPLINE");
-  Scene cubic = c.load(dir2);
-  SceneAnimator cubic_animator(cubic, path);
-  cubic_animator.apply(1);
-  expect_near(centre_of(cubic, "mover", c.mover), dvec3(1.5, 0.0, 0.0), 1e-5, "Hermite at u = 0.5");
+  const std::vector<float> shrink = {1, 1, 1, 0, 0, 0};
+  c.builder.add_animation_channel(c.camera, "scale", pop_times, shrink);
+  Scene shrinking = c.load(dir2);
+  try {
+    SceneAnimator refused(shrinking, path);
+    FAIL() << "a camera without a pose was played";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(fmt::format("the animated camera (node {}) at frame 2 (t = 2 s)", c.camera)),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(GltfAnimation, BadAnimationsAndScenesWithoutOneAreRefused) {
