@@ -6,6 +6,7 @@
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <embree3/rtcore.h>
 #include <fmt/format.h>
@@ -21,6 +22,9 @@ struct RayScene::Impl {
   std::atomic<int64_t> bytes{0};
   std::atomic<int64_t> peak{0};
   std::string error;
+  /// Per geometry: whether its index buffer holds the mesh's triangles reversed (Mesh::mirrored)
+  /// as uploaded; an animation that mirrors a mesh flips the flag and the order together.
+  std::vector<bool> mirrored;
 };
 
 namespace {
@@ -91,6 +95,7 @@ RayScene::RayScene(const SceneGeometry& geometry, bool refittable)
     }
     std::memcpy(v, mesh.positions.data(), mesh.positions.size() * sizeof(vec3));
     std::memcpy(idx, mesh.indices.data(), mesh.indices.size() * sizeof(uint32_t));
+    impl_->mirrored.push_back(mesh.mirrored);
     if (refittable) rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_REFIT);
     if (geometry.single_sided[m]) {
       rtcSetGeometryUserData(g, const_cast<Mesh*>(&mesh));
@@ -117,11 +122,14 @@ double RayScene::update() {
     if (!v) throw IoError(fmt::format("Embree has no vertex buffer for mesh '{}' to update", mesh.name));
     std::memcpy(v, mesh.positions.data(), mesh.positions.size() * sizeof(vec3));
     rtcUpdateGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0);
-    // The same triangles, but a mirroring animation reverses their vertex order (Mesh::mirrored).
-    auto* idx = static_cast<uint32_t*>(rtcGetGeometryBufferData(g, RTC_BUFFER_TYPE_INDEX, 0));
-    if (idx && std::memcmp(idx, mesh.indices.data(), mesh.indices.size() * sizeof(uint32_t)) != 0) {
+    // The same triangles, but a mirroring animation reverses their vertex order: the hit's
+    // barycentrics must refer to the order the mesh has now.
+    if (mesh.mirrored != impl_->mirrored[m]) {
+      auto* idx = static_cast<uint32_t*>(rtcGetGeometryBufferData(g, RTC_BUFFER_TYPE_INDEX, 0));
+      if (!idx) throw IoError(fmt::format("Embree has no index buffer for mesh '{}' to update", mesh.name));
       std::memcpy(idx, mesh.indices.data(), mesh.indices.size() * sizeof(uint32_t));
       rtcUpdateGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0);
+      impl_->mirrored[m] = mesh.mirrored;
     }
     rtcCommitGeometry(g);
   }
