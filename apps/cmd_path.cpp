@@ -119,12 +119,14 @@ void run_path_command(const PathArgs& a) {
   run.work_dir = fs::path(a.out) / "work";
   run.refit = bvh == "refit";
 
+  // The path checked against the scene before the first frame (run_path plays it on its own animator).
+  const SceneAnimator animation(loaded.scene, run.path);
   fmt::print("path on {} ({} triangles): {} frames, {}{}; {}, truth {}\n", loaded.scene.name,
              loaded.scene.triangle_count(), a.frames,
              run.path.camera_keys.empty() ? "the scene's camera" : fmt::format("{} camera key{}", run.path.camera_keys.size(), run.path.camera_keys.size() == 1 ? "" : "s"),
              a.spin_deg ? fmt::format(", meshes turning {} deg per frame (BVH {})", *a.spin_deg, bvh)
              : a.gltf_animation ? fmt::format(", the scene's glTF animation from {:g} s to {:g} s (BVH {})",
-                                              loaded.scene.animation.start(), loaded.scene.animation.end(), bvh)
+                                              animation.time_of(0), animation.time_of(a.frames - 1), bvh)
                                 : "",
              describe(rig), provider->name());
   // The frames go to <stem>_path.jsonl.partial as they finish, renamed to the final name when

@@ -2,6 +2,7 @@
 #include "renderer/scene.hpp"
 
 #include <algorithm>
+#include <array>
 
 #include <fmt/format.h>
 
@@ -29,10 +30,10 @@ double key_value(const NodeAnimation::Channel& ch, size_t k, int width, int c) {
 }
 
 /// A channel's value at time t (glTF 2.0 §3.11 "Animations" and Appendix C: linear with slerp for
-/// rotations, step, cubic Hermite spline), `width` numbers.
-std::vector<double> sample(const NodeAnimation::Channel& ch, double t, int width) {
+/// rotations, step, cubic Hermite spline): `width` numbers of the four.
+std::array<double, 4> sample(const NodeAnimation::Channel& ch, double t, int width) {
   const auto [k, u] = key_interval(ch.times, t);
-  std::vector<double> out(static_cast<size_t>(width));
+  std::array<double, 4> out{};
   const bool last = k + 1 >= ch.times.size() || u == 0.0;
   for (int c = 0; c < width; ++c) out[static_cast<size_t>(c)] = key_value(ch, k, width, c);
   if (last || ch.interpolation == NodeAnimation::Interpolation::step) return out;
@@ -62,26 +63,27 @@ std::vector<double> sample(const NodeAnimation::Channel& ch, double t, int width
 
 }  // namespace
 
-double NodeAnimation::start() const {
-  double t = channels.empty() ? 0.0 : channels.front().times.front();
-  for (const Channel& c : channels) t = std::min(t, c.times.front());
-  return t;
+dmat4 NodeAnimation::Local::transform() const {
+  if (matrix) return *matrix;
+  dmat4 t(1.0), s(1.0);
+  t[3] = dvec4(translation, 1.0);
+  s[0][0] = scale.x;
+  s[1][1] = scale.y;
+  s[2][2] = scale.z;
+  return t * dmat4(glm::mat3_cast(rotation)) * s;
 }
 
-double NodeAnimation::end() const {
-  double t = channels.empty() ? 0.0 : channels.front().times.back();
-  for (const Channel& c : channels) t = std::max(t, c.times.back());
-  return t;
+bool NodeAnimation::above(int ancestor, int node) const {
+  for (int n = node; n >= 0 && static_cast<size_t>(n) < parent.size(); n = parent[static_cast<size_t>(n)])
+    if (n == ancestor) return true;
+  return false;
 }
 
 std::pair<double, double> NodeAnimation::time_range(const std::vector<int>& nodes) const {
   bool any = false;
   double lo = 0.0, hi = 0.0;
   for (const Channel& c : channels) {
-    bool moves_one = false;
-    for (const int node : nodes)
-      for (int n = node; n >= 0 && !moves_one; n = parent[static_cast<size_t>(n)]) moves_one = n == c.node;
-    if (!moves_one) continue;
+    if (std::none_of(nodes.begin(), nodes.end(), [&](int node) { return above(c.node, node); })) continue;
     lo = any ? std::min(lo, c.times.front()) : c.times.front();
     hi = any ? std::max(hi, c.times.back()) : c.times.back();
     any = true;
@@ -90,10 +92,7 @@ std::pair<double, double> NodeAnimation::time_range(const std::vector<int>& node
 }
 
 bool NodeAnimation::moves(int node) const {
-  for (int n = node; n >= 0 && static_cast<size_t>(n) < parent.size(); n = parent[static_cast<size_t>(n)])
-    for (const Channel& c : channels)
-      if (c.node == n) return true;
-  return false;
+  return std::any_of(channels.begin(), channels.end(), [&](const Channel& c) { return above(c.node, node); });
 }
 
 dmat4 NodeAnimation::local_at(int node, double time) const {
@@ -102,21 +101,16 @@ dmat4 NodeAnimation::local_at(int node, double time) const {
   for (const Channel& c : channels) {
     if (c.node != node) continue;
     if (c.property == Property::rotation) {
-      const std::vector<double> v = sample(c, time, 4);
+      const std::array<double, 4> v = sample(c, time, 4);
       const dquat q(v[3], v[0], v[1], v[2]);
       const double len = glm::length(q);
       l.rotation = len > 0.0 ? q / len : dquat(1.0, 0.0, 0.0, 0.0);
     } else {
-      const std::vector<double> v = sample(c, time, 3);
+      const std::array<double, 4> v = sample(c, time, 3);
       (c.property == Property::translation ? l.translation : l.scale) = dvec3(v[0], v[1], v[2]);
     }
   }
-  dmat4 t(1.0), s(1.0);
-  t[3] = dvec4(l.translation, 1.0);
-  s[0][0] = l.scale.x;
-  s[1][1] = l.scale.y;
-  s[2][2] = l.scale.z;
-  return t * dmat4(glm::mat3_cast(l.rotation)) * s;
+  return l.transform();
 }
 
 dmat4 NodeAnimation::world(int node, double time) const {

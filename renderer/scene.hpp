@@ -114,6 +114,9 @@ struct NodeAnimation {
     dquat rotation{1.0, 0.0, 0.0, 0.0};  ///< glm order (w, x, y, z), unit length
     dvec3 scale{1.0};
     std::optional<dmat4> matrix;
+
+    /// The matrix, or T * R * S.
+    [[nodiscard]] dmat4 transform() const;
   };
   enum class Property { translation, rotation, scale };
   enum class Interpolation { linear, step, cubic_spline };
@@ -126,7 +129,6 @@ struct NodeAnimation {
     /// Per key: the value (3 numbers, 4 for a rotation x, y, z, w); for a cubic spline the in-tangent,
     /// the value and the out-tangent, in that order.
     std::vector<double> values;
-    std::string where;  ///< JSON path ("/animations/0/channels/1")
   };
 
   std::vector<int> parent;    ///< per glTF node: its parent in the loaded scene, -1 for a root or a node outside it
@@ -134,9 +136,6 @@ struct NodeAnimation {
   std::vector<Channel> channels;
 
   [[nodiscard]] bool empty() const { return channels.empty(); }
-  /// The first and the last key time over every channel (0, 0 when there is none).
-  [[nodiscard]] double start() const;
-  [[nodiscard]] double end() const;
   /// The first and the last key time over the channels that move one of `nodes` (a channel on the
   /// node itself or on an ancestor); (0, 0) when none does.
   [[nodiscard]] std::pair<double, double> time_range(const std::vector<int>& nodes) const;
@@ -148,6 +147,8 @@ struct NodeAnimation {
 
  private:
   [[nodiscard]] dmat4 local_at(int node, double time) const;
+  /// Whether `ancestor` is `node` or one of its ancestors in the loaded hierarchy.
+  [[nodiscard]] bool above(int ancestor, int node) const;
 };
 
 /// A loaded scene.

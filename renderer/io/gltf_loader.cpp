@@ -583,28 +583,27 @@ class Converter {
     return static_cast<int>(scene.textures.size() - 1);
   }
 
-  static dmat4 local_matrix(const tinygltf::Node& n) {
+  /// A node's own transform as glTF gives it: its matrix, or translation, rotation (normalized)
+  /// and scale.
+  static NodeAnimation::Local local_of(const tinygltf::Node& n) {
+    NodeAnimation::Local l;
     if (n.matrix.size() == 16) {
       dmat4 m;
       for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 4; ++r) m[c][r] = n.matrix[static_cast<size_t>(c * 4 + r)];
-      return m;
+      l.matrix = m;
+      return l;
     }
-    dmat4 t(1.0), r(1.0), s(1.0);
-    if (n.translation.size() == 3) t[3] = dvec4(n.translation[0], n.translation[1], n.translation[2], 1.0);
+    if (n.translation.size() == 3) l.translation = dvec3(n.translation[0], n.translation[1], n.translation[2]);
     if (n.rotation.size() == 4) {
-      dquat q(n.rotation[3], n.rotation[0], n.rotation[1], n.rotation[2]);  // glm: (w, x, y, z)
+      const dquat q(n.rotation[3], n.rotation[0], n.rotation[1], n.rotation[2]);  // glm: (w, x, y, z)
       const double len = glm::length(q);
-      if (len > 0.0) q = q / len;
-      r = dmat4(glm::mat3_cast(q));
+      if (len > 0.0) l.rotation = q / len;
     }
-    if (n.scale.size() == 3) {
-      s[0][0] = n.scale[0];
-      s[1][1] = n.scale[1];
-      s[2][2] = n.scale[2];
-    }
-    return t * r * s;
+    if (n.scale.size() == 3) l.scale = dvec3(n.scale[0], n.scale[1], n.scale[2]);
+    return l;
   }
+
 
   /// The file's node animations (translation, rotation, scale channels of the loaded scene's
   /// nodes) and the node hierarchy they move, for paths (renderer/animation.hpp); a still render
@@ -615,21 +614,8 @@ class Converter {
     // The hierarchy as the loaded scene has it (the traversal checked it for cycles): a node
     // outside it, and what it parents there, does not move anything shown.
     a.parent = parent_;
-    a.local.resize(m_.nodes.size());
-    for (size_t i = 0; i < m_.nodes.size(); ++i) {
-      const tinygltf::Node& n = m_.nodes[i];
-      NodeAnimation::Local& l = a.local[i];
-      if (n.matrix.size() == 16) {
-        l.matrix = local_matrix(n);
-        continue;
-      }
-      if (n.translation.size() == 3) l.translation = dvec3(n.translation[0], n.translation[1], n.translation[2]);
-      if (n.rotation.size() == 4) {
-        const dquat q(n.rotation[3], n.rotation[0], n.rotation[1], n.rotation[2]);
-        if (glm::length(q) > 0.0) l.rotation = q / glm::length(q);
-      }
-      if (n.scale.size() == 3) l.scale = dvec3(n.scale[0], n.scale[1], n.scale[2]);
-    }
+    a.local.clear();
+    for (const tinygltf::Node& n : m_.nodes) a.local.push_back(local_of(n));
     size_t weights = 0, outside = 0;
     std::map<std::pair<int, int>, std::string> keyed;  // (node, property) -> the channel keying it
     for (size_t ai = 0; ai < m_.animations.size(); ++ai) {
@@ -647,7 +633,6 @@ class Converter {
                                                    m_.nodes.size()));
         NodeAnimation::Channel ch;
         ch.node = gc.target_node;
-        ch.where = cpath;
         int width = 3;
         if (gc.target_path == "translation") ch.property = NodeAnimation::Property::translation;
         else if (gc.target_path == "scale") ch.property = NodeAnimation::Property::scale;
@@ -753,7 +738,7 @@ class Converter {
                                            "with two parents, which glTF forbids");
       visited[ni] = true;
       const tinygltf::Node& n = m_.nodes[ni];
-      item.world = item.world * local_matrix(n);
+      item.world = item.world * local_of(n).transform();
       order.push_back(item);
       if (n.mesh >= 0) {
         const auto& prims = m_.meshes[static_cast<size_t>(n.mesh)].primitives;
