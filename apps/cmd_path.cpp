@@ -38,6 +38,7 @@ struct PathArgs {
   std::optional<std::string> camera_keys;
   std::optional<double> spin_deg;
   bool gltf_animation = false;
+  std::string gltf_clip;
   std::string spin_axis = "0,1,0";
   std::string spin_prefix;
   std::string bvh;  // empty: refit, and not given
@@ -72,7 +73,7 @@ double percentile(std::vector<double> v, double q) {
 
 void run_path_command(const PathArgs& a) {
   // Nothing moves without a spin or an animation: a BVH update asked for would never be done.
-  if (!a.bvh.empty() && !a.spin_deg && !a.gltf_animation)
+  if (!a.bvh.empty() && !a.spin_deg && !a.gltf_animation && a.gltf_clip.empty())
     throw InputError("--bvh requires --spin-deg or --gltf-animation (nothing else moves the scene's meshes)");
   const std::string bvh = a.bvh.empty() ? "refit" : a.bvh;
   if (bvh != "refit" && bvh != "rebuild")
@@ -80,8 +81,9 @@ void run_path_command(const PathArgs& a) {
   validation::PathRun run;
   run.path.frames = a.frames;
   if (a.camera_keys) run.path.camera_keys = parse_camera_keys(*a.camera_keys);
-  run.path.gltf_animation = a.gltf_animation;
-  if (a.gltf_animation && a.truth == "blender")
+  run.path.gltf_animation = a.gltf_animation || !a.gltf_clip.empty();
+  run.path.gltf_clip = a.gltf_clip;
+  if (run.path.gltf_animation && a.truth == "blender")
     throw InputError("--gltf-animation with --truth blender: Blender renders the scene file at rest, not as it moves "
                      "along the path; use --truth full or povray");
   if (a.spin_deg) {
@@ -125,8 +127,11 @@ void run_path_command(const PathArgs& a) {
              loaded.scene.triangle_count(), a.frames,
              run.path.camera_keys.empty() ? "the scene's camera" : fmt::format("{} camera key{}", run.path.camera_keys.size(), run.path.camera_keys.size() == 1 ? "" : "s"),
              a.spin_deg ? fmt::format(", meshes turning {} deg per frame (BVH {})", *a.spin_deg, bvh)
-             : a.gltf_animation ? fmt::format(", the scene's glTF animation from {:g} s to {:g} s (BVH {})",
-                                              animation.time_of(0), animation.time_of(a.frames - 1), bvh)
+             : run.path.gltf_animation
+                 ? fmt::format(", the scene's glTF animation ({}) from {:g} s to {:g} s, {} mesh(es) and {} light(s) "
+                               "moving (BVH {})",
+                               animation.clip(), animation.time_of(0), animation.time_of(a.frames - 1),
+                               animation.turning_meshes(), animation.moving_lights(), bvh)
                                 : "",
              describe(rig), provider->name());
   // The frames go to <stem>_path.jsonl.partial as they finish, renamed to the final name when
@@ -200,8 +205,11 @@ void register_path_command(CLI::App& root) {
       ->needs(spin);
   p->add_flag("--gltf-animation", a->gltf_animation,
                                   "Play the scene file's own node animations over the frames, from their first key time "
-                                  "to their last:\nanimated meshes move with their nodes, an animated scene camera moves "
-                                  "the rig (not with --camera-keys or --spin-deg)");
+                                  "to their last:\nanimated meshes and lights move with their nodes, an animated scene "
+                                  "camera moves the rig (not with --camera-keys or --spin-deg)");
+  p->add_option("--gltf-clip", a->gltf_clip,
+                "Play only this glTF animation (clip) of the scene, by name or index (implies --gltf-animation; "
+                "without it every clip plays at once)");
   p->add_option("--bvh", a->bvh,
                 "Per-frame BVH update of a moving scene (--spin-deg, --gltf-animation): refit (default) or rebuild");
   p->add_option("--threads,-t", a->threads, "Worker threads (0 = all cores)")->capture_default_str();

@@ -2,7 +2,9 @@
 #include "renderer/animation.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <map>
 #include <optional>
 #include <sstream>
 #include <tuple>
@@ -98,6 +100,10 @@ void PathSpec::validate() const {
   if (gltf_animation && (!camera_keys.empty() || spin))
     throw InputError(fmt::format("a path plays the scene's glTF animation or {}, not both; drop one",
                                  spin ? "a spin" : "camera keys"));
+  if (!gltf_clip.empty() && !gltf_animation)
+    throw InputError(fmt::format("the glTF clip '{}' is chosen, but the path does not play the scene's glTF "
+                                 "animation; ask for it too",
+                                 gltf_clip));
   if (spin) {
     if (!unit_axis(spin->axis))
       throw InputError("the spin axis is zero or not finite; give a direction such as 0,1,0");
@@ -114,25 +120,32 @@ void PathSpec::validate() const {
 SceneAnimator::SceneAnimator(Scene& scene, const PathSpec& path) : scene_(scene), path_(path) {
   path_.validate();
   if (path_.gltf_animation) {
-    const NodeAnimation& a = scene.animation;
-    if (a.empty())
+    if (scene.animation.empty())
       throw InputError(fmt::format("scene '{}' has no glTF node animation (translation, rotation or scale channels) "
                                    "to play along the path; give camera keys or a spin instead",
                                    scene.name));
-    std::vector<int> moved;  // the nodes of what moves: meshes, and the camera
+    play_clips(scene.animation);
+    const NodeAnimation& a = played_;
+    std::vector<int> moved;  // the nodes of what moves: meshes, lights and the camera
     for (size_t m = 0; m < scene.meshes.size(); ++m)
-      if (!scene.meshes[m].local_positions.empty()) {
+      if (!scene.meshes[m].local_positions.empty() && a.moves(scene.meshes[m].node)) {
         turning_.push_back(m);
         moved.push_back(scene.meshes[m].node);
+      }
+    for (size_t l = 0; l < scene.lights.size(); ++l)
+      if (scene.lights[l].node >= 0 && a.moves(scene.lights[l].node)) {
+        lights_.push_back(l);
+        moved.push_back(scene.lights[l].node);
       }
     if (!scene.cameras.empty() && a.moves(scene.cameras.front().node)) {
       camera_node_ = scene.cameras.front().node;
       moved.push_back(camera_node_);
     }
     if (moved.empty())
-      throw InputError(fmt::format("the glTF animation of scene '{}' moves none of its meshes and not its camera "
-                                   "(its channels key other nodes); nothing would change along the path",
-                                   scene.name));
+      throw InputError(fmt::format("the glTF animation of scene '{}' ({}) moves none of its meshes, none of its lights "
+                                   "and not its camera (its channels key other nodes); nothing would change along the "
+                                   "path",
+                                   scene.name, clip_));
     std::tie(start_, end_) = a.time_range(moved);
     // Every frame's camera has a pose: a scale keyed to 0 would stop the path half-way.
     if (camera_node_ >= 0)
@@ -160,16 +173,69 @@ SceneAnimator::SceneAnimator(Scene& scene, const PathSpec& path) : scene_(scene)
   pivot_ = path_.spin->pivot ? *path_.spin->pivot : dvec3(0.5f * (bounds.lo + bounds.hi));
 }
 
+void SceneAnimator::play_clips(const NodeAnimation& all) {
+  played_ = all;
+  played_.channels.clear();
+  std::optional<size_t> chosen;
+  const std::string& name = path_.gltf_clip;
+  if (name.empty()) {
+    clip_ = all.clips.size() == 1 ? all.clip_label(0) : "every clip";
+  } else {
+    std::vector<size_t> named;
+    for (size_t c = 0; c < all.clips.size(); ++c)
+      if (all.clips[c] == name) named.push_back(c);
+    if (named.size() > 1)
+      throw InputError(fmt::format("scene '{}' has {} glTF animations named '{}' (#{} and #{}); choose one by its "
+                                   "index",
+                                   scene_.name, named.size(), name, named[0], named[1]));
+    if (named.size() == 1) {
+      chosen = named.front();
+    } else {
+      size_t index = 0;
+      const auto [end, ec] = std::from_chars(name.data(), name.data() + name.size(), index);
+      if (ec != std::errc() || end != name.data() + name.size() || index >= all.clips.size())
+        throw InputError(fmt::format("scene '{}' has no glTF animation '{}'; its animations are {} (choose one by "
+                                     "name or by index)",
+                                     scene_.name, name, all.clip_list()));
+      chosen = index;
+    }
+    clip_ = all.clip_label(*chosen);
+  }
+  // Two clips that key one property of a node (the idle and the walk of one character) cannot
+  // play at once.
+  std::map<std::pair<int, int>, int> keyed;  // (node, property) -> clip
+  for (const NodeAnimation::Channel& c : all.channels) {
+    if (chosen && static_cast<size_t>(c.clip) != *chosen) continue;
+    const auto [it, first] = keyed.emplace(std::pair(c.node, static_cast<int>(c.property)), c.clip);
+    if (!first)
+      throw InputError(fmt::format("the glTF animations {} and {} of scene '{}' both key node {}'s {}, so they "
+                                   "cannot play at once; choose one clip",
+                                   all.clip_label(static_cast<size_t>(it->second)),
+                                   all.clip_label(static_cast<size_t>(c.clip)), scene_.name, c.node,
+                                   c.property == NodeAnimation::Property::translation ? "translation"
+                                   : c.property == NodeAnimation::Property::rotation  ? "rotation"
+                                                                                      : "scale"));
+    played_.channels.push_back(c);
+  }
+}
+
 void SceneAnimator::apply(int frame) {
   if (frame < 0 || frame >= path_.frames)
     throw InputError(fmt::format("frame {} is outside the path's 0..{}", frame, path_.frames - 1));
-  if (turning_.empty()) return;
   if (path_.gltf_animation) {
     const double t = time_of(frame);
+    for (const size_t l : lights_) {
+      // glTF: a light sits at its node's origin and shines down the node's -Z; scale does not matter.
+      Light& light = scene_.lights[l];
+      const dmat4 w = played_.world(light.node, t);
+      light.position = vec3(dvec3(w[3]));
+      const dvec3 d = dvec3(w * dvec4(0.0, 0.0, -1.0, 0.0));
+      if (glm::length(d) > 0.0) light.direction = vec3(glm::normalize(d));
+    }
     for (const size_t m : turning_) {
       Mesh& mesh = scene_.meshes[m];
       // The node's world transform at t places its own geometry; normals by its inverse transpose.
-      const dmat4 w = scene_.animation.world(mesh.node, t);
+      const dmat4 w = played_.world(mesh.node, t);
       const double det = glm::determinant(dmat3(w));
       for (size_t i = 0; i < mesh.local_positions.size(); ++i)
         mesh.positions[i] = vec3(dvec3(w * dvec4(dvec3(mesh.local_positions[i]), 1.0)));
@@ -190,6 +256,7 @@ void SceneAnimator::apply(int frame) {
     }
     return;
   }
+  if (turning_.empty()) return;
   const double radians = degrees_to_radians(path_.spin->degrees_per_frame * frame);
   const dmat3 r = rotation(*unit_axis(path_.spin->axis), radians);
   for (size_t k = 0; k < turning_.size(); ++k) {
@@ -207,7 +274,7 @@ double SceneAnimator::time_of(int frame) const {
 }
 
 CameraPose SceneAnimator::camera_at(int frame, const CameraPose& base) const {
-  if (camera_node_ >= 0) return CameraPose::from_matrix(scene_.animation.world(camera_node_, time_of(frame)));
+  if (camera_node_ >= 0) return CameraPose::from_matrix(played_.world(camera_node_, time_of(frame)));
   const std::vector<CameraKey>& keys = path_.camera_keys;
   if (keys.empty()) return base;
   if (keys.size() == 1 || path_.frames == 1) return CameraPose::look_at(keys.front().position, keys.front().target);

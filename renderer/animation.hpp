@@ -32,17 +32,22 @@ struct Spin {
 /// A path of `frames` frames: the camera along `camera_keys` (none: the rig's own pose; one: that
 /// pose; more: piecewise linear in position and target, the keys spread evenly over the frames,
 /// the first at frame 0 and the last at frame frames-1) and an optional spin; or, with
-/// `gltf_animation`, the scene file's own node animations (Scene::animation) played from their
-/// first key time to their last, spread evenly over the frames: the meshes of animated nodes move
-/// rigidly with their nodes, and an animated scene camera moves the rig.
+/// `gltf_animation`, the scene file's own node animations (Scene::animation; every clip, or the
+/// one `gltf_clip` names) played from their first key time to their last, spread evenly over the
+/// frames: the meshes of animated nodes move rigidly with their nodes, lights on animated nodes
+/// with them, and an animated scene camera moves the rig.
 struct PathSpec {
   int frames = 1;
   std::vector<CameraKey> camera_keys;
   std::optional<Spin> spin;
   bool gltf_animation = false;
+  /// The glTF animation (clip) to play, by name or, where no clip has that name, by index; empty:
+  /// every clip at once.
+  std::string gltf_clip;
 
   /// InputError naming the field: frames outside 1..100000, a key whose target equals its
-  /// position, a zero spin axis, a non-finite angle, gltf_animation with camera keys or a spin.
+  /// position, a zero spin axis, a non-finite angle, gltf_animation with camera keys or a spin, a
+  /// gltf_clip without gltf_animation.
   void validate() const;
 };
 
@@ -52,28 +57,40 @@ struct PathSpec {
 class SceneAnimator {
  public:
   /// InputError when the spin's prefix matches no mesh, or gltf_animation is asked of a scene
-  /// without node animations.
+  /// without node animations, of a clip the scene does not have, or of clips that key one
+  /// property of a node twice (the clips of one character: choose one with gltf_clip).
   SceneAnimator(Scene& scene, const PathSpec& path);
 
   [[nodiscard]] int frames() const { return path_.frames; }
   [[nodiscard]] bool moves_geometry() const { return !turning_.empty(); }
   /// The meshes that move along the path (turning, or on animated nodes).
   [[nodiscard]] size_t turning_meshes() const { return turning_.size(); }
+  /// The lights that move along the path (on animated nodes).
+  [[nodiscard]] size_t moving_lights() const { return lights_.size(); }
+  /// What plays: the clip's label ("'walk'", "#2"), or "every clip" (empty without gltf_animation).
+  [[nodiscard]] const std::string& clip() const { return clip_; }
   /// The animation time of `frame` (seconds; 0 without gltf_animation).
   [[nodiscard]] double time_of(int frame) const;
 
-  /// Sets the moving meshes' positions and normals to those of `frame` (0 <= frame < frames()).
+  /// Sets the moving meshes' positions and normals, and the moving lights' positions and
+  /// directions, to those of `frame` (0 <= frame < frames()).
   void apply(int frame);
   /// The centre camera pose at `frame`; `base` when the path has no camera keys and no animated
   /// scene camera.
   [[nodiscard]] CameraPose camera_at(int frame, const CameraPose& base) const;
 
  private:
+  /// Sets played_ to the channels of the clips that play (path_.gltf_clip) and clip_ to its label.
+  void play_clips(const NodeAnimation& all);
+
   Scene& scene_;
   PathSpec path_;
   dvec3 pivot_{0.0};
   std::vector<size_t> turning_;  ///< indices of the moving meshes
+  std::vector<size_t> lights_;   ///< indices of the moving lights
   std::vector<std::vector<vec3>> base_positions_, base_normals_;
+  NodeAnimation played_;  ///< the scene's animation, its channels those of the clips that play
+  std::string clip_;
   int camera_node_ = -1;  ///< the scene camera's node when the glTF animation moves it
   double start_ = 0.0, end_ = 0.0;  ///< the glTF animation's time range over what it moves
 };

@@ -73,6 +73,16 @@ dmat4 NodeAnimation::Local::transform() const {
   return t * dmat4(glm::mat3_cast(rotation)) * s;
 }
 
+std::string NodeAnimation::clip_label(size_t clip) const {
+  return clip < clips.size() && !clips[clip].empty() ? fmt::format("'{}'", clips[clip]) : fmt::format("#{}", clip);
+}
+
+std::string NodeAnimation::clip_list() const {
+  std::string out;
+  for (size_t c = 0; c < clips.size(); ++c) out += (c > 0 ? ", " : "") + clip_label(c);
+  return out;
+}
+
 bool NodeAnimation::above(int ancestor, int node) const {
   for (int n = node; n >= 0 && static_cast<size_t>(n) < parent.size(); n = parent[static_cast<size_t>(n)])
     if (n == ancestor) return true;

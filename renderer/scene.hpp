@@ -69,6 +69,7 @@ struct Light {
   float range = 0.0f;  ///< 0 = infinite
   float inner_cone = 0.0f;
   float outer_cone = 0.78539816f;
+  int node = -1;  ///< the glTF node that places it (-1: none); an animation along a path moves it
 };
 
 /// Largest coordinate magnitude, in metres, a scene may use: vertices, cameras and lights. Embree
@@ -122,6 +123,7 @@ struct NodeAnimation {
   enum class Interpolation { linear, step, cubic_spline };
   /// One channel: a property of a node keyed over time.
   struct Channel {
+    int clip = 0;  ///< the glTF animation it belongs to (index into clips)
     int node = -1;
     Property property = Property::translation;
     Interpolation interpolation = Interpolation::linear;
@@ -133,9 +135,14 @@ struct NodeAnimation {
 
   std::vector<int> parent;    ///< per glTF node: its parent in the loaded scene, -1 for a root or a node outside it
   std::vector<Local> local;   ///< per glTF node: its rest transform
+  std::vector<std::string> clips;  ///< per glTF animation: its name ("" when it has none)
   std::vector<Channel> channels;
 
   [[nodiscard]] bool empty() const { return channels.empty(); }
+  /// A clip as messages name it: 'name', or #index where it has none.
+  [[nodiscard]] std::string clip_label(size_t clip) const;
+  /// Every clip's label, comma-separated.
+  [[nodiscard]] std::string clip_list() const;
   /// The first and the last key time over the channels that move one of `nodes` (a channel on the
   /// node itself or on an ancestor); (0, 0) when none does.
   [[nodiscard]] std::pair<double, double> time_range(const std::vector<int>& nodes) const;

@@ -334,7 +334,8 @@ int GltfBuilder::add_directional_light(const std::string& name, const vec3& dire
 }
 
 int GltfBuilder::add_animation_channel(int node, const std::string& property, std::span<const float> times,
-                                       std::span<const float> values, const std::string& interpolation) {
+                                       std::span<const float> values, const std::string& interpolation,
+                                       const std::string& clip) {
   const size_t width = property == "rotation" ? 4 : 3;
   const size_t per_key = interpolation == "CUBICSPLINE" ? 3 : 1;
   if (node < 0 || static_cast<size_t>(node) >= nodes_.size() || times.empty() ||
@@ -346,10 +347,16 @@ int GltfBuilder::add_animation_channel(int node, const std::string& property, st
                                  json::array({static_cast<double>(*lo)}), json::array({static_cast<double>(*hi)}));
   const int output = add_accessor(add_buffer_view(values.data(), values.size_bytes(), 0), kFloat,
                                   values.size() / width, width == 4 ? "VEC4" : "VEC3");
-  animation_samplers_.push_back({{"input", input}, {"output", output}, {"interpolation", interpolation}});
-  animation_channels_.push_back(
-      {{"sampler", animation_samplers_.size() - 1}, {"target", {{"node", node}, {"path", property}}}});
-  return static_cast<int>(animation_channels_.size()) - 1;
+  auto it = std::find_if(animations_.begin(), animations_.end(), [&](const json& a) { return a["name"] == clip; });
+  if (it == animations_.end()) {
+    animations_.push_back({{"name", clip}, {"channels", json::array()}, {"samplers", json::array()}});
+    it = animations_.end() - 1;
+  }
+  json& samplers = (*it)["samplers"];
+  json& channels = (*it)["channels"];
+  samplers.push_back({{"input", input}, {"output", output}, {"interpolation", interpolation}});
+  channels.push_back({{"sampler", samplers.size() - 1}, {"target", {{"node", node}, {"path", property}}}});
+  return static_cast<int>(channels.size()) - 1;
 }
 
 int GltfBuilder::set_camera(const std::string& name, const CameraPose& pose, double yfov, double znear, double zfar,
@@ -403,9 +410,7 @@ json GltfBuilder::document() const {
   put("accessors", accessors_);
   put("bufferViews", buffer_views_);
   put("cameras", cameras_);
-  if (!animation_channels_.empty())
-    doc["animations"] = json::array(
-        {{{"name", "animation"}, {"channels", animation_channels_}, {"samplers", animation_samplers_}}});
+  put("animations", animations_);
   if (!textures_.empty())
     doc["samplers"] = json::array({{{"magFilter", kLinear}, {"minFilter", kLinearMipmapLinear}, {"wrapS", kRepeat},
                                     {"wrapT", kRepeat}}});

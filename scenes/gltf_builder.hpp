@@ -101,9 +101,12 @@ class GltfBuilder {
                  const RigDefaults& rig);
   /// Keys one property of a node in the scene's animation: `property` "translation", "scale"
   /// (3 floats per key) or "rotation" (x, y, z, w per key); `interpolation` "LINEAR", "STEP" or
-  /// "CUBICSPLINE" (then in-tangent, value and out-tangent per key). Returns the channel's index.
+  /// "CUBICSPLINE" (then in-tangent, value and out-tangent per key). The channel goes into the
+  /// glTF animation (clip) named `clip`, created at its first channel. Returns the channel's index
+  /// within its clip.
   int add_animation_channel(int node, const std::string& property, std::span<const float> times,
-                            std::span<const float> values, const std::string& interpolation = "LINEAR");
+                            std::span<const float> values, const std::string& interpolation = "LINEAR",
+                            const std::string& clip = "animation");
   /// Radiance of rays that miss (scene extras).
   void set_background(const vec3& rgb) { background_ = rgb; }
   /// The ambient term of DESIGN §3 (scene extras).
@@ -153,8 +156,8 @@ class GltfBuilder {
   nlohmann::json nodes_ = nlohmann::json::array();
   nlohmann::json lights_ = nlohmann::json::array();
   nlohmann::json cameras_ = nlohmann::json::array();
-  nlohmann::json animation_channels_ = nlohmann::json::array();
-  nlohmann::json animation_samplers_ = nlohmann::json::array();
+  /// The animations in the order of their first channel: name, channels and samplers.
+  nlohmann::json animations_ = nlohmann::json::array();
   std::vector<int> roots_;
   std::vector<Geometry> geometries_;
   std::vector<MeshCounts> mesh_counts_;

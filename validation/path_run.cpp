@@ -29,6 +29,7 @@ json animation_json(const PathRun& run) {
           {"camera_keys", keys},
           {"spin", spin},
           {"gltf_animation", run.path.gltf_animation},
+          {"gltf_clip", run.path.gltf_clip.empty() ? json(nullptr) : json(run.path.gltf_clip)},
           {"bvh_update", run.refit ? "refit" : "rebuild"}};
 }
 

@@ -258,7 +258,7 @@ std::string option_text(const Where& where, const toml::node& node, const std::s
 }
 
 const std::vector<std::string> kTopKeys = {"sweep", "timing", "options", "output", "path", "gate"};
-const std::vector<std::string> kPathKeys = {"frames", "camera_keys", "spin", "gltf_animation", "bvh"};
+const std::vector<std::string> kPathKeys = {"frames", "camera_keys", "spin", "gltf_animation", "gltf_clip", "bvh"};
 const std::vector<std::string> kSpinKeys = {"axis", "degrees_per_frame", "pivot", "mesh_prefix"};
 const std::vector<std::string> kSweepKeys = {"name",          "description",      "scenes",        "pipelines",
                                              "baseline",      "interaxial_m",     "max_disparity_px",
@@ -331,6 +331,14 @@ void parse_path(const Where& where, const toml::node& node, SweepDefinition& d) 
     path.spin = s;
   }
   if (const toml::node* v = table.get("gltf_animation")) path.gltf_animation = bool_at(where, *v, "path.gltf_animation");
+  if (const toml::node* v = table.get("gltf_clip")) {
+    path.gltf_clip = string_at(where, *v, "path.gltf_clip");
+    if (path.gltf_clip.empty()) where.fail(*v, "path.gltf_clip", "is empty; name a glTF animation, or drop the key");
+    // A clip plays the scene's animation; saying gltf_animation = false beside it contradicts it.
+    if (table.get("gltf_animation") != nullptr && !path.gltf_animation)
+      where.fail(*v, "path.gltf_clip", "chooses a glTF animation, but gltf_animation = false; drop one");
+    path.gltf_animation = true;
+  }
   if (const toml::node* v = table.get("bvh")) {
     const std::string bvh = string_at(where, *v, "path.bvh");
     if (bvh != "refit" && bvh != "rebuild")
@@ -347,7 +355,7 @@ void parse_path(const Where& where, const toml::node& node, SweepDefinition& d) 
   if (path.spin || path.gltf_animation)
     for (const std::string& truth : d.truths)
       if (truth == "blender")
-        where.fail(node, path.spin ? "path.spin" : "path.gltf_animation",
+        where.fail(node, path.spin ? "path.spin" : table.get("gltf_clip") ? "path.gltf_clip" : "path.gltf_animation",
                    fmt::format("truth '{}' renders the scene file at rest, not as it moves along the path; a path "
                                "with {} needs truths \"full\" or \"povray\"",
                                truth, path.spin ? "a spin" : "the glTF animation"));

@@ -329,6 +329,7 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
                  {"bvh_update_s", scene.update->bvh_update_s},
                  {"animate_s", scene.update->animate_s},
                  {"turning_meshes", scene.animator->turning_meshes()},
+                 {"moving_lights", scene.animator->moving_lights()},
                  {"animation_time_s", d.path->gltf_animation ? json(scene.animator->time_of(*cell.frame)) : json(nullptr)},
                  {"camera",
                   {{"position", {rig.pose().position.x, rig.pose().position.y, rig.pose().position.z}},

@@ -1,9 +1,11 @@
 // Structural glTF JSON check with JSON-pointer error messages.
 #include "renderer/io/gltf_check.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <string_view>
+#include <vector>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -180,6 +182,46 @@ class Checker {
     opt_integer(*t, "texCoord", p, 0, 255);
   }
 
+  /// Whether the file uses `extension`.
+  [[nodiscard]] bool uses(const std::string& extension) const {
+    const json* used = find(doc_, "extensionsUsed");
+    return used && std::find(used->begin(), used->end(), extension) != used->end();
+  }
+
+  /// The accessor types glTF 2.0 §3.7.2.1 allows the attributes read here, widened by
+  /// KHR_mesh_quantization where the file uses it: POSITION VEC3 of floats (quantized: 8- or
+  /// 16-bit integers, normalized or not), NORMAL VEC3 of floats (quantized: normalized signed 8 or
+  /// 16 bits), TEXCOORD_n VEC2 of floats or normalized unsigned 8 or 16 bits (quantized: any 8- or
+  /// 16-bit integers).
+  void attribute_type(const std::string& name, const json& accessor_index, const std::string& prim_path) const {
+    const bool position = name == "POSITION", normal = name == "NORMAL", uv = name.rfind("TEXCOORD_", 0) == 0;
+    if (!position && !normal && !uv) return;
+    const size_t ai = accessor_index.get<size_t>();
+    const json& a = (*find(doc_, "accessors"))[ai];
+    const uint64_t c = find(a, "componentType")->get<uint64_t>();
+    const json* nm = find(a, "normalized");
+    const bool normalized = nm && nm->get<bool>();
+    const std::string& t = find(a, "type")->get_ref<const std::string&>();
+    const bool quantized = uses("KHR_mesh_quantization");
+    const bool small_int = c == 5120 || c == 5121 || c == 5122 || c == 5123;
+    bool ok = c == 5126;
+    std::string allowed = "of FLOAT (5126)";
+    if (uv) {
+      ok = ok || (quantized ? small_int : normalized && (c == 5121 || c == 5123));
+      allowed = quantized ? "of FLOAT, or of 8- or 16-bit integers (KHR_mesh_quantization)"
+                          : "of FLOAT (5126), or of normalized UNSIGNED_BYTE (5121) or UNSIGNED_SHORT (5123)";
+    } else if (quantized) {
+      ok = ok || (position ? small_int : normalized && (c == 5120 || c == 5122));
+      allowed = position ? "of FLOAT, or of 8- or 16-bit integers (KHR_mesh_quantization)"
+                         : "of FLOAT, or of normalized BYTE or SHORT (KHR_mesh_quantization)";
+    }
+    if (t != (uv ? "VEC2" : "VEC3") || !ok)
+      fail(prim_path + "/attributes/" + name,
+           fmt::format("accessor {} is {} of component type {}{}; {} must be {} {}{}", ai, t, c,
+                       normalized ? " (normalized)" : "", name, uv ? "VEC2" : "VEC3", allowed,
+                       quantized || uv ? "" : " (integer types need KHR_mesh_quantization)"));
+  }
+
   void extras(const json& obj, const std::string& path) const {
     const json* e = member(obj, "extras", path);
     if (!e || !e->is_object()) return;  // extras may be anything; only ours is checked
@@ -239,6 +281,16 @@ class Checker {
       }
       opt_index(n, "mesh", p, "meshes");
       opt_index(n, "camera", p, "cameras");
+      opt_index(n, "skin", p, "skins");
+      if (const json* w = member(n, "weights", p)) {
+        require_array(*w, p + "/weights");
+        for (size_t i = 0; i < w->size(); ++i) number((*w)[i], fmt::format("{}/weights/{}", p, i));
+      }
+      if (find(n, "matrix"))
+        for (const char* trs : {"translation", "rotation", "scale"})
+          if (find(n, trs))
+            fail(p + "/" + trs, "the node has a matrix too; glTF gives a node either a matrix or translation, "
+                                "rotation and scale, not both; keep one");
       if (const json* m = member(n, "matrix", p)) {
         number_array(*m, p + "/matrix", 16);
         // Column-major: the last row is elements 3, 7, 11 and 15. A projective row would divide
@@ -276,6 +328,29 @@ class Checker {
       extras(n, p);
     });
 
+    // glTF 2.0 §3.5.3: the nodes form disjoint strict trees; no node is the child of two.
+    if (const json* nodes = find(doc_, "nodes")) {
+      std::vector<std::string> parent_of(nodes->size());
+      for (size_t ni = 0; ni < nodes->size(); ++ni)
+        if (const json* ch = find((*nodes)[ni], "children"))
+          for (size_t i = 0; i < ch->size(); ++i) {
+            const auto c = (*ch)[i].get<size_t>();
+            const std::string here = fmt::format("/nodes/{}/children/{}", ni, i);
+            if (!parent_of[c].empty())
+              fail(here, fmt::format("node {} is already a child at {}; a glTF node has one parent at most", c,
+                                     parent_of[c]));
+            parent_of[c] = here;
+          }
+    }
+
+    each(doc_, "skins", "", [&](const json& sk, const std::string& p) {
+      const json* joints = member(sk, "joints", p, true);
+      require_array(*joints, p + "/joints");
+      for (size_t i = 0; i < joints->size(); ++i) index((*joints)[i], fmt::format("{}/joints/{}", p, i), "nodes");
+      opt_index(sk, "inverseBindMatrices", p, "accessors");
+      opt_index(sk, "skeleton", p, "nodes");
+    });
+
     each(doc_, "meshes", "", [&](const json& m, const std::string& p) {
       const json* prims = member(m, "primitives", p, true);
       require_array(*prims, p + "/primitives");
@@ -287,6 +362,9 @@ class Checker {
         opt_index(prim, "indices", pp, "accessors");
         opt_index(prim, "material", pp, "materials");
         opt_integer(prim, "mode", pp, 0, 6);
+        each(prim, "targets", pp, [&](const json& t, const std::string& tp) {
+          for (auto it = t.begin(); it != t.end(); ++it) index(it.value(), tp + "/" + it.key(), "accessors");
+        });
       });
     });
 
@@ -299,6 +377,10 @@ class Checker {
              fmt::format("{} is not a glTF component type (5120 BYTE, 5121 UNSIGNED_BYTE, 5122 SHORT, "
                          "5123 UNSIGNED_SHORT, 5125 UNSIGNED_INT, 5126 FLOAT)", ct));
       opt_bool(a, "normalized", p);
+      if (const json* nm = find(a, "normalized"); nm && nm->get<bool>() && (ct == 5126 || ct == 5125))
+        fail(p + "/normalized", fmt::format("is true for component type {}; only 8- and 16-bit integers are "
+                                            "normalized",
+                                            ct == 5126 ? "FLOAT" : "UNSIGNED_INT"));
       opt_integer(a, "count", p, 1, (uint64_t{1} << 53), true);
       const std::string& type = string(*member(a, "type", p, true), p + "/type");
       if (type != "SCALAR" && type != "VEC2" && type != "VEC3" && type != "VEC4" && type != "MAT2" &&
@@ -324,17 +406,50 @@ class Checker {
       }
     });
 
+    each(doc_, "buffers", "", [&](const json& b, const std::string& p) {
+      opt_string(b, "uri", p);
+      opt_integer(b, "byteLength", p, 1, (uint64_t{1} << 53), true);
+    });
+
+    // The attributes' accessor types, now that the accessors are known to be well formed.
+    each(doc_, "meshes", "", [&](const json& m, const std::string& p) {
+      each(m, "primitives", p, [&](const json& prim, const std::string& pp) {
+        const json& attrs = *find(prim, "attributes");
+        for (auto it = attrs.begin(); it != attrs.end(); ++it) attribute_type(it.key(), it.value(), pp);
+      });
+    });
+
     each(doc_, "bufferViews", "", [&](const json& v, const std::string& p) {
       opt_index(v, "buffer", p, "buffers", true);
       opt_integer(v, "byteOffset", p);
       opt_integer(v, "byteLength", p, 1, (uint64_t{1} << 53), true);
       opt_integer(v, "byteStride", p, 4, 252);
+      if (const json* st = find(v, "byteStride"); st && st->get<uint64_t>() % 4 != 0)
+        fail(p + "/byteStride", fmt::format("{} is not a multiple of 4", st->get<uint64_t>()));
       opt_integer(v, "target", p);
+      // The view lies within its buffer's declared length (both were checked above).
+      const auto offset = find(v, "byteOffset") ? find(v, "byteOffset")->get<uint64_t>() : uint64_t{0};
+      const auto length = find(v, "byteLength")->get<uint64_t>();
+      const json& buffer = (*find(doc_, "buffers"))[find(v, "buffer")->get<size_t>()];
+      const auto size = find(buffer, "byteLength")->get<uint64_t>();
+      if (offset > size || length > size - offset)
+        fail(p, fmt::format("bytes [{}, {}) lie outside buffer {} of {} bytes", offset, offset + length,
+                            find(v, "buffer")->get<size_t>(), size));
     });
 
-    each(doc_, "buffers", "", [&](const json& b, const std::string& p) {
-      opt_string(b, "uri", p);
-      opt_integer(b, "byteLength", p, 1, (uint64_t{1} << 53), true);
+    // Accessors start at a multiple of their component size, in the view and in the buffer.
+    each(doc_, "accessors", "", [&](const json& a, const std::string& p) {
+      const json* view = find(a, "bufferView");
+      if (!view) return;
+      const uint64_t ct = find(a, "componentType")->get<uint64_t>();
+      const uint64_t size = ct == 5120 || ct == 5121 ? 1 : ct == 5122 || ct == 5123 ? 2 : 4;
+      const uint64_t offset = find(a, "byteOffset") ? find(a, "byteOffset")->get<uint64_t>() : 0;
+      const json& bv = (*find(doc_, "bufferViews"))[view->get<size_t>()];
+      const uint64_t view_offset = find(bv, "byteOffset") ? find(bv, "byteOffset")->get<uint64_t>() : 0;
+      if (offset % size != 0 || (view_offset + offset) % size != 0)
+        fail(p + "/byteOffset", fmt::format("the accessor starts at byte {} of its buffer (bufferView {} at {}, plus "
+                                            "{}), not a multiple of its component size {}",
+                                            view_offset + offset, view->get<size_t>(), view_offset, offset, size));
     });
 
     each(doc_, "materials", "", [&](const json& m, const std::string& p) {
@@ -366,6 +481,10 @@ class Checker {
       opt_string(im, "mimeType", p);
       if (!find(im, "uri") && !find(im, "bufferView"))
         fail(p, "image has neither 'uri' nor 'bufferView'");
+      if (find(im, "uri") && find(im, "bufferView"))
+        fail(p, "image has both 'uri' and 'bufferView'; give one");
+      if (find(im, "bufferView") && !find(im, "mimeType"))
+        fail(p + "/mimeType", "is required for an image in a bufferView (image/png or image/jpeg)");
     });
 
     each(doc_, "animations", "", [&](const json& a, const std::string& p) {
@@ -407,7 +526,14 @@ class Checker {
         if (const json* zf = member(*per, "zfar", pp))
           if (number(*zf, pp + "/zfar") <= znear) fail(pp + "/zfar", "must be greater than znear");
       } else if (type == "orthographic") {
-        require_object(*member(c, "orthographic", p, true), p + "/orthographic");
+        const std::string op = p + "/orthographic";
+        const json& o = require_object(*member(c, "orthographic", p, true), op);
+        for (const char* k : {"xmag", "ymag"})
+          if (number(*member(o, k, op, true), op + "/" + k) == 0.0) fail(op + "/" + k, "must not be zero");
+        const double znear = number(*member(o, "znear", op, true), op + "/znear");
+        if (znear < 0.0) fail(op + "/znear", fmt::format("znear {} must not be negative", znear));
+        if (number(*member(o, "zfar", op, true), op + "/zfar") <= znear)
+          fail(op + "/zfar", "must be greater than znear");
       } else {
         fail(p + "/type", fmt::format("'{}' is not a camera type (perspective, orthographic)", type));
       }

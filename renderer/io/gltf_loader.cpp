@@ -42,6 +42,8 @@ struct GlbParts {
   std::string json_text;
   bool is_glb = false;
   bool has_bin = false;  ///< a .glb with a BIN chunk
+  uint64_t bin_length = 0;  ///< its length in bytes
+  uint64_t json_end = 0;    ///< where the JSON chunk ends in the file (a .glb)
 };
 
 uint32_t read_u32(const std::string& bytes, size_t offset) {
@@ -102,9 +104,53 @@ GlbParts split_container(const std::string& bytes, const std::string& file, bool
                                    "written without its binary data; export the scene again",
                                    file, bin_at));
     parts.has_bin = true;
+    parts.bin_length = bin_len;
   }
+  parts.json_end = bin_at;
   parts.json_text = bytes.substr(20, json_len);
   return parts;
+}
+
+/// The file as tinygltf is to read it. tinygltf 2.7 refuses some valid files: a skin without
+/// inverseBindMatrices (optional in glTF 2.0), an animation channel without a target node, and an
+/// index accessor that has no bufferView (every index from sparse substitution). Skins are not
+/// played (nodes render in their bind pose; the converter reads their use from the JSON), so a file
+/// with skins is handed over without them. The other two are refused here, naming the JSON path.
+std::string tinygltf_input(const json& doc, const std::string& bytes, const GlbParts& parts, const std::string& file) {
+  if (auto anims = doc.find("animations"); anims != doc.end())
+    for (size_t a = 0; a < anims->size(); ++a)
+      if (auto chs = (*anims)[a].find("channels"); chs != (*anims)[a].end())
+        for (size_t c = 0; c < chs->size(); ++c)
+          if (!(*chs)[c].at("target").contains("node"))
+            throw InputError(fmt::format("{}: /animations/{}/channels/{}/target: a channel without a node (one an "
+                                         "extension targets) cannot be read here; remove the channel",
+                                         file, a, c));
+  if (auto meshes = doc.find("meshes"); meshes != doc.end())
+    for (size_t m = 0; m < meshes->size(); ++m)
+      for (size_t p = 0; p < (*meshes)[m].at("primitives").size(); ++p) {
+        const json& prim = (*meshes)[m]["primitives"][p];
+        if (auto i = prim.find("indices"); i != prim.end() && !doc["accessors"][i->get<size_t>()].contains("bufferView"))
+          throw InputError(fmt::format("{}: /meshes/{}/primitives/{}/indices: accessor {} has no bufferView (its "
+                                       "indices all come from sparse substitution), which cannot be read here; "
+                                       "export the indices densely",
+                                       file, m, p, i->get<size_t>()));
+      }
+  if (!doc.contains("skins")) return bytes;
+  json reduced = doc;
+  reduced.erase("skins");
+  for (json& node : reduced["nodes"]) node.erase("skin");
+  std::string text = reduced.dump();
+  if (!parts.is_glb) return text;
+  // A .glb: the new JSON chunk (padded with spaces to 4 bytes) before the file's own BIN chunk.
+  while (text.size() % 4 != 0) text.push_back(' ');
+  const std::string rest = bytes.substr(parts.json_end);
+  const auto u32 = [](uint64_t v) {
+    std::string out(4, '\0');
+    for (int i = 0; i < 4; ++i) out[static_cast<size_t>(i)] = static_cast<char>((v >> (8 * i)) & 0xFF);
+    return out;
+  };
+  return bytes.substr(0, 8) + u32(20 + text.size() + rest.size()) + u32(text.size()) + bytes.substr(16, 4) + text +
+         rest;
 }
 
 /// A JSON parser message with the token it last read cut to 40 characters: a syntax error inside
@@ -138,12 +184,37 @@ std::string percent_decode(const std::string& s) {
 }
 
 /// A base64 data URI buffer must decode to exactly its declared byteLength (as the loader demands).
-void check_data_uri_length(const json& buffer, const std::string& where, const std::string& file) {
-  const std::string& uri = buffer.at("uri").get_ref<const std::string&>();
+/// A base64 data URI of one of the media types glTF names for `top` ("buffers" or "images"), its
+/// payload of base64 characters only.
+void check_data_uri(const std::string& uri, const std::string& top, const std::string& where, const std::string& file) {
   const size_t comma = uri.find(',');
   if (comma == std::string::npos || uri.rfind(";base64", comma) == std::string::npos)
     throw InputError(fmt::format("{}: {}/uri: data URI is not base64-encoded; only base64 data URIs are "
                                  "supported", file, where));
+  const std::string type = uri.substr(5, uri.rfind(";base64", comma) - 5);
+  const bool known = top == "buffers" ? type == "application/octet-stream" || type == "application/gltf-buffer"
+                                      : type == "image/png" || type == "image/jpeg";
+  if (!known)
+    throw InputError(fmt::format("{}: {}/uri: data URI of media type '{}'; {} take {}", file, where, type, top,
+                                 top == "buffers" ? "'data:application/octet-stream;base64,...'"
+                                                  : "'data:image/png;base64,...' or 'data:image/jpeg;base64,...'"));
+  size_t end = uri.size();
+  for (size_t pad = 0; end > comma + 1 && pad < 2 && uri[end - 1] == '='; ++pad) --end;
+  for (size_t i = comma + 1; i < end; ++i) {
+    const auto c = static_cast<unsigned char>(uri[i]);
+    if (!std::isalnum(c) && c != '+' && c != '/')
+      throw InputError(fmt::format("{}: {}/uri: the data URI's base64 payload has the character '{}' at position "
+                                   "{}; the data is damaged, export the scene again",
+                                   file, where, std::isprint(c) ? std::string(1, static_cast<char>(c))
+                                                                : fmt::format("\\x{:02x}", c),
+                                   i - comma - 1));
+  }
+}
+
+void check_data_uri_length(const json& buffer, const std::string& where, const std::string& file) {
+  const std::string& uri = buffer.at("uri").get_ref<const std::string&>();
+  check_data_uri(uri, "buffers", where, file);
+  const size_t comma = uri.find(',');
   size_t chars = uri.size() - comma - 1;
   size_t pad = 0;
   while (chars > 0 && pad < 2 && uri[comma + chars] == '=') { --chars; ++pad; }
@@ -219,10 +290,16 @@ AllowedFiles check_external_files(const json& doc, const fs::path& dir, const st
               "{}: /buffers/{}: has no uri, {}; give it the uri of its .bin file or a data URI", file, i,
               parts.is_glb && i == 0 ? "so it is the .glb's BIN chunk, but the file has none (damaged or truncated)"
                                      : "which only the first buffer of a .glb may omit (it is the BIN chunk)"));
+        // The BIN chunk may be padded to 4 bytes past the buffer, never shorter.
+        if (std::string(top) == "buffers" && e.at("byteLength").get<uint64_t>() > parts.bin_length)
+          throw InputError(fmt::format("{}: /buffers/0/byteLength: {} bytes, but the .glb's BIN chunk holds {}; the "
+                                       "file is damaged or truncated, export the scene again",
+                                       file, e.at("byteLength").get<uint64_t>(), parts.bin_length));
         continue;
       }
       if (is_data_uri(u->get<std::string>())) {
         if (std::string(top) == "buffers") check_data_uri_length(e, fmt::format("/buffers/{}", i), file);
+        else check_data_uri(u->get<std::string>(), top, fmt::format("/images/{}", i), file);
         continue;
       }
       const std::string where = fmt::format("/{}/{}/uri", top, i);
@@ -369,7 +446,8 @@ class Converter {
                                    "area (its vertices coincide or lie on one line), so nothing can be seen; check "
                                    "the primitives' indices and POSITION accessors, or pick another scene",
                                    file_, scene.triangle_count()));
-    if (!m_.skins.empty()) warn("skins", fmt::format("{} skin(s) ignored: meshes render in their bind pose", m_.skins.size()));
+    if (auto skins = doc_.find("skins"); skins != doc_.end() && !skins->empty())  // not handed to tinygltf
+      warn("skins", fmt::format("{} skin(s) ignored: meshes render in their bind pose", skins->size()));
     for (const auto& [key, count] : warning_counts_)
       scene.warnings.push_back(count > 1 ? fmt::format("{} ({} occurrences)", warning_text_[key], count)
                                          : warning_text_[key]);
@@ -393,12 +471,13 @@ class Converter {
   }
 
   void check_extensions() {
-    static const std::set<std::string> supported = {"KHR_lights_punctual"};
+    static const std::set<std::string> supported = {"KHR_lights_punctual", "KHR_mesh_quantization"};
     for (size_t i = 0; i < m_.extensionsRequired.size(); ++i)
       if (!supported.count(m_.extensionsRequired[i]))
         fail(fmt::format("/extensionsRequired/{}", i),
              fmt::format("extension '{}' is required by the file but not supported (supported: "
-                         "KHR_lights_punctual); re-export without it", m_.extensionsRequired[i]));
+                         "KHR_lights_punctual, KHR_mesh_quantization); re-export without it",
+                         m_.extensionsRequired[i]));
     for (const std::string& e : m_.extensionsUsed)
       if (!supported.count(e)) warn("ext:" + e, fmt::format("extension '{}' is ignored", e));
   }
@@ -451,13 +530,18 @@ class Converter {
         for (int c = 0; c < v.components; ++c)
           out[i * v.components + c] =
               read_component(v.base + i * v.stride + c * v.component_size, v.component_type, v.normalized);
-    apply_sparse(index, v, out);
+    for_each_sparse(index, v, [&](uint32_t target, const unsigned char* value) {
+      for (int c = 0; c < v.components; ++c)
+        out[target * v.components + c] = read_component(value + c * v.component_size, v.component_type, v.normalized);
+    });
     for (float f : out)
       if (!std::isfinite(f)) fail(fmt::format("/accessors/{}", index), fmt::format("contains a non-finite value (used by {})", path));
     return out;
   }
 
-  void apply_sparse(int index, const AccessorView& v, std::vector<float>& out) {
+  /// Calls set(element, value bytes) for every sparse substitution of accessor `index`, in order.
+  template <class Set>
+  void for_each_sparse(int index, const AccessorView& v, Set&& set) {
     const tinygltf::Accessor& a = m_.accessors[static_cast<size_t>(index)];
     if (!a.sparse.isSparse) return;
     const std::string sp = fmt::format("/accessors/{}/sparse", index);
@@ -478,8 +562,7 @@ class Converter {
       const uint32_t target = read_index(idx + i * isize, a.sparse.indices.componentType);
       if (target >= v.count)
         fail(sp + "/indices", fmt::format("sparse index {} at element {} is out of range for {} elements", target, i, v.count));
-      for (int c = 0; c < v.components; ++c)
-        out[target * v.components + c] = read_component(val + i * elem + c * v.component_size, v.component_type, v.normalized);
+      set(target, val + i * elem);
     }
   }
 
@@ -492,11 +575,12 @@ class Converter {
         v.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
       fail(path, fmt::format("index accessor {} has component type {}; indices must be UNSIGNED_BYTE, "
                              "UNSIGNED_SHORT or UNSIGNED_INT", index, v.component_type));
-    if (m_.accessors[static_cast<size_t>(index)].sparse.isSparse)
-      warn("sparse-indices", "sparse index accessors (the dense part is used)");
     std::vector<uint32_t> out(v.count, 0);
     if (v.base)
       for (size_t i = 0; i < v.count; ++i) out[i] = read_index(v.base + i * v.stride, v.component_type);
+    for_each_sparse(index, v, [&](uint32_t target, const unsigned char* value) {
+      out[target] = read_index(value, v.component_type);
+    });
     for (size_t i = 0; i < out.size(); ++i)
       if (out[i] >= vertex_count)
         fail(fmt::format("/accessors/{}", index),
@@ -518,6 +602,10 @@ class Converter {
       if (gm.normalTexture.index >= 0) warn("normalTexture", "normal textures are ignored (geometric or vertex normals are used)");
       if (gm.emissiveTexture.index >= 0 || gm.emissiveFactor[0] > 0 || gm.emissiveFactor[1] > 0 || gm.emissiveFactor[2] > 0)
         warn("emissive", "emission is ignored (direct light from punctual lights only)");
+      if (gm.occlusionTexture.index >= 0)
+        warn("occlusionTexture", "occlusion textures are ignored (direct light only; the ambient term is not occluded)");
+      if (gm.pbrMetallicRoughness.metallicRoughnessTexture.index >= 0)
+        warn("metallicRoughnessTexture", "metallic-roughness textures are ignored (surfaces are Lambertian)");
       if (gm.alphaMode != "OPAQUE") warn("alpha:" + gm.alphaMode, fmt::format("alphaMode {} (rendered as OPAQUE)", gm.alphaMode));
       for (const auto& [ext, value] : gm.extensions) warn("ext:" + ext, fmt::format("material extension '{}' is ignored", ext));
       const int t = gm.pbrMetallicRoughness.baseColorTexture.index;
@@ -617,9 +705,11 @@ class Converter {
     a.local.clear();
     for (const tinygltf::Node& n : m_.nodes) a.local.push_back(local_of(n));
     size_t weights = 0, outside = 0;
-    std::map<std::pair<int, int>, std::string> keyed;  // (node, property) -> the channel keying it
     for (size_t ai = 0; ai < m_.animations.size(); ++ai) {
       const tinygltf::Animation& anim = m_.animations[ai];
+      a.clips.push_back(anim.name);
+      // glTF 2.0 §3.11: within one animation, a node's property is keyed by one channel at most.
+      std::map<std::pair<int, int>, std::string> keyed;  // (node, property) -> the channel keying it
       for (size_t ci = 0; ci < anim.channels.size(); ++ci) {
         const tinygltf::AnimationChannel& gc = anim.channels[ci];
         const std::string cpath = fmt::format("/animations/{}/channels/{}", ai, ci);
@@ -632,6 +722,7 @@ class Converter {
           fail(cpath + "/target/node", fmt::format("node {} does not exist (the file has {} nodes)", gc.target_node,
                                                    m_.nodes.size()));
         NodeAnimation::Channel ch;
+        ch.clip = static_cast<int>(ai);
         ch.node = gc.target_node;
         int width = 3;
         if (gc.target_path == "translation") ch.property = NodeAnimation::Property::translation;
@@ -688,10 +779,9 @@ class Converter {
         ch.values.assign(values.begin(), values.end());
         const auto [it, first] = keyed.emplace(std::pair(ch.node, static_cast<int>(ch.property)), cpath);
         if (!first)
-          warn(fmt::format("animation-twice-{}", cpath),
-               fmt::format("{} keys node {}'s {} as {} does; every animation plays at once, and the later channel in "
-                           "file order wins",
-                           cpath, ch.node, gc.target_path, it->second));
+          fail(cpath + "/target", fmt::format("keys node {}'s {} as {} does; within one animation a node's property may "
+                                              "be keyed by one channel only",
+                                              ch.node, gc.target_path, it->second));
         a.channels.push_back(std::move(ch));
       }
     }
@@ -700,10 +790,11 @@ class Converter {
       warn("animation-outside", fmt::format("{} animation channel(s) key nodes outside the loaded scene and are not "
                                             "played", outside));
     if (!a.channels.empty())
-      scene.warnings.push_back(fmt::format("{} animation(s) with {} node channel(s): a still image shows the nodes at rest; "
-                                        "a path plays them (`stereobench path --gltf-animation`, a sweep's "
-                                        "[path] gltf_animation = true)",
-                                        m_.animations.size(), a.channels.size()));
+      scene.warnings.push_back(fmt::format("{} animation(s) ({}) with {} node channel(s): a still image shows the nodes "
+                                           "at rest; a path plays them (`stereobench path --gltf-animation`, or "
+                                           "`--gltf-clip NAME` for one; a sweep's [path] gltf_animation = true, or "
+                                           "gltf_clip = \"NAME\")",
+                                           m_.animations.size(), a.clip_list(), a.channels.size()));
   }
 
   /// Walks the scene's node forest iteratively (deep or cyclic hierarchies cannot overflow the stack).
@@ -803,14 +894,15 @@ class Converter {
   void visit(Scene& scene, int ni, const dmat4& world) {
     const tinygltf::Node& n = m_.nodes[static_cast<size_t>(ni)];
     const std::string npath = fmt::format("/nodes/{}", ni);
-    if (n.skin >= 0) warn("node-skin", "skinned nodes render in their bind pose");
+    if (doc_.at("nodes")[static_cast<size_t>(ni)].contains("skin"))  // skins are not handed to tinygltf
+      warn("node-skin", "skinned nodes render in their bind pose");
     if (n.mesh >= 0) convert_mesh(scene, ni, n.mesh, world);
     if (n.camera >= 0) convert_camera(scene, ni, world);
     auto ext = n.extensions.find("KHR_lights_punctual");
     if (ext != n.extensions.end()) {
-      if (scene.animation.moves(ni)) warn("animated-light", "lights on animated nodes stay where they are at rest");
       const int li = ext->second.Get("light").GetNumberAsInt();
       convert_light(scene, li, world);
+      scene.lights.back().node = ni;
     }
   }
 
@@ -862,10 +954,32 @@ class Converter {
                            v, mesh.name, p.x, p.y, p.z, kMaxSceneCoordinate));
         mesh.positions[v] = vec3(p);
       }
+      // Every other attribute has POSITION's count: checked before it is read, so that a small
+      // file cannot make the loader allocate for a count it does not have.
+      const auto same_count = [&](int accessor, const std::string& where) {
+        const size_t n = view_of(accessor, where).count;
+        if (n != nv) fail(where, fmt::format("accessor {} has {} elements but POSITION has {}", accessor, n, nv));
+      };
+      for (const auto& [name, accessor] : prim.attributes)
+        if (name.rfind("COLOR_", 0) == 0)
+          warn("vertex-colors", "vertex colours (COLOR_n) are ignored: the base colour is the material's factor and "
+                                "texture");
+      std::vector<float> nrm;
       if (auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
-        const std::vector<float> nrm = read_floats(it->second, 3, ppath + "/attributes/NORMAL");
-        if (nrm.size() != pos.size())
-          fail(ppath + "/attributes/NORMAL", fmt::format("has {} elements but POSITION has {}", nrm.size() / 3, nv));
+        same_count(it->second, ppath + "/attributes/NORMAL");
+        nrm = read_floats(it->second, 3, ppath + "/attributes/NORMAL");
+        // glTF normals are unit length; a zero one has no direction to interpolate.
+        size_t zero = 0;
+        for (size_t v = 0; v < nv; ++v) zero += nrm[v * 3] == 0.0f && nrm[v * 3 + 1] == 0.0f && nrm[v * 3 + 2] == 0.0f;
+        if (zero > 0) {
+          scene.warnings.push_back(
+              fmt::format("{}/attributes/NORMAL: {} of the {} vertex normals have length zero (accessor {}); the "
+                          "primitive is shaded with its geometric normals",
+                          ppath, zero, nv, it->second));
+          nrm.clear();
+        }
+      }
+      if (!nrm.empty()) {
         mesh.normals.resize(nv);
         if (animated) {
           mesh.local_normals.resize(nv);
@@ -880,9 +994,8 @@ class Converter {
       const int tc = prim.material >= 0 ? scene.materials[static_cast<size_t>(prim.material)].texcoord : 0;
       const std::string uv_name = fmt::format("TEXCOORD_{}", tc);
       if (auto it = prim.attributes.find(uv_name); it != prim.attributes.end()) {
+        same_count(it->second, ppath + "/attributes/" + uv_name);
         const std::vector<float> uv = read_floats(it->second, 2, ppath + "/attributes/" + uv_name);
-        if (uv.size() / 2 != nv)
-          fail(ppath + "/attributes/" + uv_name, fmt::format("has {} elements but POSITION has {}", uv.size() / 2, nv));
         mesh.uvs.resize(nv);
         for (size_t v = 0; v < nv; ++v) mesh.uvs[v] = vec2(uv[v * 2], uv[v * 2 + 1]);
       } else if (prim.material >= 0 && scene.materials[static_cast<size_t>(prim.material)].base_color_texture >= 0) {
@@ -1050,6 +1163,8 @@ Scene load_gltf(const fs::path& path, const GltfLoadOptions& options) {
   const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
   AllowedFiles allowed = check_external_files(doc, dir, file, parts);
 
+  const std::string input = tinygltf_input(doc, bytes, parts, file);
+
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(keep_image_bytes, nullptr);
   loader.SetFsCallbacks({allowed_file_exists, tinygltf::ExpandFilePath, read_allowed_file, tinygltf::WriteWholeFile,
@@ -1057,9 +1172,9 @@ Scene load_gltf(const fs::path& path, const GltfLoadOptions& options) {
   tinygltf::Model model;
   std::string err, warn;
   const bool ok = parts.is_glb
-      ? loader.LoadBinaryFromMemory(&model, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),
-                                    static_cast<unsigned int>(bytes.size()), dir.string())
-      : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), static_cast<unsigned int>(bytes.size()),
+      ? loader.LoadBinaryFromMemory(&model, &err, &warn, reinterpret_cast<const unsigned char*>(input.data()),
+                                    static_cast<unsigned int>(input.size()), dir.string())
+      : loader.LoadASCIIFromString(&model, &err, &warn, input.data(), static_cast<unsigned int>(input.size()),
                                    dir.string());
   if (!ok || !err.empty()) {
     while (!err.empty() && (err.back() == '\n' || err.back() == '\r')) err.pop_back();

@@ -52,7 +52,10 @@ TEST(PathCommand, TheScenesGltfAnimationMovesItsMeshAndCamera) {
                            (dir / "out").string() + "' --frames 3";
   const test::CliRun r = test::run_cli(base + " --gltf-animation --pipelines plain-rt,repro-rt");
   ASSERT_EQ(r.code, 0) << r.out;
-  EXPECT_NE(r.out.find("the scene's glTF animation from 0 s to 2 s (BVH refit)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("the scene's glTF animation ('animation') from 0 s to 2 s, 1 mesh(es) and 0 light(s) moving "
+                       "(BVH refit)"),
+            std::string::npos)
+      << r.out;
   const std::vector<json> frames = frame_lines(dir / "out" / "path-animation-test_path.jsonl");
   ASSERT_EQ(frames.size(), 3u);
   for (int f = 0; f < 3; ++f) {
@@ -63,11 +66,16 @@ TEST(PathCommand, TheScenesGltfAnimationMovesItsMeshAndCamera) {
     EXPECT_GT(frames[f]["pipelines"]["repro-rt"]["metrics"]["psnr"].get<double>(), 30.0);
   }
   EXPECT_EQ(frames[1]["bvh"], "refit") << "the box moves";
+  EXPECT_EQ(frames[0]["animation"]["gltf_clip"], nullptr) << "every clip";
+  // One clip by name, which implies --gltf-animation; the record names it.
+  const test::CliRun clip = test::run_cli(base + " --gltf-clip animation --pipelines plain-rt");
+  ASSERT_EQ(clip.code, 0) << clip.out;
+  EXPECT_EQ(frame_lines(dir / "out" / "path-animation-test_path.jsonl")[0]["animation"]["gltf_clip"], "animation");
   // The truth of the same frame without the animation differs: the box and camera did move.
   EXPECT_NE(frames[0]["true_disocclusion_fraction"], frames[2]["true_disocclusion_fraction"]);
   // Blender renders the file at rest; with camera keys or a spin the path has two masters.
   for (const char* bad : {" --gltf-animation --truth blender", " --gltf-animation --spin-deg 5",
-                          " --gltf-animation --camera-keys '0,1,6>0,0.5,0'"}) {
+                          " --gltf-animation --camera-keys '0,1,6>0,0.5,0'", " --gltf-clip walk"}) {
     const test::CliRun refused = test::run_cli(base + bad + " --pipelines plain-rt");
     EXPECT_EQ(refused.code, 3) << bad << "\n" << refused.out;
   }

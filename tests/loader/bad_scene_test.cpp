@@ -34,6 +34,7 @@ int add_camera(MiniGltf& g, const json& node, bool root = true) {
   g.doc["cameras"] = json::array({{{"type", "perspective"}, {"perspective", {{"yfov", 0.7}, {"znear", 0.1}}}}});
   json n = {{"camera", 0}, {"translation", {0, 0, 3}}};
   n.update(node);
+  if (n.contains("matrix")) n.erase("translation");  // a node has a matrix or TRS, not both
   return g.add_node(n, root);
 }
 
@@ -112,7 +113,7 @@ std::vector<BadCase> corpus() {
   c.push_back({"stride_out_of_range", "a.gltf", edited([](MiniGltf& g) { g.doc["bufferViews"][0]["byteStride"] = 2; }), "/bufferViews/0/byteStride: value 2 is out of range"});
   c.push_back({"bad_component_type", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["componentType"] = 5124; }), "/accessors/0/componentType"});
   c.push_back({"bad_accessor_type", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["type"] = "VEC5"; }), "/accessors/0/type"});
-  c.push_back({"position_wrong_type", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["type"] = "VEC2"; }), "/meshes/0/primitives/0/attributes/POSITION: accessor 0 has type VEC2"});
+  c.push_back({"position_wrong_type", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["type"] = "VEC2"; }), "/meshes/0/primitives/0/attributes/POSITION: accessor 0 is VEC2 of component type 5126; POSITION must be VEC3"});
   c.push_back({"index_value_out_of_range", "a.gltf", edited([](MiniGltf& g) {
     std::vector<uint16_t> idx = {0, 1, 7, 0};
     const int a = g.add_accessor(g.add_view(idx), 5123, 3, "SCALAR");
@@ -296,6 +297,90 @@ std::vector<BadCase> corpus() {
   c.push_back({"lights_not_an_array", "a.gltf",
                edited([](MiniGltf& g) { g.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::object(); }),
                "/extensions/KHR_lights_punctual/lights: expected a JSON array"});
+  // An image's bufferView outside its buffer was read out of bounds (a segmentation fault).
+  c.push_back({"image_view_outside_buffer", "a.gltf", edited([](MiniGltf& g) {
+    std::vector<unsigned char> png(16, 0x42);
+    const int v = g.add_view(png.data(), png.size());
+    g.doc["bufferViews"][v]["byteOffset"] = 100000000;
+    g.doc["images"] = json::array({{{"bufferView", v}, {"mimeType", "image/png"}}});
+  }), "/bufferViews/1: bytes [100000000, 100000016) lie outside buffer 0"});
+  c.push_back({"stride_not_multiple_of_4", "a.gltf", edited([](MiniGltf& g) { g.doc["bufferViews"][0]["byteStride"] = 13; }),
+               "/bufferViews/0/byteStride: 13 is not a multiple of 4"});
+  c.push_back({"image_uri_and_view", "a.gltf", edited([](MiniGltf& g) {
+    std::vector<unsigned char> png(16, 0x42);
+    g.doc["images"] = json::array({{{"uri", "a.png"}, {"bufferView", g.add_view(png.data(), png.size())}, {"mimeType", "image/png"}}});
+  }), "/images/0: image has both 'uri' and 'bufferView'"});
+  c.push_back({"image_view_without_mime_type", "a.gltf", edited([](MiniGltf& g) {
+    std::vector<unsigned char> png(16, 0x42);
+    g.doc["images"] = json::array({{{"bufferView", g.add_view(png.data(), png.size())}}});
+  }), "/images/0/mimeType: is required"});
+  c.push_back({"orthographic_without_xmag", "a.gltf", edited([](MiniGltf& g) {
+    g.doc["cameras"] = json::array({{{"type", "orthographic"}, {"orthographic", {{"ymag", 1}, {"znear", 0}, {"zfar", 9}}}}});
+  }), "/cameras/0/orthographic/xmag: required"});
+  c.push_back({"matrix_and_translation", "a.gltf", edited([](MiniGltf& g) {
+    g.doc["nodes"][0]["matrix"] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    g.doc["nodes"][0]["translation"] = {1, 0, 0};
+  }), "/nodes/0/translation: the node has a matrix too"});
+  // The second parent lies outside the scene: the traversal never meets the node twice.
+  c.push_back({"two_parents_one_outside_the_scene", "a.gltf", edited([](MiniGltf& g) {
+    g.add_node({{"children", {0}}}, false);
+    g.add_node({{"children", {0}}});
+    g.doc["scenes"][0]["nodes"] = {2};
+  }), "/nodes/2/children/0: node 0 is already a child at /nodes/1/children/0"});
+  c.push_back({"skin_out_of_range", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["skin"] = 3; }),
+               "/nodes/0/skin: refers to skins[3]"});
+  c.push_back({"morph_target_out_of_range", "a.gltf", edited([](MiniGltf& g) {
+    g.doc["meshes"][0]["primitives"][0]["targets"] = json::array({{{"POSITION", 9}}});
+  }), "/meshes/0/primitives/0/targets/0/POSITION: refers to accessors[9]"});
+  c.push_back({"position_unsigned_byte", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["componentType"] = 5121; }),
+               "POSITION must be VEC3 of FLOAT (5126) (integer types need KHR_mesh_quantization)"});
+  c.push_back({"float_normalized", "a.gltf", edited([](MiniGltf& g) { g.doc["accessors"][0]["normalized"] = true; }),
+               "/accessors/0/normalized: is true for component type FLOAT"});
+  c.push_back({"misaligned_accessor", "a.gltf", edited([](MiniGltf& g) {
+    g.doc["accessors"][0]["byteOffset"] = 1;
+    g.doc["accessors"][0]["count"] = 2;
+  }), "/accessors/0/byteOffset: the accessor starts at byte 1 of its buffer"});
+  // A count far beyond POSITION's was read (gigabytes) before it was compared.
+  c.push_back({"normal_count_beyond_positions", "a.gltf", edited([](MiniGltf& g) {
+    g.doc["accessors"].push_back({{"componentType", 5126}, {"count", 100000000}, {"type", "VEC3"}});
+    g.doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = 1;
+  }), "/meshes/0/primitives/0/attributes/NORMAL: accessor 1 has 100000000 elements but POSITION has 3"});
+  // tinygltf's own messages named no JSON path, quoted whole payloads or misled.
+  c.push_back({"glb_buffer_longer_than_bin", "a.glb", [](const std::filesystem::path& p) {
+    MiniGltf g;
+    g.add_triangle();
+    g.finish_buffer("");
+    g.doc["buffers"][0]["byteLength"] = 124;
+    g.write_glb(p);
+  }, "/buffers/0/byteLength: 124 bytes, but the .glb's BIN chunk holds 36"});
+  c.push_back({"base64_bad_character", "a.gltf", [](const std::filesystem::path& p) {
+    MiniGltf g;
+    g.add_triangle();
+    std::string payload = MiniGltf::base64(g.bin);
+    payload[5] = '!';
+    g.finish_buffer("data:application/octet-stream;base64," + payload);
+    MiniGltf::write_text(p, g.doc.dump());
+  }, "/buffers/0/uri: the data URI's base64 payload has the character '!' at position 5"});
+  c.push_back({"data_uri_without_media_type", "a.gltf", [](const std::filesystem::path& p) {
+    MiniGltf g;
+    g.add_triangle();
+    g.finish_buffer("data:;base64," + MiniGltf::base64(g.bin));
+    MiniGltf::write_text(p, g.doc.dump());
+  }, "/buffers/0/uri: data URI of media type ''; buffers take 'data:application/octet-stream;base64,...'"});
+  c.push_back({"channel_without_node", "a.gltf", edited([](MiniGltf& g) {
+    std::vector<float> t = {0.0f};
+    std::vector<float> v = {0, 0, 0};
+    const int in = g.add_accessor(g.add_view(t), 5126, 1, "SCALAR");
+    g.doc["accessors"][in]["min"] = {0};
+    g.doc["accessors"][in]["max"] = {0};
+    const int out = g.add_accessor(g.add_view(v), 5126, 1, "VEC3");
+    g.doc["animations"] = json::array({{{"samplers", {{{"input", in}, {"output", out}}}},
+                                        {"channels", {{{"sampler", 0}, {"target", {{"path", "translation"}}}}}}}});
+  }), "/animations/0/channels/0/target: a channel without a node"});
+  c.push_back({"index_accessor_without_view", "a.gltf", edited([](MiniGltf& g) {
+    g.doc["accessors"].push_back({{"componentType", 5123}, {"count", 3}, {"type", "SCALAR"}});
+    g.doc["meshes"][0]["primitives"][0]["indices"] = 1;
+  }), "/meshes/0/primitives/0/indices: accessor 1 has no bufferView"});
   return c;
 }
 

@@ -93,6 +93,9 @@ TEST(GltfLoader, EveryComponentTypeStrideAndNormalisation) {
       {{"attributes", {{"POSITION", pos}}}, {"indices", ic}, {"material", 0}},
   }));
   g.add_node({{"mesh", m}});
+  // Normals of normalized bytes are KHR_mesh_quantization's; the core allows only floats.
+  g.doc["extensionsUsed"] = {"KHR_mesh_quantization"};
+  g.doc["extensionsRequired"] = {"KHR_mesh_quantization"};
   g.write_gltf(dir / "a.gltf");
   const Scene scene = io::load_gltf(dir / "a.gltf");
   ASSERT_EQ(scene.meshes.size(), 3u);
@@ -128,6 +131,88 @@ TEST(GltfLoader, SparseAccessorAndAccessorWithoutView) {
   const Scene scene = io::load_gltf(dir / "s.gltf");
   expect_vec3(scene.meshes[0].positions[1], {5, 5, 5});
   expect_vec3(scene.meshes[0].positions[2], {0, 1, 0});
+}
+
+TEST(GltfLoader, SparseIndicesAreSubstituted) {
+  // A quad's second triangle written as a copy of the first, corrected by sparse substitution
+  // (glTF 2.0 §3.6.2.3 applies to every accessor, indices too).
+  ScratchDir dir("sparse-indices");
+  MiniGltf g;
+  const int pos = g.add_positions({0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0});
+  std::vector<uint16_t> dense = {0, 1, 2, 0, 1, 2};
+  const int idx = g.add_accessor(g.add_view(dense), 5123, 6, "SCALAR");
+  std::vector<uint8_t> where = {4, 5, 0, 0};
+  std::vector<uint16_t> values = {2, 3};
+  g.doc["accessors"][idx]["sparse"] = {{"count", 2},
+                                       {"indices", {{"bufferView", g.add_view(where)}, {"componentType", 5121}}},
+                                       {"values", {{"bufferView", g.add_view(values)}}}};
+  g.add_node({{"mesh", g.add_mesh(json::array({{{"attributes", {{"POSITION", pos}}}, {"indices", idx}}}))}});
+  g.write_gltf(dir / "q.gltf");
+  const Scene scene = io::load_gltf(dir / "q.gltf");
+  ASSERT_EQ(scene.meshes.size(), 1u);
+  EXPECT_EQ(scene.meshes[0].indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3}));
+  for (const std::string& w : scene.warnings) EXPECT_EQ(w.find("sparse index"), std::string::npos) << w;
+}
+
+TEST(GltfLoader, ZeroLengthNormalsFallBackToTheGeometricNormalWithAWarning) {
+  ScratchDir dir("zero-normals");
+  MiniGltf g;
+  const int pos = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  std::vector<float> normals = {0, 0, 1, 0, 0, 0, 0, 0, 1};
+  const int nrm = g.add_accessor(g.add_view(normals), 5126, 3, "VEC3");
+  g.add_node({{"mesh", g.add_mesh(json::array({{{"attributes", {{"POSITION", pos}, {"NORMAL", nrm}}}}}))}});
+  g.write_gltf(dir / "z.gltf");
+  const Scene scene = io::load_gltf(dir / "z.gltf");
+  ASSERT_EQ(scene.meshes.size(), 1u);
+  EXPECT_TRUE(scene.meshes[0].normals.empty()) << "shaded with the geometric normal";
+  const auto named = std::count_if(scene.warnings.begin(), scene.warnings.end(), [](const std::string& w) {
+    return w.find("/meshes/0/primitives/0/attributes/NORMAL: 1 of the 3 vertex normals have length zero") !=
+           std::string::npos;
+  });
+  EXPECT_EQ(named, 1) << fmt::format("{}", fmt::join(scene.warnings, "\n"));
+}
+
+TEST(GltfLoader, QuantizedPositionsLoadWithKhrMeshQuantization) {
+  ScratchDir dir("quantized");
+  MiniGltf g;
+  // Integer positions (not normalized) scaled by the node, as KHR_mesh_quantization allows.
+  std::vector<int16_t> xyz = {0, 0, 0, 1000, 0, 0, 0, 1000, 0, 0};
+  const int pos = g.add_accessor(g.add_view(xyz.data(), 9 * sizeof(int16_t)), 5122, 3, "VEC3");
+  g.doc["accessors"][pos]["min"] = {0, 0, 0};
+  g.doc["accessors"][pos]["max"] = {1000, 1000, 0};
+  g.add_node({{"mesh", g.add_mesh(json::array({{{"attributes", {{"POSITION", pos}}}}}))},
+              {"scale", {0.001, 0.001, 0.001}}});
+  g.write_gltf(dir / "plain.gltf");
+  EXPECT_THROW((void)io::load_gltf(dir / "plain.gltf"), InputError) << "integer positions need the extension";
+  g.doc["extensionsUsed"] = {"KHR_mesh_quantization"};
+  g.doc["extensionsRequired"] = {"KHR_mesh_quantization"};
+  g.write_gltf(dir / "q.gltf");
+  const Scene scene = io::load_gltf(dir / "q.gltf");
+  ASSERT_EQ(scene.meshes.size(), 1u);
+  expect_vec3(scene.meshes[0].positions[1], {1, 0, 0});
+  expect_vec3(scene.meshes[0].positions[2], {0, 1, 0});
+}
+
+TEST(GltfLoader, ASkinWithoutInverseBindMatricesLoadsInItsBindPose) {
+  // inverseBindMatrices is optional in glTF 2.0 (identity matrices); the skin is not played.
+  ScratchDir dir("skin");
+  for (const char* name : {"s.gltf", "s.glb"}) {
+    MiniGltf g;
+    g.add_triangle();
+    g.add_node({{"translation", {0, 1, 0}}}, false);
+    g.doc["nodes"][0]["skin"] = 0;
+    g.doc["nodes"][0]["children"] = {1};
+    g.doc["skins"] = json::array({{{"joints", {1}}}});
+    if (std::string(name).ends_with(".glb")) g.write_glb(dir / name);
+    else g.write_gltf(dir / name);
+    const Scene scene = io::load_gltf(dir / name);
+    ASSERT_EQ(scene.meshes.size(), 1u) << name;
+    expect_vec3(scene.meshes[0].positions[1], {1, 0, 0});
+    EXPECT_EQ(std::count_if(scene.warnings.begin(), scene.warnings.end(),
+                            [](const std::string& w) { return w.find("1 skin(s) ignored") != std::string::npos; }),
+              1)
+        << name;
+  }
 }
 
 TEST(GltfLoader, APrimitiveWhosePositionsAreAllZeroIsSkippedWithAWarning) {
@@ -345,12 +430,16 @@ TEST(GltfLoader, UnsupportedFeaturesAreNamedOnce) {
   ScratchDir dir("unsup");
   MiniGltf g;
   const int pos = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
-  g.doc["materials"] = json::array({{{"normalTexture", {{"index", 0}}}}, {{"normalTexture", {{"index", 0}}}}});
+  g.doc["materials"] = json::array(
+      {{{"normalTexture", {{"index", 0}}}, {"occlusionTexture", {{"index", 0}}}},
+       {{"normalTexture", {{"index", 0}}}, {"pbrMetallicRoughness", {{"metallicRoughnessTexture", {{"index", 0}}}}}}});
+  std::vector<float> colours = {1, 0, 0, 1, 0, 0, 1, 0, 0};
+  const int colour = g.add_accessor(g.add_view(colours), 5126, 3, "VEC3");
   const uint8_t px[] = {255, 255, 255, 255};
   const std::vector<unsigned char> png = io::encode_png(px, 1, 1, 4);
   g.doc["images"] = json::array({{{"bufferView", g.add_view(png.data(), png.size())}, {"mimeType", "image/png"}}});
   g.doc["textures"] = json::array({{{"source", 0}}});
-  const int m = g.add_mesh(json::array({{{"attributes", {{"POSITION", pos}}}, {"material", 0}},
+  const int m = g.add_mesh(json::array({{{"attributes", {{"POSITION", pos}, {"COLOR_0", colour}}}, {"material", 0}},
                                         {{"attributes", {{"POSITION", pos}}}, {"material", 1}},
                                         {{"attributes", {{"POSITION", pos}}}, {"mode", 1}}}));
   g.add_node({{"mesh", m}});
@@ -367,6 +456,13 @@ TEST(GltfLoader, UnsupportedFeaturesAreNamedOnce) {
   EXPECT_EQ(normal_warnings, 1);
   EXPECT_EQ(line_warnings, 1);
   EXPECT_EQ(ext_warnings, 1);
+  // Inputs the Lambertian shading does not use are named too.
+  for (const char* named : {"vertex colours (COLOR_n) are ignored", "occlusion textures are ignored",
+                            "metallic-roughness textures are ignored"})
+    EXPECT_EQ(std::count_if(scene.warnings.begin(), scene.warnings.end(),
+                            [&](const std::string& w) { return w.find(named) != std::string::npos; }),
+              1)
+        << named << " in:\n" << fmt::format("{}", fmt::join(scene.warnings, "\n"));
   bool counted = false;
   for (const std::string& w : scene.warnings) counted |= w.find("normal textures") != std::string::npos && w.find("2 occurrences") != std::string::npos;
   EXPECT_TRUE(counted);

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -190,10 +191,7 @@ TEST(GltfAnimation, MirroringScaleZeroRestScaleAndTheTimeRangeOfWhatMoves) {
   a.builder.add_animation_channel(a.mover, "scale", step_times, mirror, "STEP");
   const std::vector<float> pop_times = {0.0f, 2.0f}, pop = {0, 0, 0, 1, 1, 1};
   a.builder.add_animation_channel(a.still, "scale", pop_times, pop);
-  // Two channels keying one property: both kept, the later wins, and the load says so.
-  a.builder.add_animation_channel(a.still, "scale", pop_times, pop);
   Scene scene = a.load(dir);
-  EXPECT_TRUE(warned(scene, "the later channel in file order wins"));
   const PathSpec path = gltf_path(3);
   SceneAnimator animator(scene, path);
   EXPECT_DOUBLE_EQ(animator.time_of(2), 2.0);
@@ -253,8 +251,152 @@ TEST(GltfAnimation, ARefitBvhOfAMirroredSmoothMeshShadesAsAFreshOne) {
   EXPECT_GT(std::count_if(u.begin(), u.end(), [](float x) { return x > 0.0f; }), 0) << "something is lit";
 }
 
+/// The traced left eye of `scene` through the rig of its camera, 96x54.
+Image traced_left(const Scene& scene) {
+  const RenderScene prepared(scene);
+  const StereoRig rig = test::rig_at(scene, 96, 54);
+  TraceCounts counts;
+  return traced_eye(prepared, rig.eye(Eye::left), Executor(2), counts);
+}
+
+const Light& light_named(const Scene& scene, const std::string& name) {
+  for (const Light& l : scene.lights)
+    if (l.name == name) return l;
+  throw std::logic_error("no light " + name);
+}
+
+bool same_radiance(const Image& a, const Image& b) {
+  const std::span<const float> x(a.data_f32(planes::rgb), 3 * a.pixel_count());
+  const std::span<const float> y(b.data_f32(planes::rgb), 3 * b.pixel_count());
+  return x.size() == y.size() && std::equal(x.begin(), x.end(), y.begin());
+}
+
+TEST(GltfAnimation, LightsOnAnimatedNodesMoveAndShineAsIfPlacedThere) {
+  // A lamp on a mesh-less node that carries it 2 m along +X, and a spot on the mover turning a
+  // quarter about +Y: only lights move, so the path is valid and refits nothing.
+  test::ScratchDir dir;
+  AnimatedScene a;
+  const int holder = a.builder.add_node("holder", -1, scenes::NodeTransform::at(dvec3(-1.0, 0.0, 1.0)));
+  a.builder.add_point_light("carried", vec3(0.0f, 2.0f, 0.0f), vec3(1.0f, 0.8f, 0.6f), 15.0f, holder);
+  const std::vector<float> times = {0.0f, 1.0f}, carry = {-1, 0, 1, 1, 0, 1};
+  a.builder.add_animation_channel(holder, "translation", times, carry);
+  Scene scene = a.load(dir);
+  ASSERT_EQ(scene.lights.size(), 2u);
+  EXPECT_FALSE(warned(scene, "stay where they are")) << "lights follow their nodes now";
+  SceneAnimator animator(scene, gltf_path(2));
+  EXPECT_EQ(animator.moving_lights(), 1u);
+  EXPECT_EQ(animator.turning_meshes(), 0u);
+  EXPECT_FALSE(animator.moves_geometry());
+  const Image at_rest = traced_left(scene);
+  animator.apply(1);
+  expect_near(dvec3(light_named(scene, "carried").position), dvec3(1.0, 2.0, 1.0), 1e-6, "carried lamp at frame 1");
+  expect_near(dvec3(light_named(scene, "lamp").position), dvec3(0.0, 4.0, 2.0), 1e-6, "the root lamp stays");
+  const Image moved = traced_left(scene);
+  EXPECT_FALSE(same_radiance(at_rest, moved)) << "the moved lamp lights the boxes differently";
+
+  // The same lamp placed there in a still file shades bit-identically.
+  test::ScratchDir dir2("still");
+  AnimatedScene b;
+  const int fixed = b.builder.add_node("holder", -1, scenes::NodeTransform::at(dvec3(1.0, 0.0, 1.0)));
+  b.builder.add_point_light("carried", vec3(0.0f, 2.0f, 0.0f), vec3(1.0f, 0.8f, 0.6f), 15.0f, fixed);
+  EXPECT_TRUE(same_radiance(moved, traced_left(b.load(dir2))));
+
+  // A directional light turns with its node: a quarter turn about +Y takes -Z to -X.
+  test::ScratchDir dir3("sun");
+  AnimatedScene c;
+  c.builder.add_directional_light("sun", vec3(0.0f, 0.0f, -1.0f), vec3(1.0f), 2.0f, c.mover);
+  const float h = static_cast<float>(std::sqrt(0.5));
+  const std::vector<float> quarter = {0, 0, 0, 1, 0, h, 0, h};
+  c.builder.add_animation_channel(c.mover, "rotation", times, quarter);
+  Scene turning = c.load(dir3);
+  SceneAnimator sunrise(turning, gltf_path(2));
+  EXPECT_EQ(sunrise.moving_lights(), 1u);
+  sunrise.apply(1);
+  expect_near(dvec3(light_named(turning, "sun").direction), dvec3(-1.0, 0.0, 0.0), 1e-6, "the sun's direction, turned");
+}
+
+TEST(GltfAnimation, OneClipPlaysByNameOrIndexAndClipsKeyingOnePropertyCannotPlayTogether) {
+  test::ScratchDir dir;
+  AnimatedScene a;
+  const std::vector<float> times = {0.0f, 2.0f};
+  const std::vector<float> walk = {0, 0, 0, 4, 0, 0}, hop = {0, 0, 0, 0, 2, 0};
+  a.builder.add_animation_channel(a.mover, "translation", times, walk, "LINEAR", "walk");
+  a.builder.add_animation_channel(a.mover, "translation", times, hop, "LINEAR", "hop");
+  const std::vector<float> late = {3.0f, 4.0f}, grow = {1, 1, 1, 2, 2, 2};
+  a.builder.add_animation_channel(a.still, "scale", late, grow, "LINEAR", "hop");
+  Scene scene = a.load(dir);
+  ASSERT_EQ(scene.animation.clips, (std::vector<std::string>{"walk", "hop"}));
+  EXPECT_TRUE(warned(scene, "2 animation(s) ('walk', 'hop')")) << "the load names the clips";
+
+  // Every clip at once: both key the mover's translation.
+  try {
+    SceneAnimator both(scene, gltf_path(3));
+    FAIL() << "two clips keying one property played together";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(fmt::format("'walk' and 'hop' of scene 'animated-test' both key node {}'s "
+                                                     "translation",
+                                                     a.mover)),
+              std::string::npos)
+        << e.what();
+  }
+
+  PathSpec path = gltf_path(3);
+  path.gltf_clip = "walk";
+  {
+    SceneAnimator walking(scene, path);
+    EXPECT_EQ(walking.clip(), "'walk'");
+    EXPECT_EQ(walking.turning_meshes(), 2u) << "the mover and its rider, not the still box of the other clip";
+    EXPECT_DOUBLE_EQ(walking.time_of(2), 2.0) << "the time range is the clip's own";
+    walking.apply(2);
+    expect_near(centre_of(scene, "mover", a.mover), dvec3(4.0, 0.0, 0.0), 1e-5, "walked");
+  }
+  path.gltf_clip = "1";  // no clip has that name: the index
+  {
+    SceneAnimator hopping(scene, path);
+    EXPECT_EQ(hopping.clip(), "'hop'");
+    EXPECT_EQ(hopping.turning_meshes(), 3u);
+    EXPECT_DOUBLE_EQ(hopping.time_of(0), 0.0);
+    EXPECT_DOUBLE_EQ(hopping.time_of(2), 4.0);
+    hopping.apply(1);
+    expect_near(centre_of(scene, "mover", a.mover), dvec3(0.0, 2.0, 0.0), 1e-5, "hopped, at t = 2 s");
+  }
+  for (const std::string bad : {"run", "2", "-1"}) {
+    path.gltf_clip = bad;
+    try {
+      SceneAnimator none(scene, path);
+      FAIL() << bad;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(fmt::format("has no glTF animation '{}'; its animations are 'walk', 'hop'",
+                                                       bad)),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  // A clip chosen without playing the animation is a contradiction.
+  PathSpec keys_only;
+  keys_only.frames = 2;
+  keys_only.gltf_clip = "walk";
+  EXPECT_THROW(keys_only.validate(), InputError);
+}
+
 TEST(GltfAnimation, BadAnimationsAndScenesWithoutOneAreRefused) {
   test::ScratchDir dir;
+  {
+    AnimatedScene a;  // one clip keying a property twice: glTF forbids it
+    const std::vector<float> times = {0.0f, 1.0f}, moves = {0, 0, 0, 1, 0, 0};
+    a.builder.add_animation_channel(a.mover, "translation", times, moves);
+    a.builder.add_animation_channel(a.mover, "translation", times, moves);
+    a.builder.write(dir / "twice.gltf");
+    try {
+      (void)io::load_gltf(dir / "twice.gltf");
+      FAIL() << "a clip keying one property twice was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("/animations/0/channels/1/target: keys node 0's translation as "
+                                           "/animations/0/channels/0 does"),
+                std::string::npos)
+          << e.what();
+    }
+  }
   {
     AnimatedScene a;
     const std::vector<float> times = {1.0f, 0.5f};  // decreasing

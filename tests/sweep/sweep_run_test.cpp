@@ -421,6 +421,7 @@ TEST(SweepRun, AGltfAnimationPlaysAlongThePath) {
     const json& a = cells[static_cast<size_t>(f)]["animation"];
     EXPECT_DOUBLE_EQ(a["animation_time_s"].get<double>(), 3.0 * f) << "frames spread over the keys' 0..3 s";
     EXPECT_EQ(a["turning_meshes"], 1) << "the box moves, the wall does not";
+    EXPECT_EQ(a["moving_lights"], 0);
   }
   EXPECT_NE(test::read_text(dir / "out" / cells[0]["images"]["truth_png"].get<std::string>()),
             test::read_text(dir / "out" / cells[1]["images"]["truth_png"].get<std::string>()))
