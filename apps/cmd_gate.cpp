@@ -43,8 +43,15 @@ void run_update(const GateArgs& a, const fs::path& file) {
                                          : validation::RegressionSettings{}.min_repetitions;
   const validation::GateResults results = validation::load_gate_results(a.results);
   for (const std::string& w : results.warnings) fmt::print(stderr, "warning: {}\n", w);
-  validation::Baseline baseline = fs::exists(file) ? validation::load_baseline(file) : validation::Baseline{};
+  // Damaged entries are mended by rewriting them; one the update leaves alone stops it.
+  std::vector<validation::DamagedEntry> damaged;
+  validation::Baseline baseline = fs::exists(file) ? validation::load_baseline(file, &damaged) : validation::Baseline{};
   const std::vector<validation::BaselineChange> changes = validation::update_baseline(baseline, results, selection);
+  for (const validation::DamagedEntry& d : damaged)
+    if (std::none_of(changes.begin(), changes.end(), [&](const validation::BaselineChange& c) {
+          return c.cell_id == d.cell_id && c.pipeline == d.pipeline;
+        }))
+      throw InputError(fmt::format("{} (this update does not rewrite it; the baseline is left as it was)", d.message));
   validation::save_baseline(file, baseline);
   for (const validation::BaselineChange& c : changes) {
     if (c.replaced)

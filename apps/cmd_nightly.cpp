@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <optional>
 #include <array>
 #include <chrono>
 #include <cstdio>
@@ -170,6 +171,10 @@ void run_nightly(const NightlyArgs& a) {
   // does a missing report asset (the report is written last).
   const HistoryFile history_before = read_history(history_file);
   reports::check_report_assets(reports::report_assets_dir());  // before the history's folder is made
+  // The run folders go under --out: a folder that cannot be made is named as that option (the
+  // default history file lies there too, and was blamed).
+  if (const std::optional<std::string> why = io::unwritable_folder(out))
+    throw IoError(fmt::format("--out {}: {}; give a folder you can write", out.string(), *why));
   check_history_writable(history_file, !a.history.empty());
   for (const std::string& w : history_before.warnings) fmt::print(stderr, "warning: {}\n", w);
 

@@ -65,11 +65,15 @@ std::optional<int> optional_count(const json& j, const char* key, const char* fi
 }
 
 /// An optional quantity of a spec: absent or null, else a finite number; InputError naming the field.
-std::optional<double> optional_quantity(const json& j, const char* key, const char* field) {
+/// An optional positive quantity below `below` (a rig's interaxial, disparity, convergence,
+/// field of view).
+std::optional<double> optional_quantity(const json& j, const char* key, const char* field,
+                                        double below = std::numeric_limits<double>::infinity()) {
   if (!j.contains(key) || j.at(key).is_null()) return std::nullopt;
   const json& v = j.at(key);
-  if (!v.is_number() || !std::isfinite(v.get<double>()))
-    throw InputError(fmt::format("{} is {}, not a finite number", field, v.dump()));
+  if (!v.is_number() || !(v.get<double>() > 0.0 && v.get<double>() < below))
+    throw InputError(fmt::format("{} is {}, not a positive finite number{}", field, v.dump(),
+                                 std::isinf(below) ? std::string() : fmt::format(" below {:g}", below)));
   return v.get<double>();
 }
 
@@ -166,7 +170,7 @@ ReferenceSpec spec_from_json(const json& j) {
   s.rig.convergence = optional_quantity(r, "convergence_m", "spec.rig_overrides.convergence_m");
   s.rig.width = optional_count(r, "width", "spec.rig_overrides.width", kMaxImageSide);
   s.rig.height = optional_count(r, "height", "spec.rig_overrides.height", kMaxImageSide);
-  s.rig.vfov = optional_quantity(r, "vfov_rad", "spec.rig_overrides.vfov_rad");
+  s.rig.vfov = optional_quantity(r, "vfov_rad", "spec.rig_overrides.vfov_rad", 3.141592653589793);
   return s;
 }
 
@@ -177,6 +181,14 @@ ReferenceSpec spec_in(const json& provenance, const fs::path& file) {
     throw InputError(fmt::format("{}: has no field 'spec' (what the reference renders), so it cannot be rendered again; "
                                  "generate the reference anew (stereobench reference generate)",
                                  file.string()));
+  if (!provenance.at("spec").is_object())
+    throw InputError(fmt::format("{}: field 'spec' is {}, not an object; the provenance is damaged: remove the entry "
+                                 "and generate it again",
+                                 file.string(), brief(provenance.at("spec"))));
+  if (provenance.value("version", json(nullptr)) != 1)
+    throw InputError(fmt::format("{}: version {} is not the provenance version this stereobench writes and reads (1); "
+                                 "use the stereobench that wrote it, or remove the entry and generate it again",
+                                 file.string(), brief(provenance.value("version", json(nullptr)))));
   try {
     spec = spec_from_json(provenance.at("spec"));
   } catch (const json::exception& e) {

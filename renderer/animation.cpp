@@ -113,7 +113,10 @@ void PathSpec::validate() const {
       throw InputError(fmt::format("the spin angle per frame {} is not within ±360 degrees (one turn per frame); give "
                                    "the angle turned between two frames",
                                    spin->degrees_per_frame));
-    if (spin->pivot && !finite(*spin->pivot)) throw InputError("the spin pivot is not finite");
+    if (spin->pivot && !within_scene_range(*spin->pivot))
+      throw InputError(fmt::format("the spin pivot ({:g}, {:g}, {:g}) m is not finite or lies beyond the ±{:g} m a "
+                                   "scene may span; give a point in the scene, in metres",
+                                   spin->pivot->x, spin->pivot->y, spin->pivot->z, kMaxSceneCoordinate));
   }
 }
 

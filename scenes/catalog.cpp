@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -64,6 +65,19 @@ void write_stamp(const fs::path& path, const std::string& stamp) {
   io::write_text_atomically(stamp_path(path), stamp_with_size(path, stamp));
 }
 
+/// Generates built-in scene `name` (with `options`) into `path` under `scenes_dir` and stamps it;
+/// a scenes folder that cannot take it is named with the option that sets it.
+GenerateResult generate_into(const std::string& name, const GenerateOptions& options, const fs::path& path,
+                             const fs::path& scenes_dir, const std::string& stamp) {
+  if (const std::optional<std::string> why = io::unwritable_folder(scenes_dir))
+    throw IoError(fmt::format("the scenes folder {} (--scenes-dir, or $STEREOBENCH_SCENES) cannot hold the generated "
+                              "scene '{}': {}; give a folder you can write",
+                              scenes_dir.string(), name, *why));
+  GenerateResult r = generate(name, options, path);
+  write_stamp(r.path, stamp);
+  return r;
+}
+
 }  // namespace
 
 fs::path default_scenes_dir() {
@@ -120,9 +134,7 @@ fs::path resolve_scene(const std::string& spec, const fs::path& scenes_dir) {
 
 GenerateResult generate_builtin(const std::string& name, const fs::path& scenes_dir) {
   const GeneratorInfo& info = find_generator(name);
-  GenerateResult r = generate(info.name, GenerateOptions{}, scenes_dir / info.file_name);
-  write_stamp(r.path, stamp_text(info.name));
-  return r;
+  return generate_into(info.name, GenerateOptions{}, scenes_dir / info.file_name, scenes_dir, stamp_text(info.name));
 }
 
 fs::path resolve_builtin(const std::string& name, const std::map<std::string, double>& params,
@@ -134,9 +146,7 @@ fs::path resolve_builtin(const std::string& name, const std::map<std::string, do
   if (cached(path, stamp)) return path;
   GenerateOptions options;
   options.params = params;
-  const GenerateResult r = generate(info.name, options, path);
-  write_stamp(r.path, stamp);
-  return r.path;
+  return generate_into(info.name, options, path, scenes_dir, stamp).path;
 }
 
 fs::path builtin_path(const std::string& name, const std::map<std::string, double>& params,
@@ -147,7 +157,15 @@ fs::path builtin_path(const std::string& name, const std::map<std::string, doubl
 LoadedScene load_scene(const std::string& spec, const std::filesystem::path& scenes_dir, std::optional<int> lights) {
   LoadedScene out;
   out.file = resolve_scene(spec, scenes_dir);
-  out.scene = io::load_gltf(out.file);
+  try {
+    out.scene = io::load_gltf(out.file);
+  } catch (const InputError& e) {
+    if (is_scene_file_spec(spec)) throw;
+    // A cached built-in scene damaged after its stamp was written (same size, other bytes).
+    throw InputError(fmt::format("{}; it is the built-in scene '{}' generated into the scenes folder: remove {} and "
+                                 "it is generated again",
+                                 e.what(), spec, out.file.string()));
+  }
   for (const std::string& w : out.scene.warnings) fmt::print(stderr, "warning: {}\n", w);
   out.lights_in_file = out.scene.lights.size();
   if (lights) keep_first_lights(out.scene, *lights);

@@ -31,7 +31,7 @@ const BaselineEntry* Baseline::find(const std::string& cell_id, const std::strin
   return p == c->second.end() ? nullptr : &p->second;
 }
 
-Baseline parse_baseline(const json& doc, const std::string& source) {
+Baseline parse_baseline(const json& doc, const std::string& source, std::vector<DamagedEntry>* damaged) {
   if (!doc.is_object())
     throw InputError(
         fmt::format("{}: a baseline is a JSON object {{cell_id: {{pipeline: {{samples_s, ...}}}}}}", source));
@@ -41,16 +41,24 @@ Baseline parse_baseline(const json& doc, const std::string& source) {
       throw InputError(fmt::format("{}: entry '{}' is not an object of pipelines", source, cell_id));
     for (const auto& [pipeline, e] : pipes.items()) {
       const std::string where = fmt::format("{}: '{}' / {}", source, cell_id, pipeline);
-      if (!e.is_object() || !e.contains("samples_s") || !e["samples_s"].is_array() || e["samples_s"].empty())
-        throw InputError(
-            fmt::format("{}: samples_s must be a non-empty array of seconds; rewrite the entry with "
-                        "`stereobench gate --update-baseline`",
-                        where));
+      const auto refuse = [&](const std::string& why) {
+        const std::string text =
+            fmt::format("{}: {}; rewrite the entry with `stereobench gate --update-baseline --baseline {} --results "
+                        "FILE --cells '{}' --only {}`, or remove it",
+                        where, why, source, cell_id, pipeline);
+        if (damaged == nullptr) throw InputError(text);
+        damaged->push_back({cell_id, pipeline, text});
+      };
+      if (!e.is_object() || !e.contains("samples_s") || !e["samples_s"].is_array() || e["samples_s"].empty()) {
+        refuse("samples_s must be a non-empty array of seconds");
+        continue;
+      }
       BaselineEntry entry;
-      for (const json& s : e["samples_s"]) {
-        if (!s.is_number() || !std::isfinite(s.get<double>()) || !(s.get<double>() > 0.0))
-          throw InputError(fmt::format("{}: samples_s holds {}, not a positive time in seconds", where, s.dump()));
-        entry.samples_s.push_back(s.get<double>());
+      for (const json& s : e["samples_s"])
+        if (s.is_number() && std::isfinite(s.get<double>()) && s.get<double>() > 0.0) entry.samples_s.push_back(s.get<double>());
+      if (entry.samples_s.size() != e["samples_s"].size()) {
+        refuse(fmt::format("samples_s holds {}, not only positive times in seconds", e["samples_s"].dump()));
+        continue;
       }
       entry.median_s = median_of(entry.samples_s);
       if (e.contains("recorded") && e["recorded"].is_string()) entry.recorded = e["recorded"].get<std::string>();
@@ -61,7 +69,7 @@ Baseline parse_baseline(const json& doc, const std::string& source) {
   return b;
 }
 
-Baseline load_baseline(const std::filesystem::path& file) {
+Baseline load_baseline(const std::filesystem::path& file, std::vector<DamagedEntry>* damaged) {
   if (!std::filesystem::exists(file))
     throw InputError(
         fmt::format("baseline {} does not exist; create it with `stereobench gate --update-baseline "
@@ -74,7 +82,7 @@ Baseline load_baseline(const std::filesystem::path& file) {
   } catch (const io::JsonTextError& e) {
     throw InputError(fmt::format("baseline {} is not valid JSON ({})", file.string(), e.what()));
   }
-  return parse_baseline(doc, file.string());
+  return parse_baseline(doc, file.string(), damaged);
 }
 
 json baseline_json(const Baseline& baseline) {

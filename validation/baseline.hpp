@@ -32,11 +32,21 @@ struct Baseline {
   [[nodiscard]] bool empty() const noexcept { return cells.empty(); }
 };
 
+/// A malformed baseline entry: where, and what is wrong (the message, naming the file).
+struct DamagedEntry {
+  std::string cell_id;
+  std::string pipeline;
+  std::string message;
+};
+
 /// Parses baseline JSON; InputError naming `source` and the cell/pipeline for a malformed entry
 /// (samples must be a non-empty array of positive finite seconds).
-[[nodiscard]] Baseline parse_baseline(const nlohmann::json& doc, const std::string& source);
+/// With `damaged` given, a malformed (cell, pipeline) entry is left out and listed there instead
+/// (an update that rewrites it can mend the file).
+[[nodiscard]] Baseline parse_baseline(const nlohmann::json& doc, const std::string& source,
+                                      std::vector<DamagedEntry>* damaged = nullptr);
 /// Reads a baseline file; IoError if it cannot be read, InputError if it is not valid JSON.
-[[nodiscard]] Baseline load_baseline(const std::filesystem::path& file);
+[[nodiscard]] Baseline load_baseline(const std::filesystem::path& file, std::vector<DamagedEntry>* damaged = nullptr);
 /// The baseline as JSON, keys sorted.
 [[nodiscard]] nlohmann::json baseline_json(const Baseline& baseline);
 /// Writes the baseline atomically (the old file stays whole until the new one is complete).

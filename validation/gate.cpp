@@ -116,7 +116,10 @@ RegressionSettings read_regression(const toml::table& table, const std::string& 
     } else if (k == "min_repetitions") {
       const std::optional<int64_t> v = node.is_integer() ? node.value<int64_t>() : std::nullopt;
       if (!v || *v < 1 || *v > 1000000)
-        config_error(source, node.source(), "[regression] min_repetitions must be an integer of at least 1");
+        config_error(source, node.source(),
+                     fmt::format("[regression] min_repetitions{} must be an integer from 1 to 1000000 (the timing "
+                                 "samples per side the rank test needs; 3 is the least that can fail)",
+                                 v ? fmt::format(" = {}", *v) : std::string()));
       r.min_repetitions = static_cast<int>(*v);
     } else {
       config_error(source, key.source(),

@@ -26,6 +26,10 @@ bool open_and_sniff_exr(const fs::path& path) {
   const fs::file_status status = fs::status(path, ec);
   if (!fs::exists(status)) throw InputError(fmt::format("{}: no such file; check the path", path.string()));
   if (fs::is_directory(status)) throw InputError(fmt::format("{} is a folder, not an image file", path.string()));
+  // An image reader on a device never ends (/dev/zero) or blocks (a terminal).
+  if (!fs::is_regular_file(status))
+    throw InputError(fmt::format("{} is a device, pipe or socket, not an image file; give the path of an image file",
+                                 path.string()));
   std::ifstream in(path, std::ios::binary);
   if (!in)
     throw IoError(fmt::format("{} exists but cannot be opened for reading; check its permissions", path.string()));

@@ -369,7 +369,13 @@ void check_cell_record(const json& line, const std::string& where) {
   if (line["cell_id"].get<std::string>().empty()) throw InputError(fmt::format("{}: cell_id is empty", where));
   // The gate keys baselines and rule globs by the id and reads the scene from the fields: the two
   // must tell the same cell.
-  if (const std::optional<std::string> id = cell_id_from_json(line["cell"]); id && *id != line["cell_id"])
+  std::optional<std::string> id;
+  try {
+    id = cell_id_from_json(line["cell"]);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}; the line is damaged or edited by hand", where, e.what()));
+  }
+  if (id && *id != line["cell_id"])
     throw InputError(fmt::format("{}: cell_id {} does not match the cell's fields, which give \"{}\"; the line is "
                                  "damaged or edited by hand",
                                  where, line["cell_id"].dump(), *id));
@@ -379,6 +385,11 @@ void check_cell_record(const json& line, const std::string& where) {
   if (line.contains("cell_count") && line["cell_index"].get<long long>() >= line["cell_count"].get<long long>())
     throw InputError(fmt::format("{}: cell_index {} is not below cell_count {}; the line is damaged or edited by hand",
                                  where, line["cell_index"].dump(), line["cell_count"].dump()));
+  for (const char* f : {"rig.interaxial_m", "rig.convergence_m", "rig.max_disparity_px"})
+    if (const double x = find(line, f)->get<double>(); !(x > 0.0 && std::isfinite(x)))
+      throw InputError(fmt::format("{}: field '{}' is {}; a rig's interaxial, convergence and max disparity are "
+                                   "positive; the line is damaged or edited by hand",
+                                   where, f, find(line, f)->dump()));
   if (line["rig"]["width"].get<long long>() <= 0 || line["rig"]["height"].get<long long>() <= 0)
     throw InputError(fmt::format("{}: rig.width and rig.height must be positive, not {}x{}", where,
                                  line["rig"]["width"].dump(), line["rig"]["height"].dump()));
@@ -400,6 +411,15 @@ void check_cell_record(const json& line, const std::string& where) {
                           "validation.holes.not_reprojected.recall", "validation.holes.not_reprojected.precision"})
       require_within(p, where, prefix, f, 0.0, 1.0);
     require_within(p, where, prefix, "validation.total_s", 0.0, kMax);
+    // A left eye synthesized in part is measured as the right eye is.
+    require(p, where, prefix, "validation.left_eye", Kind::object_or_null, true);
+    if (const json* left = find(p, "validation.left_eye"); left != nullptr && left->is_object()) {
+      for (const char* m : {"psnr", "ssim", "mse"})
+        require(p, where, prefix, std::string("validation.left_eye.metrics.") + m, Kind::metric, m == std::string("mse"));
+      require_within(p, where, prefix, "validation.left_eye.metrics.psnr", 0.0, std::numeric_limits<double>::infinity());
+      require_within(p, where, prefix, "validation.left_eye.metrics.ssim", -1.0, 1.0);
+      require_within(p, where, prefix, "validation.left_eye.metrics.mse", 0.0, 255.0 * 255.0);
+    }
     if (p.contains("timing")) {
       for (const char* t : {"median_s", "min_s", "max_s", "speedup_median", "right_over_left_median"}) {
         require(p, where, prefix, std::string("timing.") + t, Kind::number_or_null, true);

@@ -51,41 +51,56 @@ std::string cell_id(const SweepCell& cell) {
 }
 
 std::optional<std::string> cell_id_from_json(const json& cell) {
-  if (!cell.is_object()) return std::nullopt;
-  const auto number = [&cell](const char* key, std::optional<double>& out) {
-    const auto it = cell.find(key);
-    if (it == cell.end() || !(it->is_null() || it->is_number())) return false;
-    if (it->is_number()) out = it->get<double>();
-    return true;
+  if (!cell.is_object()) throw InputError(fmt::format("cell is {}, not an object", cell.type_name()));
+  for (const char* key : {"scene", "scene_params", "interaxial_m", "max_disparity_px", "convergence_m", "lights",
+                          "resolution", "truth"})
+    if (!cell.contains(key)) return std::nullopt;
+  const auto field = [&cell](const char* key) -> const json& { return cell.at(key); };
+  const auto bad = [](const char* key, const json& v, const char* want) {
+    std::string shown = v.dump();
+    if (shown.size() > 40) shown = shown.substr(0, 37) + "...";
+    return InputError(fmt::format("cell.{} is {}; it must be {}", key, shown, want));
   };
-  const auto integer = [&cell](const char* key, std::optional<int>& out, bool required) {
-    const auto it = cell.find(key);
-    if (it == cell.end()) return !required;
-    if (!(it->is_null() || it->is_number_integer())) return false;
-    if (it->is_number_integer()) out = it->get<int>();
-    return true;
+  // An axis the definition left to the scene is null; a value is positive and finite.
+  const auto positive = [&](const char* key, std::optional<double>& out) {
+    const json& v = field(key);
+    if (v.is_null()) return;
+    if (!v.is_number() || !(v.get<double>() > 0.0 && std::isfinite(v.get<double>())))
+      throw bad(key, v, "a positive number, or null (the scene's default)");
+    out = v.get<double>();
+  };
+  const auto text = [&](const char* key, bool nullable) -> std::optional<std::string> {
+    const json& v = field(key);
+    if (nullable && v.is_null()) return std::nullopt;
+    if (!v.is_string() || v.get_ref<const std::string&>().empty())
+      throw bad(key, v, nullable ? "a non-empty string, or null" : "a non-empty string");
+    return v.get<std::string>();
   };
   SweepCell c;
-  const auto scene = cell.find("scene");
-  const auto params = cell.find("scene_params");
-  const auto resolution = cell.find("resolution");
-  const auto truth = cell.find("truth");
-  if (scene == cell.end() || !scene->is_string() || params == cell.end() || !params->is_object() ||
-      resolution == cell.end() || !(resolution->is_string() || resolution->is_null()) || truth == cell.end() ||
-      !truth->is_string())
-    return std::nullopt;
+  const std::string scene = *text("scene", false);
+  const json& params = field("scene_params");
+  if (!params.is_object()) throw bad("scene_params", params, "an object of numbers");
   std::map<std::string, double> values;
-  for (const auto& [key, value] : params->items()) {
-    if (!value.is_number()) return std::nullopt;
+  for (const auto& [key, value] : params.items()) {
+    if (!value.is_number() || !std::isfinite(value.get<double>()))
+      throw InputError(fmt::format("cell.scene_params.{} is {}; it must be a finite number", key, value.dump()));
     values[key] = value.get<double>();
   }
-  c.scene.label = scene_label(scene->get<std::string>(), values);
-  if (!number("interaxial_m", c.interaxial_m) || !number("max_disparity_px", c.max_disparity_px) ||
-      !number("convergence_m", c.convergence_m) || !integer("lights", c.lights, true) ||
-      !integer("frame", c.frame, false))
-    return std::nullopt;
-  if (resolution->is_string()) c.resolution = SweepResolution{resolution->get<std::string>(), 0, 0};
-  c.truth = truth->get<std::string>();
+  c.scene.label = scene_label(scene, values);
+  positive("interaxial_m", c.interaxial_m);
+  positive("max_disparity_px", c.max_disparity_px);
+  positive("convergence_m", c.convergence_m);
+  if (const json& v = field("lights"); !v.is_null()) {
+    if (!v.is_number_integer() || v.get<long long>() < 1) throw bad("lights", v, "an integer of at least 1, or null (all)");
+    c.lights = v.get<int>();
+  }
+  if (const auto it = cell.find("frame"); it != cell.end()) {
+    if (!it->is_number_integer() || it->get<long long>() < 0 || it->get<long long>() > 100000)
+      throw bad("frame", *it, "a frame number, 0..100000");
+    c.frame = it->get<int>();
+  }
+  if (const std::optional<std::string> r = text("resolution", true)) c.resolution = SweepResolution{*r, 0, 0};
+  c.truth = *text("truth", false);
   return cell_id(c);
 }
 
@@ -326,7 +341,14 @@ void parse_path(const Where& where, const toml::node& node, SweepDefinition& d) 
         where.fail(*v, "path.spin.degrees_per_frame",
                    fmt::format("{} is not within ±360 (degrees turned between two frames)", s.degrees_per_frame));
     }
-    if (const toml::node* v = spin.get("pivot")) s.pivot = point_at(where, *v, "path.spin.pivot", "[0, 0.5, 0]");
+    if (const toml::node* v = spin.get("pivot")) {
+      s.pivot = point_at(where, *v, "path.spin.pivot", "[0, 0.5, 0]");
+      if (!within_scene_range(*s.pivot))
+        where.fail(*v, "path.spin.pivot",
+                   fmt::format("({:g}, {:g}, {:g}) lies beyond the ±{:g} m a scene may span; give a point in the "
+                               "scene, in metres",
+                               s.pivot->x, s.pivot->y, s.pivot->z, kMaxSceneCoordinate));
+    }
     if (const toml::node* v = spin.get("mesh_prefix")) s.mesh_prefix = string_at(where, *v, "path.spin.mesh_prefix");
     path.spin = s;
   }

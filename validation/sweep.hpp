@@ -122,7 +122,8 @@ struct SweepCell {
 [[nodiscard]] std::string cell_id(const SweepCell& cell);
 
 /// The id that the axes of a results line's "cell" object (cell_to_json's fields) give, or
-/// nothing when one of them is missing or of the wrong type.
+/// nothing when one of them is missing. InputError naming the field ("cell.interaxial_m is -1; it
+/// must be ...") when one is of the wrong type or out of its range.
 [[nodiscard]] std::optional<std::string> cell_id_from_json(const nlohmann::json& cell);
 
 }  // namespace sb::validation

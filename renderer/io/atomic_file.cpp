@@ -159,7 +159,19 @@ bool names_open_file(const std::vector<fs::path>& chain) {
   return std::any_of(chain.begin(), chain.end(), [](const fs::path& p) {
     std::error_code ec;
     const std::string s = fs::absolute(p, ec).lexically_normal().string();
-    return s.rfind("/proc/", 0) == 0 || s.rfind("/dev/fd/", 0) == 0;
+    if (s.rfind("/dev/fd/", 0) == 0) return true;
+    // /proc/self/fd/N, /proc/thread-self/fd/N, /proc/PID/fd/N, /proc/PID/task/TID/fd/N; not any
+    // other name under /proc, which is no folder a file can be written into.
+    if (s.rfind("/proc/", 0) != 0) return false;
+    const size_t fd = s.find("/fd/");
+    if (fd == std::string::npos) return false;
+    const std::string owner = s.substr(6, fd - 6);  // between "/proc/" and "/fd/"
+    const auto digits = [](const std::string& t) {
+      return !t.empty() && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
+    };
+    const size_t task = owner.find("/task/");
+    return owner == "self" || owner == "thread-self" || digits(owner) ||
+           (task != std::string::npos && digits(owner.substr(0, task)) && digits(owner.substr(task + 6)));
   });
 }
 
@@ -391,8 +403,14 @@ std::optional<std::string> unwritable_folder(const fs::path& folder) {
 
 std::string read_file(const fs::path& path) {
   std::error_code ec;
-  if (fs::is_directory(path, ec))
+  const fs::file_status status = fs::status(path, ec);
+  if (fs::is_directory(status))
     throw InputError(fmt::format("{} is a folder, not a file; give the path of the file to read", path.string()));
+  // A pipe is read to its end (process substitution, /dev/stdin redirected from a file); a device
+  // may never end (/dev/zero) or wait for a terminal.
+  if (fs::is_character_file(status) || fs::is_block_file(status) || fs::is_socket(status))
+    throw InputError(fmt::format("{} is a device or socket, not a file; give the path of the file to read",
+                                 path.string()));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(fmt::format("cannot read {}: {}", path.string(), std::strerror(errno)));
   // Read in blocks rather than through a stream buffer copy, which would swallow a failed

@@ -79,7 +79,8 @@ void write_text_atomically(const std::filesystem::path& path, const std::string&
 /// not when the first is written. Why the folder cannot be written, or nothing.
 [[nodiscard]] std::optional<std::string> unwritable_folder(const std::filesystem::path& folder);
 
-/// Reads a whole file; IoError naming the path if it cannot be read.
+/// Reads a whole file, or a pipe to its end; InputError for a folder or a device (which may never
+/// end), IoError naming the path if it cannot be read.
 [[nodiscard]] std::string read_file(const std::filesystem::path& path);
 
 }  // namespace sb::io

@@ -188,6 +188,33 @@ TEST(Cli, AFileLargerThanTheMemoryLimitIsAnIoErrorNotATruncatedFile) {
       << r.out;
 }
 
+TEST(Cli, ADeviceGivenAsAnInputFileIsBadInputNotReadWithoutEnd) {
+  // Every text input goes through one reader, which read /dev/zero until memory ran out.
+  for (const std::string args : {"gate --config /dev/zero --results /dev/zero", "scenes info /dev/zero",
+                                 "report /dev/zero --out /dev/null/never"}) {
+    const CliRun r = test::run_shell("ulimit -v 4000000 && timeout 60 " + std::string(SB_CLI_PATH) + " " + args);
+    EXPECT_EQ(r.code, 3) << args << "\n" << r.out;
+    EXPECT_NE(r.out.find("/dev/zero"), std::string::npos) << args << "\n" << r.out;
+  }
+}
+
+TEST(Cli, APathUnderProcThatIsNoOpenFileIsAnUnwritableFolderNamedByItsOption) {
+  // Only /proc/self/fd/N and its kin are a process's open files; /proc/x was written "in place"
+  // (after the whole timing, for bench --json) and failed naming neither option nor remedy.
+  CliRun r = test::run_cli("bench --scene lit-plane --resolution 32x18 --repetitions 1 --pipelines plain-rt --json "
+                           "/proc/x/y.json");
+  EXPECT_EQ(r.code, 4) << r.out;
+  EXPECT_NE(r.out.find("--json /proc/x/y.json: its folder /proc/x"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("per-stage"), std::string::npos) << "refused before the timing: " << r.out;
+  test::ScratchDir dir("procscenes");
+  r = test::run_cli("render --scene lit-plane --resolution 32x18 --scenes-dir /proc/x --out " + test::quoted(dir / "o"));
+  EXPECT_EQ(r.code, 4) << r.out;
+  EXPECT_NE(r.out.find("the scenes folder /proc/x (--scenes-dir, or $STEREOBENCH_SCENES) cannot hold the generated "
+                       "scene 'lit-plane'"),
+            std::string::npos)
+      << r.out;
+}
+
 TEST(Cli, RenderWritesEveryOutputAndBenchPrintsATable) {
   test::ScratchDir dir("render");
   const std::string common = " --scenes-dir '" + (dir / "scenes").string() + "' --resolution 64x36";

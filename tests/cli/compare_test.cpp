@@ -145,6 +145,11 @@ TEST_F(Compare, MismatchedAndMissingInputsAreBadInput) {
 
   r = compare(q(path("a.png")));
   EXPECT_EQ(r.code, 3) << r.out;  // B is required
+
+  // A device is no image: /dev/zero was read without end (the run spun until killed).
+  r = test::run_shell("timeout 30 " + std::string(SB_CLI_PATH) + " compare /dev/zero " + q(path("a.png")));
+  EXPECT_EQ(r.code, 3) << r.out;
+  EXPECT_NE(r.out.find("/dev/zero is a device, pipe or socket, not an image file"), std::string::npos) << r.out;
 }
 
 TEST_F(Compare, AStoppedComparisonLeavesNoOutputs) {
@@ -168,18 +173,23 @@ TEST_F(Compare, AStoppedComparisonLeavesNoOutputs) {
   EXPECT_EQ(r.code, 4) << r.out;
   EXPECT_NE(r.out.find("--json " + (path("file") / "v.json").string()), std::string::npos) << r.out;
   none_left("file/v.json");
-  // A file its folder cannot take (under /proc) fails only when written: the error names the option
-  // and what to do, and the pictures go with it.
-  r = compare(ab() + " --diff " + q(path("d.png")) + " --ssim-map " + q(path("s.png")) + " --json /proc/sb-compare.json");
+  // A file that fails only when written (/dev/full: a full disk): the error names the option and
+  // what to do, and the pictures go with it.
+  r = compare(ab() + " --diff " + q(path("d.png")) + " --ssim-map " + q(path("s.png")) + " --json /dev/full");
   EXPECT_EQ(r.code, 4) << r.out;
-  EXPECT_NE(r.out.find("--json: cannot open /proc/sb-compare.json"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--json: cannot write /dev/full: No space left on device"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("give --json a path you can write"), std::string::npos) << r.out;
   for (const char* name : {"d.png", "s.png"}) EXPECT_FALSE(fs::exists(path(name))) << name;
-  // So do the pictures' options (their errors named neither the option nor what to do).
+  // So do the pictures' options (their errors named neither the option nor what to do), through a
+  // link named as a picture.
+  fs::create_symlink("/dev/full", path("full.png"));
   for (const char* option : {"--diff", "--ssim-map"}) {
-    r = compare(ab() + " " + option + " /proc/sb-compare.png");
+    r = compare(ab() + " " + option + " " + q(path("full.png")));
     EXPECT_EQ(r.code, 4) << r.out;
-    EXPECT_NE(r.out.find(std::string(option) + ": cannot open /proc/sb-compare.png"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(std::string(option) + ": cannot write " + path("full.png").string() +
+                         ": No space left on device"),
+              std::string::npos)
+        << r.out;
     EXPECT_NE(r.out.find(std::string("give ") + option + " a path you can write"), std::string::npos) << r.out;
   }
   // A picture name the run refuses is not its output: the file stays.

@@ -63,6 +63,10 @@ TEST(GateConfig, BadValuesAreRejected) {
   EXPECT_NE(config_error("[defaults]\nmin_psnr = true\n").find("false to turn the check off"), std::string::npos);
   EXPECT_NE(config_error("[regression]\nalpha = 1.5\n").find("alpha"), std::string::npos);
   EXPECT_NE(config_error("[regression]\nmin_repetitions = 2.5\n").find("min_repetitions"), std::string::npos);
+  // The upper bound is said, with the value (it read "must be an integer of at least 1").
+  EXPECT_NE(config_error("[regression]\nmin_repetitions = 1000000000000\n")
+                .find("min_repetitions = 1000000000000 must be an integer from 1 to 1000000"),
+            std::string::npos);
   EXPECT_NE(config_error("[[rule]]\npipeline = 3\n").find("pipeline"), std::string::npos);
   EXPECT_NE(config_error("rule = 1\n").find("[[rule]]"), std::string::npos);
   // A syntax error names the line and column.

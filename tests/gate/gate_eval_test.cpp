@@ -368,6 +368,27 @@ TEST(GateEval, BaselineUpdateTouchesOnlyWhatIsNamed) {
       << run.out;
   EXPECT_EQ(read_text(dir / "baseline.json"), kept);
 
+  // A damaged entry is mended by an update that rewrites it (its remedy used to fail on the same
+  // damage), and stops one that does not, leaving the file as it was.
+  {
+    json damaged = json::parse(kept);
+    damaged[id0]["repro-rt"]["samples_s"] = "x";
+    write_file(dir / "damaged.json", damaged.dump(2));
+    run = run_cli("gate --update-baseline --cells '*|e=0.12m|*' --results " + (dir / "results.jsonl").string() +
+                  " --baseline " + (dir / "damaged.json").string());
+    EXPECT_EQ(run.code, 3) << run.out;
+    EXPECT_NE(run.out.find(fmt::format("'{}' / repro-rt: samples_s must be a non-empty array of seconds", id0)),
+              std::string::npos)
+        << run.out;
+    EXPECT_NE(run.out.find("this update does not rewrite it"), std::string::npos) << run.out;
+    EXPECT_EQ(read_text(dir / "damaged.json"), damaged.dump(2));
+    run = run_cli("gate --update-baseline --only repro-rt --results " + (dir / "results.jsonl").string() +
+                  " --baseline " + (dir / "damaged.json").string());
+    ASSERT_EQ(run.code, 0) << run.out;
+    EXPECT_EQ(validation::load_baseline(dir / "damaged.json").find(id0, "repro-rt")->samples_s,
+              std::vector<double>({0.010, 0.011, 0.012}));
+  }
+
   // One timing sample (a smoke sweep's): stored as asked, with a warning that every time check
   // against it can only warn, and how many samples the config's rank test needs.
   std::vector<json> single = passing_cells();
@@ -561,16 +582,15 @@ TEST(GateCli, BadInputIsExitThree) {
   EXPECT_EQ(run.code, 4) << run.out;
   EXPECT_NE(run.out.find("--json " + (dir / "notafolder" / "gate.json").string()), std::string::npos) << run.out;
   EXPECT_FALSE(std::filesystem::exists(dir / "junit.xml"));
-  // An output whose folder is there but which cannot be written (under /proc) fails only when it is
-  // written: the table's verdict line ("-> PASS (exit 0)") used to end standard output of a run
-  // that exited 4.
-  run = run_cli("gate" + config + " --results " + (dir / "pass.jsonl").string() + " --junit /proc/sb-gate-junit.xml");
+  // An output that fails only when it is written (/dev/full: a full disk): the table's verdict line
+  // ("-> PASS (exit 0)") used to end standard output of a run that exited 4.
+  run = run_cli("gate" + config + " --results " + (dir / "pass.jsonl").string() + " --junit /dev/full");
   EXPECT_EQ(run.code, 4) << run.out;
   EXPECT_NE(run.out.find("gate: the verdict above does not stand: its report files could not be written (exit 4)"),
             std::string::npos)
       << run.out;
-  EXPECT_NE(run.out.find("--junit: cannot open /proc/sb-gate-junit.xml"), std::string::npos) << run.out;
-  EXPECT_EQ(run.out.find("wrote /proc"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("--junit: cannot write /dev/full: No space left on device"), std::string::npos) << run.out;
+  EXPECT_EQ(run.out.find("wrote /dev/full"), std::string::npos) << run.out;
   // A folder given as an output is bad input naming it.
   run = run_cli("gate" + config + " --results " + (dir / "pass.jsonl").string() + " --junit " + dir.path().string());
   EXPECT_EQ(run.code, 3) << run.out;

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
+#include <tuple>
 #include <utility>
 
 #include <fmt/format.h>
@@ -257,8 +258,10 @@ TEST(ReferenceStore, ImpossibleSpecValuesAndAnImageOfAnotherSizeAreCorrupt) {
   const std::string original = test::read_text(prov);
   // Values no command line gives: each is a damaged provenance naming the field (a negative width
   // was reported as a changed scene, whose advised update then failed; 32.7 was read as 32).
+  // A negative interaxial, a zero convergence and a field of view beyond pi were "scene-changed".
   const std::pair<const char*, json> edits[] = {{"width", -32}, {"width", 32.7}, {"width", 4294967328.0},
-                                                {"height", "18"}, {"convergence_m", "inf"}};
+                                                {"height", "18"}, {"convergence_m", "inf"}, {"interaxial_m", -1},
+                                                {"convergence_m", 0}, {"vfov_rad", 100}};
   for (const auto& [field, value] : edits) {
     json p = json::parse(original);
     p["spec"]["rig_overrides"][field] = value;
@@ -274,6 +277,17 @@ TEST(ReferenceStore, ImpossibleSpecValuesAndAnImageOfAnotherSizeAreCorrupt) {
   const test::CliRun lights = test::run_cli(ref(dir, "verify") + " --no-render " + box);
   EXPECT_EQ(lights.code, 2) << lights.out;
   EXPECT_NE(lights.out.find("spec.lights is 0, not a whole number"), std::string::npos) << lights.out;
+  // A spec that is no object, and a provenance version this stereobench does not write.
+  for (const auto& [field, value, said] :
+       {std::tuple<const char*, json, const char*>{"spec", nullptr, "field 'spec' is null, not an object"},
+        {"version", 2, "version 2 is not the provenance version this stereobench writes and reads (1)"}}) {
+    json q = json::parse(original);
+    q[field] = value;
+    std::ofstream(prov, std::ios::trunc) << q.dump(2);
+    const test::CliRun r = test::run_cli(ref(dir, "verify") + " --no-render " + box);
+    EXPECT_EQ(r.code, 2) << field << ": " << r.out;
+    EXPECT_NE(r.out.find(said), std::string::npos) << r.out;
+  }
   std::ofstream(prov, std::ios::trunc) << original;
 
   // Another entry's image with its hash recorded: the hash holds, the size does not (it stopped

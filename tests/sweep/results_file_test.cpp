@@ -8,6 +8,9 @@
 #include <fstream>
 #include <limits>
 #include <string>
+#include <tuple>
+
+#include <fmt/format.h>
 
 #include "renderer/error.hpp"
 #include "support/scratch_dir.hpp"
@@ -242,6 +245,24 @@ TEST(ResultsFile, BadLinesAndDuplicatesRejected) {
   expect_refused(relabelled, "checked.jsonl:2: cell_id \"box-wall:size=0.5|e=0.064m|c=default|96x54|lights=all|full\" "
                              "does not match the cell's fields, which give \"box-wall:size=0.5|e=0.12m|c=default|"
                              "96x54|lights=all|full\"");
+  // An axis of the wrong type or out of range, which the gate turned into a reproduce command
+  // (`--interaxial -1`) or passed over.
+  for (const auto& [key, value, want] :
+       {std::tuple<const char*, json, const char*>{"interaxial_m", -1.0, "a positive number, or null"},
+        {"interaxial_m", "abc", "a positive number, or null"},
+        {"lights", -3, "an integer of at least 1, or null"},
+        {"scene_params", json::array({1}), "an object of numbers"},
+        {"frame", "a", "a frame number"}}) {
+    json broken = axes;
+    broken["cell"][key] = value;
+    expect_refused(broken, fmt::format("checked.jsonl:2: cell.{} is {}; it must be {}", key, value.dump(), want));
+  }
+  json negative_rig = cell(1, "b");
+  negative_rig["rig"]["convergence_m"] = -2.0;
+  expect_refused(negative_rig, "checked.jsonl:2: field 'rig.convergence_m' is -2.0; a rig's interaxial, convergence");
+  json left_text = cell(1, "b");
+  left_text["pipelines"]["plain-rt"]["validation"]["left_eye"] = {{"metrics", {{"psnr", "x"}, {"ssim", 0.9}, {"mse", 1.0}}}};
+  expect_refused(left_text, "checked.jsonl:2: field 'pipelines.plain-rt.validation.left_eye.metrics.psnr'");
   json more = cell(1, "b");
   more["pipelines"]["repro-rt"] = more["pipelines"]["plain-rt"];
   expect_refused(more, "checked.jsonl:2: the cell validates pipelines plain-rt, repro-rt, but line 1 of the same "

@@ -385,6 +385,8 @@ TEST(SweepDefinition, RejectsBadPaths) {
        "def.toml:3: path.gltf_clip: truth 'blender' renders the scene file at rest"},
       {"[sweep]\n[path]\nframes = 3\ngltf_animation = true\n[path.spin]\n", "plays the scene's glTF animation or a spin, not both"},
       {"[sweep]\n[path]\nframes = 3\n[path.spin]\nmesh_prefix = 4\n", "def.toml:5: path.spin.mesh_prefix: must be a string"},
+      {"[sweep]\n[path]\nframes = 3\n[path.spin]\npivot = [1e300, 0, 0]\n",
+       "def.toml:5: path.spin.pivot: (1e+300, 0, 0) lies beyond the ±1e+15 m a scene may span"},
       {"[sweep]\n[path]\nframes = 3\n[path.spin]\ndegrees_per_frame = 1e308\n",
        "def.toml:5: path.spin.degrees_per_frame: 1e+308 is not within ±360"},
       {"[sweep]\n[path]\nframes = 3\ncamera_keys = [[0, 1, 4, 0, 1, 3], [0, 1, 3, 0, 1, 4]]\n",
