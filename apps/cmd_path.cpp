@@ -208,7 +208,7 @@ void register_path_command(CLI::App& root) {
                                   "to their last:\nanimated meshes and lights move with their nodes, an animated scene "
                                   "camera moves the rig (not with --camera-keys or --spin-deg)");
   p->add_option("--gltf-clip", a->gltf_clip,
-                "Play only this glTF animation (clip) of the scene, by name or index (implies --gltf-animation; "
+                "Play only this glTF animation (clip) of the scene, by name or #index (implies --gltf-animation; "
                 "without it every clip plays at once)");
   p->add_option("--bvh", a->bvh,
                 "Per-frame BVH update of a moving scene (--spin-deg, --gltf-animation): refit (default) or rebuild");

@@ -136,10 +136,11 @@ SceneAnimator::SceneAnimator(Scene& scene, const PathSpec& path) : scene_(scene)
         moved.push_back(scene.meshes[m].node);
       }
     for (size_t l = 0; l < scene.lights.size(); ++l)
-      if (scene.lights[l].node >= 0 && a.moves(scene.lights[l].node)) {
-        lights_.push_back(l);
-        moved.push_back(scene.lights[l].node);
-      }
+      if (scene.lights[l].node >= 0 && a.moves(scene.lights[l].node)) lights_.push_back(l);
+    // Every light of the file counts for what moves, kept or not (--lights): the frames show the
+    // same animation times whatever the light count.
+    for (const int node : a.light_nodes)
+      if (a.moves(node)) moved.push_back(node);
     if (!scene.cameras.empty() && a.moves(scene.cameras.front().node)) {
       camera_node_ = scene.cameras.front().node;
       moved.push_back(camera_node_);
@@ -183,13 +184,22 @@ void SceneAnimator::play_clips(const NodeAnimation& all) {
   const std::string& name = path_.gltf_clip;
   if (name.empty()) {
     clip_ = all.clips.size() == 1 ? all.clip_label(0) : "every clip";
+  } else if (name[0] == '#') {  // by index, as messages label a clip
+    size_t index = 0;
+    const auto [end, ec] = std::from_chars(name.data() + 1, name.data() + name.size(), index);
+    if (ec != std::errc() || end != name.data() + name.size() || index >= all.clips.size())
+      throw InputError(fmt::format("scene '{}' has no glTF animation {}; its animations are {} (choose one by name, "
+                                   "or by #index)",
+                                   scene_.name, name, all.clip_list()));
+    chosen = index;
+    clip_ = all.clip_label(index);
   } else {
     std::vector<size_t> named;
     for (size_t c = 0; c < all.clips.size(); ++c)
       if (all.clips[c] == name) named.push_back(c);
     if (named.size() > 1)
       throw InputError(fmt::format("scene '{}' has {} glTF animations named '{}' (#{} and #{}); choose one by its "
-                                   "index",
+                                   "#index",
                                    scene_.name, named.size(), name, named[0], named[1]));
     if (named.size() == 1) {
       chosen = named.front();
@@ -198,7 +208,7 @@ void SceneAnimator::play_clips(const NodeAnimation& all) {
       const auto [end, ec] = std::from_chars(name.data(), name.data() + name.size(), index);
       if (ec != std::errc() || end != name.data() + name.size() || index >= all.clips.size())
         throw InputError(fmt::format("scene '{}' has no glTF animation '{}'; its animations are {} (choose one by "
-                                     "name or by index)",
+                                     "name, or by #index)",
                                      scene_.name, name, all.clip_list()));
       chosen = index;
     }
@@ -233,7 +243,8 @@ void SceneAnimator::apply(int frame) {
       const dmat4 w = played_.world(light.node, t);
       light.position = vec3(dvec3(w[3]));
       const dvec3 d = dvec3(w * dvec4(0.0, 0.0, -1.0, 0.0));
-      if (glm::length(d) > 0.0) light.direction = vec3(glm::normalize(d));
+      // Scaled to nothing, it has no direction: -Z, as the loader gives one (not the last frame's).
+      light.direction = glm::length(d) > 0.0 ? vec3(glm::normalize(d)) : vec3(0.0f, 0.0f, -1.0f);
     }
     for (const size_t m : turning_) {
       Mesh& mesh = scene_.meshes[m];

@@ -41,8 +41,8 @@ struct PathSpec {
   std::vector<CameraKey> camera_keys;
   std::optional<Spin> spin;
   bool gltf_animation = false;
-  /// The glTF animation (clip) to play, by name or, where no clip has that name, by index; empty:
-  /// every clip at once.
+  /// The glTF animation (clip) to play: by name, by "#index", or by a bare index where no clip has
+  /// that name; empty: every clip at once.
   std::string gltf_clip;
 
   /// InputError naming the field: frames outside 1..100000, a key whose target equals its

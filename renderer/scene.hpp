@@ -136,6 +136,9 @@ struct NodeAnimation {
   std::vector<int> parent;    ///< per glTF node: its parent in the loaded scene, -1 for a root or a node outside it
   std::vector<Local> local;   ///< per glTF node: its rest transform
   std::vector<std::string> clips;  ///< per glTF animation: its name ("" when it has none)
+  /// The node of every light the loaded scene places, before any are dropped (keep_first_lights):
+  /// what an animation moves, and so its time range, does not depend on how many lights are kept.
+  std::vector<int> light_nodes;
   std::vector<Channel> channels;
 
   [[nodiscard]] bool empty() const { return channels.empty(); }

@@ -211,7 +211,7 @@ constexpr Field kCellFields[] = {
     {"cell_count", Kind::integer, true},
     {"cell", Kind::object},
     {"cell.scene", Kind::string},
-    {"cell.resolution", Kind::string},
+    {"cell.resolution", Kind::string_or_null},  // null: the scene's own size (no resolutions axis)
     {"cell.truth", Kind::string},
     {"cell.lights", Kind::integer_or_null, true},
     {"rig", Kind::object},

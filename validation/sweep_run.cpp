@@ -330,6 +330,7 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
                  {"animate_s", scene.update->animate_s},
                  {"turning_meshes", scene.animator->turning_meshes()},
                  {"moving_lights", scene.animator->moving_lights()},
+                 {"gltf_clip", d.path->gltf_clip.empty() ? json(nullptr) : json(d.path->gltf_clip)},
                  {"animation_time_s", d.path->gltf_animation ? json(scene.animator->time_of(*cell.frame)) : json(nullptr)},
                  {"camera",
                   {{"position", {rig.pose().position.x, rig.pose().position.y, rig.pose().position.z}},

@@ -169,9 +169,10 @@ bool names_open_file(const std::vector<fs::path>& chain) {
     const auto digits = [](const std::string& t) {
       return !t.empty() && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
     };
+    const auto process = [&](const std::string& t) { return t == "self" || t == "thread-self" || digits(t); };
     const size_t task = owner.find("/task/");
-    return owner == "self" || owner == "thread-self" || digits(owner) ||
-           (task != std::string::npos && digits(owner.substr(0, task)) && digits(owner.substr(task + 6)));
+    return task == std::string::npos ? process(owner)
+                                     : process(owner.substr(0, task)) && digits(owner.substr(task + 6));
   });
 }
 

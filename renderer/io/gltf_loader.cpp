@@ -192,12 +192,14 @@ void check_data_uri(const std::string& uri, const std::string& top, const std::s
     throw InputError(fmt::format("{}: {}/uri: data URI is not base64-encoded; only base64 data URIs are "
                                  "supported", file, where));
   const std::string type = uri.substr(5, uri.rfind(";base64", comma) - 5);
+  // Images: PNG and JPEG in glTF 2.0, other image types through extensions (EXT_texture_webp,
+  // KHR_texture_basisu), which a texture may name beside a PNG fallback.
   const bool known = top == "buffers" ? type == "application/octet-stream" || type == "application/gltf-buffer"
-                                      : type == "image/png" || type == "image/jpeg";
+                                      : type.rfind("image/", 0) == 0 && type.size() > 6;
   if (!known)
     throw InputError(fmt::format("{}: {}/uri: data URI of media type '{}'; {} take {}", file, where, type, top,
                                  top == "buffers" ? "'data:application/octet-stream;base64,...'"
-                                                  : "'data:image/png;base64,...' or 'data:image/jpeg;base64,...'"));
+                                                  : "an image type, e.g. 'data:image/png;base64,...'"));
   size_t end = uri.size();
   for (size_t pad = 0; end > comma + 1 && pad < 2 && uri[end - 1] == '='; ++pad) --end;
   for (size_t i = comma + 1; i < end; ++i) {
@@ -903,6 +905,7 @@ class Converter {
       const int li = ext->second.Get("light").GetNumberAsInt();
       convert_light(scene, li, world);
       scene.lights.back().node = ni;
+      scene.animation.light_nodes.push_back(ni);
     }
   }
 

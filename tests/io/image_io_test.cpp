@@ -659,6 +659,17 @@ TEST_F(ImageIoTest, AnOpenFileOfTheProcessIsAppendedToNotReplaced) {
   ASSERT_EQ(::stat(path("log").c_str(), &after), 0);
   EXPECT_EQ(after.st_ino, before.st_ino) << "the file was replaced";
   EXPECT_EQ(entries(), std::vector<std::string>{"log"});
+  // The same file through its thread's table, and through its process id's.
+  const int again = ::open(path("log").c_str(), O_WRONLY | O_APPEND);
+  ASSERT_GE(again, 0);
+  const std::string tid = std::to_string(::gettid()), pid = std::to_string(::getpid());
+  for (const std::string& name :
+       std::vector<std::string>{"/proc/self/task/" + tid + "/fd/", "/proc/thread-self/fd/", "/proc/" + pid + "/fd/"})
+    io::write_text_atomically(name + std::to_string(again), "+");
+  ::close(again);
+  EXPECT_EQ(read_bytes(path("log")), (std::vector<unsigned char>{'o', 'l', 'd', 'n', 'e', 'w', '+', '+', '+'}));
+  ASSERT_EQ(::stat(path("log").c_str(), &after), 0);
+  EXPECT_EQ(after.st_ino, before.st_ino) << "the file was replaced";
   // A stereo EXR (its writer seeks) reaches a pipe whole.
   int pipe_fds[2];
   ASSERT_EQ(::pipe(pipe_fds), 0);

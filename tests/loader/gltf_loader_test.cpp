@@ -215,6 +215,17 @@ TEST(GltfLoader, ASkinWithoutInverseBindMatricesLoadsInItsBindPose) {
   }
 }
 
+TEST(GltfLoader, AnImageDataUriOfAnExtensionsTypeLoads) {
+  // EXT_texture_webp and KHR_texture_basisu name images of other types beside a PNG fallback.
+  ScratchDir dir("webp");
+  MiniGltf g;
+  g.add_triangle();
+  g.doc["images"] = json::array({{{"uri", "data:image/webp;base64,UklGRg=="}}});
+  g.doc["extensionsUsed"] = {"EXT_texture_webp"};
+  g.write_gltf(dir / "w.gltf");
+  EXPECT_EQ(io::load_gltf(dir / "w.gltf").meshes.size(), 1u);
+}
+
 TEST(GltfLoader, APrimitiveWhosePositionsAreAllZeroIsSkippedWithAWarning) {
   // Without a bufferView or sparse values every vertex is (0, 0, 0): nothing of it can be seen,
   // whatever count it declares, so it is neither read nor rendered.

@@ -287,6 +287,15 @@ TEST(GltfAnimation, LightsOnAnimatedNodesMoveAndShineAsIfPlacedThere) {
   EXPECT_EQ(animator.moving_lights(), 1u);
   EXPECT_EQ(animator.turning_meshes(), 0u);
   EXPECT_FALSE(animator.moves_geometry());
+  {
+    // The carried lamp dropped (--lights 1): nothing visible moves, and the frames keep their times.
+    Scene one_light = scene;
+    keep_first_lights(one_light, 1);
+    ASSERT_EQ(one_light.lights.front().name, "lamp");
+    const SceneAnimator kept(one_light, gltf_path(2));
+    EXPECT_EQ(kept.moving_lights(), 0u);
+    EXPECT_DOUBLE_EQ(kept.time_of(1), animator.time_of(1));
+  }
   const Image at_rest = traced_left(scene);
   animator.apply(1);
   expect_near(dvec3(light_named(scene, "carried").position), dvec3(1.0, 2.0, 1.0), 1e-6, "carried lamp at frame 1");
@@ -350,6 +359,8 @@ TEST(GltfAnimation, OneClipPlaysByNameOrIndexAndClipsKeyingOnePropertyCannotPlay
     walking.apply(2);
     expect_near(centre_of(scene, "mover", a.mover), dvec3(4.0, 0.0, 0.0), 1e-5, "walked");
   }
+  path.gltf_clip = "#0";  // by index, as messages label a clip
+  EXPECT_EQ(SceneAnimator(scene, path).clip(), "'walk'");
   path.gltf_clip = "1";  // no clip has that name: the index
   {
     SceneAnimator hopping(scene, path);
@@ -360,6 +371,8 @@ TEST(GltfAnimation, OneClipPlaysByNameOrIndexAndClipsKeyingOnePropertyCannotPlay
     hopping.apply(1);
     expect_near(centre_of(scene, "mover", a.mover), dvec3(0.0, 2.0, 0.0), 1e-5, "hopped, at t = 2 s");
   }
+  path.gltf_clip = "#2";
+  EXPECT_THROW(SceneAnimator(scene, path), InputError);
   for (const std::string bad : {"run", "2", "-1"}) {
     path.gltf_clip = bad;
     try {

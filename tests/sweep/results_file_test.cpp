@@ -240,6 +240,17 @@ TEST(ResultsFile, BadLinesAndDuplicatesRejected) {
     append_result(file, axes);
     EXPECT_EQ(read_results(file).cells.size(), 2u) << "an id that matches its fields";
   }
+  {
+    // A sweep without a resolutions axis renders the scene's own size and writes resolution null:
+    // its own file was refused by every reader.
+    json scene_size = axes;
+    scene_size["cell"]["resolution"] = nullptr;
+    scene_size["cell_id"] = "box-wall:size=0.5|e=0.064m|c=default|res=default|lights=all|full";
+    const auto file = dir / "scene-size.jsonl";
+    append_result(file, cell(0, "a"));
+    append_result(file, scene_size);
+    EXPECT_EQ(read_results(file).cells.size(), 2u);
+  }
   json relabelled = axes;
   relabelled["cell"]["interaxial_m"] = 0.12;
   expect_refused(relabelled, "checked.jsonl:2: cell_id \"box-wall:size=0.5|e=0.064m|c=default|96x54|lights=all|full\" "
