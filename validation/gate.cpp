@@ -219,13 +219,21 @@ bool timed_check(std::string_view check) {
   return check == kRegressionCheck || std::any_of(std::begin(kMetricChecks), std::end(kMetricChecks), reads_timing);
 }
 
+/// `v` with `places` decimals, or in exponent form where that would print more than a dozen
+/// digits (a limit of 1e308 printed 309).
+std::string decimals(double v, int places, bool sign = false) {
+  const std::string plus = sign && !std::signbit(v) ? "+" : "";
+  if (std::abs(v) >= 1e6) return plus + fmt::format("{:.4g}", v);
+  return plus + fmt::format("{:.{}f}", v, places);
+}
+
 std::string value_text(const std::string& check, double v) {
   if (std::isnan(v)) return "-";
   if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  if (check == "psnr" || check == "left_psnr") return fmt::format("{:.2f} dB", v);
-  if (check == "speedup") return fmt::format("{:.2f}x", v);
-  if (check == "right_share") return fmt::format("{:.1f} %", 100.0 * v);
-  if (check == kRegressionCheck) return fmt::format("{:+.1f} %", 100.0 * v);
+  if (check == "psnr" || check == "left_psnr") return decimals(v, 2) + " dB";
+  if (check == "speedup") return decimals(v, 2) + "x";
+  if (check == "right_share") return decimals(100.0 * v, 1) + " %";
+  if (check == kRegressionCheck) return decimals(100.0 * v, 1, true) + " %";
   return fmt::format("{:.4g}", v);
 }
 

@@ -91,6 +91,15 @@ TEST(GateEval, ThresholdAboveTheMeasuredValueFails) {
             "--interaxial 0.064 --convergence 2");
 }
 
+TEST(GateEval, AHugeLimitIsShownInExponentFormNotAsThreeHundredDigits) {
+  const std::string config = kConfig + "[[rule]]\npipeline = \"repro-rt\"\nmin_speedup = 1e308\n";
+  const validation::GateReport r = evaluate(passing_cells(), {}, config);
+  const validation::GateCheck* speedup = find_check(r, "repro-rt", "speedup");
+  ASSERT_NE(speedup, nullptr);
+  EXPECT_EQ(speedup->verdict, Verdict::fail);
+  EXPECT_NE(speedup->message.find("is below the minimum 1e+308x"), std::string::npos) << speedup->message;
+}
+
 TEST(GateEval, RightEyeShareOfTheLeft) {
   const std::string config = kConfig + "max_right_share = 0.2\nwarn_right_share = 0.18\n";
   std::vector<json> cells = passing_cells();
