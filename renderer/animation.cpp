@@ -184,34 +184,28 @@ void SceneAnimator::play_clips(const NodeAnimation& all) {
   const std::string& name = path_.gltf_clip;
   if (name.empty()) {
     clip_ = all.clips.size() == 1 ? all.clip_label(0) : "every clip";
-  } else if (name[0] == '#') {  // by index, as messages label a clip
-    size_t index = 0;
-    const auto [end, ec] = std::from_chars(name.data() + 1, name.data() + name.size(), index);
-    if (ec != std::errc() || end != name.data() + name.size() || index >= all.clips.size())
-      throw InputError(fmt::format("scene '{}' has no glTF animation {}; its animations are {} (choose one by name, "
-                                   "or by #index)",
-                                   scene_.name, name, all.clip_list()));
-    chosen = index;
-    clip_ = all.clip_label(index);
   } else {
+    // "#N" is an index, as messages label a clip; a bare number is a name first, then an index.
+    const bool hash = name[0] == '#';
     std::vector<size_t> named;
-    for (size_t c = 0; c < all.clips.size(); ++c)
+    for (size_t c = 0; c < all.clips.size() && !hash; ++c)
       if (all.clips[c] == name) named.push_back(c);
     if (named.size() > 1)
       throw InputError(fmt::format("scene '{}' has {} glTF animations named '{}' (#{} and #{}); choose one by its "
                                    "#index",
                                    scene_.name, named.size(), name, named[0], named[1]));
-    if (named.size() == 1) {
-      chosen = named.front();
-    } else {
+    if (named.empty()) {
+      const char* const first = name.data() + (hash ? 1 : 0);
+      const char* const last = name.data() + name.size();
       size_t index = 0;
-      const auto [end, ec] = std::from_chars(name.data(), name.data() + name.size(), index);
-      if (ec != std::errc() || end != name.data() + name.size() || index >= all.clips.size())
+      const auto [end, ec] = std::from_chars(first, last, index);
+      if (ec != std::errc() || end != last || index >= all.clips.size())
         throw InputError(fmt::format("scene '{}' has no glTF animation '{}'; its animations are {} (choose one by "
                                      "name, or by #index)",
                                      scene_.name, name, all.clip_list()));
-      chosen = index;
+      named.push_back(index);
     }
+    chosen = named.front();
     clip_ = all.clip_label(*chosen);
   }
   // Two clips that key one property of a node (the idle and the walk of one character) cannot
@@ -237,15 +231,7 @@ void SceneAnimator::apply(int frame) {
     throw InputError(fmt::format("frame {} is outside the path's 0..{}", frame, path_.frames - 1));
   if (path_.gltf_animation) {
     const double t = time_of(frame);
-    for (const size_t l : lights_) {
-      // glTF: a light sits at its node's origin and shines down the node's -Z; scale does not matter.
-      Light& light = scene_.lights[l];
-      const dmat4 w = played_.world(light.node, t);
-      light.position = vec3(dvec3(w[3]));
-      const dvec3 d = dvec3(w * dvec4(0.0, 0.0, -1.0, 0.0));
-      // Scaled to nothing, it has no direction: -Z, as the loader gives one (not the last frame's).
-      light.direction = glm::length(d) > 0.0 ? vec3(glm::normalize(d)) : vec3(0.0f, 0.0f, -1.0f);
-    }
+    for (const size_t l : lights_) scene_.lights[l].place(played_.world(scene_.lights[l].node, t));
     for (const size_t m : turning_) {
       Mesh& mesh = scene_.meshes[m];
       // The node's world transform at t places its own geometry; normals by its inverse transpose.

@@ -73,6 +73,12 @@ dmat4 NodeAnimation::Local::transform() const {
   return t * dmat4(glm::mat3_cast(rotation)) * s;
 }
 
+void Light::place(const dmat4& world) {
+  position = vec3(dvec3(world[3]));
+  const dvec3 d = dvec3(world * dvec4(0.0, 0.0, -1.0, 0.0));
+  direction = glm::length(d) > 0.0 ? vec3(glm::normalize(d)) : vec3(0.0f, 0.0f, -1.0f);
+}
+
 std::string NodeAnimation::clip_label(size_t clip) const {
   return clip < clips.size() && !clips[clip].empty() ? fmt::format("'{}'", clips[clip]) : fmt::format("#{}", clip);
 }

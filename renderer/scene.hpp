@@ -70,6 +70,10 @@ struct Light {
   float inner_cone = 0.0f;
   float outer_cone = 0.78539816f;
   int node = -1;  ///< the glTF node that places it (-1: none); an animation along a path moves it
+
+  /// Places the light by its node's world transform, as KHR_lights_punctual does: at the node's
+  /// origin, shining down its -Z (scale does not matter; scaled to nothing, down world -Z).
+  void place(const dmat4& world);
 };
 
 /// Largest coordinate magnitude, in metres, a scene may use: vertices, cameras and lights. Embree

@@ -1108,9 +1108,7 @@ class Converter {
            fmt::format("light '{}' is placed at ({:g}, {:g}, {:g}) m, beyond the ±{:g} m a scene may span; check "
                        "its node's translation and the file's units",
                        l.name, world[3].x, world[3].y, world[3].z, kMaxSceneCoordinate));
-    l.position = vec3(world[3]);
-    const dvec3 d = dvec3(world * dvec4(0.0, 0.0, -1.0, 0.0));
-    l.direction = glm::length(d) > 0.0 ? vec3(glm::normalize(d)) : vec3(0.0f, 0.0f, -1.0f);
+    l.place(world);
     scene.lights.push_back(l);
   }
 
