@@ -51,6 +51,14 @@ void require_scene_memory(const Scene& scene) {
     vertices += m.positions.size();
   }
   for (const Texture& t : scene.textures) texels += static_cast<uint64_t>(t.width) * static_cast<uint64_t>(t.height);
+  // A texture that cut-outs read is kept once more, level 0 alone (SceneGeometry); counted once
+  // per material that reads it, an upper bound.
+  for (const Material& m : scene.materials)
+    if (m.alpha_mode == Material::AlphaMode::mask && m.base_color_texture >= 0 &&
+        static_cast<size_t>(m.base_color_texture) < scene.textures.size()) {
+      const Texture& t = scene.textures[static_cast<size_t>(m.base_color_texture)];
+      texels += static_cast<uint64_t>(t.width) * static_cast<uint64_t>(t.height) * 3 / 4;  // 16 B each below
+    }
   require_memory(kBvhBytesPerTriangle * triangles + kBvhBytesPerVertex * vertices + texels * 16 * 4 / 3,
                  fmt::format("preparing scene '{}' for rendering ({} triangles, {} texels of textures)", scene.name,
                              triangles, texels),

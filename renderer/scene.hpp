@@ -25,11 +25,17 @@ struct Texture {
 
 /// Lambertian material (DESIGN §3): albedo = base colour factor x base colour texture.
 struct Material {
+  /// glTF alphaMode. `mask` cuts the surface out where its alpha (base colour factor alpha x base
+  /// colour texture alpha) is below alpha_cutoff: rays and the rasterizer pass through there, shadow
+  /// rays too (SceneGeometry::opaque_at). `blend` is rendered as opaque (reported by the loader).
+  enum class AlphaMode { opaque, mask, blend };
   std::string name;
   vec4 base_color{1.0f};
   int base_color_texture = -1;  ///< index into Scene::textures, or -1
   int texcoord = 0;             ///< which TEXCOORD_n set the texture reads
   bool double_sided = false;    ///< glTF doubleSided
+  AlphaMode alpha_mode = AlphaMode::opaque;
+  float alpha_cutoff = 0.5f;    ///< glTF alphaCutoff (mask only): opaque where alpha >= alpha_cutoff
 };
 
 /// A triangle mesh in world space (one glTF primitive instanced by one node).

@@ -21,6 +21,50 @@ SceneGeometry::SceneGeometry(const Scene& s) : scene(&s) {
     const bool double_sided = m.material < 0 || s.materials[static_cast<size_t>(m.material)].double_sided;
     single_sided.push_back(double_sided ? 0 : 1);
   }
+  // Cut-outs: one level-0 copy of each texture they read, then their records (pointers into the
+  // finished vector).
+  std::vector<int> texture_slot(s.textures.size(), -1);
+  std::vector<int> material_cutout(s.materials.size(), -1);
+  std::vector<std::pair<int, Cutout>> pending;  // per cut-out material: texture slot, record
+  for (size_t i = 0; i < s.materials.size(); ++i) {
+    const Material& mat = s.materials[i];
+    if (mat.alpha_mode != Material::AlphaMode::mask) continue;
+    int slot = -1;
+    const int t = mat.base_color_texture;
+    if (t >= 0 && static_cast<size_t>(t) < s.textures.size()) {
+      if (texture_slot[static_cast<size_t>(t)] < 0) {
+        texture_slot[static_cast<size_t>(t)] = static_cast<int>(cutout_textures_.size());
+        cutout_textures_.emplace_back(s.textures[static_cast<size_t>(t)], false);
+      }
+      slot = texture_slot[static_cast<size_t>(t)];
+    }
+    material_cutout[i] = static_cast<int>(pending.size());
+    pending.push_back({slot, Cutout{nullptr, mat.base_color.w, mat.alpha_cutoff}});
+  }
+  for (auto& [slot, cutout] : pending) {
+    if (slot >= 0) cutout.texture = &cutout_textures_[static_cast<size_t>(slot)];
+    cutouts.push_back(cutout);
+  }
+  cutout_of.reserve(s.meshes.size());
+  for (const Mesh& m : s.meshes)
+    cutout_of.push_back(m.material >= 0 && static_cast<size_t>(m.material) < s.materials.size()
+                            ? material_cutout[static_cast<size_t>(m.material)]
+                            : -1);
+}
+
+bool SceneGeometry::opaque_at(uint32_t mesh, uint32_t tri, vec2 bary) const {
+  const int32_t c = cutout_of[mesh];
+  if (c < 0) return true;
+  const Cutout& cut = cutouts[static_cast<size_t>(c)];
+  float alpha = cut.factor_alpha;
+  const Mesh& m = scene->meshes[mesh];
+  if (cut.texture != nullptr && !m.uvs.empty()) {
+    const uint32_t* idx = &m.indices[3 * static_cast<size_t>(tri)];
+    const float b1 = bary.x, b2 = bary.y, b0 = 1.0f - b1 - b2;
+    const vec2 uv = b0 * m.uvs[idx[0]] + b1 * m.uvs[idx[1]] + b2 * m.uvs[idx[2]];
+    alpha *= cut.texture->sample_bilinear(uv, 0).w;
+  }
+  return alpha >= cut.cutoff;
 }
 
 std::pair<uint32_t, uint32_t> SceneGeometry::locate(uint32_t prim_id) const {

@@ -43,7 +43,7 @@ int wrap_clamp(int i, int n) { return std::clamp(i, 0, n - 1); }
 
 }  // namespace
 
-MipTexture::MipTexture(const Texture& texture)
+MipTexture::MipTexture(const Texture& texture, bool chain)
     : repeat_s_(texture.repeat_s), repeat_t_(texture.repeat_t), name_(texture.name) {
   if (texture.width <= 0 || texture.height <= 0)
     throw InputError(fmt::format("texture '{}': size {}x{} is not positive; a texture needs at least one texel",
@@ -64,7 +64,7 @@ MipTexture::MipTexture(const Texture& texture)
   levels_.push_back(std::move(base));
 
   // Coarser levels: separable box filter, horizontal pass then vertical pass, accumulated in double.
-  while (levels_.back().width > 1 || levels_.back().height > 1) {
+  while (chain && (levels_.back().width > 1 || levels_.back().height > 1)) {
     const Level& src = levels_.back();
     const int sw = src.width, sh = src.height;
     const int dw = half_size(sw), dh = half_size(sh);

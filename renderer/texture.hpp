@@ -24,9 +24,9 @@ namespace sb {
 /// Wrapping is per axis from the Texture: REPEAT (repeat_s / repeat_t) or CLAMP_TO_EDGE.
 class MipTexture {
  public:
-  /// Builds the chain; throws InputError naming the texture if its size is not positive or its
-  /// rgba array does not hold width * height * 4 floats.
-  explicit MipTexture(const Texture& texture);
+  /// Builds the chain (level 0 alone without `chain`); throws InputError naming the texture if its
+  /// size is not positive or its rgba array does not hold width * height * 4 floats.
+  explicit MipTexture(const Texture& texture, bool chain = true);
 
   [[nodiscard]] int levels() const;
   /// Size of a level; throws InputError for a level outside [0, levels()).

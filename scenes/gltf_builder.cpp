@@ -204,6 +204,13 @@ int GltfBuilder::add_material(const std::string& name, const vec4& base_color, i
   return static_cast<int>(materials_.size()) - 1;
 }
 
+void GltfBuilder::set_alpha_mask(int material, double cutoff) {
+  if (material < 0 || material >= static_cast<int>(materials_.size()))
+    throw std::logic_error(fmt::format("glTF builder: no material {} to make a cut-out", material));
+  materials_[static_cast<size_t>(material)]["alphaMode"] = "MASK";
+  materials_[static_cast<size_t>(material)]["alphaCutoff"] = cutoff;
+}
+
 int GltfBuilder::add_texture(const std::string& name, int width, int height, std::span<const uint8_t> rgba8) {
   if (width <= 0 || height <= 0 ||
       rgba8.size() != static_cast<size_t>(width) * static_cast<size_t>(height) * 4)

@@ -72,6 +72,9 @@ class GltfBuilder {
   int add_material(const std::string& name, const vec3& base_color, int texture = -1, bool double_sided = true) {
     return add_material(name, vec4(base_color, 1.0f), texture, double_sided);
   }
+  /// Makes a material a cut-out: glTF alphaMode MASK with `cutoff` (the alpha is the base colour
+  /// factor's times the texture's).
+  void set_alpha_mask(int material, double cutoff = 0.5);
   /// A base colour texture from RGBA8 sRGB pixels (row 0 at the top), embedded as PNG (stored as
   /// RGB when every alpha is 255) and sampled with REPEAT and LINEAR_MIPMAP_LINEAR.
   int add_texture(const std::string& name, int width, int height, std::span<const uint8_t> rgba8);

@@ -80,6 +80,12 @@ std::string hash_scene(const Scene& scene) {
     sha.add_value(m.base_color_texture);
     sha.add_value(m.texcoord);
     sha.add_value(static_cast<uint8_t>(m.double_sided));
+    // Only a cut-out changes what is rendered (BLEND renders as OPAQUE); opaque materials hash as
+    // they did before cut-outs existed, so stored references keep their scene hashes.
+    if (m.alpha_mode == Material::AlphaMode::mask) {
+      sha.add("alpha-mask");
+      sha.add_value(m.alpha_cutoff);
+    }
   }
   sha.add_value(static_cast<uint64_t>(scene.textures.size()));
   for (const Texture& t : scene.textures) {

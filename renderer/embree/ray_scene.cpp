@@ -25,6 +25,13 @@ struct RayScene::Impl {
   /// Per geometry: whether its index buffer holds the mesh's triangles reversed (Mesh::mirrored)
   /// as uploaded; an animation that mirrors a mesh flips the flag and the order together.
   std::vector<bool> mirrored;
+  /// What the hit filters of a geometry need: reserved up front, so the addresses Embree keeps
+  /// stay valid.
+  struct Filter {
+    const SceneGeometry* geometry = nullptr;
+    uint32_t mesh = 0;
+  };
+  std::vector<Filter> filters;
 };
 
 namespace {
@@ -43,20 +50,44 @@ bool on_memory(void* user, ssize_t bytes, bool /*post*/) {
   return true;
 }
 
-/// Rejects hits on the back of single-sided triangles (the rasterizer's culling rule).
-void cull_back_faces(const RTCFilterFunctionNArguments* args) {
-  const auto* mesh = static_cast<const Mesh*>(args->geometryUserPtr);
+/// Whether a hit lies on a cut-out's transparent part (SceneGeometry::opaque_at).
+bool cut_away(const RayScene::Impl::Filter& f, const RTCFilterFunctionNArguments* args, unsigned i) {
+  const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+  const vec2 bary(RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
+  return !f.geometry->opaque_at(f.mesh, prim, bary);
+}
+
+/// Primary and restricted rays: rejects hits on the back of single-sided triangles (the
+/// rasterizer's culling rule) and on a cut-out's transparent part.
+void filter_hits(const RTCFilterFunctionNArguments* args) {
+  const auto& f = *static_cast<const RayScene::Impl::Filter*>(args->geometryUserPtr);
+  const Mesh& mesh = f.geometry->scene->meshes[f.mesh];
+  const bool cull = f.geometry->single_sided[f.mesh] != 0, cutout = f.geometry->has_cutout(f.mesh);
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] == 0) continue;
-    const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
-    const vec3 v0 = mesh->positions[mesh->indices[prim * 3 + 0]];
-    const vec3 v1 = mesh->positions[mesh->indices[prim * 3 + 1]];
-    const vec3 v2 = mesh->positions[mesh->indices[prim * 3 + 2]];
-    const vec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
-                 RTCRayN_dir_z(args->ray, args->N, i));
-    // Facing the ray origin <=> the triangle normal points against the ray direction.
-    if (glm::dot(glm::cross(v1 - v0, v2 - v0), d) >= 0.0f) args->valid[i] = 0;
+    if (cull) {
+      const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+      const vec3 v0 = mesh.positions[mesh.indices[prim * 3 + 0]];
+      const vec3 v1 = mesh.positions[mesh.indices[prim * 3 + 1]];
+      const vec3 v2 = mesh.positions[mesh.indices[prim * 3 + 2]];
+      const vec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                   RTCRayN_dir_z(args->ray, args->N, i));
+      // Facing the ray origin <=> the triangle normal points against the ray direction.
+      if (glm::dot(glm::cross(v1 - v0, v2 - v0), d) >= 0.0f) {
+        args->valid[i] = 0;
+        continue;
+      }
+    }
+    if (cutout && cut_away(f, args, i)) args->valid[i] = 0;
   }
+}
+
+/// Occlusion queries (shadow rays, the validation of reprojected pixels): light passes through a
+/// cut-out's transparent part. Back faces block, as for every occlusion query.
+void filter_occlusion(const RTCFilterFunctionNArguments* args) {
+  const auto& f = *static_cast<const RayScene::Impl::Filter*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i)
+    if (args->valid[i] != 0 && cut_away(f, args, i)) args->valid[i] = 0;
 }
 
 }  // namespace
@@ -81,6 +112,7 @@ RayScene::RayScene(const SceneGeometry& geometry, bool refittable)
   rtcSetSceneFlags(impl_->scene, refittable ? RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_DYNAMIC : RTC_SCENE_FLAG_ROBUST);
   rtcSetSceneBuildQuality(impl_->scene, refittable ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_MEDIUM);
   const Scene& s = *geometry.scene;
+  impl_->filters.reserve(s.meshes.size());
   for (size_t m = 0; m < s.meshes.size(); ++m) {
     const Mesh& mesh = s.meshes[m];
     RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -97,9 +129,11 @@ RayScene::RayScene(const SceneGeometry& geometry, bool refittable)
     std::memcpy(idx, mesh.indices.data(), mesh.indices.size() * sizeof(uint32_t));
     impl_->mirrored.push_back(mesh.mirrored);
     if (refittable) rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_REFIT);
-    if (geometry.single_sided[m]) {
-      rtcSetGeometryUserData(g, const_cast<Mesh*>(&mesh));
-      rtcSetGeometryIntersectFilterFunction(g, cull_back_faces);
+    if (geometry.single_sided[m] || geometry.has_cutout(static_cast<uint32_t>(m))) {
+      impl_->filters.push_back({&geometry, static_cast<uint32_t>(m)});
+      rtcSetGeometryUserData(g, &impl_->filters.back());
+      rtcSetGeometryIntersectFilterFunction(g, filter_hits);
+      if (geometry.has_cutout(static_cast<uint32_t>(m))) rtcSetGeometryOccludedFilterFunction(g, filter_occlusion);
     }
     rtcCommitGeometry(g);
     const unsigned id = rtcAttachGeometry(impl_->scene, g);

@@ -468,6 +468,14 @@ class Checker {
       opt_number_array_in(m, "emissiveFactor", p, 3, 0.0, 1.0, "glTF colour factors are linear, 0..1");
       opt_bool(m, "doubleSided", p);
       opt_string(m, "alphaMode", p);
+      if (const json* mode = find(m, "alphaMode")) {
+        const std::string& text = mode->get_ref<const std::string&>();
+        if (text != "OPAQUE" && text != "MASK" && text != "BLEND")
+          fail(p + "/alphaMode", fmt::format("is \"{}\"; glTF allows OPAQUE, MASK or BLEND", text));
+      }
+      if (const json* cutoff = member(m, "alphaCutoff", p))
+        if (number(*cutoff, p + "/alphaCutoff") < 0.0)
+          fail(p + "/alphaCutoff", fmt::format("value {:g} is negative; glTF alphaCutoff is at least 0", cutoff->get<double>()));
     });
 
     each(doc_, "textures", "", [&](const json& t, const std::string& p) {

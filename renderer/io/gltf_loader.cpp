@@ -608,7 +608,13 @@ class Converter {
         warn("occlusionTexture", "occlusion textures are ignored (direct light only; the ambient term is not occluded)");
       if (gm.pbrMetallicRoughness.metallicRoughnessTexture.index >= 0)
         warn("metallicRoughnessTexture", "metallic-roughness textures are ignored (surfaces are Lambertian)");
-      if (gm.alphaMode != "OPAQUE") warn("alpha:" + gm.alphaMode, fmt::format("alphaMode {} (rendered as OPAQUE)", gm.alphaMode));
+      if (gm.alphaMode == "MASK") {
+        mat.alpha_mode = Material::AlphaMode::mask;
+        mat.alpha_cutoff = static_cast<float>(gm.alphaCutoff);
+      } else if (gm.alphaMode == "BLEND") {
+        mat.alpha_mode = Material::AlphaMode::blend;
+        warn("alpha:BLEND", "alphaMode BLEND (rendered as OPAQUE: surfaces are not blended)");
+      }
       for (const auto& [ext, value] : gm.extensions) warn("ext:" + ext, fmt::format("material extension '{}' is ignored", ext));
       const int t = gm.pbrMetallicRoughness.baseColorTexture.index;
       if (t >= 0 && options_.load_textures) {

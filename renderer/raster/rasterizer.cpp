@@ -68,11 +68,12 @@ void bin_chunk(Chunk& chunk, const TileGrid& grid) {
 /// One tile's depth buffer and winning triangles. The tile owns its pixels: no locks, no atomics.
 class TileRaster {
  public:
-  TileRaster(const PixelRect& rect, int image_width, const uint8_t* write_mask)
+  TileRaster(const PixelRect& rect, int image_width, const uint8_t* write_mask, const raster::SetupInputs& inputs)
       : rect_(rect),
         tile_width_(rect.width()),
         image_width_(image_width),
         mask_(write_mask),
+        inputs_(&inputs),
         depth_(static_cast<size_t>(rect.width()) * rect.height(), std::numeric_limits<float>::infinity()),
         winner_(depth_.size(), nullptr) {}
 
@@ -106,12 +107,12 @@ class TileRaster {
       if (use_spans) {
         int lo = 0, hi = x_end - x_begin;
         if (!covered_span(row, step_x, lo, hi)) continue;
-        for (int x = x_begin + lo; x <= x_begin + hi; ++x) fragment(t, x, q_row, image_row, tile_row);
+        for (int x = x_begin + lo; x <= x_begin + hi; ++x) fragment(t, x, y, q_row, image_row, tile_row);
         continue;
       }
       int64_t e0 = row[0], e1 = row[1], e2 = row[2];
       for (int x = x_begin; x <= x_end; ++x, e0 += step_x[0], e1 += step_x[1], e2 += step_x[2])
-        if ((e0 | e1 | e2) >= 0) fragment(t, x, q_row, image_row, tile_row);
+        if ((e0 | e1 | e2) >= 0) fragment(t, x, y, q_row, image_row, tile_row);
     }
   }
 
@@ -176,7 +177,7 @@ class TileRaster {
  private:
   /// Depth test of a covered pixel centre (x, y) of the tile; 1/w is evaluated from the absolute
   /// pixel centre so that the depth never depends on the tile size.
-  void fragment(const RasterTriangle& t, int x, double q_row, size_t image_row, size_t tile_row) {
+  void fragment(const RasterTriangle& t, int x, int y, double q_row, size_t image_row, size_t tile_row) {
     if (mask_ != nullptr && mask_[image_row + x] == 0) return;
     ++tested;
     const double q = t.inv_w.x * (x + 0.5) + q_row;
@@ -184,6 +185,9 @@ class TileRaster {
     const float d = static_cast<float>(1.0 / q);
     const size_t i = tile_row + static_cast<size_t>(x - rect_.x0);
     if (d < depth_[i] || (d == depth_[i] && winner_[i] != nullptr && t.prim < winner_[i]->prim)) {
+      // A cut-out's transparent part writes nothing (the alpha test, after the depth test that
+      // it would have passed: the same result, tested for fewer fragments).
+      if (inputs_->geometry->has_cutout(t.mesh) && cut_away(t, x, y, q)) return;
       depth_[i] = d;
       winner_[i] = &t;
       ++written;
@@ -220,10 +224,30 @@ class TileRaster {
     return true;
   }
 
+  /// Whether the cut-out triangle t is transparent at pixel centre (x, y), where 1/w is q: its
+  /// barycentrics exactly as resolve() computes them for the G-buffer.
+  bool cut_away(const RasterTriangle& t, int x, int y, double q) {
+    const SceneGeometry& geometry = *inputs_->geometry;
+    const uint32_t local = t.prim - geometry.first_triangle[t.mesh];
+    if (t.prim != cut_prim_) {
+      cut_prim_ = t.prim;
+      const uint32_t* idx = &geometry.scene->meshes[t.mesh].indices[3 * static_cast<size_t>(local)];
+      const raster::ProjectedVertex* v = inputs_->vertices + inputs_->vertex_base[t.mesh];
+      (void)raster::triangle_planes(v[idx[0]], v[idx[1]], v[idx[2]], cut_planes_);
+    }
+    const double xc = x + 0.5, yc = y + 0.5, inv_q = 1.0 / q;
+    const double b1 = (cut_planes_.b1_w.x * xc + cut_planes_.b1_w.y * yc + cut_planes_.b1_w.z) * inv_q;
+    const double b2 = (cut_planes_.b2_w.x * xc + cut_planes_.b2_w.y * yc + cut_planes_.b2_w.z) * inv_q;
+    return !geometry.opaque_at(t.mesh, local, vec2(static_cast<float>(b1), static_cast<float>(b2)));
+  }
+
   PixelRect rect_;
   int tile_width_;
   int image_width_;
   const uint8_t* mask_;
+  const raster::SetupInputs* inputs_;
+  uint32_t cut_prim_ = kNoPrimitiveId;  ///< the triangle whose planes cut_planes_ holds
+  raster::TrianglePlanes cut_planes_;
   std::vector<float> depth_;
   std::vector<const RasterTriangle*> winner_;
 };
@@ -312,7 +336,7 @@ GBuffer rasterize(const SceneGeometry& geometry, const EyeCamera& eye, const Exe
   std::vector<TileCounts> tile_counts(grid.count());
   executor.for_tiles(width, height, tile, [&](const PixelRect& rect) {
     const size_t index = grid.index_of(rect);
-    TileRaster raster(rect, width, options.write_mask);
+    TileRaster raster(rect, width, options.write_mask, inputs);
     for (const Chunk& chunk : chunks) {
       const size_t begin = chunk.bin_offsets[index], end = chunk.bin_offsets[index + 1];
       for (size_t k = begin; k < end; ++k) {

@@ -1,5 +1,6 @@
 // POV-Ray SDL export of a scene and one eye (see povray_export.hpp and docs/truth_povray.md).
 #include "validation/providers/povray_export.hpp"
+#include "validation/providers/providers.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -173,6 +174,7 @@ void check_exportable(const Scene& scene) {
           "leave the light out with --lights",
           scene.name, i, light.name));
   }
+  refuse_cutouts(scene, "povray");
 }
 
 ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::filesystem::path& dir) {

@@ -1,0 +1,227 @@
+// Cut-outs (glTF alphaMode MASK): a surface exists where its alpha reaches the cutoff, for the
+// rasterizer, primary rays and shadow rays alike; a cut-out that is transparent everywhere renders
+// as if it were absent, one at exactly the cutoff as if it were opaque; the loader reads the mode
+// and cutoff and refuses values glTF does not allow; Blender and POV-Ray, which would render them
+// opaque, refuse them.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <string_view>
+#include <tuple>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "renderer/error.hpp"
+#include "renderer/io/gltf_loader.hpp"
+#include "renderer/render_scene.hpp"
+#include "scenes/gltf_builder.hpp"
+#include "support/render_support.hpp"
+#include "support/scratch_dir.hpp"
+#include "validation/truth.hpp"
+
+namespace sb {
+namespace {
+
+constexpr int kWidth = 160, kHeight = 120;
+
+/// What stands in front of the wall.
+enum class Front { none, opaque, cutout_texture, cutout_factor };
+
+/// A grey wall 3 m behind a 2 m red square at the origin, both facing a camera at (0, 0, 5), lit
+/// by a point light beside the camera so that the square's shadow falls on the wall. The square
+/// is `front`: absent, opaque, cut out by a 4x4 checker of alpha 0 and 255 (one period across
+/// it), or cut out by its factor alone (base colour alpha `factor_alpha`).
+Scene cutout_scene(const test::ScratchDir& dir, Front front, float factor_alpha = 1.0f, double cutoff = 0.5) {
+  scenes::GltfBuilder b("cutout-test", 1);
+  const int grey = b.add_material("wall", vec3(0.6f));
+  scenes::MeshData wall;
+  wall.add_quad(vec3(-6, -4, -3), vec3(6, -4, -3), vec3(6, 4, -3), vec3(-6, 4, -3), vec3(0, 0, 1));
+  b.add_node("wall", b.add_mesh("wall", wall, grey));
+  if (front != Front::none) {
+    int texture = -1;
+    if (front == Front::cutout_texture) {
+      std::vector<uint8_t> rgba;
+      for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 4; ++x) rgba.insert(rgba.end(), {230, 40, 40, static_cast<uint8_t>((x + y) % 2 ? 0 : 255)});
+      texture = b.add_texture("checker", 4, 4, rgba);
+    }
+    const int red = b.add_material("square", vec4(0.8f, 0.1f, 0.1f, factor_alpha), texture);
+    if (front == Front::cutout_texture || front == Front::cutout_factor) b.set_alpha_mask(red, cutoff);
+    scenes::MeshData square;
+    square.add_quad(vec3(-1, -1, 0), vec3(1, -1, 0), vec3(1, 1, 0), vec3(-1, 1, 0), vec3(0, 0, 1), 0.5f);
+    b.add_node("square", b.add_mesh("square", square, red));
+  }
+  b.add_point_light("lamp", vec3(1.5f, 1.0f, 4.0f), vec3(1.0f), 40.0f);
+  RigDefaults rig;
+  rig.width = kWidth;
+  rig.height = kHeight;
+  rig.interaxial = 0.2;
+  rig.convergence = 5.0;
+  b.set_camera("camera", CameraPose::look_at(dvec3(0.0, 0.0, 5.0), dvec3(0.0)), 0.8, 0.05, 0.0, rig);
+  const std::string name = "cutout.gltf";
+  b.write(dir / name);
+  return io::load_gltf(dir / name);
+}
+
+/// Whether the named plane of both images holds the same bits.
+bool same_plane(const Image& a, const Image& b, std::string_view plane) {
+  const Plane& p = a.plane(plane);
+  const Plane& q = b.plane(plane);
+  const size_t bytes = a.pixel_count() * static_cast<size_t>(p.channels()) * 4;
+  return p.type() == PlaneType::f32 ? std::memcmp(p.data_f32(), q.data_f32(), bytes) == 0
+                                    : std::memcmp(p.data_u32(), q.data_u32(), bytes) == 0;
+}
+
+const std::vector<std::string> kPipelines = {"plain-raster", "plain-rt"};
+
+TEST(Cutout, LoadsAlphaModeMaskWithItsCutoff) {
+  test::ScratchDir dir;
+  const Scene s = cutout_scene(dir, Front::cutout_factor, 1.0f, 0.25);
+  ASSERT_EQ(s.materials.size(), 2u);
+  EXPECT_EQ(s.materials[0].alpha_mode, Material::AlphaMode::opaque);
+  EXPECT_EQ(s.materials[1].alpha_mode, Material::AlphaMode::mask);
+  EXPECT_FLOAT_EQ(s.materials[1].alpha_cutoff, 0.25f);
+  const RenderScene prepared(s);
+  EXPECT_FALSE(prepared.geometry().has_cutout(0));
+  EXPECT_TRUE(prepared.geometry().has_cutout(1));
+}
+
+TEST(Cutout, ATransparentCutoutRendersAsIfAbsentAndOneAtTheCutoffAsIfOpaque) {
+  test::ScratchDir dir;
+  const Scene absent = cutout_scene(dir, Front::none);
+  const Scene see_through = cutout_scene(dir, Front::cutout_factor, 0.3f, 0.5);
+  const Scene opaque = cutout_scene(dir, Front::opaque, 0.5f);
+  const Scene at_cutoff = cutout_scene(dir, Front::cutout_factor, 0.5f, 0.5);
+  const RenderScene r_absent(absent), r_see(see_through), r_opaque(opaque), r_at(at_cutoff);
+  const StereoRig rig = test::rig_at(absent, kWidth, kHeight);
+  for (const std::string& p : kPipelines) {
+    const StereoResult a = test::render_with(p, r_absent, rig), s = test::render_with(p, r_see, rig);
+    const StereoResult o = test::render_with(p, r_opaque, rig), c = test::render_with(p, r_at, rig);
+    for (const auto& [x, y, what] : {std::tuple(&a, &s, "transparent cut-out against no square"),
+                                     std::tuple(&o, &c, "cut-out at its cutoff against an opaque square")}) {
+      // The square's triangles come after the wall's, so even the primitive ids agree.
+      for (const std::string_view plane : {planes::rgb, planes::depth, planes::primid}) {
+        EXPECT_TRUE(same_plane(x->left, y->left, plane)) << p << ", " << what << ", left " << plane;
+        EXPECT_TRUE(same_plane(x->right, y->right, plane)) << p << ", " << what << ", right " << plane;
+      }
+    }
+  }
+}
+
+TEST(Cutout, RaysAndTheRasterizerSeeAndCastShadowsThroughTheSameHoles) {
+  test::ScratchDir dir;
+  const Scene cut = cutout_scene(dir, Front::cutout_texture), opaque = cutout_scene(dir, Front::opaque);
+  const Scene absent = cutout_scene(dir, Front::none);
+  const RenderScene r_cut(cut), r_opaque(opaque), r_absent(absent);
+  const StereoRig rig = test::rig_at(cut, kWidth, kHeight);
+  const uint32_t wall_last = r_cut.geometry().first_triangle[1];  // the square's first id
+  const StereoResult raster = test::render_with("plain-raster", r_cut, rig);
+  const StereoResult rt = test::render_with("plain-rt", r_cut, rig);
+  const StereoResult full = test::render_with("plain-rt", r_opaque, rig);
+  const StereoResult bare = test::render_with("plain-rt", r_absent, rig);
+
+  const size_t n = static_cast<size_t>(kWidth) * kHeight;
+  const uint32_t* id_rt = rt.left.data_u32(planes::primid);
+  const uint32_t* id_raster = raster.left.data_u32(planes::primid);
+  const uint32_t* id_full = full.left.data_u32(planes::primid);
+  size_t square_full = 0, square_cut = 0, differ = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (id_full[i] == kNoPrimitiveId || id_full[i] < wall_last) continue;  // outside the square
+    ++square_full;
+    square_cut += id_rt[i] >= wall_last && id_rt[i] != kNoPrimitiveId;
+    differ += (id_rt[i] >= wall_last) != (id_raster[i] >= wall_last);
+  }
+  // A checker of two alphas, bilinear between texel centres and cut at 0.5: half the square.
+  ASSERT_GT(square_full, 2000u);
+  EXPECT_NEAR(static_cast<double>(square_cut) / static_cast<double>(square_full), 0.5, 0.05);
+  // The two paths cut at the same places up to pixels a hair from a cut edge.
+  EXPECT_LE(differ, square_full / 100) << differ << " of " << square_full;
+
+  // Shadows: where the opaque square shadows the wall, the cut-out lets light through its holes
+  // (the wall as lit without any square) and blocks it elsewhere (black, no ambient).
+  const float* c_cut = rt.left.data_f32(planes::rgb);
+  const float* c_full = full.left.data_f32(planes::rgb);
+  const float* c_bare = bare.left.data_f32(planes::rgb);
+  const uint32_t* id_bare = bare.left.data_u32(planes::primid);
+  size_t shadowed = 0, through = 0, blocked = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (id_full[i] >= wall_last || id_rt[i] >= wall_last || id_bare[i] == kNoPrimitiveId) continue;
+    if (!(c_full[3 * i] == 0.0f && c_bare[3 * i] > 0.0f)) continue;  // wall in the opaque square's shadow
+    ++shadowed;
+    through += std::equal(c_cut + 3 * i, c_cut + 3 * i + 3, c_bare + 3 * i);
+    blocked += c_cut[3 * i] == 0.0f;
+  }
+  ASSERT_GT(shadowed, 200u);
+  EXPECT_EQ(through + blocked, shadowed);
+  EXPECT_GT(through, shadowed / 5);
+  EXPECT_GT(blocked, shadowed / 5);
+}
+
+TEST(Cutout, EveryPipelineIsDeterministicAcrossThreadCounts) {
+  test::ScratchDir dir;
+  const Scene cut = cutout_scene(dir, Front::cutout_texture);
+  const RenderScene prepared(cut);
+  const StereoRig rig = test::rig_at(cut, kWidth, kHeight);
+  for (const std::string p : {"plain-raster", "plain-rt", "repro-rt", "repro-reraster", "rt-atomic", "bidir-warp"}) {
+    const StereoResult one = test::render_with(p, prepared, rig, 1);
+    const StereoResult three = test::render_with(p, prepared, rig, 3);
+    EXPECT_TRUE(same_plane(one.left, three.left, planes::rgb)) << p;
+    EXPECT_TRUE(same_plane(one.right, three.right, planes::rgb)) << p;
+  }
+}
+
+TEST(Cutout, AlphaModesAndCutoffsGltfDoesNotAllowAreRefusedByPath) {
+  test::ScratchDir dir;
+  (void)cutout_scene(dir, Front::cutout_factor);
+  const nlohmann::json doc = nlohmann::json::parse(std::ifstream(dir / "cutout.gltf"));
+  ASSERT_EQ(doc["materials"][1]["alphaMode"], "MASK");
+  const auto load_with = [&](const char* key, const nlohmann::json& value) {
+    nlohmann::json bad = doc;
+    bad["materials"][1][key] = value;
+    std::ofstream(dir / "changed.gltf") << bad.dump();
+    return io::load_gltf(dir / "changed.gltf");
+  };
+  const auto expect_refused = [&](const char* key, const nlohmann::json& value) {
+    try {
+      (void)load_with(key, value);
+      ADD_FAILURE() << key << " = " << value.dump() << " loaded";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string("/materials/1/") + key), std::string::npos) << e.what();
+    }
+  };
+  expect_refused("alphaMode", "mask");
+  expect_refused("alphaMode", 1);
+  expect_refused("alphaCutoff", -0.5);
+  expect_refused("alphaCutoff", "half");
+
+  const Scene s = load_with("alphaMode", "BLEND");
+  EXPECT_EQ(s.materials[1].alpha_mode, Material::AlphaMode::blend);
+  EXPECT_TRUE(std::any_of(s.warnings.begin(), s.warnings.end(),
+                          [](const std::string& w) { return w.find("BLEND") != std::string::npos; }));
+}
+
+TEST(Cutout, TheExternalGroundTruthsRefuseCutoutsTheyWouldRenderOpaque) {
+  test::ScratchDir dir;
+  const Scene cut = cutout_scene(dir, Front::cutout_texture), opaque = cutout_scene(dir, Front::opaque);
+  for (const char* name : {"blender", "povray"}) {
+    const auto provider = validation::make_truth_provider(name);
+    try {
+      provider->check_scene(cut, dir / "cutout.gltf");
+      ADD_FAILURE() << name << " accepted a cut-out";
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("material 1 ('square') is a cut-out"), std::string::npos) << what;
+      EXPECT_NE(what.find("`full` provider"), std::string::npos) << what;
+    }
+    EXPECT_NO_THROW(provider->check_scene(opaque, dir / "cutout.gltf")) << name;
+  }
+  EXPECT_NO_THROW(validation::make_truth_provider("full")->check_scene(cut, dir / "cutout.gltf"));
+}
+
+}  // namespace
+}  // namespace sb
