@@ -201,10 +201,11 @@ void render_bidirectional(const RenderScene& scene, const StereoRig& rig, const 
       r.counters.set("depth_cracks_left",
                      mark_depth_cracks(r.left, settings.max_crack, settings.crack_depth_ratio, executor));
     }
-    // Without interpolation the runs are only counted: every hole stays for the caller.
-    const int fill_width = settings.interpolate_cracks ? settings.max_crack : 0;
-    cracks_right = fill_cracks(r.right, fill_width, executor);
-    cracks_left = fill_cracks(r.left, fill_width, executor);
+    // Without interpolation the runs are only counted (cracks of up to max_crack pixels apart from
+    // larger holes): every hole stays for the caller.
+    const CrackMode mode = settings.interpolate_cracks ? CrackMode::fill : CrackMode::count;
+    cracks_right = fill_cracks(r.right, settings.max_crack, executor, mode);
+    cracks_left = fill_cracks(r.left, settings.max_crack, executor, mode);
   }
   r.counters.set("hole_pixels", cracks_right.hole_pixels);
   r.counters.set("hole_pixels_left", cracks_left.hole_pixels);

@@ -77,7 +77,7 @@ uint64_t mark_depth_cracks(Image& image, int max_width, double depth_ratio, cons
   return marked;
 }
 
-CrackFillStats fill_cracks(Image& image, int max_width, const Executor& executor) {
+CrackFillStats fill_cracks(Image& image, int max_width, const Executor& executor, CrackMode mode) {
   require_crack_planes(image, max_width);
   float* rgb = image.data_f32(planes::rgb);
   float* depth = image.data_f32(planes::depth);
@@ -88,9 +88,11 @@ CrackFillStats fill_cracks(Image& image, int max_width, const Executor& executor
   const int w = image.width(), h = image.height();
   const auto hole = static_cast<uint32_t>(Source::hole);
 
-  std::atomic<uint64_t> hole_pixels{0}, cracks{0}, filled{0}, large{0}, large_pixels{0}, border{0}, border_pixels{0};
+  std::atomic<uint64_t> hole_pixels{0}, cracks{0}, filled{0}, large{0}, large_pixels{0}, border{0}, border_pixels{0},
+      unfilled{0}, unfilled_pixels{0};
   executor.for_range(static_cast<size_t>(h), 4, [&](size_t begin, size_t end) {
-    uint64_t n_holes = 0, n_cracks = 0, n_filled = 0, n_large = 0, n_large_px = 0, n_border = 0, n_border_px = 0;
+    uint64_t n_holes = 0, n_cracks = 0, n_filled = 0, n_large = 0, n_large_px = 0, n_border = 0, n_border_px = 0,
+             n_unfilled = 0, n_unfilled_px = 0;
     for (size_t y = begin; y < end; ++y) {
       const size_t row = y * static_cast<size_t>(w);
       int x = 0;
@@ -113,6 +115,11 @@ CrackFillStats fill_cracks(Image& image, int max_width, const Executor& executor
         if (b - a > max_width) {
           ++n_large;
           n_large_px += n;
+          continue;
+        }
+        if (mode == CrackMode::count) {
+          ++n_unfilled;
+          n_unfilled_px += n;
           continue;
         }
         // Interpolate between L = a - 1 and R = b.
@@ -142,6 +149,8 @@ CrackFillStats fill_cracks(Image& image, int max_width, const Executor& executor
     large_pixels += n_large_px;
     border += n_border;
     border_pixels += n_border_px;
+    unfilled += n_unfilled;
+    unfilled_pixels += n_unfilled_px;
   });
   CrackFillStats s;
   s.hole_pixels = hole_pixels;
@@ -151,6 +160,8 @@ CrackFillStats fill_cracks(Image& image, int max_width, const Executor& executor
   s.large_hole_pixels = large_pixels;
   s.border_holes = border;
   s.border_hole_pixels = border_pixels;
+  s.cracks_unfilled = unfilled;
+  s.crack_pixels_unfilled = unfilled_pixels;
   return s;
 }
 
@@ -168,6 +179,10 @@ void add_crack_counters(Counters& counters, const CrackFillStats& stats) {
   counters.set("large_hole_pixels", stats.large_hole_pixels);
   counters.set("border_holes", stats.border_holes);
   counters.set("border_hole_pixels", stats.border_hole_pixels);
+  if (stats.cracks_unfilled > 0 || stats.crack_pixels_unfilled > 0) {
+    counters.set("cracks_unfilled", stats.cracks_unfilled);
+    counters.set("crack_pixels_unfilled", stats.crack_pixels_unfilled);
+  }
 }
 
 }  // namespace sb

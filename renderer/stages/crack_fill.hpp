@@ -24,10 +24,16 @@ struct CrackFillStats {
   uint64_t large_hole_pixels = 0;
   uint64_t border_holes = 0;   ///< runs that touch the left or right image edge, of any length
   uint64_t border_hole_pixels = 0;
+  uint64_t cracks_unfilled = 0;  ///< runs of crack width counted but left as holes (CrackMode::count)
+  uint64_t crack_pixels_unfilled = 0;
 
   /// Hole pixels left after filling.
-  [[nodiscard]] uint64_t holes_left() const { return large_hole_pixels + border_hole_pixels; }
+  [[nodiscard]] uint64_t holes_left() const { return large_hole_pixels + border_hole_pixels + crack_pixels_unfilled; }
 };
+
+/// Whether fill_cracks interpolates the runs of crack width, or only counts them (a pipeline that
+/// traces its cracks instead).
+enum class CrackMode { fill, count };
 
 /// Fills the cracks of an eye image (planes rgb, depth, normal, albedo, primid, source; holes are
 /// the pixels tagged `hole`). For a run of n <= max_width hole pixels between non-hole pixels L
@@ -41,8 +47,9 @@ struct CrackFillStats {
 ///  - tag `inpainted`.
 /// Every other pixel is left untouched. Rows run in parallel; each row reads and writes only
 /// itself, so the result does not depend on the thread count. max_width 0 fills nothing.
-/// InputError for a negative max_width or a missing plane.
-CrackFillStats fill_cracks(Image& image, int max_width, const Executor& executor);
+/// InputError for a negative max_width or a missing plane. With CrackMode::count the image is not
+/// changed: the runs of at most max_width pixels are counted as cracks_unfilled.
+CrackFillStats fill_cracks(Image& image, int max_width, const Executor& executor, CrackMode mode = CrackMode::fill);
 
 /// Kim's crack detection by depth (§3.2: a crack shows a surface farther than the pixels around
 /// it). In a composed image a narrow sliver of a farther surface can show through where the

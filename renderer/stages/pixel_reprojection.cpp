@@ -180,8 +180,11 @@ std::vector<uint64_t> reprojection_writes(const PixelReprojector& reprojector, c
 }
 
 uint64_t lemma1_bound(const StereoRig& rig, double z_min) {
-  const double range = rig.focal_px() * rig.params().interaxial / z_min;
-  return static_cast<uint64_t>(std::ceil(range)) + 1;
+  const double range = std::ceil(rig.focal_px() * rig.params().interaxial / z_min);
+  // Saturated where it does not fit (a rig of a vanishing field of view): a bound, never wrapped.
+  constexpr double kLargest = 9.0e18;  // below 2^63, exactly representable
+  if (!(range < kLargest)) return static_cast<uint64_t>(kLargest);
+  return static_cast<uint64_t>(range) + 1;
 }
 
 void add_write_counters(Counters& counters, const std::vector<uint64_t>& histogram, const StereoRig& rig,

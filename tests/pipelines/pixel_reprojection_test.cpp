@@ -5,6 +5,7 @@
 // than smeared.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 
@@ -77,6 +78,24 @@ TEST_P(PairAgreement, ScanlineAndParallelVariantsGiveIdenticalRightEyes) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AnalyticScenes, PairAgreement, ::testing::ValuesIn(test::analytic_scenes()), test::param_name);
+
+TEST(Lemma1Bound, IsFOverZTimesEAndSaturatesWhereItDoesNotFit) {
+  const Scene scene = test::load_builtin("box-wall");
+  RigOverrides o;
+  o.width = 160;
+  o.height = 90;
+  const StereoRig rig = resolve_rig(scene, o);
+  const double f_e = rig.focal_px() * rig.params().interaxial;
+  EXPECT_EQ(lemma1_bound(rig, 2.0), static_cast<uint64_t>(std::ceil(f_e / 2.0)) + 1);
+  // A field of view of 1e-17 degrees and a 1 m interaxial converged 1e15 m away: f e / z is about
+  // 1e20 px, beyond 64 bits (it once wrapped to 1).
+  o.vfov = 1e-17 * 3.14159265358979 / 180.0;
+  o.interaxial = 1.0;
+  o.convergence = 1e15;
+  const StereoRig narrow = resolve_rig(scene, o);
+  ASSERT_GT(narrow.focal_px() / 6.0, 1e19);
+  EXPECT_EQ(lemma1_bound(narrow, 6.0), uint64_t{9'000'000'000'000'000'000u});
+}
 
 /// The right eye's PSNR against plain-rt that a scene must reach at 600x600, e = 15 px. The aim is
 /// 38 dB; measured below it:

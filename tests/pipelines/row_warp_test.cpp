@@ -301,6 +301,19 @@ TEST(CrackFill, FillsNarrowCracksAndCountsTheRest) {
   EXPECT_EQ(fill_cracks(none, 0, Executor(1)).pixels_filled, 0u);
   EXPECT_TRUE(none == before);
   EXPECT_THROW((void)fill_cracks(none, -1, Executor(1)), InputError);
+
+  // Counting only (a pipeline that traces its cracks): the image untouched, the two cracks
+  // counted apart from the large hole and the border runs, every hole pixel still left.
+  Image counted = before;
+  const CrackFillStats c = fill_cracks(counted, kDefaultCrackWidth, Executor(2), CrackMode::count);
+  EXPECT_TRUE(counted == before);
+  EXPECT_EQ(c.cracks, 0u);
+  EXPECT_EQ(c.pixels_filled, 0u);
+  EXPECT_EQ(c.cracks_unfilled, 2u);
+  EXPECT_EQ(c.crack_pixels_unfilled, 3u);
+  EXPECT_EQ(c.large_holes, 1u);
+  EXPECT_EQ(c.border_holes, 2u);
+  EXPECT_EQ(c.holes_left(), c.hole_pixels);
 }
 
 TEST(CrackFill, DepthCracksAreFarSurfacesBetweenNearerPixels) {
