@@ -26,7 +26,9 @@ namespace {
 namespace fs = std::filesystem;
 
 /// Bumped whenever the export, the script or the settings change.
-constexpr const char* kRevision = "blender-export-3";
+constexpr const char* kRevision = "blender-export-4";
+/// Cut-out holes a camera or shadow ray may pass in Cycles (transparent bounces); ours pass any.
+constexpr int kTransparentBounces = 64;
 /// Environment variable naming the Blender executable (a path, or a name looked up on PATH).
 constexpr const char* kExecutableVariable = "STEREOBENCH_BLENDER";
 
@@ -172,12 +174,15 @@ nlohmann::json export_lights(const Scene& scene) {
 }
 
 /// Writes the textures that materials use as linear float EXRs (RGB), so that Cycles reads exactly
-/// the decoded values of the in-memory scene; returns their PARAMS entries (null for unused ones).
+/// the decoded values of the in-memory scene; a texture that a cut-out reads also gets its alpha as
+/// a grey EXR of its own (`alpha_file`). Returns their PARAMS entries (null for unused ones).
 nlohmann::json export_textures(const Scene& scene, const fs::path& work_dir) {
-  std::vector<bool> used(scene.textures.size(), false);
+  std::vector<bool> used(scene.textures.size(), false), cut(scene.textures.size(), false);
   for (const Material& m : scene.materials)
-    if (m.base_color_texture >= 0 && static_cast<size_t>(m.base_color_texture) < scene.textures.size())
+    if (m.base_color_texture >= 0 && static_cast<size_t>(m.base_color_texture) < scene.textures.size()) {
       used[static_cast<size_t>(m.base_color_texture)] = true;
+      if (m.alpha_mode == Material::AlphaMode::mask) cut[static_cast<size_t>(m.base_color_texture)] = true;
+    }
   nlohmann::json textures = nlohmann::json::array();
   for (size_t t = 0; t < scene.textures.size(); ++t) {
     if (!used[t]) {
@@ -185,29 +190,43 @@ nlohmann::json export_textures(const Scene& scene, const fs::path& work_dir) {
       continue;
     }
     const Texture& tex = scene.textures[t];
-    Image image(tex.width, tex.height);
-    float* rgb = image.add_plane(planes::rgb).data_f32();
-    const size_t n = static_cast<size_t>(tex.width) * static_cast<size_t>(tex.height);
-    for (size_t i = 0; i < n; ++i)
-      for (size_t c = 0; c < 3; ++c) rgb[3 * i + c] = tex.rgba[4 * i + c];
+    // One EXR of channels 0-2, or of channel 3 in every channel.
+    const auto write = [&](const fs::path& file, bool alpha) {
+      Image image(tex.width, tex.height);
+      float* rgb = image.add_plane(planes::rgb).data_f32();
+      const size_t n = static_cast<size_t>(tex.width) * static_cast<size_t>(tex.height);
+      for (size_t i = 0; i < n; ++i)
+        for (size_t c = 0; c < 3; ++c) rgb[3 * i + c] = tex.rgba[4 * i + (alpha ? 3 : c)];
+      io::write_exr(file, image);
+    };
     const fs::path file = work_dir / fmt::format("texture_{}.exr", t);
-    io::write_exr(file, image);
+    write(file, false);
     // Blender has one extension mode for both axes; a texture that repeats along one axis only is
     // repeated along both (reported as a known gap in docs/truth_blender.md).
     const bool repeat = tex.repeat_s || tex.repeat_t;
     textures.push_back({{"file", fs::absolute(file).string()},
                         {"extension", repeat ? "REPEAT" : "EXTEND"},
                         {"mixed_wrap", tex.repeat_s != tex.repeat_t}});
+    if (cut[t]) {
+      const fs::path alpha = work_dir / fmt::format("texture_{}_alpha.exr", t);
+      write(alpha, true);
+      textures.back()["alpha_file"] = fs::absolute(alpha).string();
+    }
   }
   return textures;
 }
 
 nlohmann::json material_json(const Material& m, int texture_count) {
   const int texture = m.base_color_texture >= 0 && m.base_color_texture < texture_count ? m.base_color_texture : -1;
-  return {{"name", m.name},
-          {"base_color", {double(m.base_color.x), double(m.base_color.y), double(m.base_color.z)}},
-          {"texture", texture},
-          {"texcoord", m.texcoord}};
+  nlohmann::json j = {{"name", m.name},
+                      {"base_color", {double(m.base_color.x), double(m.base_color.y), double(m.base_color.z)}},
+                      {"texture", texture},
+                      {"texcoord", m.texcoord},
+                      {"cutout", nullptr}};
+  // A cut-out: opaque where factor alpha x texture alpha >= cutoff (SceneGeometry::opaque_at).
+  if (m.alpha_mode == Material::AlphaMode::mask)
+    j["cutout"] = {{"factor_alpha", double(m.base_color.w)}, {"cutoff", double(m.alpha_cutoff)}};
+  return j;
 }
 
 /// The Cycles and colour-management settings the script applies (recorded in TruthRender).
@@ -235,7 +254,8 @@ nlohmann::json cycles_settings(int threads) {
           {"gamma", 1.0},
           {"output", "OPEN_EXR RGBA 32-bit float, ZIP"},
           {"threads", threads > 0 ? nlohmann::json(threads) : nlohmann::json("auto")},
-          {"materials", "Diffuse BSDF roughness 0 of the albedo in light passes; Emission of albedo x ambient, no BSDF, in the ambient pass"},
+          {"materials", "Diffuse BSDF roughness 0 of the albedo in light passes; Emission of albedo x ambient, no BSDF, in the ambient pass; a cut-out mixes in a Transparent BSDF where factor alpha x texture alpha (Linear) is below its cutoff"},
+          {"transparent_bounces", "64 (min 64: no Russian roulette) when a material is a cut-out, else 0"},
           {"world", "Background visible to camera rays only (Light Path 'Is Camera Ray'), sampling_method NONE"},
           {"importer", "import_scene.gltf import_shading=NORMALS (glTF normals as custom split normals) merge_vertices=False"},
           {"shadow_terminator_offsets", 0.0},
@@ -265,7 +285,6 @@ class BlenderProvider final : public TruthProvider {
 
   void check_scene(const Scene& scene, const fs::path& scene_file) const override {
     (void)export_lights(scene);  // InputError for what Cycles cannot reproduce
-    refuse_cutouts(scene, name());
     if (scene_file.empty() || !fs::is_regular_file(scene_file))
       throw InputError(fmt::format("the blender provider imports the scene's glTF file, but '{}' is not a file; "
                                    "render a scene loaded from a .gltf/.glb file",
@@ -308,6 +327,11 @@ class BlenderProvider final : public TruthProvider {
     params["default_material"] = material_json(white, 0);
     params["background"] = vec_json(scene.background);
     params["ambient"] = double(scene.ambient);
+    // A ray may pass through this many cut-out holes (camera and shadow rays alike).
+    const bool cutouts = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) {
+      return m.alpha_mode == Material::AlphaMode::mask;
+    });
+    params["transparent_bounces"] = cutouts ? kTransparentBounces : 0;
     const double shift_x = (0.5 * eye.width - eye.cx) / eye.height;
     const double shift_y = (eye.cy - 0.5 * eye.height) / eye.height;
     params["camera"] = {{"origin", vec_json(eye.origin)},

@@ -103,14 +103,15 @@ def make_material(name, spec, textures, switches):
     factor = spec["base_color"]
     rgba = (factor[0], factor[1], factor[2], 1.0)
     colour_socket = None
+    uv = None
     if spec["texture"] >= 0:
+        uv = nodes.new("ShaderNodeUVMap")
+        uv.uv_map = uv_map_name(spec["texcoord"])
         tex = textures[spec["texture"]]
         image_node = nodes.new("ShaderNodeTexImage")
         image_node.image = tex["image"]
         image_node.interpolation = "Linear"
         image_node.extension = tex["extension"]
-        uv = nodes.new("ShaderNodeUVMap")
-        uv.uv_map = uv_map_name(spec["texcoord"])
         tree.links.new(uv.outputs["UV"], image_node.inputs["Vector"])
         multiply = nodes.new("ShaderNodeVectorMath")
         multiply.operation = "MULTIPLY"
@@ -129,7 +130,37 @@ def make_material(name, spec, textures, switches):
         tree.links.new(colour_socket, emission.inputs["Color"])
     else:
         emission.inputs["Color"].default_value = rgba
-    switches.append((tree, out.inputs["Surface"], diffuse.outputs["BSDF"], emission.outputs["Emission"]))
+    surface = out.inputs["Surface"]
+    if spec["cutout"] is not None:
+        # A cut-out: a Transparent BSDF where alpha = factor alpha x texture alpha (bilinear, as
+        # SceneGeometry::opaque_at reads it) is below the cutoff, the material where it is not.
+        alpha = nodes.new("ShaderNodeMath")
+        alpha.operation = "MULTIPLY"
+        alpha.inputs[0].default_value = spec["cutout"]["factor_alpha"]
+        alpha.inputs[1].default_value = 1.0
+        if spec["texture"] >= 0 and textures[spec["texture"]]["alpha"] is not None:
+            alpha_node = nodes.new("ShaderNodeTexImage")
+            alpha_node.image = textures[spec["texture"]]["alpha"]
+            alpha_node.interpolation = "Linear"
+            alpha_node.extension = textures[spec["texture"]]["extension"]
+            tree.links.new(uv.outputs["UV"], alpha_node.inputs["Vector"])
+            channels = nodes.new("ShaderNodeSeparateColor")
+            tree.links.new(alpha_node.outputs["Color"], channels.inputs["Color"])
+            tree.links.new(channels.outputs[0], alpha.inputs[1])
+        below = nodes.new("ShaderNodeMath")
+        below.operation = "LESS_THAN"
+        below.use_clamp = False
+        tree.links.new(alpha.outputs["Value"], below.inputs[0])
+        below.inputs[1].default_value = spec["cutout"]["cutoff"]
+        transparent = nodes.new("ShaderNodeBsdfTransparent")
+        transparent.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+        mix = nodes.new("ShaderNodeMixShader")
+        # Fac 1 (below the cutoff) takes the second shader: the transparent one.
+        tree.links.new(below.outputs["Value"], mix.inputs["Fac"])
+        tree.links.new(transparent.outputs["BSDF"], mix.inputs[2])
+        tree.links.new(mix.outputs["Shader"], out.inputs["Surface"])
+        surface = mix.inputs[1]
+    switches.append((tree, surface, diffuse.outputs["BSDF"], emission.outputs["Emission"]))
     return mat
 
 
@@ -142,7 +173,11 @@ def setup_materials():
         image = bpy.data.images.load(t["file"], check_existing=False)
         image.colorspace_settings.name = "Non-Color"
         image.alpha_mode = "STRAIGHT"
-        textures.append({"image": image, "extension": t["extension"]})
+        alpha = None
+        if "alpha_file" in t:
+            alpha = bpy.data.images.load(t["alpha_file"], check_existing=False)
+            alpha.colorspace_settings.name = "Non-Color"
+        textures.append({"image": image, "alpha": alpha, "extension": t["extension"]})
     switches = []
     ours = [make_material("stereobench_%d" % i, m, textures, switches)
             for i, m in enumerate(PARAMS["materials"])]
@@ -307,9 +342,10 @@ def setup_render():
     c.glossy_bounces = 0
     c.transmission_bounces = 0
     c.volume_bounces = 0
-    c.transparent_max_bounces = 0
+    # Cut-out holes pass camera and shadow rays; the minimum as large keeps Russian roulette off.
+    c.transparent_max_bounces = PARAMS["transparent_bounces"]
     c.min_light_bounces = 0
-    c.min_transparent_bounces = 0
+    c.min_transparent_bounces = PARAMS["transparent_bounces"]
     c.caustics_reflective = False
     c.caustics_refractive = False
     c.blur_glossy = 0.0
