@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <filesystem>
 #include <regex>
 #include <string>
 #include <system_error>
@@ -182,6 +183,14 @@ int main(int argc, char** argv) {
     return static_cast<int>(e.code());
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "stereobench: error: out of memory; try a smaller scene or resolution\n");
+    return static_cast<int>(sb::ExitCode::environment);
+  } catch (const std::filesystem::filesystem_error& e) {
+    // A path the file system refused where no command checked it first (a link loop, a folder
+    // without permission): named, with its reason.
+    std::string paths = e.path1().string();
+    if (!e.path2().empty()) paths += " and " + e.path2().string();
+    std::fprintf(stderr, "stereobench: error: cannot use %s: %s; check that path (a link that loops, a folder without "
+                 "permission, a full disk)\n", paths.c_str(), e.code().message().c_str());
     return static_cast<int>(sb::ExitCode::environment);
   } catch (const std::system_error& e) {
     // What the operating system refused, e.g. printing to a full disk ("cannot write to file").

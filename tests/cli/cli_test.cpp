@@ -215,6 +215,20 @@ TEST(Cli, APathUnderProcThatIsNoOpenFileIsAnUnwritableFolderNamedByItsOption) {
       << r.out;
 }
 
+TEST(Cli, AFileSystemRefusalNamesThePathAndItsReason) {
+  // A store behind a link that loops: the file system refuses where no command checks first. It
+  // was reported as "filesystem error: status: ..." with advice about full disks and pipes.
+  test::ScratchDir dir("loop");
+  std::filesystem::create_symlink("loop2", dir / "loop1");
+  std::filesystem::create_symlink("loop1", dir / "loop2");
+  const CliRun r = test::run_cli("reference generate --scene lit-plane --resolution 32x18 --store " +
+                                 test::quoted(dir / "loop1"));
+  EXPECT_EQ(r.code, 4) << r.out;
+  EXPECT_NE(r.out.find("cannot use " + (dir / "loop1").string()), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("Too many levels of symbolic links; check that path"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("closed pipe"), std::string::npos) << r.out;
+}
+
 TEST(Cli, RenderWritesEveryOutputAndBenchPrintsATable) {
   test::ScratchDir dir("render");
   const std::string common = " --scenes-dir '" + (dir / "scenes").string() + "' --resolution 64x36";
