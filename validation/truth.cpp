@@ -30,13 +30,4 @@ std::unique_ptr<TruthProvider> make_truth_provider(std::string_view name) {
                                fmt::join(truth_provider_names(), ", ")));
 }
 
-void refuse_cutouts(const Scene& scene, std::string_view provider) {
-  for (size_t i = 0; i < scene.materials.size(); ++i)
-    if (scene.materials[i].alpha_mode == Material::AlphaMode::mask)
-      throw InputError(fmt::format(
-          "scene '{}': material {} ('{}') is a cut-out (glTF alphaMode MASK), which the {} provider renders "
-          "opaque; use the `full` provider for this scene",
-          scene.name, i, scene.materials[i].name, provider));
-}
-
 }  // namespace sb::validation

@@ -1,8 +1,8 @@
 // Cut-outs (glTF alphaMode MASK): a surface exists where its alpha reaches the cutoff, for the
 // rasterizer, primary rays and shadow rays alike; a cut-out that is transparent everywhere renders
 // as if it were absent, one at exactly the cutoff as if it were opaque; the loader reads the mode
-// and cutoff and refuses values glTF does not allow; POV-Ray, whose export would render them
-// opaque, refuses them (Blender renders them: tests/blender).
+// and cutoff and refuses values glTF does not allow. The external ground truths render them too
+// (tests/blender, tests/povray).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -23,7 +23,6 @@
 #include "support/render_support.hpp"
 #include "support/cutout_scene.hpp"
 #include "support/scratch_dir.hpp"
-#include "validation/truth.hpp"
 
 namespace sb {
 namespace {
@@ -167,23 +166,6 @@ TEST(Cutout, AlphaModesAndCutoffsGltfDoesNotAllowAreRefusedByPath) {
   EXPECT_EQ(s.materials[1].alpha_mode, Material::AlphaMode::blend);
   EXPECT_TRUE(std::any_of(s.warnings.begin(), s.warnings.end(),
                           [](const std::string& w) { return w.find("BLEND") != std::string::npos; }));
-}
-
-TEST(Cutout, PovRayRefusesCutoutsItWouldRenderOpaque) {
-  test::ScratchDir dir;
-  const Scene cut = cutout_scene(dir, Front::cutout_texture), opaque = cutout_scene(dir, Front::opaque);
-  const auto povray = validation::make_truth_provider("povray");
-  try {
-    povray->check_scene(cut, test::cutout_file(dir));
-    ADD_FAILURE() << "povray accepted a cut-out";
-  } catch (const InputError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find("material 1 ('square') is a cut-out"), std::string::npos) << what;
-    EXPECT_NE(what.find("`full` provider"), std::string::npos) << what;
-  }
-  EXPECT_NO_THROW(povray->check_scene(opaque, test::cutout_file(dir)));
-  for (const char* name : {"full", "blender"})
-    EXPECT_NO_THROW(validation::make_truth_provider(name)->check_scene(cut, test::cutout_file(dir))) << name;
 }
 
 }  // namespace

@@ -1,6 +1,5 @@
 // POV-Ray SDL export of a scene and one eye (see povray_export.hpp and docs/truth_povray.md).
 #include "validation/providers/povray_export.hpp"
-#include "validation/providers/providers.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -118,6 +117,16 @@ nlohmann::json json_vec(const dvec3& v) { return nlohmann::json::array({v.x, v.y
 /// The base colour texture of `material`, baked with its base colour factor, as a 3-channel
 /// half-float EXR (POV-Ray 3.7 reads EXR image maps through OpenEXR's half RGBA interface; a file
 /// without an alpha channel is opaque, so the texture's alpha cannot make the surface transparent).
+/// A cut-out's alpha (texture channel 3) as a grey EXR, for the function that decides coverage.
+void write_alpha_texture(const Texture& texture, const std::filesystem::path& path) {
+  Image image(texture.width, texture.height);
+  float* rgb = image.add_plane(planes::rgb).data_f32();
+  const std::size_t n = static_cast<std::size_t>(texture.width) * static_cast<std::size_t>(texture.height);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = texture.rgba[i * 4 + 3];
+  io::write_exr(path, image);
+}
+
 void write_baked_texture(const Texture& texture, const vec4& factor, const std::filesystem::path& path) {
   Image image(texture.width, texture.height);
   float* rgb = image.add_plane(planes::rgb).data_f32();
@@ -174,7 +183,6 @@ void check_exportable(const Scene& scene) {
           "leave the light out with --lights",
           scene.name, i, light.name));
   }
-  refuse_cutouts(scene, "povray");
 }
 
 ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::filesystem::path& dir) {
@@ -202,6 +210,11 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
     const std::filesystem::path file = dir / texture_name[m];
     write_baked_texture(texture, material.base_color, file);
     out.texture_files.push_back(file);
+    if (material.alpha_mode == Material::AlphaMode::mask) {
+      const std::filesystem::path alpha = dir / fmt::format("alpha_{}.exr", m);
+      write_alpha_texture(texture, alpha);
+      out.texture_files.push_back(alpha);
+    }
   }
 
   out.sdl_file = dir / "scene.pov";
@@ -225,7 +238,16 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
               eye.width, eye.height);
     sdl.print("#version 3.7;\n");
     const bool ambient = scene.ambient != 0.0f;
-    sdl.print("global_settings {{ assumed_gamma 1.0 ambient_light rgb {} max_trace_level 5 }}\n", ambient ? 1 : 0);
+    // A cut-out's holes pass camera and shadow rays (pigment rgbt 1), each pass one trace level.
+    const bool cutouts = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) {
+      return m.alpha_mode == Material::AlphaMode::mask;
+    });
+    sdl.print("global_settings {{ assumed_gamma 1.0 ambient_light rgb {} max_trace_level {} }}\n", ambient ? 1 : 0,
+              cutouts ? kCutoutTraceLevel : 5);
+    for (std::size_t m = 0; m < scene.materials.size(); ++m)
+      if (scene.materials[m].alpha_mode == Material::AlphaMode::mask && !texture_name[m].empty())
+        sdl.print("#declare SB_Alpha_{} = function {{ pigment {{ image_map {{ exr \"alpha_{}.exr\" interpolate 2 }} }} }}\n",
+                  m, m);
     sdl.print("background {{ rgb <{:.9g}, {:.9g}, {:.9g}> }}\n", scene.background.x, scene.background.y,
               scene.background.z);
     sdl.print("camera {{\n  perspective\n  location {}\n  right {}\n  up {}\n  direction {}\n}}\n",
@@ -275,6 +297,10 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
       const Material* material = mesh.material >= 0 ? &scene.materials[static_cast<std::size_t>(mesh.material)] : nullptr;
       const std::string* tex = mesh.material >= 0 ? &texture_name[static_cast<std::size_t>(mesh.material)] : nullptr;
       const bool textured = tex && !tex->empty() && !mesh.uvs.empty();
+      const bool cutout = material && material->alpha_mode == Material::AlphaMode::mask;
+      // A cut-out without a texture to read is the factor's alpha everywhere: absent below the
+      // cutoff (SceneGeometry::opaque_at), opaque otherwise.
+      if (cutout && !textured && material->base_color.w < material->alpha_cutoff) continue;
       sdl.print("mesh2 {{  // '{}'\n  vertex_vectors {{ {}", mesh.name, mesh.positions.size());
       for (const vec3& p : mesh.positions) sdl.print(",\n    <{:.9g}, {:.9g}, {:.9g}>", p.x, p.y, p.z);
       sdl.print("\n  }}\n");
@@ -293,7 +319,15 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
       for (std::size_t t = 0; t < tris; ++t)
         sdl.print(",\n    <{}, {}, {}>", mesh.indices[3 * t], mesh.indices[3 * t + 1], mesh.indices[3 * t + 2]);
       sdl.print("\n  }}\n");
-      if (textured) {
+      if (textured && cutout) {
+        // Coverage as SceneGeometry::opaque_at decides it: factor alpha x bilinear texture alpha
+        // against the cutoff, 0 (the hole: fully transmitting) or 1 (the material).
+        sdl.print("  texture {{ uv_mapping function {{ select(SB_Alpha_{}(x, y, z).red * {:.9g} - {:.9g}, 0, 1) }}\n"
+                  "    texture_map {{\n      [0 pigment {{ rgbt 1 }}]\n"
+                  "      [1 pigment {{ uv_mapping image_map {{ exr \"{}\" interpolate 2 }} }} finish {{ SB_Finish }}]\n"
+                  "    }}\n  }}\n",
+                  mesh.material, material->base_color.w, material->alpha_cutoff, *tex);
+      } else if (textured) {
         sdl.print("  texture {{ pigment {{ uv_mapping image_map {{ exr \"{}\" interpolate 2 }} }} "
                   "finish {{ SB_Finish }} }}\n",
                   *tex);

@@ -17,7 +17,9 @@
 namespace sb::validation::povray {
 
 /// The export's revision: changes whenever the SDL written for a given scene and eye changes.
-inline constexpr const char* kExportRevision = "povray-export-1";
+inline constexpr const char* kExportRevision = "povray-export-2";
+/// max_trace_level of a scene with cut-outs: how many holes a camera or shadow ray may pass.
+inline constexpr int kCutoutTraceLevel = 64;
 
 /// Point lights fall off as 2 / (1 + (d / fd)^2) in POV-Ray 3.7 (fade_power 2); fd is this
 /// fraction of the light's smallest distance to any triangle, so that the relative deviation from
