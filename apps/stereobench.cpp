@@ -189,8 +189,11 @@ int main(int argc, char** argv) {
     // without permission): named, with its reason.
     std::string paths = e.path1().string();
     if (!e.path2().empty()) paths += " and " + e.path2().string();
-    std::fprintf(stderr, "stereobench: error: cannot use %s: %s; check that path (a link that loops, a folder without "
-                 "permission, a full disk)\n", paths.c_str(), e.code().message().c_str());
+    if (paths.empty())  // e.g. the working folder, deleted while the command ran
+      std::fprintf(stderr, "stereobench: error: %s; check the working folder and the paths given\n", e.what());
+    else
+      std::fprintf(stderr, "stereobench: error: cannot use %s: %s; check that path (a link that loops, a folder "
+                   "without permission, a full disk)\n", paths.c_str(), e.code().message().c_str());
     return static_cast<int>(sb::ExitCode::environment);
   } catch (const std::system_error& e) {
     // What the operating system refused, e.g. printing to a full disk ("cannot write to file").

@@ -38,9 +38,10 @@ RegionStats connected_regions(std::span<const uint8_t> mask, int width, int heig
 }
 
 std::span<const char* const> hole_counter_names() {
-  static constexpr std::array<const char*, 9> names = {
-      "hole_pixels", "missed", "overlapped", "bad", "grid_cells", "grid_cells_subdivided",
-      "grid_triangles", "large_holes", "large_hole_pixels"};
+  static constexpr std::array<const char*, 11> names = {
+      "hole_pixels",    "missed",         "overlapped",  "bad",
+      "grid_cells",     "grid_cells_subdivided", "grid_triangles", "large_holes",
+      "large_hole_pixels", "cracks_unfilled", "crack_pixels_unfilled"};
   return names;
 }
 

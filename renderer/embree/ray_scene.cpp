@@ -57,8 +57,8 @@ bool cut_away(const RayScene::Impl::Filter& f, const RTCFilterFunctionNArguments
   return !f.geometry->opaque_at(f.mesh, prim, bary);
 }
 
-/// Primary and restricted rays: rejects hits on the back of single-sided triangles (the
-/// rasterizer's culling rule) and on a cut-out's transparent part.
+/// Nearest-hit queries (primary rays, hole tracing, source-frustum rays): rejects hits on the back
+/// of single-sided triangles (the rasterizer's culling rule) and on a cut-out's transparent part.
 void filter_hits(const RTCFilterFunctionNArguments* args) {
   const auto& f = *static_cast<const RayScene::Impl::Filter*>(args->geometryUserPtr);
   const Mesh& mesh = f.geometry->scene->meshes[f.mesh];
@@ -82,8 +82,9 @@ void filter_hits(const RTCFilterFunctionNArguments* args) {
   }
 }
 
-/// Occlusion queries (shadow rays, the validation of reprojected pixels): light passes through a
-/// cut-out's transparent part. Back faces block, as for every occlusion query.
+/// Occlusion queries (shadow rays, the length-restricted rays that validate reprojected pixels):
+/// light and sight pass through a cut-out's transparent part. Back faces block, as for every
+/// occlusion query.
 void filter_occlusion(const RTCFilterFunctionNArguments* args) {
   const auto& f = *static_cast<const RayScene::Impl::Filter*>(args->geometryUserPtr);
   for (unsigned i = 0; i < args->N; ++i)

@@ -179,10 +179,8 @@ void add_crack_counters(Counters& counters, const CrackFillStats& stats) {
   counters.set("large_hole_pixels", stats.large_hole_pixels);
   counters.set("border_holes", stats.border_holes);
   counters.set("border_hole_pixels", stats.border_hole_pixels);
-  if (stats.cracks_unfilled > 0 || stats.crack_pixels_unfilled > 0) {
-    counters.set("cracks_unfilled", stats.cracks_unfilled);
-    counters.set("crack_pixels_unfilled", stats.crack_pixels_unfilled);
-  }
+  counters.set("cracks_unfilled", stats.cracks_unfilled);
+  counters.set("crack_pixels_unfilled", stats.crack_pixels_unfilled);
 }
 
 }  // namespace sb

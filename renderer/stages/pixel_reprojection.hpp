@@ -130,6 +130,7 @@ void complete_right_eye(const RenderScene& scene, const StereoRig& rig, const Pi
 
 /// Lemma 1's bound on the writes to one right pixel for the nearest depth `z_min`: the disparity
 /// range f e / z_min in pixels, rounded up, plus one for rounding the reprojected columns.
+/// Saturates at 9e18 where the bound does not fit (a rig with a vanishing field of view).
 [[nodiscard]] uint64_t lemma1_bound(const StereoRig& rig, double z_min);
 
 /// Adds the write histogram to the counters: writes_max, writes_bound (Lemma 1 for the left eye's

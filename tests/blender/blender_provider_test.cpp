@@ -13,12 +13,15 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "renderer/error.hpp"
 #include "renderer/render_scene.hpp"
 #include "scenes/catalog.hpp"
+#include "scenes/gltf_builder.hpp"
 #include "renderer/io/gltf_loader.hpp"
 #include "support/cutout_scene.hpp"
 #include "support/mini_gltf.hpp"
@@ -247,6 +250,38 @@ TEST(BlenderCutout, SeesAndCastsShadowsThroughTheSameHolesAsFull) {
   // (alpha within float rounding of the cutoff) may flip where Embree and Cycles interpolate the
   // texture coordinates differently in the last bit; an opaque square would differ on thousands.
   EXPECT_LE(differ, 40u);
+}
+
+TEST(BlenderFailure, APrimitiveWithoutTheUvsOfItsTexturedMaterialBesideOneWithThemIsRefused) {
+  // Blender merges the two into one mesh and gives the first texture coordinates (0, 0): its
+  // texture (and a cut-out's coverage) would be read there, where ours takes the factor alone.
+  const test::ScratchDir dir;
+  scenes::GltfBuilder b("uv-split", 1);
+  std::vector<uint8_t> texel = {200, 30, 30, 255};
+  const int textured = b.add_material("textured", vec3(1.0f), b.add_texture("red", 1, 1, texel));
+  scenes::MeshData quad;
+  quad.add_quad(vec3(-1, -1, 0), vec3(1, -1, 0), vec3(1, 1, 0), vec3(-1, 1, 0), vec3(0, 0, 1));
+  const scenes::MeshData right = scenes::transformed(quad, scenes::translation({2.5f, 0.0f, 0.0f}));
+  const int both = b.add_mesh("both", {{b.add_geometry(quad, true), textured}, {b.add_geometry(right, true), textured}});
+  b.add_node("pair", both);
+  b.add_point_light("lamp", vec3(0.0f, 0.0f, 3.0f), vec3(1.0f), 10.0f);
+  b.set_camera("camera", CameraPose::look_at(dvec3(0.0, 0.0, 6.0), dvec3(0.0)), 0.8, 0.05, 0.0, RigDefaults{});
+  b.write(dir / "both.gltf");
+  // The second primitive loses its texture coordinates (the builder writes them for every
+  // textured primitive).
+  nlohmann::json doc = nlohmann::json::parse(std::ifstream(dir / "both.gltf"));
+  doc["meshes"][both]["primitives"][1]["attributes"].erase("TEXCOORD_0");
+  std::ofstream(dir / "split.gltf") << doc.dump();
+  const Scene scene = io::load_gltf(dir / "split.gltf");
+  ASSERT_EQ(scene.meshes.size(), 2u);
+  ASSERT_TRUE(scene.meshes[1].uvs.empty());
+  try {
+    validation::make_truth_provider("blender")->check_scene(scene, dir / "split.gltf");
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("has a primitive without TEXCOORD_0 beside one with it"), std::string::npos)
+        << e.what();
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

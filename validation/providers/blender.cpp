@@ -289,6 +289,24 @@ class BlenderProvider final : public TruthProvider {
       throw InputError(fmt::format("the blender provider imports the scene's glTF file, but '{}' is not a file; "
                                    "render a scene loaded from a .gltf/.glb file",
                                    scene_file.string()));
+    // Blender merges a glTF mesh's primitives into one mesh, whose UV map then covers every
+    // primitive: one without the texture coordinates its material reads gets (0, 0) there, where
+    // ours takes the factor alone (albedo and a cut-out's coverage).
+    for (size_t b = 0; b < scene.meshes.size(); ++b) {
+      const Mesh& without = scene.meshes[b];
+      if (!without.uvs.empty() || without.material < 0 ||
+          scene.materials[static_cast<size_t>(without.material)].base_color_texture < 0)
+        continue;
+      const int set = scene.materials[static_cast<size_t>(without.material)].texcoord;
+      for (const Mesh& with : scene.meshes)
+        if (&with != &without && with.node == without.node && !with.uvs.empty() &&
+            (with.material < 0 ? 0 : scene.materials[static_cast<size_t>(with.material)].texcoord) == set)
+          throw InputError(fmt::format(
+              "scene '{}': mesh '{}' (node {}) has a primitive without TEXCOORD_{} beside one with it; Blender "
+              "merges them and gives the first coordinates (0, 0), where its textured material (albedo, cut-out) "
+              "takes the factor alone: add texture coordinates to that primitive, or use the full or povray provider",
+              scene.name, without.name, without.node, set));
+    }
     // Blender's importer brings in every node of the file; the loaded scene is glTF scene 0 (or
     // `scene`) alone.
     if (scene.nodes_not_loaded > 0)
