@@ -27,7 +27,8 @@ namespace fs = std::filesystem;
 void list_generators() {
   fmt::print("{:<15} {:<20} {}\n", "scene", "file", "description");
   for (const scenes::GeneratorInfo& g : scenes::generators()) {
-    fmt::print("{:<15} {:<20} {}{}\n", g.name, g.file_name, g.description, g.analytic ? " [analytic test scene]" : "");
+    fmt::print("{:<15} {:<20} {}{}{}\n", g.name, g.file_name, g.description, g.analytic ? " [analytic test scene]" : "",
+               g.builtin ? "" : " [on demand: not in --all]");
     for (const scenes::GeneratorParam& p : g.params)
       fmt::print("{:<15}   --param {}={} ({} .. {}): {}\n", "", p.name, p.default_value, p.min_value, p.max_value, p.help);
   }

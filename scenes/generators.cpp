@@ -22,7 +22,7 @@ const std::vector<GeneratorEntry>& entries() {
   static const std::vector<GeneratorEntry> list = {
       spheres_generator(),   atrium_generator(),   bistro_generator(),         temple_generator(),
       dragon_generator(),    complexity_generator(), lit_plane_generator(),    box_wall_generator(),
-      thin_pole_generator(), textured_plane_generator(), slanted_plane_generator(),
+      thin_pole_generator(), textured_plane_generator(), slanted_plane_generator(), fence_generator(),
   };
   return list;
 }

@@ -55,5 +55,6 @@ GeneratorEntry box_wall_generator();
 GeneratorEntry thin_pole_generator();
 GeneratorEntry textured_plane_generator();
 GeneratorEntry slanted_plane_generator();
+GeneratorEntry fence_generator();
 
 }  // namespace sb::scenes
