@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cstdlib>
 #include <map>
+#include <optional>
 #include <set>
 #include <span>
 
@@ -12,6 +13,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/io/file_lock.hpp"
 #include "renderer/io/image_io.hpp"
 #include "renderer/io/json_text.hpp"
 #include "sb_version.hpp"
@@ -230,11 +232,21 @@ bool holds_report(const fs::path& out) {
 
 /// Prepares the output folder: new, empty, or an earlier report (finished, or stopped before its
 /// index was written) whose index, assets and images go. A folder holding anything else is refused
-/// (check_report_folder, naming it as `named`).
-void prepare_out_dir(const fs::path& out, const std::string& named) {
+/// (check_report_folder, naming it as `named`). Returns the lock on the folder, held until the
+/// report is written: a second report into the folder meanwhile is refused (InputError), since the
+/// two would remove each other's images and assets.
+io::FileLock prepare_out_dir(const fs::path& out, const std::string& named) {
   check_report_folder(out, named);
   std::error_code ec;
-  if (fs::exists(out, ec) && !fs::is_empty(out, ec)) {
+  fs::create_directories(out, ec);
+  if (ec) throw IoError(fmt::format("cannot create the report folder {}: {}", out.string(), ec.message()));
+  std::optional<io::FileLock> lock = io::FileLock::try_acquire(out);
+  if (!lock)
+    throw InputError(fmt::format("{}: another report is being written there; wait for it to end, or give another "
+                                 "folder",
+                                 named));
+  check_report_folder(out, named);  // again, under the lock
+  if (!fs::is_empty(out, ec)) {
     // The index first: a folder never holds an index.html whose assets or images are gone.
     for (const char* sub : {"index.html", "assets", "images"}) {
       fs::remove_all(out / sub, ec);
@@ -242,9 +254,8 @@ void prepare_out_dir(const fs::path& out, const std::string& named) {
     }
     // An index being written when a run was killed is removed when the new index is written.
   }
-  fs::create_directories(out, ec);
-  if (ec) throw IoError(fmt::format("cannot create the report folder {}: {}", out.string(), ec.message()));
   io::write_text_atomically(out / kReportMarker, fmt::format("{} {}\n", kGenerator, SB_VERSION_STRING));
+  return std::move(*lock);
 }
 
 /// Copies a file atomically (the destination's folders are created).
@@ -415,7 +426,8 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
   }
 
   const fs::path out = options.out_dir;
-  prepare_out_dir(out, options.out_name.empty() ? fmt::format("--out {}", out.string()) : options.out_name);
+  const io::FileLock lock =
+      prepare_out_dir(out, options.out_name.empty() ? fmt::format("--out {}", out.string()) : options.out_name);
   ReportSummary summary;
   summary.warnings = results.warnings;
 

@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "renderer/io/file_lock.hpp"
 #include "support/run_cli.hpp"
 #include "support/report_support.hpp"
 #include "support/scratch_dir.hpp"
@@ -362,6 +363,37 @@ TEST(Report, ImagesOfEveryPipelineKeepTheirOwnFolderAndALinkedResultsFileFindsTh
   EXPECT_NE(a, b);
   EXPECT_EQ(test::read_text(dir / "out" / a), test::read_text(dir / "run" / "cells" / "0000" / "a.png")) << a;
   EXPECT_EQ(test::read_text(dir / "out" / b), test::read_text(dir / "run" / "cells" / "0000" / "b.png")) << b;
+}
+
+}  // namespace
+}  // namespace sb
+
+namespace sb {
+namespace {
+
+TEST(Report, ASecondReportIntoAFolderBeingWrittenIsRefused) {
+  // Two reports into one folder would remove each other's images and assets and could leave an
+  // index.html naming files that are gone: while one writes (its lock on the folder, held here),
+  // another is refused, and the folder is left as it was.
+  test::ScratchDir dir;
+  write_text(dir / "results.jsonl", minimal_line("a", 0).dump() + "\n");
+  const std::string args = "report " + quoted(dir / "results.jsonl") + " --out " + quoted(dir / "out");
+  const test::CliRun first = test::run_cli(args);
+  ASSERT_EQ(first.code, 0) << first.out;
+  const std::string index = test::read_text(dir / "out" / "index.html");
+  {
+    const io::FileLock held = io::FileLock::acquire(dir / "out");
+    const test::CliRun second = test::run_cli(args + " --title other");
+    EXPECT_EQ(second.code, 3) << second.out;
+    EXPECT_NE(second.out.find("--out " + (dir / "out").string() +
+                              ": another report is being written there; wait for it to end, or give another folder"),
+              std::string::npos)
+        << second.out;
+    EXPECT_EQ(test::read_text(dir / "out" / "index.html"), index) << "the report being written is left alone";
+    EXPECT_TRUE(fs::exists(dir / "out" / "assets" / "report.js"));
+  }
+  const test::CliRun after = test::run_cli(args + " --title other");
+  EXPECT_EQ(after.code, 0) << after.out;
 }
 
 }  // namespace
