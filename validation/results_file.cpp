@@ -251,7 +251,14 @@ json value_at(const json& root, std::string_view dotted) {
 
 ResultsWriterLock::ResultsWriterLock(const fs::path& results, const std::vector<size_t>& cells) {
   std::error_code ec;
-  if (results.has_parent_path()) fs::create_directories(results.parent_path(), ec);
+  if (results.has_parent_path() && !fs::is_directory(results.parent_path(), ec)) {
+    fs::create_directories(results.parent_path(), ec);
+    if (ec || !fs::is_directory(results.parent_path()))
+      throw IoError(fmt::format("cannot create the folder {} of the results file {}: {}; give --out (or --results) "
+                                "a folder you can write",
+                                results.parent_path().string(), results.string(),
+                                ec ? ec.message() : "a file of that name is in the way"));
+  }
   // Through links to the file itself, so that two spellings of one results file share the lock.
   const fs::path real = fs::weakly_canonical(fs::absolute(io::follow_links(results), ec), ec);
   const fs::path path = lock_path(ec ? results : real);

@@ -21,6 +21,7 @@
 #include "renderer/animation.hpp"
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/io/file_lock.hpp"
 #include "renderer/io/gltf_loader.hpp"
 #include "renderer/io/json_text.hpp"
 #include "renderer/io/render_output.hpp"
@@ -401,6 +402,9 @@ void check_out_folders(const SweepRunOptions& options) {
 void claim_out_folder(const SweepDefinition& d, const SweepRunOptions& options) {
   const fs::path marker = options.out_dir / kOutMarker;
   const json mine = {{"sweep", d.name}, {"definition_sha256", d.sha256}, {"definition", d.file.string()}};
+  // Checked and written under a lock on the folder: two sweeps started together into one new folder
+  // would otherwise both find no marker and both claim it.
+  const io::FileLock lock = io::FileLock::acquire(options.out_dir);
   if (fs::exists(marker)) {
     json theirs;
     try {

@@ -16,6 +16,8 @@
 #include <thread>
 
 #include "scenes/gltf_builder.hpp"
+#include "renderer/io/file_lock.hpp"
+#include "support/lock_wait.hpp"
 #include "support/run_cli.hpp"
 #include "support/scratch_dir.hpp"
 #include "validation/results_file.hpp"
@@ -604,6 +606,45 @@ TEST(SweepRun, BadDefinitionAndShardAreUsageErrors) {
   const test::CliRun fixed = test::run_cli("sweep run " + quoted(dir / "near.toml") + " --out " + quoted(dir / "near") +
                                            " --scenes-dir " + quoted(dir / "scenes"));
   EXPECT_EQ(fixed.code, 0) << fixed.out;
+}
+
+
+TEST(SweepRun, TwoDefinitionsStartedTogetherIntoOneFolderDoNotBothRun) {
+  // A sweep checks the folder's marker and writes its own under a lock on the folder. Held here,
+  // the sweep waits at the check; the marker of another definition written meanwhile (as the sweep
+  // holding the lock would) is then found, and the waiting sweep is refused, as it is when it
+  // starts after (both used to find no marker, run, and overwrite each other's images).
+  test::ScratchDir dir;
+  std::ofstream(dir / "b.toml") << "[sweep]\nname = \"b\"\nscenes = [\"box-wall\"]\npipelines = [\"plain-rt\"]\n"
+                                   "resolutions = [\"64x36\"]\n[timing]\nrepetitions = 1\nwarmup = 0\n";
+  fs::create_directories(dir / "out");
+  {
+    io::FileLock held = io::FileLock::acquire(dir / "out");
+    test::start_cli_in_background("sweep run " + quoted(dir / "b.toml") + " --out " + quoted(dir / "out") +
+                                      " --results " + quoted(dir / "b.jsonl") + " --threads 1 --scenes-dir " +
+                                      quoted(dir / "scenes"),
+                                  dir / "b.log");
+    ASSERT_TRUE(test::wait_for_lock_waiter(dir / "out")) << test::read_text(dir / "b.log");
+    std::ofstream(dir / "out" / ".stereobench-sweep.json")
+        << json{{"sweep", "a"}, {"definition_sha256", std::string(64, '0')}, {"definition", "a.toml"}}.dump(2) << "\n";
+  }
+  const test::CliRun b = test::wait_for_background(dir / "b.log");
+  EXPECT_EQ(b.code, 3) << b.out;
+  EXPECT_NE(b.out.find("holds the cells of sweep 'a'"), std::string::npos) << b.out;
+  EXPECT_FALSE(fs::exists(dir / "out" / "cells")) << "no cell ran";
+  EXPECT_EQ(json::parse(test::read_text(dir / "out" / ".stereobench-sweep.json"))["sweep"], "a");
+}
+
+TEST(SweepRun, AnOutFolderThatCannotBeMadeIsNamed) {
+  // A folder that cannot be created is named as such, not as a lock file that does not exist.
+  test::ScratchDir dir;
+  std::ofstream(dir / "blocker") << "a file where a folder should be\n";
+  const test::CliRun r = test::run_cli("sweep run " + quoted(fs::path(SB_SOURCE_DIR) / "ci" / "smoke.toml") +
+                                       " --out " + quoted(dir / "blocker" / "new"));
+  EXPECT_EQ(r.code, 4) << r.out;
+  EXPECT_NE(r.out.find("cannot create the folder " + (dir / "blocker" / "new").string()), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("give --out (or --results) a folder you can write"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("lock file"), std::string::npos) << r.out;
 }
 
 }  // namespace
