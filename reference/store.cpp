@@ -21,6 +21,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/io/file_lock.hpp"
 #include "renderer/io/image_io.hpp"
 #include "renderer/io/json_text.hpp"
 #include "renderer/io/unique_fd.hpp"
@@ -297,10 +298,9 @@ mode_t current_umask() {
 }
 
 /// Makes a new working folder of `kind` for entry `id`: made (mkdtemp) and locked under a name the
-/// clean-up does not look at, then renamed, so that no other run can find it unlocked.
+/// clean-up does not look at, then renamed, so that no other run can find it unlocked. The store
+/// exists (generate makes it).
 void make_working_folder(const fs::path& root, const std::string& id, const char* kind, WorkingFolder& out) {
-  std::error_code made_root;
-  fs::create_directories(root, made_root);  // a new store
   std::string made = (root / fmt::format(".{}.mk-XXXXXX", id)).string();
   if (::mkdtemp(made.data()) == nullptr) {
     const int err = errno;
@@ -528,6 +528,16 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
   // that name, or a rig that differs by less than the id shows, would silently take the entry's
   // place. Regenerating from the same scene and spec replaces it (also when the scene's camera has
   // changed since, as `reference update` does), as does an entry whose provenance cannot be read.
+  // The check and the replacement are made under a lock on the id (".ID.lock" in the store, removed
+  // when done), so that a generate of the same id running meanwhile is waited for, and then checked
+  // against.
+  std::error_code made_root;
+  fs::create_directories(root_, made_root);  // a new store
+  if (made_root)
+    throw IoError(fmt::format("cannot create the reference store {}: {}; give a --store you can write",
+                              root_.string(), made_root.message()));
+  io::FileLock id_lock = io::FileLock::acquire(root_ / fmt::format(".{}.lock", id));
+  id_lock.remove_when_released();  // the store keeps entries only
   if (fs::exists(root_ / id / kProvenance)) {
     std::optional<ReferenceSpec> before;
     json before_rig;

@@ -17,6 +17,8 @@
 
 #include "reference/store.hpp"
 #include "scenes/catalog.hpp"
+#include "renderer/io/file_lock.hpp"
+#include "support/lock_wait.hpp"
 #include "support/run_cli.hpp"
 #include "support/scratch_dir.hpp"
 
@@ -519,6 +521,42 @@ TEST(ReferenceStore, MissingToolIsUnavailableNotAPass) {
   EXPECT_NE(update.out.find("1 reference(s) could not be checked, so not updated"), std::string::npos) << update.out;
   EXPECT_NE(update.out.find("box-wall_povray_32x18"), std::string::npos) << update.out;
   EXPECT_EQ(test::run_cli(ref(dir, "verify") + " " + full).code, 0) << "the damaged full entry was rewritten";
+}
+
+
+TEST(ReferenceStore, AnotherRigGeneratedMeanwhileDoesNotReplaceAnEntry) {
+  // Two generates of one id with different rigs at once: the check and the replacement are made
+  // under the id's lock, held here. The second generate waits at it; the entry of the other rig
+  // put in place meanwhile (as the generate holding the lock would) is then found and the waiting
+  // one refused, as when it starts after (it used to pass the check and replace that entry).
+  test::ScratchDir dir;
+  const std::string args = " --scene box-wall --resolution 32x18 --threads 1";
+  const std::string id = "box-wall_full_32x18_e64.0mm_c4.08m";
+  ASSERT_EQ(test::run_cli("reference generate --store " + quoted(dir / "first") + " --scenes-dir " + quoted(kScenes) +
+                          args)
+                .code,
+            0);
+  ASSERT_TRUE(fs::is_directory(dir / "first" / id));
+  fs::create_directories(dir / "store");
+  const fs::path lock_file = dir / "store" / ("." + id + ".lock");
+  {
+    const io::FileLock held = io::FileLock::acquire(lock_file);
+    test::start_cli_in_background(ref(dir, "generate") + args + " --interaxial 0.06404", dir / "second.log");
+    ASSERT_TRUE(test::wait_for_lock_waiter(lock_file)) << test::read_text(dir / "second.log");
+    fs::copy(dir / "first" / id, dir / "store" / id, fs::copy_options::recursive);
+  }
+  const test::CliRun second = test::wait_for_background(dir / "second.log");
+  EXPECT_EQ(second.code, 3) << second.out;
+  EXPECT_NE(second.out.find("reference '" + id + "' in " + (dir / "store").string() +
+                            " was made with another rig (interaxial_m: recorded 0.064, now 0.06404;"),
+            std::string::npos)
+      << second.out;
+  EXPECT_EQ(test::read_text(dir / "store" / id / "provenance.json"),
+            test::read_text(dir / "first" / id / "provenance.json"))
+      << "the entry made meanwhile is kept";
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(dir / "store")) left.push_back(e.path().filename().string());
+  EXPECT_EQ(left, std::vector<std::string>{id}) << "the id's lock file goes with the generate";
 }
 
 }  // namespace
