@@ -205,6 +205,15 @@ void discard_outputs(std::initializer_list<NamedPath> outputs) noexcept {
   }
 }
 
+void write_all_or_none(std::initializer_list<NamedPath> outputs, const std::function<void()>& write) {
+  try {
+    write();
+  } catch (...) {
+    discard_outputs(outputs);
+    throw;
+  }
+}
+
 void prepare_output_folder(const std::string& folder, const char* option) {
   if (const auto why = io::unwritable_folder(folder))
     throw IoError(fmt::format("{} {}: {}; give a folder you can write", option, folder, *why));

@@ -84,6 +84,12 @@ void remove_earlier_outputs(std::initializer_list<NamedPath> outputs);
 /// regular files only, "" and "-" skipped), so that none is left beside its error.
 void discard_outputs(std::initializer_list<NamedPath> outputs) noexcept;
 
+/// Runs `write`, which writes several output files one after another, all or none: when it throws,
+/// those of `outputs` already written are removed (discard_outputs) before the error goes on, so
+/// that a run stopped on the way leaves none of them behind (a JUnit file without its JSON would
+/// read as the run's verdict).
+void write_all_or_none(std::initializer_list<NamedPath> outputs, const std::function<void()>& write);
+
 /// Runs `write`, which writes the output file an option names; an IoError it throws is given the
 /// option's name and what to do, e.g. "--json: cannot open /proc/x.json: ...; give --json a path
 /// you can write".

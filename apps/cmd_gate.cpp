@@ -129,16 +129,17 @@ void run_gate(const GateArgs& a) {
   // they are written. Exit 4 leaves neither file: a JUnit file beside a failed run would read as
   // its verdict.
   try {
-    if (!a.junit.empty())
-      write_option_file("--junit", a.junit, validation::junit_xml(report, "stereobench gate " + a.results));
-    if (!a.json_out.empty())
-      write_option_file("--json", a.json_out,
-                        validation::gate_report_json(report, a.config, a.results,
-                                                     baseline_note.empty() ? baseline_file.string() : "")
-                                .dump(2) +
-                            "\n");
+    write_all_or_none({{"--junit", &a.junit}, {"--json", &a.json_out}}, [&] {
+      if (!a.junit.empty())
+        write_option_file("--junit", a.junit, validation::junit_xml(report, "stereobench gate " + a.results));
+      if (!a.json_out.empty())
+        write_option_file("--json", a.json_out,
+                          validation::gate_report_json(report, a.config, a.results,
+                                                       baseline_note.empty() ? baseline_file.string() : "")
+                                  .dump(2) +
+                              "\n");
+    });
   } catch (const IoError&) {
-    discard_outputs({{"--junit", &a.junit}, {"--json", &a.json_out}});
     fmt::print("{}gate: the verdict above does not stand: its report files could not be written (exit 4)\n",
                validation::format_gate_table(report));
     throw;

@@ -21,6 +21,7 @@
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/io/file_lock.hpp"
 #include "renderer/text.hpp"
 #include "reports/report.hpp"
 #include "validation/gate.hpp"
@@ -94,9 +95,20 @@ bool history_holds(const HistoryFile& history, const std::string& run_id) {
   return std::any_of(history.runs.begin(), history.runs.end(), [&](const json& r) { return r["run_id"] == run_id; });
 }
 
+/// The run folder chosen, with its claim on its id in the history (held for the run's life) and the
+/// history as read while choosing.
+struct ChosenRun {
+  fs::path dir;
+  bool resumed = false;
+  io::FileLock claim;
+  HistoryFile history;
+};
+
 /// The run folder: the newest unfinished run of this definition version (resumed), else a new one
-/// whose id neither a folder in `out` nor a line of `history` (which other sweeps may share) has.
-fs::path choose_run_dir(const fs::path& out, const SweepDefinition& d, const HistoryFile& history, bool* resumed) {
+/// whose id neither a folder in `out`, nor a line of the history, nor another run's claim on it has
+/// (other sweeps, with other --out folders, may share the history). Chosen under the history's lock,
+/// the history read again under it, so that runs started in the same second take different ids.
+ChosenRun choose_run_dir(const fs::path& out, const SweepDefinition& d, const fs::path& history_file) {
   std::vector<std::string> ids;
   std::error_code ec;
   if (fs::is_directory(out, ec))
@@ -112,15 +124,25 @@ fs::path choose_run_dir(const fs::path& out, const SweepDefinition& d, const His
     const std::string na = a.size() > 17 ? a.substr(17) : "1", nb = b.size() > 17 ? b.substr(17) : "1";
     return na.size() != nb.size() ? na.size() < nb.size() : na < nb;
   });
-  *resumed = false;
+  const io::FileLock lock = lock_history(history_file);
+  ChosenRun chosen;
+  chosen.history = read_history(history_file);
   if (!ids.empty()) {
     const fs::path newest = out / ids.back();
     if (!fs::exists(newest / kRunDoneFile, ec)) {
       const ResultsFile r = read_results(newest / "results.jsonl");
       const bool same = r.cells.empty() || r.cells.front().value("definition_sha256", "") == d.sha256;
       if (same) {
-        *resumed = true;
-        return newest;
+        std::optional<io::FileLock> claim = claim_run_id(history_file, ids.back());
+        if (!claim)
+          throw InputError(fmt::format("the unfinished run {} is being run by another nightly (it holds the claim {} "
+                                       "on id {} in {}); wait for that run to end, or give another --out",
+                                       newest.string(), run_claim_path(history_file, ids.back()).string(),
+                                       ids.back(), history_file.string()));
+        chosen.dir = newest;
+        chosen.resumed = true;
+        chosen.claim = std::move(*claim);
+        return chosen;
       }
       fmt::print(stderr, "note: the unfinished run {} holds results of another version of {}; starting a new run\n",
                  newest.string(), d.file.string());
@@ -128,10 +150,30 @@ fs::path choose_run_dir(const fs::path& out, const SweepDefinition& d, const His
   }
   const std::string base = utc_now("%Y%m%dT%H%M%SZ");
   std::string id = base;
-  for (int n = 2; fs::exists(out / id, ec) || history_holds(history, id); ++n) id = fmt::format("{}-{}", base, n);
+  for (int n = 2;; id = fmt::format("{}-{}", base, n++)) {
+    if (fs::exists(out / id, ec) || history_holds(chosen.history, id) || run_id_claimed(history_file, id)) continue;
+    std::optional<io::FileLock> claim = claim_run_id(history_file, id);
+    if (!claim) continue;  // made meanwhile by a process that does not take the history's lock
+    chosen.claim = std::move(*claim);
+    break;
+  }
   fs::create_directories(out / id, ec);
   if (ec) throw IoError(fmt::format("cannot create the run folder {}: {}", (out / id).string(), ec.message()));
-  return out / id;
+  chosen.dir = out / id;
+  return chosen;
+}
+
+/// InputError when `history` holds run `run_id` of another results file than this run's: a
+/// history shared between sweeps whose line took this id, so this run cannot be recorded there.
+void refuse_foreign_run(const HistoryFile& history, const fs::path& history_file, const std::string& run_id,
+                        const std::string& results_in_history, const fs::path& results, const fs::path& run_dir) {
+  for (const json& r : history.runs)
+    if (r["run_id"] == run_id && r.value("results", "") != results_in_history)
+      throw InputError(fmt::format(
+          "{} already holds a run {} of another results file ({}, sweep '{}'), so this run ({}) cannot be recorded "
+          "there; give this sweep its own --history, or move the unfinished run folder {} away to start a new run",
+          history_file.string(), run_id, r.value("results", "?"), r.value("sweep", "?"), results.string(),
+          run_dir.string()));
 }
 
 /// Makes sure the history line can be appended at the end of the run, before the sweep costs
@@ -194,8 +236,9 @@ void run_nightly(const NightlyArgs& a) {
   const int threads = checked_threads(a.threads);  // before a run folder is made
 
   // 1. The sweep, into the run folder.
-  bool resumed = false;
-  const fs::path run_dir = choose_run_dir(out, d, history_before, &resumed);
+  ChosenRun chosen = choose_run_dir(out, d, history_file);
+  const fs::path& run_dir = chosen.dir;
+  const bool resumed = chosen.resumed;
   const std::string run_id = run_dir.filename().string();
   SweepRunOptions o;
   o.out_dir = run_dir;
@@ -211,13 +254,7 @@ void run_nightly(const NightlyArgs& a) {
   reports::check_report_folder(report_dir, report_name);  // written last, checked first
   // A resumed run whose id a line of another run took meanwhile (a history shared between sweeps)
   // could not be recorded: stop before the sweep.
-  for (const json& r : history_before.runs)
-    if (r["run_id"] == run_id && r.value("results", "") != results_in_history)
-      throw InputError(fmt::format(
-          "{} already holds a run {} of another results file ({}, sweep '{}'), so this run ({}) cannot be recorded "
-          "there; give this sweep its own --history, or move the unfinished run folder {} away to start a new run",
-          history_file.string(), run_id, r.value("results", "?"), r.value("sweep", "?"), o.results.string(),
-          run_dir.string()));
+  refuse_foreign_run(chosen.history, history_file, run_id, results_in_history, o.results, run_dir);
   o.scenes_dir = a.scenes_dir;
   if (!a.cache.empty()) o.truth_cache = fs::path(a.cache);
   o.definition_label = a.definition;
@@ -266,11 +303,19 @@ void run_nightly(const NightlyArgs& a) {
   run.results = results_in_history;
   std::vector<json> cells;
   for (const GateCell& c : results.cells) cells.push_back(c.record);
-  if (history_holds(history_before, run_id))
-    fmt::print(stderr, "note: {} already holds run {}; not appended again\n", history_file.string(), run_id);
-  else
-    append_history(history_file, history_entry(run, cells, gate));
-  const HistoryFile history = read_history(history_file);
+  HistoryFile history;
+  {
+    // Checked again under the lock: the history may have taken lines since the run began.
+    const io::FileLock history_lock = lock_history(history_file);
+    history = read_history(history_file);
+    refuse_foreign_run(history, history_file, run_id, results_in_history, o.results, run_dir);
+    if (history_holds(history, run_id)) {
+      fmt::print(stderr, "note: {} already holds run {}; not appended again\n", history_file.string(), run_id);
+    } else {
+      append_history(history_file, history_entry(run, cells, gate));
+      history = read_history(history_file);
+    }
+  }
 
   // 4. The report with the trends.
   const reports::ResultsFile report_results = reports::read_results_file(o.results);
@@ -289,21 +334,27 @@ void run_nightly(const NightlyArgs& a) {
   const reports::ReportSummary s = reports::write_report(report_results, options);
   for (const std::string& w : s.warnings) fmt::print(stderr, "warning: {}\n", w);
 
-  io::write_text_atomically(junit_file, junit_xml(gate, "stereobench nightly " + o.results.string()));
-  io::write_text_atomically(gate_json_file, gate_report_json(gate, gate_file, o.results.string(),
-                                                             baseline_note.empty() ? baseline_file.string() : "")
-                                                    .dump(2) +
-                                                "\n");
+  // The verdict files and the done file stand together: a write that fails removes those written.
   const int code = exit_code(gate.worst);
-  io::write_text_atomically(run_dir / kRunDoneFile,
-                            json{{"run_id", run_id},
-                                 {"date", run.date},
-                                 {"gate_verdict", gate_verdict(gate)},
-                                 {"exit_code", code},
-                                 {"history", history_file.string()},
-                                 {"report", s.index_html.string()}}
-                                    .dump(2) +
-                                "\n");
+  const std::string junit_path = junit_file.string(), gate_json_path = gate_json_file.string(),
+                    done_path = (run_dir / kRunDoneFile).string();
+  write_all_or_none({{"gate JUnit", &junit_path}, {"gate JSON", &gate_json_path}, {"nightly.json", &done_path}}, [&] {
+    io::write_text_atomically(junit_file, junit_xml(gate, "stereobench nightly " + o.results.string()));
+    io::write_text_atomically(gate_json_file, gate_report_json(gate, gate_file, o.results.string(),
+                                                               baseline_note.empty() ? baseline_file.string() : "")
+                                                      .dump(2) +
+                                                  "\n");
+    io::write_text_atomically(done_path,
+                              json{{"run_id", run_id},
+                                   {"date", run.date},
+                                   {"gate_verdict", gate_verdict(gate)},
+                                   {"exit_code", code},
+                                   {"history", history_file.string()},
+                                   {"report", s.index_html.string()}}
+                                      .dump(2) +
+                                  "\n");
+  });
+  drop_run_claim(history_file, chosen.claim);
   fmt::print("history {} ({} runs)\nreport {}\ngate verdict: {} (exit {})\n", history_file.string(),
              history.runs.size(), s.index_html.string(), gate_verdict(gate), code);
   if (code != 0) throw VerdictExit{code};

@@ -193,4 +193,38 @@ void append_history(const fs::path& file, const json& entry) {
   append_result(file, entry, "history file");
 }
 
+fs::path run_claim_path(const fs::path& file, const std::string& run_id) {
+  return fs::path(file.string() + ".claims") / run_id;
+}
+
+io::FileLock lock_history(const fs::path& file) { return io::FileLock::acquire(file.string() + ".lock"); }
+
+std::optional<io::FileLock> claim_run_id(const fs::path& file, const std::string& run_id) {
+  const fs::path claim = run_claim_path(file, run_id);
+  std::error_code ec;
+  fs::create_directories(claim.parent_path(), ec);
+  if (ec)
+    throw IoError(fmt::format("cannot create {}, the folder of the run claims of history {}: {}; give a history file "
+                              "in a writable folder",
+                              claim.parent_path().string(), file.string(), ec.message()));
+  return io::FileLock::try_acquire(claim);
+}
+
+bool run_id_claimed(const fs::path& file, const std::string& run_id) {
+  std::error_code ec;
+  return fs::exists(run_claim_path(file, run_id), ec);
+}
+
+void drop_run_claim(const fs::path& file, io::FileLock& claim) noexcept {
+  if (!claim.held()) return;
+  try {
+    const io::FileLock lock = lock_history(file);  // no run is opening claims meanwhile
+    std::error_code ec;
+    fs::remove(claim.path(), ec);
+    fs::remove(claim.path().parent_path(), ec);  // the claims folder, when no other claim is left in it
+  } catch (const std::exception&) {  // best effort: the claim file stays, and so does its id
+  }
+  claim.release();
+}
+
 }  // namespace sb::validation

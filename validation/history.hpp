@@ -4,11 +4,13 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "renderer/io/file_lock.hpp"
 #include "validation/gate.hpp"
 
 namespace sb::validation {
@@ -55,5 +57,26 @@ struct HistoryFile {
 /// Appends one run's line atomically (append_result: one write under a lock, fsync). The line is
 /// checked first (check_history_line).
 void append_history(const std::filesystem::path& file, const nlohmann::json& entry);
+
+/// Runs that share a history file take turns at it: the lock file FILE.lock is held while a run
+/// chooses its id (reading the history under it) and while it appends its line, so that two runs
+/// started in the same second never take one id. Waits while another run holds it (briefly).
+[[nodiscard]] io::FileLock lock_history(const std::filesystem::path& file);
+
+/// The claim file of run id `run_id` in history FILE: FILE.claims/ID.
+[[nodiscard]] std::filesystem::path run_claim_path(const std::filesystem::path& file, const std::string& run_id);
+
+/// The claim of run `run_id` on its id in history FILE: the file FILE.claims/ID, locked by the run
+/// while it lives (a killed run's claim is free again, for the run's resume). Call under
+/// lock_history. nullopt when another live run holds it.
+[[nodiscard]] std::optional<io::FileLock> claim_run_id(const std::filesystem::path& file, const std::string& run_id);
+
+/// Whether an id has a claim file in history FILE, held or not: a run in progress, or one that was
+/// killed and may be resumed; a new run takes another id. Call under lock_history.
+[[nodiscard]] bool run_id_claimed(const std::filesystem::path& file, const std::string& run_id);
+
+/// Removes the claim file of a finished run (its line is in the history, which keeps its id taken),
+/// and the claims folder when it is left empty, and lets the claim go. Best effort: a claim file left behind only keeps an id already taken.
+void drop_run_claim(const std::filesystem::path& file, io::FileLock& claim) noexcept;
 
 }  // namespace sb::validation

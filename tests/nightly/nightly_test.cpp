@@ -11,6 +11,7 @@
 #include <ctime>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <fstream>
 #include <regex>
 #include <string>
@@ -21,6 +22,8 @@
 #include <nlohmann/json.hpp>
 
 #include "renderer/error.hpp"
+#include "renderer/io/file_lock.hpp"
+#include "support/lock_wait.hpp"
 #include "support/run_cli.hpp"
 #include "support/report_support.hpp"
 #include "support/scratch_dir.hpp"
@@ -463,6 +466,116 @@ TEST(NightlyTest, SweepsSharingAHistoryKeepTheirRunsApart) {
   EXPECT_NE(c.out.find("already holds a run " + taken + " of another results file"), std::string::npos) << c.out;
   EXPECT_FALSE(fs::exists(dir / "runs-c" / taken / "results.jsonl")) << "no cell ran";
   EXPECT_EQ(json_lines(dir / "shared.jsonl").size(), other_runs + 2);
+}
+
+
+/// The nightly command line of the tiny sweep with `out` and `history` in place of the defaults.
+std::string nightly_args_into(const test::ScratchDir& dir, const std::string& out, const fs::path& history) {
+  std::string args = nightly_args(dir) + " --history " + quoted(history);
+  const std::string runs = " --out " + quoted(dir / "runs");
+  args.replace(args.find(runs), runs.size(), " --out " + quoted(dir / out));
+  return args;
+}
+
+TEST(NightlyTest, ConcurrentRunsSharingAHistoryTakeDifferentIds) {
+  // Two runs into their own --out, one history, started together: each takes its own id (both
+  // used to take the id of their second and append it twice, after which every nightly on that
+  // history was refused), both are recorded, and the history stays readable for the next run.
+  test::ScratchDir dir;
+  write_inputs(dir);
+  const fs::path history = dir / "shared.jsonl";
+  test::start_cli_in_background(nightly_args_into(dir, "a", history), dir / "a.log");
+  test::start_cli_in_background(nightly_args_into(dir, "b", history), dir / "b.log");
+  const test::CliRun a = test::wait_for_background(dir / "a.log");
+  const test::CliRun b = test::wait_for_background(dir / "b.log");
+  ASSERT_EQ(a.code, 0) << a.out;
+  ASSERT_EQ(b.code, 0) << b.out;
+  const std::vector<json> lines = json_lines(history);
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_NE(lines[0]["run_id"], lines[1]["run_id"]);
+  for (const json& line : lines) {
+    EXPECT_FALSE(fs::exists(validation::run_claim_path(history, line["run_id"].get<std::string>())))
+        << "a finished run drops its claim";
+  }
+  const test::CliRun next = test::run_cli(nightly_args_into(dir, "a", history));
+  EXPECT_EQ(next.code, 0) << next.out;
+  EXPECT_EQ(json_lines(history).size(), 3u);
+}
+
+TEST(NightlyTest, AnIdClaimedByARunningNightlyIsNotTaken) {
+  // Runs of another --out sharing the history hold claims on the ids of every second of the next
+  // two minutes (as running nightlies do, before their history lines exist): a new run takes the
+  // next free id of its second.
+  test::ScratchDir dir;
+  write_inputs(dir);
+  const fs::path history = dir / "shared.jsonl";
+  std::vector<io::FileLock> claims;
+  {
+    const io::FileLock lock = validation::lock_history(history);
+    const std::time_t now = std::time(nullptr);
+    for (std::time_t t = now; t < now + 120; ++t) {
+      std::tm utc{};
+      gmtime_r(&t, &utc);
+      std::array<char, 32> id{};
+      std::strftime(id.data(), id.size(), "%Y%m%dT%H%M%SZ", &utc);
+      std::optional<io::FileLock> claim = validation::claim_run_id(history, id.data());
+      ASSERT_TRUE(claim.has_value()) << id.data();
+      claims.push_back(std::move(*claim));
+    }
+  }
+  const test::CliRun r = test::run_cli(nightly_args_into(dir, "runs-b", history));
+  ASSERT_EQ(r.code, 0) << r.out;
+  const std::vector<json> lines = json_lines(history);
+  ASSERT_EQ(lines.size(), 1u);
+  const std::string id = lines[0]["run_id"].get<std::string>();
+  EXPECT_TRUE(std::regex_match(id, std::regex(R"(\d{8}T\d{6}Z-2)"))) << id;
+  EXPECT_TRUE(fs::is_directory(dir / "runs-b" / id));
+}
+
+TEST(NightlyTest, ResumingARunThatAnotherNightlyIsRunningIsRefused) {
+  // An unfinished run folder whose id another live nightly holds (the claim, held here): the
+  // resume is refused before any cell runs; once that run has gone (its claim free), it resumes.
+  test::ScratchDir dir;
+  write_inputs(dir);
+  const std::string id = "20260101T000000Z";
+  fs::create_directories(dir / "runs" / id);
+  const fs::path history = dir / "runs" / "history.jsonl";
+  {
+    std::optional<io::FileLock> claim = validation::claim_run_id(history, id);
+    ASSERT_TRUE(claim.has_value());
+    const test::CliRun r = test::run_cli(nightly_args(dir));
+    EXPECT_EQ(r.code, 3) << r.out;
+    EXPECT_NE(r.out.find("the unfinished run " + (dir / "runs" / id).string() +
+                         " is being run by another nightly (it holds the claim " +
+                         validation::run_claim_path(history, id).string() + " on id " + id + " in " +
+                         history.string() + "); wait for that run to end, or give another --out"),
+              std::string::npos)
+        << r.out;
+    EXPECT_FALSE(fs::exists(dir / "runs" / id / "results.jsonl")) << "no cell ran";
+  }
+  // The claim of a run that was killed stays behind, free: the run resumes under its id.
+  ASSERT_TRUE(fs::exists(validation::run_claim_path(history, id)));
+  const test::CliRun again = test::run_cli(nightly_args(dir));
+  ASSERT_EQ(again.code, 0) << again.out;
+  EXPECT_NE(again.out.find("run " + id + " (resumed)"), std::string::npos) << again.out;
+  EXPECT_FALSE(fs::exists(validation::run_claim_path(history, id))) << "the finished run dropped its claim";
+}
+
+TEST(NightlyTest, AFinalWriteThatFailsLeavesNoVerdict) {
+  // gate-junit.xml, gate.json and nightly.json are written one after the other: when one fails (a
+  // full disk; here gate.json is a link to /dev/full, which a run leaves in place), the ones
+  // already written go, so that the stopped run (exit 4) leaves no verdict behind.
+  test::ScratchDir dir;
+  write_inputs(dir);
+  const fs::path run = dir / "runs" / "20260101T000000Z";
+  fs::create_directories(run);
+  fs::create_symlink("/dev/full", run / "gate.json");
+  const test::CliRun r = test::run_cli(nightly_args(dir));
+  EXPECT_EQ(r.code, 4) << r.out;
+  EXPECT_NE(r.out.find("gate.json"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(run / "gate-junit.xml")) << "the JUnit file written before was removed";
+  EXPECT_FALSE(fs::exists(run / "nightly.json"));
+  EXPECT_TRUE(fs::exists(run / "results.jsonl")) << "the run was resumed and ran its cells";
 }
 
 }  // namespace
