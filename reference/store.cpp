@@ -536,7 +536,11 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
   if (made_root)
     throw IoError(fmt::format("cannot create the reference store {}: {}; give a --store you can write",
                               root_.string(), made_root.message()));
-  io::FileLock id_lock = io::FileLock::acquire(root_ / fmt::format(".{}.lock", id));
+  const fs::path lock_file = root_ / fmt::format(".{}.lock", id);
+  io::FileLock id_lock = io::FileLock::acquire(lock_file, [&] {
+    fmt::print(stderr, "note: another run is generating reference {} (it holds {}); waiting for it to finish\n", id,
+               lock_file.string());
+  });
   id_lock.remove_when_released();  // the store keeps entries only
   if (fs::exists(root_ / id / kProvenance)) {
     std::optional<ReferenceSpec> before;

@@ -25,8 +25,9 @@ std::optional<FileLock> FileLock::lock(const fs::path& path, bool wait) {
     out.fd_.reset(folder ? ::open(path.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC)
                          : ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644));
     if (!out.fd_.valid())
-      throw IoError(fmt::format("cannot open {}, the lock {}: {}; give a folder you can write", path.string(),
-                                folder ? "folder" : "file", std::strerror(errno)));
+      throw IoError(fmt::format("cannot open {}, the lock {}: {}; every user of that folder must be able to write it "
+                                "(check its permissions), or give a folder you can write",
+                                path.string(), folder ? "folder" : "file", std::strerror(errno)));
     int err = 0;
     while (::flock(out.fd_.get(), LOCK_EX | (wait ? 0 : LOCK_NB)) != 0 && (err = errno) == EINTR) err = 0;
     if (err == EWOULDBLOCK) return std::nullopt;
@@ -60,6 +61,12 @@ void FileLock::release() noexcept {
 }
 
 FileLock FileLock::acquire(const fs::path& path) { return *lock(path, true); }
+
+FileLock FileLock::acquire(const fs::path& path, const std::function<void()>& on_wait) {
+  if (std::optional<FileLock> now = lock(path, false)) return std::move(*now);
+  on_wait();
+  return *lock(path, true);
+}
 
 std::optional<FileLock> FileLock::try_acquire(const fs::path& path) { return lock(path, false); }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <optional>
 
 #include "renderer/io/unique_fd.hpp"
@@ -26,6 +27,9 @@ class FileLock {
   /// else is a lock file, created (empty) when missing. IoError naming the path when it cannot be
   /// opened or locked.
   [[nodiscard]] static FileLock acquire(const std::filesystem::path& path);
+  /// The same, calling `on_wait` once before waiting when another holds the lock (to say what the
+  /// run waits for).
+  [[nodiscard]] static FileLock acquire(const std::filesystem::path& path, const std::function<void()>& on_wait);
   /// The same without waiting: nullopt when another holds the lock.
   [[nodiscard]] static std::optional<FileLock> try_acquire(const std::filesystem::path& path);
 

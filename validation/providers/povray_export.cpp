@@ -114,19 +114,23 @@ std::string vec_d(const dvec3& v) { return fmt::format("<{:.17g}, {:.17g}, {:.17
 
 nlohmann::json json_vec(const dvec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
 
-/// The base colour texture of `material`, baked with its base colour factor, as a 3-channel
-/// half-float EXR (POV-Ray 3.7 reads EXR image maps through OpenEXR's half RGBA interface; a file
-/// without an alpha channel is opaque, so the texture's alpha cannot make the surface transparent).
-/// A cut-out's alpha (texture channel 3) as a grey EXR, for the function that decides coverage.
-void write_alpha_texture(const Texture& texture, const std::filesystem::path& path) {
+/// A cut-out's coverage map as a grey EXR: alpha x factor alpha - cutoff + 0.5 per texel, so that
+/// the surface exists where the bilinear lookup is at least 0.5 (the lookup is linear, so the shift
+/// commutes with it). POV-Ray reads image maps in half precision; centred on 0.5, a texel exactly
+/// at the cutoff stays exactly 0.5, where the alpha itself (e.g. 128/255) would be rounded.
+void write_coverage_texture(const Texture& texture, const Material& material, const std::filesystem::path& path) {
   Image image(texture.width, texture.height);
   float* rgb = image.add_plane(planes::rgb).data_f32();
   const std::size_t n = static_cast<std::size_t>(texture.width) * static_cast<std::size_t>(texture.height);
   for (std::size_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = texture.rgba[i * 4 + 3];
+    for (int c = 0; c < 3; ++c)
+      rgb[i * 3 + c] = texture.rgba[i * 4 + 3] * material.base_color.w - material.alpha_cutoff + 0.5f;
   io::write_exr(path, image);
 }
 
+/// The base colour texture of `material`, baked with its base colour factor, as a 3-channel
+/// half-float EXR (POV-Ray 3.7 reads EXR image maps through OpenEXR's half RGBA interface; the
+/// file has no alpha channel: a cut-out's coverage is a map of its own, write_coverage_texture).
 void write_baked_texture(const Texture& texture, const vec4& factor, const std::filesystem::path& path) {
   Image image(texture.width, texture.height);
   float* rgb = image.add_plane(planes::rgb).data_f32();
@@ -136,6 +140,12 @@ void write_baked_texture(const Texture& texture, const vec4& factor, const std::
   io::ExrWriteOptions options;
   options.float_format = io::ExrFloatFormat::f16;
   io::write_exr(path, image, {}, options);
+}
+
+/// Whether a material of the scene is a cut-out (glTF alphaMode MASK).
+bool cutouts_in(const Scene& scene) {
+  return std::any_of(scene.materials.begin(), scene.materials.end(),
+                     [](const Material& m) { return m.alpha_mode == Material::AlphaMode::mask; });
 }
 
 /// Whether any texture coordinate of `mesh` leaves [0, 1] along a clamped axis.
@@ -211,9 +221,9 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
     write_baked_texture(texture, material.base_color, file);
     out.texture_files.push_back(file);
     if (material.alpha_mode == Material::AlphaMode::mask) {
-      const std::filesystem::path alpha = dir / fmt::format("alpha_{}.exr", m);
-      write_alpha_texture(texture, alpha);
-      out.texture_files.push_back(alpha);
+      const std::filesystem::path coverage = dir / fmt::format("coverage_{}.exr", m);
+      write_coverage_texture(texture, material, coverage);
+      out.texture_files.push_back(coverage);
     }
   }
 
@@ -239,14 +249,13 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
     sdl.print("#version 3.7;\n");
     const bool ambient = scene.ambient != 0.0f;
     // A cut-out's holes pass camera and shadow rays (pigment rgbt 1), each pass one trace level.
-    const bool cutouts = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) {
-      return m.alpha_mode == Material::AlphaMode::mask;
-    });
+    const bool cutouts = cutouts_in(scene);
     sdl.print("global_settings {{ assumed_gamma 1.0 ambient_light rgb {} max_trace_level {} }}\n", ambient ? 1 : 0,
               cutouts ? kCutoutTraceLevel : 5);
     for (std::size_t m = 0; m < scene.materials.size(); ++m)
       if (scene.materials[m].alpha_mode == Material::AlphaMode::mask && !texture_name[m].empty())
-        sdl.print("#declare SB_Alpha_{} = function {{ pigment {{ image_map {{ exr \"alpha_{}.exr\" interpolate 2 }} }} }}\n",
+        sdl.print("#declare SB_Coverage_{} = function {{ pigment {{ image_map {{ exr \"coverage_{}.exr\" interpolate 2 }} }} "
+                  "}}\n",
                   m, m);
     sdl.print("background {{ rgb <{:.9g}, {:.9g}, {:.9g}> }}\n", scene.background.x, scene.background.y,
               scene.background.z);
@@ -320,13 +329,14 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
         sdl.print(",\n    <{}, {}, {}>", mesh.indices[3 * t], mesh.indices[3 * t + 1], mesh.indices[3 * t + 2]);
       sdl.print("\n  }}\n");
       if (textured && cutout) {
-        // Coverage as SceneGeometry::opaque_at decides it: factor alpha x bilinear texture alpha
-        // against the cutoff, 0 (the hole: fully transmitting) or 1 (the material).
-        sdl.print("  texture {{ uv_mapping function {{ select(SB_Alpha_{}(x, y, z).red * {:.9g} - {:.9g}, 0, 1) }}\n"
+        // Coverage as SceneGeometry::opaque_at decides it: the bilinear coverage map (alpha x
+        // factor alpha - cutoff + 0.5) against 0.5, giving 0 (the hole: fully transmitting) or 1
+        // (the material).
+        sdl.print("  texture {{ uv_mapping function {{ select(SB_Coverage_{}(x, y, z).red - 0.5, 0, 1) }}\n"
                   "    texture_map {{\n      [0 pigment {{ rgbt 1 }}]\n"
                   "      [1 pigment {{ uv_mapping image_map {{ exr \"{}\" interpolate 2 }} }} finish {{ SB_Finish }}]\n"
                   "    }}\n  }}\n",
-                  mesh.material, material->base_color.w, material->alpha_cutoff, *tex);
+                  mesh.material, *tex);
       } else if (textured) {
         sdl.print("  texture {{ pigment {{ uv_mapping image_map {{ exr \"{}\" interpolate 2 }} }} "
                   "finish {{ SB_Finish }} }}\n",
@@ -369,8 +379,11 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
         {"directional_light_colour", "E * colour / pi, parallel"},
         {"fade_fraction", kFadeFraction}}},
       {"lights", lights},
-      {"textures", {{"format", "EXR half RGB, base colour factor baked in"}, {"interpolate", 2},
+      {"textures", {{"format", "EXR half RGB, base colour factor baked in; a cut-out's coverage map grey, alpha x "
+                               "factor alpha - cutoff + 0.5, opaque at >= 0.5"},
+                    {"interpolate", 2},
                     {"count", out.texture_files.size()}}},
+      {"max_trace_level", cutouts_in(scene) ? kCutoutTraceLevel : 5},
       {"meshes", out.meshes},
       {"triangles", out.triangles},
       {"sdl_bytes", out.sdl_bytes},

@@ -42,9 +42,9 @@ struct ExportedLight {
 /// What export_scene wrote.
 struct ExportResult {
   std::filesystem::path sdl_file;                  ///< the .pov file
-  std::vector<std::filesystem::path> texture_files;  ///< one EXR per textured material
+  std::vector<std::filesystem::path> texture_files;  ///< one EXR per textured material, and a cut-out's coverage map
   std::size_t sdl_bytes = 0;
-  std::size_t meshes = 0;     ///< mesh2 objects written (meshes without triangles are skipped)
+  std::size_t meshes = 0;     ///< mesh2 objects written (meshes without triangles, and cut-outs transparent everywhere, are skipped)
   std::size_t triangles = 0;
   std::vector<ExportedLight> lights;
   /// Differences from the shading of DESIGN §3 that the export cannot avoid (e.g. a clamped
