@@ -109,6 +109,7 @@ struct ChosenRun {
 /// (other sweeps, with other --out folders, may share the history). Chosen under the history's lock,
 /// the history read again under it, so that runs started in the same second take different ids.
 ChosenRun choose_run_dir(const fs::path& out, const SweepDefinition& d, const fs::path& history_file) {
+  const io::FileLock lock = lock_history(history_file);  // the folders and the history read under it
   std::vector<std::string> ids;
   std::error_code ec;
   if (fs::is_directory(out, ec))
@@ -124,7 +125,6 @@ ChosenRun choose_run_dir(const fs::path& out, const SweepDefinition& d, const fs
     const std::string na = a.size() > 17 ? a.substr(17) : "1", nb = b.size() > 17 ? b.substr(17) : "1";
     return na.size() != nb.size() ? na.size() < nb.size() : na < nb;
   });
-  const io::FileLock lock = lock_history(history_file);
   ChosenRun chosen;
   chosen.history = read_history(history_file);
   if (!ids.empty()) {

@@ -21,29 +21,22 @@ SceneGeometry::SceneGeometry(const Scene& s) : scene(&s) {
     const bool double_sided = m.material < 0 || s.materials[static_cast<size_t>(m.material)].double_sided;
     single_sided.push_back(double_sided ? 0 : 1);
   }
-  // Cut-outs: one level-0 copy of each texture they read, then their records (pointers into the
-  // finished vector).
-  std::vector<int> texture_slot(s.textures.size(), -1);
+  // Cut-outs: one level-0 copy of each texture they read (reserved for every texture, so the
+  // records' pointers stay valid).
+  cutout_textures_.reserve(s.textures.size());
+  std::vector<const MipTexture*> level0(s.textures.size(), nullptr);
   std::vector<int> material_cutout(s.materials.size(), -1);
-  std::vector<std::pair<int, Cutout>> pending;  // per cut-out material: texture slot, record
   for (size_t i = 0; i < s.materials.size(); ++i) {
     const Material& mat = s.materials[i];
     if (mat.alpha_mode != Material::AlphaMode::mask) continue;
-    int slot = -1;
-    const int t = mat.base_color_texture;
-    if (t >= 0 && static_cast<size_t>(t) < s.textures.size()) {
-      if (texture_slot[static_cast<size_t>(t)] < 0) {
-        texture_slot[static_cast<size_t>(t)] = static_cast<int>(cutout_textures_.size());
-        cutout_textures_.emplace_back(s.textures[static_cast<size_t>(t)], false);
-      }
-      slot = texture_slot[static_cast<size_t>(t)];
+    const MipTexture* texture = nullptr;
+    if (const int t = mat.base_color_texture; t >= 0 && static_cast<size_t>(t) < s.textures.size()) {
+      if (level0[static_cast<size_t>(t)] == nullptr)
+        level0[static_cast<size_t>(t)] = &cutout_textures_.emplace_back(s.textures[static_cast<size_t>(t)], false);
+      texture = level0[static_cast<size_t>(t)];
     }
-    material_cutout[i] = static_cast<int>(pending.size());
-    pending.push_back({slot, Cutout{nullptr, mat.base_color.w, mat.alpha_cutoff}});
-  }
-  for (auto& [slot, cutout] : pending) {
-    if (slot >= 0) cutout.texture = &cutout_textures_[static_cast<size_t>(slot)];
-    cutouts.push_back(cutout);
+    material_cutout[i] = static_cast<int>(cutouts.size());
+    cutouts.push_back(Cutout{texture, mat.base_color.w, mat.alpha_cutoff});
   }
   cutout_of.reserve(s.meshes.size());
   for (const Mesh& m : s.meshes)

@@ -219,9 +219,11 @@ void drop_run_claim(const fs::path& file, io::FileLock& claim) noexcept {
   if (!claim.held()) return;
   try {
     const io::FileLock lock = lock_history(file);  // no run is opening claims meanwhile
+    const fs::path folder = claim.path().parent_path();
+    claim.remove_when_released();
+    claim.release();
     std::error_code ec;
-    fs::remove(claim.path(), ec);
-    fs::remove(claim.path().parent_path(), ec);  // the claims folder, when no other claim is left in it
+    fs::remove(folder, ec);  // the claims folder, when no other claim is left in it
   } catch (const std::exception&) {  // best effort: the claim file stays, and so does its id
   }
   claim.release();

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -138,9 +139,7 @@ class TileRaster {
           cached = t->prim;
           const Mesh& mesh = scene.meshes[t->mesh];
           const uint32_t* idx = &mesh.indices[3 * static_cast<size_t>(t->prim - geometry.first_triangle[t->mesh])];
-          const raster::ProjectedVertex* v = in.vertices + in.vertex_base[t->mesh];
-          // Set-up already succeeded for this triangle, so its planes exist.
-          (void)raster::triangle_planes(v[idx[0]], v[idx[1]], v[idx[2]], planes);
+          planes = planes_of(in, *t);
           has_uvs = !mesh.uvs.empty() && mesh.uvs.size() == mesh.positions.size();
           if (has_uvs) {
             const dvec2 uv0(mesh.uvs[idx[0]]);
@@ -152,8 +151,7 @@ class TileRaster {
         const double xc = x + 0.5, yc = y + 0.5;
         const double q = t->inv_w.x * xc + (t->inv_w.y * yc + t->inv_w.z);
         const double inv_q = 1.0 / q;
-        const double b1 = (planes.b1_w.x * xc + planes.b1_w.y * yc + planes.b1_w.z) * inv_q;
-        const double b2 = (planes.b2_w.x * xc + planes.b2_w.y * yc + planes.b2_w.z) * inv_q;
+        const auto [b1, b2] = barycentrics(planes, xc, yc, inv_q);
         g.depth[gi] = depth_[li];
         g.prim[gi] = t->prim;
         g.bary[gi] = vec2(static_cast<float>(b1), static_cast<float>(b2));
@@ -224,21 +222,34 @@ class TileRaster {
     return true;
   }
 
-  /// Whether the cut-out triangle t is transparent at pixel centre (x, y), where 1/w is q: its
-  /// barycentrics exactly as resolve() computes them for the G-buffer.
+  /// The perspective-correct planes of the scene triangle that t is (a piece of). Set-up succeeded
+  /// for it, so they exist.
+  static raster::TrianglePlanes planes_of(const raster::SetupInputs& in, const RasterTriangle& t) {
+    const SceneGeometry& geometry = *in.geometry;
+    const uint32_t* idx =
+        &geometry.scene->meshes[t.mesh].indices[3 * static_cast<size_t>(t.prim - geometry.first_triangle[t.mesh])];
+    const raster::ProjectedVertex* v = in.vertices + in.vertex_base[t.mesh];
+    raster::TrianglePlanes planes;
+    (void)raster::triangle_planes(v[idx[0]], v[idx[1]], v[idx[2]], planes);
+    return planes;
+  }
+
+  /// (b1, b2) at pixel centre (xc, yc), where 1/q is the depth: for the G-buffer and the alpha test.
+  static std::pair<double, double> barycentrics(const raster::TrianglePlanes& p, double xc, double yc, double inv_q) {
+    return {(p.b1_w.x * xc + p.b1_w.y * yc + p.b1_w.z) * inv_q, (p.b2_w.x * xc + p.b2_w.y * yc + p.b2_w.z) * inv_q};
+  }
+
+  /// Whether the cut-out triangle t is transparent at pixel centre (x, y), where 1/w is q: at the
+  /// barycentrics resolve() stores for the G-buffer there.
   bool cut_away(const RasterTriangle& t, int x, int y, double q) {
-    const SceneGeometry& geometry = *inputs_->geometry;
-    const uint32_t local = t.prim - geometry.first_triangle[t.mesh];
     if (t.prim != cut_prim_) {
       cut_prim_ = t.prim;
-      const uint32_t* idx = &geometry.scene->meshes[t.mesh].indices[3 * static_cast<size_t>(local)];
-      const raster::ProjectedVertex* v = inputs_->vertices + inputs_->vertex_base[t.mesh];
-      (void)raster::triangle_planes(v[idx[0]], v[idx[1]], v[idx[2]], cut_planes_);
+      cut_planes_ = planes_of(*inputs_, t);
     }
-    const double xc = x + 0.5, yc = y + 0.5, inv_q = 1.0 / q;
-    const double b1 = (cut_planes_.b1_w.x * xc + cut_planes_.b1_w.y * yc + cut_planes_.b1_w.z) * inv_q;
-    const double b2 = (cut_planes_.b2_w.x * xc + cut_planes_.b2_w.y * yc + cut_planes_.b2_w.z) * inv_q;
-    return !geometry.opaque_at(t.mesh, local, vec2(static_cast<float>(b1), static_cast<float>(b2)));
+    const auto [b1, b2] = barycentrics(cut_planes_, x + 0.5, y + 0.5, 1.0 / q);
+    const SceneGeometry& geometry = *inputs_->geometry;
+    return !geometry.opaque_at(t.mesh, t.prim - geometry.first_triangle[t.mesh],
+                               vec2(static_cast<float>(b1), static_cast<float>(b2)));
   }
 
   PixelRect rect_;
