@@ -163,6 +163,11 @@ bool Scene::has_triangle_with_area() const {
   return false;
 }
 
+bool Scene::has_cutouts() const {
+  return std::any_of(materials.begin(), materials.end(),
+                     [](const Material& m) { return m.alpha_mode == Material::AlphaMode::mask; });
+}
+
 size_t Scene::vertex_count() const {
   size_t n = 0;
   for (const Mesh& m : meshes) n += m.positions.size();

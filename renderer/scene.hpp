@@ -194,6 +194,8 @@ struct Scene {
   [[nodiscard]] size_t zero_area_triangle_count() const;
   /// Whether some triangle has a non-zero area; stops at the first one found.
   [[nodiscard]] bool has_triangle_with_area() const;
+  /// Whether some material is a cut-out (glTF alphaMode MASK).
+  [[nodiscard]] bool has_cutouts() const;
   [[nodiscard]] size_t vertex_count() const;
   [[nodiscard]] Bounds3 bounds() const;
   /// The name as the start of output file names: characters other than ASCII letters, digits and

@@ -4,6 +4,7 @@
 // one EXR per light; the passes are summed here. docs/truth_blender.md derives every constant.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <map>
 #include <mutex>
@@ -26,7 +27,7 @@ namespace {
 namespace fs = std::filesystem;
 
 /// Bumped whenever the export, the script or the settings change.
-constexpr const char* kRevision = "blender-export-4";
+constexpr const char* kRevision = "blender-export-5";
 /// Cut-out holes a camera or shadow ray may pass in Cycles (transparent bounces); ours pass any.
 constexpr int kTransparentBounces = 64;
 /// Environment variable naming the Blender executable (a path, or a name looked up on PATH).
@@ -139,19 +140,13 @@ std::string query_version(const fs::path& executable) {
 nlohmann::json vec_json(const vec3& v) { return {double(v.x), double(v.y), double(v.z)}; }
 nlohmann::json vec_json(const dvec3& v) { return {v.x, v.y, v.z}; }
 
-/// Lights that contribute (positive intensity), with their Blender parameters. InputError for a
-/// light type Cycles cannot reproduce exactly.
+/// Lights that contribute (positive intensity), with their Blender parameters: a spot is a point
+/// light whose emission the script shapes with the cone. InputError for a negative colour.
 nlohmann::json export_lights(const Scene& scene) {
   nlohmann::json lights = nlohmann::json::array();
   for (size_t i = 0; i < scene.lights.size(); ++i) {
     const Light& l = scene.lights[i];
     const std::string label = l.name.empty() ? fmt::format("#{}", i) : fmt::format("'{}' (#{})", l.name, i);
-    if (l.type == Light::Type::spot)
-      throw InputError(fmt::format(
-          "scene {}: spot light {} cannot be exported to Blender: Cycles' spot cone (cosine times smoothstep) "
-          "differs from the KHR_lights_punctual falloff of DESIGN §3; use the `full` provider (POV-Ray refuses "
-          "spots too), or replace the spot by a point light",
-          scene.path, label));
     const float max_colour = std::max({l.color.x, l.color.y, l.color.z});
     const float min_colour = std::min({l.color.x, l.color.y, l.color.z});
     if (!(l.intensity > 0.0f) || max_colour <= 0.0f) continue;  // lights nothing, here as in ours
@@ -159,10 +154,18 @@ nlohmann::json export_lights(const Scene& scene) {
       throw InputError(fmt::format("scene {}: light {} has a negative colour, which Blender cannot represent",
                                    scene.path, label));
     nlohmann::json j = {{"name", l.name}, {"color", vec_json(l.color)}};
-    if (l.type == Light::Type::point) {
+    if (l.type == Light::Type::point || l.type == Light::Type::spot) {
       j["type"] = "point";
       j["position"] = vec_json(l.position);
       j["power_w"] = kPointPowerPerIntensity * double(l.intensity);
+      if (l.type == Light::Type::spot) {
+        // KHR_lights_punctual's cone (DESIGN §3), in the float arithmetic of the shading core: the
+        // script multiplies the point light's emission by clamp((cos - cos_outer) * scale, 0, 1)^2.
+        const float cos_outer = std::cos(l.outer_cone), cos_inner = std::cos(l.inner_cone);
+        j["spot"] = {{"direction", vec_json(glm::normalize(dvec3(l.direction)))},
+                     {"cos_outer", double(cos_outer)},
+                     {"scale", double(1.0f / std::max(0.001f, cos_inner - cos_outer))}};
+      }
     } else {
       j["type"] = "directional";
       j["direction"] = vec_json(glm::normalize(l.direction));
@@ -255,6 +258,7 @@ nlohmann::json cycles_settings(int threads) {
           {"output", "OPEN_EXR RGBA 32-bit float, ZIP"},
           {"threads", threads > 0 ? nlohmann::json(threads) : nlohmann::json("auto")},
           {"materials", "Diffuse BSDF roughness 0 of the albedo in light passes; Emission of albedo x ambient, no BSDF, in the ambient pass; a cut-out mixes in a Transparent BSDF where factor alpha x texture alpha (Linear) is below its cutoff"},
+          {"lights", "point: POINT radius 0, power 4 pi I; spot: the same, its emission times KHR_lights_punctual's cone factor from the light-space Normal; directional: SUN angle 0, strength E"},
           {"transparent_bounces", "64 (min 64: no Russian roulette) when a material is a cut-out, else 0"},
           {"world", "Background visible to camera rays only (Light Path 'Is Camera Ray'), sampling_method NONE"},
           {"importer", "import_scene.gltf import_shading=NORMALS (glTF normals as custom split normals) merge_vertices=False"},
@@ -346,9 +350,7 @@ class BlenderProvider final : public TruthProvider {
     params["background"] = vec_json(scene.background);
     params["ambient"] = double(scene.ambient);
     // A ray may pass through this many cut-out holes (camera and shadow rays alike).
-    const bool cutouts = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) {
-      return m.alpha_mode == Material::AlphaMode::mask;
-    });
+    const bool cutouts = scene.has_cutouts();
     params["transparent_bounces"] = cutouts ? kTransparentBounces : 0;
     const double shift_x = (0.5 * eye.width - eye.cx) / eye.height;
     const double shift_y = (eye.cy - 0.5 * eye.height) / eye.height;

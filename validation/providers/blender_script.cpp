@@ -247,6 +247,36 @@ def setup_world():
     return seen.inputs["Strength"]
 
 
+def axes_with_z(z):
+    # Right-handed unit axes (x, y, z) with z along the given vector.
+    from mathutils import Vector
+    zv = Vector(z).normalized()
+    helper = (1.0, 0.0, 0.0) if abs(zv[0]) < 0.9 else (0.0, 1.0, 0.0)
+    xv = Vector(helper).cross(zv).normalized()
+    return xv, zv.cross(xv), zv
+
+
+def shape_spot(data, spot):
+    # Emission strength clamp((-Normal.z - cos_outer) * scale, 0, 1)^2, KHR_lights_punctual's
+    # angular attenuation, as -Normal.z * (-scale) + (-cos_outer * scale) clamped, squared.
+    tree = data.node_tree
+    emission = next(n for n in tree.nodes if n.type == "EMISSION")
+    coords = tree.nodes.new("ShaderNodeTexCoord")
+    split = tree.nodes.new("ShaderNodeSeparateXYZ")
+    ramp = tree.nodes.new("ShaderNodeMath")
+    ramp.operation = "MULTIPLY_ADD"
+    ramp.use_clamp = True
+    ramp.inputs[1].default_value = -spot["scale"]
+    ramp.inputs[2].default_value = -spot["cos_outer"] * spot["scale"]
+    square = tree.nodes.new("ShaderNodeMath")
+    square.operation = "MULTIPLY"
+    tree.links.new(coords.outputs["Normal"], split.inputs[0])
+    tree.links.new(split.outputs["Z"], ramp.inputs[0])
+    tree.links.new(ramp.outputs[0], square.inputs[0])
+    tree.links.new(ramp.outputs[0], square.inputs[1])
+    tree.links.new(square.outputs[0], emission.inputs["Strength"])
+
+
 def setup_lights():
     objects = []
     collection = bpy.context.scene.collection
@@ -257,22 +287,23 @@ def setup_lights():
             data.energy = l["power_w"]
             p = gltf_to_blender(l["position"])
             matrix = matrix_from_columns((1, 0, 0), (0, 1, 0), (0, 0, 1), p)
+            if l.get("spot") is not None:
+                # The light's local -Z along the spot's axis; in a light's node tree the Normal
+                # is the unit direction of emission in the light's local frame, so -Normal.z is
+                # the cosine of the angle to the axis.
+                matrix = matrix_from_columns(*axes_with_z([-c for c in gltf_to_blender(l["spot"]["direction"])]), p)
         elif l["type"] == "directional":
             data = bpy.data.lights.new("stereobench_light_%d" % i, "SUN")
             data.angle = 0.0
             data.energy = l["strength"]
             # A sun shines along its local -Z.
-            z = [-c for c in gltf_to_blender(l["direction"])]
-            helper = (1.0, 0.0, 0.0) if abs(z[0]) < 0.9 else (0.0, 1.0, 0.0)
-            from mathutils import Vector
-            zv = Vector(z).normalized()
-            xv = Vector(helper).cross(zv).normalized()
-            yv = zv.cross(xv)
-            matrix = matrix_from_columns(xv, yv, zv, (0.0, 0.0, 0.0))
+            matrix = matrix_from_columns(*axes_with_z([-c for c in gltf_to_blender(l["direction"])]), (0.0, 0.0, 0.0))
         else:
             fail("unsupported light type " + l["type"])
         data.color = l["color"]
-        data.use_nodes = False
+        data.use_nodes = l.get("spot") is not None
+        if data.use_nodes:
+            shape_spot(data, l["spot"])
         data.cycles.cast_shadow = True
         data.cycles.use_multiple_importance_sampling = False
         data.cycles.max_bounces = 0

@@ -142,12 +142,6 @@ void write_baked_texture(const Texture& texture, const vec4& factor, const std::
   io::write_exr(path, image, {}, options);
 }
 
-/// Whether a material of the scene is a cut-out (glTF alphaMode MASK).
-bool cutouts_in(const Scene& scene) {
-  return std::any_of(scene.materials.begin(), scene.materials.end(),
-                     [](const Material& m) { return m.alpha_mode == Material::AlphaMode::mask; });
-}
-
 /// Whether any texture coordinate of `mesh` leaves [0, 1] along a clamped axis.
 bool reads_outside_clamp(const Mesh& mesh, const Texture& texture) {
   for (const vec2& uv : mesh.uvs) {
@@ -189,8 +183,8 @@ void check_exportable(const Scene& scene) {
       throw InputError(fmt::format(
           "scene '{}': light {} ('{}') is a spot light, which the povray provider cannot render exactly: "
           "POV-Ray 3.7 fades a spotlight between its cones with a cubic smoothstep in cos(angle), the shading "
-          "of DESIGN §3 with KHR_lights_punctual's quadratic ramp; use the `full` provider for this scene or "
-          "leave the light out with --lights",
+          "of DESIGN §3 with KHR_lights_punctual's quadratic ramp; use the `full` or `blender` provider for this "
+          "scene, or leave the light out with --lights",
           scene.name, i, light.name));
   }
 }
@@ -249,7 +243,7 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
     sdl.print("#version 3.7;\n");
     const bool ambient = scene.ambient != 0.0f;
     // A cut-out's holes pass camera and shadow rays (pigment rgbt 1), each pass one trace level.
-    const bool cutouts = cutouts_in(scene);
+    const bool cutouts = scene.has_cutouts();
     sdl.print("global_settings {{ assumed_gamma 1.0 ambient_light rgb {} max_trace_level {} }}\n", ambient ? 1 : 0,
               cutouts ? kCutoutTraceLevel : 5);
     for (std::size_t m = 0; m < scene.materials.size(); ++m)
@@ -383,7 +377,7 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
                                "factor alpha - cutoff + 0.5, opaque at >= 0.5"},
                     {"interpolate", 2},
                     {"count", out.texture_files.size()}}},
-      {"max_trace_level", cutouts_in(scene) ? kCutoutTraceLevel : 5},
+      {"max_trace_level", scene.has_cutouts() ? kCutoutTraceLevel : 5},
       {"meshes", out.meshes},
       {"triangles", out.triangles},
       {"sdl_bytes", out.sdl_bytes},
