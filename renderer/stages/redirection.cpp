@@ -46,9 +46,19 @@ struct TriangleFacing {
   }
 };
 
+/// Whether some of the three x_ndc are NaN (at or behind the eye's plane) and some are not.
+bool crosses_eye_plane(const double (&x)[3]) {
+  const int behind = int(std::isnan(x[0])) + int(std::isnan(x[1])) + int(std::isnan(x[2]));
+  return behind > 0 && behind < 3;
+}
+
 /// The redirection from the vertices' x_ndc in each eye ({x0, x1, x2}) and their positions.
 uint8_t redirect_from(const EyeCamera& left, const EyeCamera& right, const double (&xl)[3], const double (&xr)[3],
                       const dvec3& v0, const dvec3& v1, const dvec3& v2, bool single_sided) {
+  // A triangle reaching behind an eye (a floor or wall passing beside and behind the viewer) has
+  // no outermost x_ndc: its projection is unbounded, and it reaches the image borders of both eyes,
+  // where each sees a part the other does not. Eq. (1) cannot rank it; both eyes rasterize it.
+  if (crosses_eye_plane(xl) || crosses_eye_plane(xr)) return kRedirectBoth;
   const double fl = frustum_from_ndc(xl[0], xl[1], xl[2]), fr = frustum_from_ndc(xr[0], xr[1], xr[2]);
   if (fl != fr) return fl > fr ? kRedirectLeft : kRedirectRight;
   const TriangleFacing facing(v0, v1, v2);

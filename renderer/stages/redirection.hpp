@@ -32,7 +32,8 @@ enum RedirectBits : uint8_t {
                                        bool single_sided);
 
 /// The eye(s) a triangle goes to: the larger frustum visibility wins; on a tie, the larger facing
-/// visibility; on an exact tie, both.
+/// visibility; on an exact tie, both. A triangle with vertices on both sides of an eye's plane
+/// (reaching behind the viewer) goes to both: eq. (1) is not defined for it.
 [[nodiscard]] uint8_t redirect(const EyeCamera& left, const EyeCamera& right, const dvec3& v0, const dvec3& v1,
                                const dvec3& v2, bool single_sided);
 

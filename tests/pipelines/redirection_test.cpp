@@ -61,6 +61,21 @@ TEST(Redirection, ExactTiesGoToBothEyes) {
   EXPECT_EQ(redirect(l, r, v0, v1, v2, false), kRedirectBoth);
 }
 
+TEST(Redirection, ATriangleReachingBehindTheEyesGoesToBoth) {
+  const StereoRig rig = test_rig();
+  const EyeCamera l = rig.eye(Eye::left), r = rig.eye(Eye::right);
+  // A floor triangle 1 m below the eyes, from 20 m ahead to 5 m behind, wider on the left: its
+  // projection reaches both eyes' image borders. With the vertices behind read as "not in the
+  // frustum" in both eyes, the facing comparison sent it to one eye, and the other eye's border
+  // strip, which the first does not see, stayed a hole.
+  const dvec3 v0(-30.0, -1.0, 5.0), v1(10.0, -1.0, 5.0), v2(-5.0, -1.0, -20.0);
+  EXPECT_EQ(redirect(l, r, v0, v1, v2, false), kRedirectBoth);
+  EXPECT_EQ(redirect(l, r, v0, v1, v2, true), kRedirectBoth);
+  // Wholly behind the eyes it is seen by neither, and ranked as before (its eye does not matter).
+  const dvec3 b0(-1.0, -1.0, 1.0), b1(2.0, -1.0, 1.0), b2(0.0, -1.0, 3.0);
+  EXPECT_NE(redirect(l, r, b0, b1, b2, false), kRedirectBoth);
+}
+
 TEST(Redirection, EachEyeRasterizesOnlyItsShare) {
   const Scene scene = test::load_builtin("box-wall");
   const RenderScene prepared(scene);
