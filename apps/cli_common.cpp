@@ -178,6 +178,22 @@ void remove_earlier_outputs(std::initializer_list<NamedPath> outputs) {
   if (first) throw *first;
 }
 
+void remove_earlier_outputs_sparing(std::initializer_list<NamedPath> inputs, std::initializer_list<NamedPath> outputs) {
+  std::optional<IoError> first;
+  for (const NamedPath& o : outputs) {
+    if (!names_file(o)) continue;
+    if (std::any_of(inputs.begin(), inputs.end(),
+                    [&](const NamedPath& in) { return names_file(in) && same_file(*o.path, *in.path); }))
+      continue;
+    try {
+      remove_earlier_output(*o.path, o.name);
+    } catch (const IoError& e) {
+      if (!first) first = e;
+    }
+  }
+  if (first) throw *first;
+}
+
 void write_for_option(const std::string& option, const std::function<void()>& write) {
   try {
     write();

@@ -80,6 +80,11 @@ void remove_earlier_output(const std::filesystem::path& path, const std::string&
 /// all are tried, then the first error is thrown.
 void remove_earlier_outputs(std::initializer_list<NamedPath> outputs);
 
+/// remove_earlier_outputs for the outputs that name no input file (by refuse_overwriting's rule):
+/// run before any check, so that a refused run leaves no earlier output behind, while an output
+/// that names an input (refused afterwards) keeps that input.
+void remove_earlier_outputs_sparing(std::initializer_list<NamedPath> inputs, std::initializer_list<NamedPath> outputs);
+
 /// Removes what a failing run wrote at these output paths (best effort; as remove_earlier_output:
 /// regular files only, "" and "-" skipped), so that none is left beside its error.
 void discard_outputs(std::initializer_list<NamedPath> outputs) noexcept;

@@ -85,6 +85,10 @@ void run_gate(const GateArgs& a) {
   // The default baseline counts as an input too: a report written over ci/baseline.json would lose
   // the stored timings.
   const std::string baseline_path = a.baseline.empty() ? validation::kDefaultBaselineFile : a.baseline;
+  // Exit 3 or 4 leaves no --junit or --json file, whatever refuses the run: an earlier green
+  // report must not stand for this one.
+  remove_earlier_outputs_sparing({{"--results", &a.results}, {"--config", &a.config}, {"the baseline", &baseline_path}},
+                                 {{"--junit", &a.junit}, {"--json", &a.json_out}});
   if (a.update_baseline) {
     if (!a.junit.empty() || !a.json_out.empty())
       throw InputError(
@@ -104,7 +108,6 @@ void run_gate(const GateArgs& a) {
                                    option));
   refuse_overwriting({{"--results", &a.results}, {"--config", &a.config}, {"the baseline", &baseline_path}},
                      {{"--junit", &a.junit}, {"--json", &a.json_out}});
-  remove_earlier_outputs({{"--junit", &a.junit}, {"--json", &a.json_out}});
   prepare_output_file_folder(a.junit, "--junit");
   prepare_output_file_folder(a.json_out, "--json");
   const validation::GateConfig config = validation::load_gate_config(a.config);

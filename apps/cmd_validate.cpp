@@ -81,16 +81,11 @@ void run_validate(const ValidateArgs& a) {
              describe(rig), executor.threads(), provider->name());
 
   const fs::path out = a.out;
-  // The summary and the pipelines' records of an earlier run go first: the files this run writes
-  // must not sit beside a summary or record that looks complete but describes another run, should
-  // this one stop on the way.
   const std::string scene_stem = fmt::format("{}_{}", scene.file_stem(), provider->name());
   const fs::path summary = out / fmt::format("{}_summary.json", scene_stem);
   const auto record_file = [&](const std::string& pipeline) {
     return out / fmt::format("{}_{}.json", scene_stem, entry_file_stem(pipeline));
   };
-  remove_earlier_output(summary, "summary");
-  for (const PipelineEntry& e : chosen) remove_earlier_output(record_file(e.name), "record");
   const std::optional<validation::TruthCache> cache =
       a.no_cache || a.cache.empty() ? std::nullopt
                                     : std::optional<validation::TruthCache>(validation::TruthCache(a.cache));
@@ -102,15 +97,16 @@ void run_validate(const ValidateArgs& a) {
              100.0 * double(target.disocclusions.count()) / double(target.truth_srgb8.pixel_count()));
   warn_geometry_before_near_plane(prepared, rig, executor);
 
-  // What this run has written, removed should it stop on the way (an image it cannot write, a full
-  // disk): the images shared by the records must not be left beside another run's.
-  std::vector<fs::path> written;
-  const auto remember = [&](const json& files) {
-    for (const auto& [name, path] : files.items()) written.emplace_back(path.get<std::string>());
-  };
-  try {
-    const json shared_images = validation::write_target_images(out, scene.file_stem(), target, executor);
-    remember(shared_images);
+  // Every file is made whole under a temporary name, and all are renamed into place at the end,
+  // the summary last: a run that stops on the way (an image it cannot write, a full disk) leaves an
+  // earlier run's summary, records and images as they were.
+  io::StagedFiles set;
+  std::vector<fs::path> stale;  // an earlier run's files of this set that this one does not write
+  validation::ImageFileOptions image_options;
+  image_options.staged = &set;
+  image_options.stale = &stale;
+  {
+    const json shared_images = validation::write_target_images(out, scene.file_stem(), target, executor, image_options);
 
     const validation::MetricOptions metric_options{a.error_threshold};
     json records = json::array();
@@ -124,12 +120,11 @@ void run_validate(const ValidateArgs& a) {
       const validation::PipelineValidation v =
           validation::validate_pipeline(target, chosen[i], options[i], executor, metric_options);
       const std::string stem = fmt::format("{}_{}", scene_stem, entry_file_stem(v.pipeline));
-      json images = validation::write_pipeline_images(out, stem, target, v, executor);
-      remember(images);
+      json images = validation::write_pipeline_images(out, stem, target, v, executor, image_options);
       images.update(shared_images);
       const json record = validation::validation_record(target, v, executor.threads(), images);
-      io::write_text_atomically(record_file(v.pipeline), record.dump(2) + "\n");
-      written.push_back(record_file(v.pipeline));
+      set.add(record_file(v.pipeline),
+              [&](const fs::path& tmp) { io::write_text_atomically(tmp, record.dump(2) + "\n"); });
       records.push_back(record);
       const validation::HoleStatistics& h = v.holes;
       fmt::print("{:<{}} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10.1f}\n", v.pipeline, name_w,
@@ -149,12 +144,23 @@ void run_validate(const ValidateArgs& a) {
                  "pipeline", name_w, "PSNR dB", "SSIM", "MSE", "err %");
       for (const std::string& line : left_lines) fmt::print("{}\n", line);
     }
-    io::write_text_atomically(summary,
-                              json{{"kind", "stereobench.validation_summary"}, {"records", records}}.dump(2) + "\n");
-  } catch (...) {
-    io::discard_output_files(written);
-    throw;
+    const std::string summary_text =
+        json{{"kind", "stereobench.validation_summary"}, {"records", records}}.dump(2) + "\n";
+    set.add(summary, [&](const fs::path& tmp) { io::write_text_atomically(tmp, summary_text); });
   }
+  try {
+    set.commit();
+  } catch (const IoError& e) {
+    // Some new files in place beside earlier ones: the earlier summary goes, so that the mix does
+    // not look complete. With none placed, the earlier run's files stand as they were.
+    if (set.placed() == 0) throw;
+    std::error_code ec;
+    fs::remove(summary, ec);
+    throw IoError(fmt::format("{}; {} of this run's files are in place and the others not, and the summary {} is "
+                              "removed so that they do not look complete: validate again",
+                              e.what(), set.placed(), summary.string()));
+  }
+  io::discard_output_files(stale);
   fmt::print("\nwrote {} (one record per pipeline beside it, images under {})\n", summary.string(), out.string());
 }
 

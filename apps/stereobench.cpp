@@ -42,11 +42,12 @@ std::string command_line(int argc, char** argv) {
 }
 
 /// An empty file or folder option (an unset shell variable, say) would read or write the current
-/// folder, or silently drop the output: refused. --cache is not among them: '' turns the ground-truth
-/// cache off.
+/// folder, or silently drop the output, and an empty name or value would be taken as not given:
+/// refused. --cache is not among them: '' turns the ground-truth cache off.
 void refuse_empty_paths(CLI::App& app) {
-  for (const char* name : {"--out", "--scenes-dir", "--store", "--results", "--history", "--json",
-                           "--junit", "--diff", "--ssim-map", "--mask", "--gate-config", "--config", "--baseline"}) {
+  for (const char* name : {"--out", "--scenes-dir", "--store", "--results", "--history", "--json", "--junit",
+                           "--diff", "--ssim-map", "--mask", "--gate-config", "--config", "--baseline", "--gltf-clip",
+                           "--bvh", "--partition", "--time-limit", "--sbatch-arg"}) {
     CLI::Option* option = app.get_option_no_throw(name);
     if (!option) continue;
     option->check(CLI::Validator(

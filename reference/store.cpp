@@ -230,13 +230,15 @@ json without_scratch_path(const json& value, const fs::path& scratch) {
   return out;
 }
 
-std::string reference_id(const Scene& scene, const ReferenceSpec& spec, const StereoRig& rig) {
+/// The entry's folder name: scene, provider, size, interaxial and convergence; the field of view
+/// and the light count where they are not the scene's (`lights_in_file`: the scene's own count).
+std::string reference_id(const Scene& scene, const ReferenceSpec& spec, const StereoRig& rig, size_t lights_in_file) {
   const RigParams& p = rig.params();
   std::string id = fmt::format("{}_{}_{}x{}_e{:.1f}mm_c{:.3g}m", scene.name, spec.provider, p.width, p.height,
                                p.interaxial * 1e3, p.convergence);
   // The scene camera's field of view goes without saying; any other is part of the id.
   if (p.vfov != resolve_rig(scene, {}).params().vfov) id += fmt::format("_v{:.4g}deg", radians_to_degrees(p.vfov));
-  if (spec.lights) id += fmt::format("_l{}", *spec.lights);
+  if (spec.lights && static_cast<size_t>(*spec.lights) != lights_in_file) id += fmt::format("_l{}", *spec.lights);
   return id;
 }
 
@@ -523,7 +525,7 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
   stored.scene = stored_scene(spec.scene);
   const Prepared p = prepare(stored, scenes_dir);
   const Scene& scene = p.loaded.scene;
-  const std::string id = reference_id(scene, stored, *p.rig);
+  const std::string id = reference_id(scene, stored, *p.rig, p.loaded.lights_in_file);
   // The id names the scene by its name alone and the rig rounded: another file (or a built-in) of
   // that name, or a rig that differs by less than the id shows, would silently take the entry's
   // place. Regenerating from the same scene and spec replaces it (also when the scene's camera has
@@ -712,7 +714,7 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
   }
   // With scene and rig as recorded, the folder's name is the id its spec gives: a renamed folder
   // would be found under a name that `reference generate` never writes, and regenerated beside it.
-  if (const std::string expected = reference_id(p.loaded.scene, spec, *p.rig); expected != id) {
+  if (const std::string expected = reference_id(p.loaded.scene, spec, *p.rig, p.loaded.lights_in_file); expected != id) {
     r.status = Status::corrupt;
     // Also an entry made before the id named a field of view other than the scene camera's.
     r.detail = fmt::format("{}: its spec makes the reference '{}', but the entry lies in folder '{}'; rename the "

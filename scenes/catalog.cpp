@@ -23,8 +23,10 @@ fs::path stamp_path(const fs::path& scene) { return fs::path(scene.string() + ".
 
 namespace {
 
+/// A parameter value in names and stamps: whole numbers in full, others in the shortest form that
+/// reads back as the same double, so that two values give two names (0.8 and 0.80000001).
 std::string format_value(double v) {
-  return v == std::floor(v) && std::fabs(v) < 1e15 ? fmt::format("{:.0f}", v) : fmt::format("{:g}", v);
+  return v == std::floor(v) && std::fabs(v) < 1e15 ? fmt::format("{:.0f}", v) : fmt::format("{}", v);
 }
 
 /// "lights=10 triangles=200000", or "default parameters".

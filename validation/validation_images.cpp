@@ -36,13 +36,24 @@ Srgb8Image disocclusion_image(const Srgb8Image& truth, const TrueDisocclusions& 
 
 namespace {
 
+/// One image file: its path and the function that writes it to a given path.
+struct FileWriter {
+  std::filesystem::path path;
+  std::function<void(const std::filesystem::path&)> write;
+};
+
 /// Runs the file writers side by side on the executor's threads. A failure cancels the writers
 /// not yet started and is rethrown once the running ones have finished; each writes atomically,
-/// so none leaves a partial file, and every file of `paths` (the set) is then removed.
-void write_side_by_side(const std::vector<std::function<void()>>& writers, const std::vector<std::filesystem::path>& paths,
-                        const Executor& executor) {
+/// so none leaves a partial file, and every file of `paths` (the set) is then removed. With
+/// options.staged the files are added to that set instead and nothing at their names changes here.
+void write_side_by_side(const std::vector<FileWriter>& writers, const std::vector<std::filesystem::path>& paths,
+                        const Executor& executor, const ImageFileOptions& options) {
+  if (options.staged != nullptr) {
+    executor.for_each(writers.size(), [&](size_t i) { options.staged->add(writers[i].path, writers[i].write); });
+    return;
+  }
   try {
-    executor.for_each(writers.size(), [&](size_t i) { writers[i](); });
+    executor.for_each(writers.size(), [&](size_t i) { writers[i].write(writers[i].path); });
   } catch (...) {
     // The set is whole or gone: files of it written beside the one that failed (or left from an
     // earlier run under the same names) would read as this run's.
@@ -60,16 +71,18 @@ json write_target_images(const std::filesystem::path& dir, const std::string& st
   const std::filesystem::path png = dir / fmt::format("{}_truth-{}.png", stem, provider);
   const std::filesystem::path dis = dir / fmt::format("{}_disocclusions.png", stem);
   json files = json::object();
-  std::vector<std::function<void()>> writers = {
-      [&] { write_png(png, target.truth_srgb8); },
-      [&] { write_png(dis, disocclusion_image(target.truth_srgb8, target.disocclusions)); }};
+  std::vector<FileWriter> writers = {
+      {png, [&](const std::filesystem::path& to) { write_png(to, target.truth_srgb8); }},
+      {dis, [&](const std::filesystem::path& to) {
+         write_png(to, disocclusion_image(target.truth_srgb8, target.disocclusions));
+       }}};
   std::vector<std::filesystem::path> paths = {png, dis};
   if (options.exr) {
-    writers.emplace_back([&] { io::write_exr(exr, target.truth.render.right); });
+    writers.push_back({exr, [&](const std::filesystem::path& to) { io::write_exr(to, target.truth.render.right); }});
     files["truth_exr"] = exr.string();
     paths.push_back(exr);
   }
-  write_side_by_side(writers, paths, executor);
+  write_side_by_side(writers, paths, executor, options);
   files["truth_png"] = png.string();
   files["true_disocclusions_png"] = dis.string();
   return files;
@@ -79,13 +92,14 @@ json write_pipeline_images(const std::filesystem::path& dir, const std::string& 
                            const PipelineValidation& v, const Executor& executor, const ImageFileOptions& options) {
   const auto path = [&](const char* suffix) { return dir / fmt::format("{}_{}", stem, suffix); };
   json files = json::object();
-  std::vector<std::function<void()>> writers = {
-      [&] { write_png(path("right.png"), v.right_srgb8); },
-      [&] { write_png(path("diff.png"), difference_image(v.right_srgb8, target.truth_srgb8)); },
-      [&] { write_png(path("ssim.png"), ssim_image(v.ssim)); },
-      [&] {
-        io::write_png_preview(path("holes.png"), hole_overlay(v.result.right, v.hole_mask, target.disocclusions.mask));
-      }};
+  using Path = std::filesystem::path;
+  std::vector<FileWriter> writers = {
+      {path("right.png"), [&](const Path& to) { write_png(to, v.right_srgb8); }},
+      {path("diff.png"), [&](const Path& to) { write_png(to, difference_image(v.right_srgb8, target.truth_srgb8)); }},
+      {path("ssim.png"), [&](const Path& to) { write_png(to, ssim_image(v.ssim)); }},
+      {path("holes.png"), [&](const Path& to) {
+         io::write_png_preview(to, hole_overlay(v.result.right, v.hole_mask, target.disocclusions.mask));
+       }}};
   // A left eye synthesized in part (measured against plain-rt's): the pipeline's own left eye and
   // its difference to plain-rt's. They belong to the set either way: an earlier run's under these
   // names go on failure, and when this pipeline renders its left eye whole.
@@ -93,19 +107,22 @@ json write_pipeline_images(const std::filesystem::path& dir, const std::string& 
   std::vector<std::filesystem::path> paths = {path("right.png"), path("diff.png"), path("ssim.png"), path("holes.png"),
                                               left_files[0], left_files[1]};
   if (v.left) {
-    writers.emplace_back([&] { write_png(left_files[0], v.left_srgb8); });
-    writers.emplace_back([&] { write_png(left_files[1], difference_image(v.left_srgb8, target.left->srgb8)); });
+    writers.push_back({left_files[0], [&](const Path& to) { write_png(to, v.left_srgb8); }});
+    writers.push_back(
+        {left_files[1], [&](const Path& to) { write_png(to, difference_image(v.left_srgb8, target.left->srgb8)); }});
     files["left_png"] = left_files[0].string();
     files["left_diff_png"] = left_files[1].string();
+  } else if (options.stale != nullptr) {
+    options.stale->insert(options.stale->end(), left_files.begin(), left_files.end());
   } else {
     io::discard_output_files(left_files);
   }
   if (options.exr) {
-    writers.emplace_back([&] { io::write_exr(path("right.exr"), v.result.right); });
+    writers.push_back({path("right.exr"), [&](const Path& to) { io::write_exr(to, v.result.right); }});
     files["right_exr"] = path("right.exr").string();
     paths.push_back(path("right.exr"));
   }
-  write_side_by_side(writers, paths, executor);
+  write_side_by_side(writers, paths, executor, options);
   files["right_png"] = path("right.png").string();
   files["diff_png"] = path("diff.png").string();
   files["ssim_png"] = path("ssim.png").string();

@@ -5,8 +5,11 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
+
+#include "renderer/io/atomic_file.hpp"
 
 #include "validation/validate.hpp"
 
@@ -17,15 +20,23 @@ namespace sb::validation {
 /// red (75 % tint over the dimmed colour). InputError if the sizes differ.
 [[nodiscard]] Srgb8Image disocclusion_image(const Srgb8Image& truth, const TrueDisocclusions& disocclusions);
 
-/// Which image files a validation writes besides its PNGs.
+/// Which image files a validation writes besides its PNGs, and how.
 struct ImageFileOptions {
   bool exr = true;  ///< the EXR of the ground truth and of every right eye (large: every AOV)
+  /// Where the files go: null, each in place as it is finished (on failure the set's files are
+  /// removed, an earlier run's included); otherwise added to this set, which the caller commits,
+  /// so that a failure before the commit leaves an earlier run's files as they were.
+  io::StagedFiles* staged = nullptr;
+  /// With `staged`: receives the files of the set this call does not write (an earlier run's
+  /// left-eye images), to be removed once the set is committed.
+  std::vector<std::filesystem::path>* stale = nullptr;
 };
 
 /// Writes the images shared by every pipeline of a target under `dir`: <stem>_truth-<provider>.exr
 /// (unless options.exr is false) and .png, and <stem>_disocclusions.png. The files are encoded
 /// side by side on the executor's threads (each file's bytes do not depend on it). Returns
-/// {name: path}; on failure none of these files is left (an earlier run's included).
+/// {name: path}; on failure none of these files is left (an earlier run's included), unless
+/// options.staged holds them.
 nlohmann::json write_target_images(const std::filesystem::path& dir, const std::string& stem,
                                    const ValidationTarget& target, const Executor& executor,
                                    const ImageFileOptions& options = {});
@@ -34,8 +45,8 @@ nlohmann::json write_target_images(const std::filesystem::path& dir, const std::
 /// false) and _right.png, _diff.png (difference heat map), _ssim.png (SSIM map) and _holes.png
 /// (hole mask against the true disocclusions: green found, red missed, blue flagged needlessly),
 /// and for a left eye synthesized in part (v.left) _left.png and _left_diff.png (its difference to
-/// plain-rt's left eye), side by side on the executor's threads. Returns {name: path}; on failure none of these files is
-/// left (an earlier run's included).
+/// plain-rt's left eye), side by side on the executor's threads. Returns {name: path}; on failure
+/// none of these files is left (an earlier run's included), unless options.staged holds them.
 nlohmann::json write_pipeline_images(const std::filesystem::path& dir, const std::string& stem,
                                      const ValidationTarget& target, const PipelineValidation& v,
                                      const Executor& executor, const ImageFileOptions& options = {});

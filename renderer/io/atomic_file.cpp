@@ -314,6 +314,7 @@ void StagedFiles::add(const fs::path& given, const std::function<void(const fs::
     staging_path = outer;
     sync_file(staged.path);
   });
+  const std::lock_guard<std::mutex> lock(mutex_);
   entries_.push_back(Entry{path, std::move(staged)});
 }
 

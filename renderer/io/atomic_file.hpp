@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
@@ -30,7 +31,8 @@ void write_atomically(const std::filesystem::path& path,
 /// final one (as write_atomically does; a folder, device, pipe or open-file path is refused with an
 /// InputError), commit() then renames them into place in the order they were added. Until commit
 /// nothing at the final names changes, so a failure while adding (a full disk) leaves an earlier
-/// set as it was; a set destroyed uncommitted removes its temporary files.
+/// set as it was; a set destroyed uncommitted removes its temporary files. add() may be called
+/// from several threads at once (each file is written by the thread that adds it).
 class StagedFiles {
  public:
   StagedFiles();
@@ -49,6 +51,7 @@ class StagedFiles {
 
  private:
   struct Entry;
+  std::mutex mutex_;  ///< guards entries_ while files are added side by side
   std::vector<Entry> entries_;
 };
 

@@ -456,6 +456,12 @@ TEST(Cli, AGeneratedVariantNeverTakesTheDefaultScenesFile) {
   ASSERT_EQ(run("scenes generate lit-plane --param albedo=0.25" + out).code, 0);
   EXPECT_TRUE(std::filesystem::exists(dir / "lit-plane_albedo-0.25.gltf"));
   EXPECT_EQ(test::read_text(dir / "lit-plane.gltf"), before);
+  // Values equal to six digits are two variants with two files: printed with six digits, the
+  // second replaced the first and a sweep ran both cells on one scene.
+  ASSERT_EQ(run("scenes generate lit-plane --param albedo=0.25000001" + out).code, 0);
+  EXPECT_TRUE(std::filesystem::exists(dir / "lit-plane_albedo-0.25000001.gltf"));
+  const std::string albedo = test::read_text(dir / "lit-plane_albedo-0.25.gltf");
+  EXPECT_EQ(albedo.find("0.25000001"), std::string::npos);
 }
 
 TEST(Cli, RenderScoresHolesOnlyWhenPixelsAreReprojected) {
@@ -578,6 +584,9 @@ TEST(Cli, RenderAndBenchRejectBadArguments) {
       {"render --scene box-wall --pipeline plain-rt --scenes-dir '' --out '" + dir.path().string() + "'",
        "--scenes-dir: is empty; give a name"},
       {"bench --scene box-wall --pipelines plain-rt --json ''" + bench_common, "--json: is empty; give a name"},
+      // An empty clip or BVH mode was taken as not given: a static path, a refit BVH.
+      {"path --scene box-wall --frames 1 --gltf-clip ''" + common, "--gltf-clip: is empty"},
+      {"path --scene box-wall --frames 1 --spin-deg 1 --bvh ''" + common, "--bvh: is empty"},
       // The results used to replace the scene file they were measured on.
       {"bench --scene box-wall --pipelines plain-rt --json '" + (dir / "scenes" / "box-wall.gltf").string() + "'" +
            bench_common,

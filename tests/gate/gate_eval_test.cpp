@@ -583,6 +583,25 @@ TEST(GateCli, BadInputIsExitThree) {
   EXPECT_EQ(run.code, 3) << run.out;
   EXPECT_FALSE(std::filesystem::exists(dir / "junit.xml"));
   EXPECT_FALSE(std::filesystem::exists(dir / "gate.json"));
+  // So does a run refused for its options before any input is read (--only without
+  // --update-baseline; one file named by both outputs): these used to leave the earlier files.
+  for (const std::string& refused :
+       {outputs + " --only repro-rt", " --junit " + (dir / "junit.xml").string() + " --json " +
+                                          (dir / "junit.xml").string()}) {
+    run = run_cli("gate" + config + " --results " + (dir / "pass.jsonl").string() + outputs);
+    ASSERT_EQ(run.code, 0) << run.out;
+    run = run_cli("gate" + config + " --results " + (dir / "pass.jsonl").string() + refused);
+    EXPECT_EQ(run.code, 3) << refused << "\n" << run.out;
+    EXPECT_FALSE(std::filesystem::exists(dir / "junit.xml")) << refused;
+    // gate.json is this refused run's output only in the first case.
+    EXPECT_EQ(std::filesystem::exists(dir / "gate.json"), refused.find("gate.json") == std::string::npos) << refused;
+  }
+  // An output naming an input is refused and the input kept.
+  const std::string pass_before = read_text(dir / "pass.jsonl");
+  run = run_cli("gate" + config + " --results " + (dir / "pass.jsonl").string() + " --junit " +
+                (dir / "pass.jsonl").string());
+  EXPECT_EQ(run.code, 3) << run.out;
+  EXPECT_EQ(read_text(dir / "pass.jsonl"), pass_before);
   // An output that cannot be written is exit 4 and leaves no output either: the JUnit file, written
   // first, used to stay when the JSON's folder was a file.
   write_file(dir / "notafolder", "x\n");

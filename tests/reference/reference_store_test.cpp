@@ -428,6 +428,12 @@ TEST(ReferenceStore, AnotherRigDoesNotReplaceAnEntry) {
   // The default interaxial given explicitly is the same rig: the entry is made again.
   EXPECT_EQ(test::run_cli(ref(dir, "generate") + args + " --interaxial 0.064").code, 0);
   EXPECT_EQ(store.ids().size(), 2u);
+  // So is the scene's own light count (box-wall has one): it made a second entry "..._l1".
+  const test::CliRun all_lights = test::run_cli(ref(dir, "generate") + args + " --lights 1");
+  EXPECT_EQ(all_lights.code, 0) << all_lights.out;
+  EXPECT_EQ(store.ids().size(), 2u);
+  const test::CliRun verified = test::run_cli(ref(dir, "verify") + " --no-render");
+  EXPECT_EQ(verified.code, 0) << verified.out;
 }
 
 TEST(ReferenceStore, WorkingFoldersOfAKilledRunAreClearedUp) {
