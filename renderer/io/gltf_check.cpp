@@ -310,9 +310,9 @@ class Checker {
       opt_number_array(n, "translation", p, 3);
       if (const json* r = member(n, "rotation", p)) {
         number_array(*r, p + "/rotation", 4);
-        double norm2 = 0.0;
-        for (const json& c : *r) norm2 += c.get<double>() * c.get<double>();
-        if (!(norm2 > 0.0))
+        double largest = 0.0;  // zero length; the squares would underflow below 1e-154
+        for (const json& c : *r) largest = std::max(largest, std::abs(c.get<double>()));
+        if (!(largest > 0.0))
           fail(p + "/rotation", "the quaternion has length zero; a rotation is a unit quaternion [x, y, z, w], "
                                 "e.g. [0, 0, 0, 1] for none");
       }
@@ -387,13 +387,16 @@ class Checker {
           type != "MAT3" && type != "MAT4")
         fail(p + "/type", fmt::format("'{}' is not a glTF accessor type (SCALAR, VEC2..4, MAT2..4)", type));
       if (const json* sp = member(a, "sparse", p)) {
+        // The reader keeps a sparse count and its byte offsets in 32-bit signed integers; a larger
+        // value would be cut to another one silently.
+        constexpr uint64_t kSparseMax = 0x7FFFFFFF;
         const std::string sp_path = p + "/sparse";
         require_object(*sp, sp_path);
-        opt_integer(*sp, "count", sp_path, 1, (uint64_t{1} << 53), true);
+        opt_integer(*sp, "count", sp_path, 1, kSparseMax, true);
         const json* idx = member(*sp, "indices", sp_path, true);
         require_object(*idx, sp_path + "/indices");
         opt_index(*idx, "bufferView", sp_path + "/indices", "bufferViews", true);
-        opt_integer(*idx, "byteOffset", sp_path + "/indices");
+        opt_integer(*idx, "byteOffset", sp_path + "/indices", 0, kSparseMax);
         const uint64_t ict = integer(*member(*idx, "componentType", sp_path + "/indices", true),
                                      sp_path + "/indices/componentType");
         if (ict != 5121 && ict != 5123 && ict != 5125)
@@ -402,7 +405,7 @@ class Checker {
         const json* val = member(*sp, "values", sp_path, true);
         require_object(*val, sp_path + "/values");
         opt_index(*val, "bufferView", sp_path + "/values", "bufferViews", true);
-        opt_integer(*val, "byteOffset", sp_path + "/values");
+        opt_integer(*val, "byteOffset", sp_path + "/values", 0, kSparseMax);
       }
     });
 
@@ -515,7 +518,19 @@ class Checker {
     });
 
     each(doc_, "samplers", "", [&](const json& s, const std::string& p) {
-      for (const char* k : {"magFilter", "minFilter", "wrapS", "wrapT"}) opt_integer(s, k, p);
+      // glTF 2.0 §5.26's enums (the reader cuts other values to 32 bits and may meet one of them).
+      const auto one_of = [&](const char* key, std::initializer_list<uint64_t> allowed, const char* names) {
+        if (const json* v = member(s, key, p)) {
+          const uint64_t x = integer(*v, p + "/" + key);
+          if (std::find(allowed.begin(), allowed.end(), x) == allowed.end())
+            fail(p + "/" + key, fmt::format("{} is not one of {}", x, names));
+        }
+      };
+      one_of("magFilter", {9728, 9729}, "9728 NEAREST, 9729 LINEAR");
+      one_of("minFilter", {9728, 9729, 9984, 9985, 9986, 9987},
+             "9728 NEAREST, 9729 LINEAR, 9984..9987 the mipmap filters");
+      one_of("wrapS", {33071, 33648, 10497}, "33071 CLAMP_TO_EDGE, 33648 MIRRORED_REPEAT, 10497 REPEAT");
+      one_of("wrapT", {33071, 33648, 10497}, "33071 CLAMP_TO_EDGE, 33648 MIRRORED_REPEAT, 10497 REPEAT");
     });
 
     each(doc_, "cameras", "", [&](const json& c, const std::string& p) {

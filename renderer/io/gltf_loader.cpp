@@ -658,6 +658,16 @@ class Converter {
     tex.height = img.height;
     tex.rgba.resize(static_cast<size_t>(img.width) * img.height * 4);
     const int ch = img.channels;
+    // PNG and JPEG decode to [0, 1]; another format OpenImageIO reads (a float TIFF or EXR, a
+    // Radiance file) may hold anything, and a NaN or negative colour would reach the images.
+    for (size_t i = 0; i < img.values.size(); ++i)
+      if (!(img.values[i] >= 0.0f && img.values[i] <= 1.0f)) {
+        const size_t texel = i / static_cast<size_t>(ch);
+        fail(ipath, fmt::format("texel ({}, {}) channel {} is {}; a base colour texture holds values in [0, 1] (glTF "
+                                "images are PNG or JPEG)",
+                                texel % static_cast<size_t>(img.width), texel / static_cast<size_t>(img.width),
+                                i % static_cast<size_t>(ch), img.values[i]));
+      }
     for (size_t p = 0; p < static_cast<size_t>(img.width) * img.height; ++p) {
       const float* s = img.values.data() + p * ch;
       float r = s[0], g = ch >= 3 ? s[1] : s[0], b = ch >= 3 ? s[2] : s[0];
@@ -692,9 +702,14 @@ class Converter {
     }
     if (n.translation.size() == 3) l.translation = dvec3(n.translation[0], n.translation[1], n.translation[2]);
     if (n.rotation.size() == 4) {
-      const dquat q(n.rotation[3], n.rotation[0], n.rotation[1], n.rotation[2]);  // glm: (w, x, y, z)
-      const double len = glm::length(q);
-      if (len > 0.0) l.rotation = q / len;
+      // glm: (w, x, y, z). Normalized after scaling by the largest component, so that components
+      // whose squares overflow (1e200) or underflow turn the node as their direction says.
+      dquat q(n.rotation[3], n.rotation[0], n.rotation[1], n.rotation[2]);
+      const double largest = std::max({std::abs(q.w), std::abs(q.x), std::abs(q.y), std::abs(q.z)});
+      if (largest > 0.0) {
+        q = q / largest;
+        l.rotation = q / glm::length(q);
+      }
     }
     if (n.scale.size() == 3) l.scale = dvec3(n.scale[0], n.scale[1], n.scale[2]);
     return l;
@@ -767,7 +782,10 @@ class Converter {
                fmt::format("accessor {} holds component type {}{}; a {} must be floats (5126){}", gs.output,
                            out.componentType, out.normalized ? " (normalized)" : "", gc.target_path,
                            ch.property == NodeAnimation::Property::rotation ? " or normalized 8- or 16-bit integers" : ""));
-        // Both are kept as doubles while the file is loaded.
+        // Both are kept as doubles while the file is loaded. The accessors' ranges first: a count
+        // beyond its buffer view is a malformed file, not a memory limit.
+        (void)view_of(gs.input, spath + "/input");
+        (void)view_of(gs.output, spath + "/output");
         require_memory(16 * (uint64_t{in.count} + uint64_t{out.count} * static_cast<uint64_t>(width)),
                        fmt::format("loading {}: {} ({} keys)", file_, spath, in.count),
                        "check the sampler's accessor counts, or use a smaller animation");

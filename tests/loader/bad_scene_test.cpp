@@ -215,6 +215,38 @@ std::vector<BadCase> corpus() {
   c.push_back({"rig_extras_huge_interaxial", "a.gltf", edited([](MiniGltf& g) { add_camera(g, {{"extras", {{"stereobench", {{"interaxial", 1e20}}}}}}); }),
                "/nodes/1/extras/stereobench/interaxial: value 1e+20 m is beyond the 1e+15 m a scene may span"});
   c.push_back({"rig_extras_negative_convergence", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["extras"]["stereobench"]["convergence"] = -1; }), "/nodes/0/extras/stereobench/convergence: value -1 must be positive"});
+  // The reader keeps sparse counts and offsets in 32 bits: 2^32 + 1 was read as 1, silently.
+  c.push_back({"sparse_count_beyond_32_bits", "a.gltf", edited([](MiniGltf& g) {
+    g.doc["accessors"][0]["sparse"] = {{"count", 4294967297ULL},
+                                       {"indices", {{"bufferView", 0}, {"componentType", 5123}}},
+                                       {"values", {{"bufferView", 0}}}};
+  }), "/accessors/0/sparse/count: value 4294967297 is out of range [1, 2147483647]"});
+  c.push_back({"sparse_offset_beyond_32_bits", "a.gltf", edited([](MiniGltf& g) {
+    g.doc["accessors"][0]["sparse"] = {{"count", 1},
+                                       {"indices", {{"bufferView", 0}, {"componentType", 5123}, {"byteOffset", 4294967296ULL}}},
+                                       {"values", {{"bufferView", 0}}}};
+  }), "/accessors/0/sparse/indices/byteOffset: value 4294967296 is out of range [0, 2147483647]"});
+  // Sampler enums: 2^32 + 33071 was read as CLAMP_TO_EDGE.
+  c.push_back({"sampler_wrap_not_an_enum", "a.gltf", edited([](MiniGltf& g) { g.doc["samplers"] = json::array({{{"wrapS", 4294967296ULL + 33071}}}); }),
+               "/samplers/0/wrapS: 4295000367 is not one of 33071 CLAMP_TO_EDGE"});
+  // A float image (a Radiance file here, its texels at 255 * 2^119) reached the images as colour
+  // far beyond 1, or as NaN and infinity.
+  c.push_back({"texture_beyond_one", "a.gltf", [](const std::filesystem::path& p) {
+    write_text(p.parent_path() / "huge.hdr", std::string("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 2\n") + std::string(16, '\xff'));
+    edited([](MiniGltf& g) {
+      g.doc["images"] = json::array({{{"uri", "huge.hdr"}}});
+      g.doc["textures"] = json::array({{{"source", 0}}});
+      g.doc["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}});
+      g.doc["meshes"][0]["primitives"][0]["material"] = 0;
+    })(p);
+  }, "/images/0: texel (0, 0) channel 0 is "});
+  // A key-time accessor running past its buffer view was refused as too large for memory (exit 4).
+  c.push_back({"animation_input_beyond_its_view", "a.gltf", edited([](MiniGltf& g) {
+    g.doc["accessors"].push_back({{"bufferView", 0}, {"componentType", 5126}, {"count", 1ULL << 50}, {"type", "SCALAR"}});
+    const int times = static_cast<int>(g.doc["accessors"].size()) - 1;
+    g.doc["animations"] = json::array({{{"samplers", json::array({{{"input", times}, {"output", 0}}})},
+                                        {"channels", json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}})}}});
+  }), "the count is wrong or the buffer is truncated (used by /animations/0/samplers/0/input)"});
   c.push_back({"zero_quaternion", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["rotation"] = {0, 0, 0, 0}; }), "/nodes/0/rotation: the quaternion has length zero"});
   c.push_back({"base_color_above_one", "a.gltf", edited([](MiniGltf& g) { g.doc["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorFactor", {2, 0.5, 0.5, 1}}}}}}); }), "/materials/0/pbrMetallicRoughness/baseColorFactor/0: value 2 is out of range [0, 1]"});
   c.push_back({"negative_ambient", "a.gltf", edited([](MiniGltf& g) { g.doc["scenes"][0]["extras"]["stereobench"]["ambient"] = -0.5; }), "/scenes/0/extras/stereobench/ambient: value -0.5 is out of range"});

@@ -49,6 +49,25 @@ TEST(GltfLoader, NodeHierarchyComposesTransforms) {
   EXPECT_EQ(mesh.node, child);
 }
 
+TEST(GltfLoader, AQuaternionIsNormalizedWhateverItsScale) {
+  // Components whose squares overflow (or underflow) a double turned nothing: the length was
+  // infinite (or zero) and the node kept the identity.
+  ScratchDir dir("quat");
+  const double s = std::sqrt(0.5);
+  std::vector<std::vector<vec3>> positions;
+  for (const double scale : {1.0, 1e200, 1e-200}) {
+    MiniGltf g;
+    const int p = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+    const int m = g.add_mesh(json::array({{{"attributes", {{"POSITION", p}}}}}));
+    g.add_node({{"mesh", m}, {"rotation", {0, 0, s * scale, s * scale}}});
+    g.write_gltf(dir / "q.gltf");
+    positions.push_back(io::load_gltf(dir / "q.gltf").meshes.at(0).positions);
+  }
+  expect_vec3(positions[0][1], {0, 1, 0});  // 90 degrees about Z
+  for (size_t k = 1; k < positions.size(); ++k)
+    for (size_t v = 0; v < 3; ++v) expect_vec3(positions[k][v], positions[0][v], 1e-6f);
+}
+
 TEST(GltfLoader, MatrixTransformAndNegativeScaleKeepsFacing) {
   ScratchDir dir("mat");
   MiniGltf g;
