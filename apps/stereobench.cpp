@@ -1,4 +1,6 @@
 // stereobench: the command-line tool. Maps subcommands to library calls and errors to exit codes.
+#include <signal.h>
+
 #include <cctype>
 #include <cerrno>
 #include <cstdio>
@@ -16,6 +18,7 @@
 
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
 #include "renderer/io/gltf_loader.hpp"
 #include "renderer/io/image_io.hpp"
 #include "renderer/memory.hpp"
@@ -139,10 +142,32 @@ int after_flushing_stdout(int code) {
   return static_cast<int>(sb::ExitCode::environment);
 }
 
+/// On an interrupt (Ctrl-C), a termination request (a job's time limit, `kill`) or a hang-up: the
+/// temporary files of the writes in progress are removed, then the signal ends the process as it
+/// would have (its exit status shows the signal).
+void remove_temporaries_and_end(int signal) {
+  sb::io::remove_temporaries_on_signal();
+  ::signal(signal, SIG_DFL);
+  ::raise(signal);
+}
+
+void handle_ending_signals() {
+  struct sigaction action {};
+  action.sa_handler = remove_temporaries_and_end;
+  sigemptyset(&action.sa_mask);
+  for (const int s : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction previous {};
+    // A signal the shell ignores for this process (nohup, a background job's SIGINT) stays ignored.
+    if (::sigaction(s, nullptr, &previous) == 0 && previous.sa_handler == SIG_IGN) continue;
+    ::sigaction(s, &action, nullptr);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   sb::keep_freed_memory();
+  handle_ending_signals();
   CLI::App app{"stereobench: offline validation and benchmarking of accelerated stereo rendering.\n"
                "Renders stereo pairs with every pipeline of the source papers, measures the synthesized\n"
                "right eye against ground truth, and reports quality, holes and time.",

@@ -2,6 +2,7 @@
 #include "renderer/io/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <limits.h>
 #include <sys/file.h>
 #include <unistd.h>
 
@@ -108,18 +109,70 @@ UniqueFd lock_temporary(const fs::path& tmp, const fs::path& path) {
   return fd;
 }
 
+/// The temporary files of writes in progress, for remove_temporaries_on_signal: fixed slots of
+/// lock-free flags and path bytes, so that a signal handler reads them without locks or the heap.
+/// Untouched slots cost no memory; a write that finds none free is only not removed on a signal
+/// (the next write of its file removes it as stale).
+struct SignalSlot {
+  std::atomic<bool> used{false};   ///< taken by a registration
+  std::atomic<bool> ready{false};  ///< `path` holds a whole name
+  char path[PATH_MAX];
+};
+constexpr size_t kSignalSlots = 512;
+SignalSlot g_signal_slots[kSignalSlots];
+
+/// Keeps a temporary file's name in a slot for its lifetime (movable, one owner).
+class SignalRegistration {
+ public:
+  explicit SignalRegistration(const fs::path& path) {
+    const std::string& name = path.native();
+    if (name.size() >= PATH_MAX) return;
+    for (size_t i = 0; i < kSignalSlots; ++i) {
+      bool free = false;
+      if (!g_signal_slots[i].used.compare_exchange_strong(free, true)) continue;
+      std::memcpy(g_signal_slots[i].path, name.c_str(), name.size() + 1);
+      g_signal_slots[i].ready.store(true, std::memory_order_release);
+      slot_ = static_cast<int>(i);
+      return;
+    }
+  }
+  SignalRegistration(SignalRegistration&& o) noexcept : slot_(std::exchange(o.slot_, -1)) {}
+  SignalRegistration& operator=(SignalRegistration&& o) noexcept {
+    if (this != &o) {
+      release();
+      slot_ = std::exchange(o.slot_, -1);
+    }
+    return *this;
+  }
+  SignalRegistration(const SignalRegistration&) = delete;
+  SignalRegistration& operator=(const SignalRegistration&) = delete;
+  ~SignalRegistration() { release(); }
+
+ private:
+  void release() {
+    if (slot_ < 0) return;
+    g_signal_slots[slot_].ready.store(false, std::memory_order_release);
+    g_signal_slots[slot_].used.store(false, std::memory_order_release);
+    slot_ = -1;
+  }
+  int slot_ = -1;
+};
+
 /// A write's temporary file for `path`, ".FILE.tmp-PID-N", locked: the stale temporaries of
-/// earlier writes of `path` are removed first.
+/// earlier writes of `path` are removed first. Its name is registered for removal on a signal
+/// until the object goes (by then it is renamed into place or removed).
 struct Temporary {
   fs::path path;
   UniqueFd lock;
+  SignalRegistration on_signal;
 };
 Temporary new_temporary(const fs::path& path) {
   remove_stale_temporaries(path);
   static std::atomic<unsigned> counter{0};
   fs::path tmp = path.parent_path() / fmt::format("{}{}-{}", temporary_prefix(path), ::getpid(), counter++);
   UniqueFd lock = lock_temporary(tmp, path);
-  return Temporary{std::move(tmp), std::move(lock)};
+  SignalRegistration on_signal(tmp);
+  return Temporary{std::move(tmp), std::move(lock), std::move(on_signal)};
 }
 
 void sync_file(const fs::path& path) {
@@ -332,6 +385,11 @@ void StagedFiles::commit() {
 
 size_t StagedFiles::placed() const {
   return static_cast<size_t>(std::count_if(entries_.begin(), entries_.end(), [](const Entry& e) { return e.placed; }));
+}
+
+void remove_temporaries_on_signal() noexcept {
+  for (SignalSlot& slot : g_signal_slots)
+    if (slot.ready.load(std::memory_order_acquire)) (void)::unlink(slot.path);
 }
 
 fs::path follow_links(const fs::path& path) { return link_chain(path).back(); }

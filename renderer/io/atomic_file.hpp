@@ -68,6 +68,11 @@ bool remove_output_file(const std::filesystem::path& path);
 /// cannot be removed is skipped (the run's own error is the one to report).
 void discard_output_files(std::span<const std::filesystem::path> paths) noexcept;
 
+/// Removes the temporary files of the writes now in progress (interrupted, they would stay as
+/// hidden .FILE.tmp-PID-N files until a later write of the same file). Async-signal-safe: for a
+/// handler of SIGINT, SIGTERM or SIGHUP, which then lets the signal end the process.
+void remove_temporaries_on_signal() noexcept;
+
 /// The file a path names, its symbolic links followed (a dangling link gives the file it would
 /// create); `path` itself when it is no link. IoError for a loop of links.
 [[nodiscard]] std::filesystem::path follow_links(const std::filesystem::path& path);

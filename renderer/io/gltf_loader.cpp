@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -1171,6 +1172,18 @@ Scene load_gltf(const fs::path& path, const GltfLoadOptions& options) {
                                  "`stereobench scenes list` for the built-in scenes", file));
   if (!fs::is_regular_file(path, ec))
     throw InputError(fmt::format("{}: not a regular file; give a .gltf or .glb file", file));
+  // The reader takes at most 4 GiB (a .glb's own length field has 32 bits), and loading holds the
+  // file about three times over (its bytes, the reader's copy, the buffers it decodes) before the
+  // meshes are converted: refused before the first byte is read, naming the file.
+  if (const uintmax_t size = fs::file_size(path, ec); !ec) {
+    if (size > std::numeric_limits<uint32_t>::max())
+      throw InputError(fmt::format("{}: {} bytes; a glTF file is at most 4 GiB (a .glb's length field has 32 bits): "
+                                   "split the scene, or keep its buffers in external .bin files",
+                                   file, size));
+    require_memory(3 * uint64_t{size}, fmt::format("loading {} ({:.1f} MiB, held about three times while it is read)",
+                                                   file, double(size) / (1024.0 * 1024.0)),
+                   "use a smaller scene, or run on a machine with more memory");
+  }
   // A file that cannot be read (permissions, a failing disk, too little memory) is an I/O failure.
   const std::string bytes = read_file(path);
   if (bytes.empty()) throw InputError(fmt::format("{}: the file is empty; give a .gltf or .glb file", file));

@@ -175,17 +175,42 @@ TEST(Cli, MoreThreadsThanCoresAreTheCoresAndSaySo) {
 
 TEST(Cli, AFileLargerThanTheMemoryLimitIsAnIoErrorNotATruncatedFile) {
   // A 4 GiB file (sparse: no disk used) read under a 3 GB address-space limit: the read fails
-  // for memory (exit 4) instead of returning the file cut short, which the loader reported as a
+  // for memory (exit 4) instead of returning the file cut short, which the reader reported as a
   // damaged file (exit 3).
   test::ScratchDir dir("bigread");
-  const std::filesystem::path big = dir / "big.gltf";
+  const std::filesystem::path big = dir / "big.toml";
   { std::ofstream(big).put(' '); }
   std::filesystem::resize_file(big, uintmax_t{4} << 30);
-  const CliRun r = test::run_shell("ulimit -v 3000000 && " + std::string(SB_CLI_PATH) + " scenes info " +
-                                   test::quoted(big));
+  const CliRun r = test::run_shell("ulimit -v 3000000 && " + std::string(SB_CLI_PATH) + " gate --config " +
+                                   test::quoted(big) + " --results " + test::quoted(big));
   EXPECT_EQ(r.code, 4) << r.out;
   EXPECT_NE(r.out.find("not enough memory to read " + big.string() + " (4294967296 bytes)"), std::string::npos)
       << r.out;
+  // A scene file is refused by its size before it is read: beyond 4 GiB no glTF reader takes it.
+  const std::filesystem::path scene = dir / "big.glb";
+  { std::ofstream(scene).put(' '); }
+  std::filesystem::resize_file(scene, uintmax_t{4} << 30);
+  const CliRun s = test::run_cli("scenes info " + test::quoted(scene));
+  EXPECT_EQ(s.code, 3) << s.out;
+  EXPECT_NE(s.out.find(scene.string() + ": 4294967296 bytes; a glTF file is at most 4 GiB"), std::string::npos)
+      << s.out;
+}
+
+TEST(Cli, ATerminatedWriteLeavesNoTemporaryFile) {
+  // SIGTERM (a job's time limit, `kill`) while a 4K render writes its EXR: the hidden temporary
+  // file (some 500 MB) stayed for good unless the same file was written again. The process still
+  // ends by the signal. (SIGINT behaves alike; a shell's background job ignores it, so the test
+  // sends SIGTERM.)
+  test::ScratchDir dir("sigterm");
+  const std::string out = test::quoted(dir / "out");
+  const CliRun r = test::run_shell(
+      std::string(SB_CLI_PATH) + " render --scene lit-plane --pipeline plain-raster --resolution 4k --stereo none " +
+      "--scenes-dir " + test::quoted(dir / "scenes") + " --out " + out + " & pid=$!; seen=0; " +
+      "for i in $(seq 1 2400); do if ls -A " + out + " 2>/dev/null | grep -q 'tmp-'; then seen=1; break; fi; " +
+      "sleep 0.05; done; kill -TERM $pid; wait $pid; echo \"seen=$seen status=$?\"; ls -A " + out);
+  ASSERT_NE(r.out.find("seen=1"), std::string::npos) << "no temporary file was seen while the render wrote: " << r.out;
+  EXPECT_NE(r.out.find("status=143"), std::string::npos) << r.out;  // 128 + SIGTERM
+  EXPECT_EQ(r.out.find(".tmp-"), std::string::npos) << r.out;
 }
 
 TEST(Cli, ADeviceGivenAsAnInputFileIsBadInputNotReadWithoutEnd) {
