@@ -424,15 +424,19 @@ class CellRowVertices {
 /// neighbour is covered by a surface nearer by more than `step` pixels of disparity. The nearer
 /// surface's silhouette lies somewhere between its last source pixel centre and the one before,
 /// so its warped image may reach up to a pixel further left than its first warped vertex: the
-/// pixel there shows either surface and is left for the hole filler.
-void mark_occluding_edges(const WarpTarget& t, double disparity_per_inverse_depth, double step) {
+/// pixel there shows either surface and is left for the hole filler. With `discarded_too` (the
+/// interpolated rule, which discards fragments of the surfaces beside a gap as well, their
+/// silhouettes among them) a discarded neighbour that near counts too (its depth is stored).
+void mark_occluding_edges(const WarpTarget& t, double disparity_per_inverse_depth, double step, bool discarded_too) {
+  const auto nearer_side = [&](uint8_t state) {
+    return state == static_cast<uint8_t>(WarpPixel::covered) ||
+           (discarded_too && state == static_cast<uint8_t>(WarpPixel::discarded));
+  };
   for (int y = t.y0; y < t.y1; ++y) {
     const size_t row = t.at(0, y);
     for (int x = 0; x + 1 < t.width; ++x) {
       const size_t o = row + x;
-      if (t.state[o] != static_cast<uint8_t>(WarpPixel::covered) ||
-          t.state[o + 1] != static_cast<uint8_t>(WarpPixel::covered))
-        continue;
+      if (t.state[o] != static_cast<uint8_t>(WarpPixel::covered) || !nearer_side(t.state[o + 1])) continue;
       if (disparity_per_inverse_depth * (static_cast<double>(t.q[o + 1]) - t.q[o]) > step)
         t.state[o] = static_cast<uint8_t>(WarpPixel::occluding_edge);
     }
@@ -641,7 +645,8 @@ std::vector<uint8_t> grid_warp(const WarpGrid& grid, const Image& source, const 
   // Marks the occluding edges of finished target rows and writes them into the target eye.
   const auto resolve = [&](const WarpTarget& rows, WarpStats& counts) {
     if (options.detect_disocclusions && options.occluding_edge_px > 0.0)
-      mark_occluding_edges(rows, from.f_px * interaxial, options.occluding_edge_px);
+      mark_occluding_edges(rows, from.f_px * interaxial, options.occluding_edge_px,
+                           options.rule == DiscardRule::interpolated);
     resolve_rows(rows, source, target, counts);
   };
   // The target rows [16 cy, 16 cy + 16) of cell row cy, clipped to the image.

@@ -35,13 +35,22 @@ class DisparityMotion {
   double inverse_c_ = 0.0;
 };
 
+/// How far left of a pixel edge a moved centre still goes to the right-hand pixel. A depth read
+/// back from float carries a relative error near 1e-7, so a surface whose motion is exactly half a
+/// pixel off a whole one (a wall at a distance where it is k + 0.5 px) gives motions a few 1e-7 px
+/// either side of the edge: rounded as they come, neighbouring pixels of the wall went one pixel
+/// apart or onto one pixel, opening gaps and overlaps all over it (thin-pole at 15 px of disparity:
+/// 33.50 dB and 21 % holes for rt-atomic, against 48 dB at 14 px). 1e-4 px is far above that
+/// noise and far below anything an image shows.
+inline constexpr double kEdgeTolerance = 1e-4;
+
 /// The target column of source pixel x moved by `motion`: the pixel whose centre is nearest to the
 /// moved centre x + 0.5 + motion, i.e. floor(x + 0.5 + motion) — written round(x + 0.5 + motion) − 0.5
-/// in centre coordinates. A moved centre exactly on a pixel edge goes to the right-hand pixel.
-/// Evaluated in double precision; the result is clamped to [−1, 2^30] so that it always fits (a NaN
-/// motion gives −1: outside the image).
+/// in centre coordinates. A moved centre on a pixel edge, or within kEdgeTolerance left of one,
+/// goes to the right-hand pixel. Evaluated in double precision; the result is clamped to
+/// [−1, 2^30] so that it always fits (a NaN motion gives −1: outside the image).
 [[nodiscard]] inline int target_column(int x, float motion) {
-  const double moved = std::floor(static_cast<double>(x) + 0.5 + static_cast<double>(motion));
+  const double moved = std::floor(static_cast<double>(x) + 0.5 + static_cast<double>(motion) + kEdgeTolerance);
   if (!(moved >= -1.0)) return -1;
   return static_cast<int>(std::min(moved, 1073741824.0));
 }
