@@ -40,11 +40,20 @@ class PixelReprojector {
   /// rig's horizontal baseline); kNoSource for a miss (infinite depth) or a column outside the image.
   /// With the rig's parallel, equally shifted eyes the projection moves by the disparity
   /// f·e·(1/c − 1/z) along the row, so the column is target_column(x, disparity) of the row warp.
-  [[nodiscard]] int32_t target(int x, int /*y*/, float depth) const {
-    if (is_miss(depth)) return kNoSource;
-    const int column = target_column(x, motion_(depth));
-    return column >= 0 && column < width_ ? column : kNoSource;
+  [[nodiscard]] int32_t target(int x, int y, float depth) const {
+    const int32_t c = column(x, y, depth);
+    return c < width_ ? c : kNoSource;
   }
+
+  /// target() without the right edge: a column >= the width for a hit beyond it (Algorithm 1 takes
+  /// note of those); kNoSource for a miss or a column left of the image.
+  [[nodiscard]] int32_t column(int x, int /*y*/, float depth) const {
+    if (is_miss(depth)) return kNoSource;
+    const int c = target_column(x, motion_(depth));
+    return c >= 0 ? c : kNoSource;
+  }
+
+  [[nodiscard]] int width() const { return width_; }
 
   [[nodiscard]] const EyeCamera& left() const { return left_; }
   [[nodiscard]] const EyeCamera& right() const { return right_; }

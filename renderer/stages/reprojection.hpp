@@ -30,8 +30,8 @@ struct ReprojectionSettings {
 };
 
 /// Renders result.left by rasterization and warps it into a new result.right (stages left_gbuffer,
-/// left_shading, grid_metric, grid_warp; the search for surfaces outside the left frustum is part of
-/// grid_warp). Returns the WarpPixel state of every right pixel; counts
+/// left_shading, grid_metric, grid_warp, and source_frustum for the search for surfaces outside
+/// the left frustum). Returns the WarpPixel state of every right pixel; counts
 /// cells, grid triangles, fragments and hole pixels; adds the "grid" overlay to result.extras when
 /// asked for.
 std::vector<uint8_t> warp_left_to_right(const RenderScene& scene, const StereoRig& rig, const ReprojectionSettings& settings,

@@ -22,9 +22,15 @@ void reproject_row(const PixelReprojector& reprojector, const float* left_depth,
   bool background_between = false;
   for (int x = 0; x < width; ++x) {
     const float depth = left_depth[static_cast<size_t>(y) * width + x];
-    const int32_t r = reprojector.target(x, y, depth);
+    const int32_t r = reprojector.column(x, y, depth);
     background_between |= is_miss(depth);
     if (r == kNoSource) continue;
+    if (r >= width) {
+      // Algorithm 1's else branch: a hit beyond the right edge sets oldR to w − 1, so that a
+      // farther surface landing inside again opens no gap over pixels already hit.
+      old_r = width - 1;
+      continue;
+    }
     // A jump of more than one pixel after an earlier reprojection leaves a gap: its pixels are NoHit,
     // whatever reached them before. The thesis calls the gap bad when the two reprojections come
     // from horizontally adjacent pixels; across a background pixel (not reprojected here) they do
