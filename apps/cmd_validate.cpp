@@ -154,11 +154,16 @@ void run_validate(const ValidateArgs& a) {
     // Some new files in place beside earlier ones: the earlier summary goes, so that the mix does
     // not look complete. With none placed, the earlier run's files stand as they were.
     if (set.placed() == 0) throw;
-    std::error_code ec;
-    fs::remove(summary, ec);
-    throw IoError(fmt::format("{}; {} of this run's files are in place and the others not, and the summary {} is "
-                              "removed so that they do not look complete: validate again",
-                              e.what(), set.placed(), summary.string()));
+    std::string summary_fate = "is removed so that they do not look complete";
+    try {
+      (void)io::remove_output_file(summary);  // through a link, the file it names
+    } catch (const IoError& removal) {
+      summary_fate = fmt::format("could not be removed ({}): remove it", removal.what());
+    }
+    io::discard_output_files(stale);
+    throw IoError(fmt::format("{}; {} of this run's files are in place and the others not, and the summary {} {}; "
+                              "validate again",
+                              e.what(), set.placed(), summary.string(), summary_fate));
   }
   io::discard_output_files(stale);
   fmt::print("\nwrote {} (one record per pipeline beside it, images under {})\n", summary.string(), out.string());

@@ -1,6 +1,4 @@
 // stereobench: the command-line tool. Maps subcommands to library calls and errors to exit codes.
-#include <signal.h>
-
 #include <cctype>
 #include <cerrno>
 #include <cstdio>
@@ -18,11 +16,11 @@
 
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
-#include "renderer/io/atomic_file.hpp"
 #include "renderer/io/gltf_loader.hpp"
 #include "renderer/io/image_io.hpp"
 #include "renderer/memory.hpp"
 #include "sb_version.hpp"
+#include "validation/process.hpp"
 
 namespace {
 
@@ -45,22 +43,23 @@ std::string command_line(int argc, char** argv) {
 }
 
 /// An empty file or folder option (an unset shell variable, say) would read or write the current
-/// folder, or silently drop the output, and an empty name or value would be taken as not given:
-/// refused. --cache is not among them: '' turns the ground-truth cache off.
-void refuse_empty_paths(CLI::App& app) {
-  for (const char* name : {"--out", "--scenes-dir", "--store", "--results", "--history", "--json", "--junit",
-                           "--diff", "--ssim-map", "--mask", "--gate-config", "--config", "--baseline", "--gltf-clip",
-                           "--bvh", "--partition", "--time-limit", "--sbatch-arg"}) {
-    CLI::Option* option = app.get_option_no_throw(name);
-    if (!option) continue;
-    option->check(CLI::Validator(
-        [](const std::string& value) {
-          return value.empty() ? std::string("is empty; give a name, or leave the option out for its default")
-                               : std::string();
-        },
-        "", "non-empty"));
-  }
-  for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) refuse_empty_paths(*sub);
+/// folder, or silently drop the output, and an empty value would be taken as not given: refused.
+/// --cache is not among them: '' turns the ground-truth cache off.
+void refuse_empty_values(CLI::App& app) {
+  const auto refuse = [&](std::initializer_list<const char*> names, const char* what) {
+    for (const char* name : names) {
+      CLI::Option* option = app.get_option_no_throw(name);
+      if (!option) continue;
+      const std::string message = fmt::format("is empty; give {}, or leave the option out for its default", what);
+      option->check(CLI::Validator(
+          [message](const std::string& value) { return value.empty() ? message : std::string(); }, "", "non-empty"));
+    }
+  };
+  refuse({"--out", "--scenes-dir", "--store", "--results", "--history", "--json", "--junit", "--diff", "--ssim-map",
+          "--mask", "--gate-config", "--config", "--baseline", "--gltf-clip", "--partition"},
+         "a name");
+  refuse({"--bvh", "--time-limit", "--sbatch-arg"}, "a value");
+  for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) refuse_empty_values(*sub);
 }
 
 /// Options that name a file to write (--json, --junit, sweep collect's merged file): a folder
@@ -142,32 +141,12 @@ int after_flushing_stdout(int code) {
   return static_cast<int>(sb::ExitCode::environment);
 }
 
-/// On an interrupt (Ctrl-C), a termination request (a job's time limit, `kill`) or a hang-up: the
-/// temporary files of the writes in progress are removed, then the signal ends the process as it
-/// would have (its exit status shows the signal).
-void remove_temporaries_and_end(int signal) {
-  sb::io::remove_temporaries_on_signal();
-  ::signal(signal, SIG_DFL);
-  ::raise(signal);
-}
-
-void handle_ending_signals() {
-  struct sigaction action {};
-  action.sa_handler = remove_temporaries_and_end;
-  sigemptyset(&action.sa_mask);
-  for (const int s : {SIGINT, SIGTERM, SIGHUP}) {
-    struct sigaction previous {};
-    // A signal the shell ignores for this process (nohup, a background job's SIGINT) stays ignored.
-    if (::sigaction(s, nullptr, &previous) == 0 && previous.sa_handler == SIG_IGN) continue;
-    ::sigaction(s, &action, nullptr);
-  }
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   sb::keep_freed_memory();
-  handle_ending_signals();
+  // Ctrl-C, `kill`, a job's end: running tools are stopped and temporary files removed.
+  sb::validation::install_stop_handler();
   CLI::App app{"stereobench: offline validation and benchmarking of accelerated stereo rendering.\n"
                "Renders stereo pairs with every pipeline of the source papers, measures the synthesized\n"
                "right eye against ground truth, and reports quality, holes and time.",
@@ -188,7 +167,7 @@ int main(int argc, char** argv) {
   sb::cli::register_reference_command(app, command_line(argc, argv));
   sb::cli::register_report_command(app);
   sb::cli::register_path_command(app);
-  refuse_empty_paths(app);
+  refuse_empty_values(app);
   refuse_folder_as_file(app);
   refuse_non_decimal_numbers(app);
 

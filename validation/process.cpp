@@ -27,6 +27,7 @@
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
 #include "renderer/io/unique_fd.hpp"
 
 extern char** environ;
@@ -64,31 +65,16 @@ void open_pipe(io::UniqueFd& read_end, io::UniqueFd& write_end, const std::strin
 std::array<std::atomic<pid_t>, 256> g_running{};
 static_assert(std::atomic<pid_t>::is_always_lock_free, "the signal handler needs lock-free slots");
 
-/// SIGINT, SIGTERM, SIGHUP, SIGQUIT: kill every running child's group, then end as the signal's
-/// default action would (the exit status still says which signal it was). Async-signal-safe.
+/// SIGINT, SIGTERM, SIGHUP, SIGQUIT: kill every running child's group and remove the temporary
+/// files of the writes in progress, then end as the signal's default action would (the exit
+/// status still says which signal it was). Async-signal-safe.
 extern "C" void stop_children_and_end(int sig) {
+  if (io::defer_signal_during_commit(sig)) return;  // raised again once the set is in place
   for (std::atomic<pid_t>& slot : g_running)
     if (const pid_t group = slot.load(); group > 0) ::kill(-group, SIGKILL);
+  io::remove_temporaries_on_signal();
   ::signal(sig, SIG_DFL);
   ::raise(sig);  // delivered when the handler returns
-}
-
-/// Installs stop_children_and_end, once, for the signals whose action is still the default (an
-/// ignored one stays ignored, as under nohup; another handler stays).
-void install_stop_handler() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    for (const int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) {
-      struct sigaction current {};
-      if (::sigaction(sig, nullptr, &current) != 0 || (current.sa_flags & SA_SIGINFO) != 0 ||
-          current.sa_handler != SIG_DFL)
-        continue;
-      struct sigaction stop {};
-      stop.sa_handler = stop_children_and_end;
-      sigemptyset(&stop.sa_mask);
-      ::sigaction(sig, &stop, nullptr);
-    }
-  });
 }
 
 /// The spawned child until it is reaped: an exception kills its group and reaps it. While it
@@ -206,6 +192,23 @@ int open_pid_fd(pid_t pid) {
 }
 
 }  // namespace
+
+void install_stop_handler() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    for (const int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) {
+      struct sigaction current {};
+      if (::sigaction(sig, nullptr, &current) != 0 || (current.sa_flags & SA_SIGINFO) != 0 ||
+          current.sa_handler != SIG_DFL)
+        continue;
+      struct sigaction stop {};
+      stop.sa_handler = stop_children_and_end;
+      sigemptyset(&stop.sa_mask);
+      ::sigaction(sig, &stop, nullptr);
+    }
+  });
+}
+
 
 std::string ProcessResult::describe() const {
   if (timed_out) return "did not finish within its time limit and was stopped";

@@ -12,6 +12,14 @@
 
 namespace sb::validation {
 
+/// For SIGINT, SIGTERM, SIGHUP and SIGQUIT, where their action is still the default (an ignored
+/// one stays ignored, as under nohup; another handler stays), installs once a handler that kills
+/// the process group of every program running now, removes the temporary files of the writes in
+/// progress (io::remove_temporaries_on_signal), and then lets the signal end the process; during
+/// the renames of a set of files (io::StagedFiles::commit) it waits for them. Called by main and
+/// before every program starts.
+void install_stop_handler();
+
 /// Where one of the child's output streams goes.
 enum class ChildOutput {
   capture,    ///< into ProcessResult::out (stdout) or ProcessResult::err (stderr)

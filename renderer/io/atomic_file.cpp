@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <csignal>
 #include <chrono>
 #include <cerrno>
 #include <cstdlib>
@@ -114,12 +115,15 @@ UniqueFd lock_temporary(const fs::path& tmp, const fs::path& path) {
 /// Untouched slots cost no memory; a write that finds none free is only not removed on a signal
 /// (the next write of its file removes it as stale).
 struct SignalSlot {
-  std::atomic<bool> used{false};   ///< taken by a registration
-  std::atomic<bool> ready{false};  ///< `path` holds a whole name
+  std::atomic<bool> used{false};     ///< taken by a registration
+  std::atomic<uint32_t> version{0};  ///< odd while `path` is written; changes with every name
   char path[PATH_MAX];
 };
 constexpr size_t kSignalSlots = 512;
 SignalSlot g_signal_slots[kSignalSlots];
+
+std::atomic<int> g_commits{0};          ///< commits of StagedFiles running now
+std::atomic<int> g_deferred_signal{0};  ///< an ending signal that came during one
 
 /// Keeps a temporary file's name in a slot for its lifetime (movable, one owner).
 class SignalRegistration {
@@ -129,9 +133,11 @@ class SignalRegistration {
     if (name.size() >= PATH_MAX) return;
     for (size_t i = 0; i < kSignalSlots; ++i) {
       bool free = false;
-      if (!g_signal_slots[i].used.compare_exchange_strong(free, true)) continue;
-      std::memcpy(g_signal_slots[i].path, name.c_str(), name.size() + 1);
-      g_signal_slots[i].ready.store(true, std::memory_order_release);
+      SignalSlot& slot = g_signal_slots[i];
+      if (!slot.used.compare_exchange_strong(free, true)) continue;
+      slot.version.fetch_add(1, std::memory_order_acq_rel);  // odd: being written
+      std::memcpy(slot.path, name.c_str(), name.size() + 1);
+      slot.version.fetch_add(1, std::memory_order_acq_rel);  // even: whole
       slot_ = static_cast<int>(i);
       return;
     }
@@ -151,8 +157,9 @@ class SignalRegistration {
  private:
   void release() {
     if (slot_ < 0) return;
-    g_signal_slots[slot_].ready.store(false, std::memory_order_release);
-    g_signal_slots[slot_].used.store(false, std::memory_order_release);
+    SignalSlot& slot = g_signal_slots[slot_];
+    slot.version.fetch_add(1, std::memory_order_acq_rel);  // odd: no name
+    slot.used.store(false, std::memory_order_release);
     slot_ = -1;
   }
   int slot_ = -1;
@@ -170,8 +177,8 @@ Temporary new_temporary(const fs::path& path) {
   remove_stale_temporaries(path);
   static std::atomic<unsigned> counter{0};
   fs::path tmp = path.parent_path() / fmt::format("{}{}-{}", temporary_prefix(path), ::getpid(), counter++);
+  SignalRegistration on_signal(tmp);  // before the file exists: a signal on the way finds its name
   UniqueFd lock = lock_temporary(tmp, path);
-  SignalRegistration on_signal(tmp);
   return Temporary{std::move(tmp), std::move(lock), std::move(on_signal)};
 }
 
@@ -372,6 +379,14 @@ void StagedFiles::add(const fs::path& given, const std::function<void(const fs::
 }
 
 void StagedFiles::commit() {
+  // An ending signal waits for the renames (a few), so that no set is left half in place by it.
+  g_commits.fetch_add(1, std::memory_order_acq_rel);
+  struct Resume {
+    ~Resume() {
+      if (g_commits.fetch_sub(1, std::memory_order_acq_rel) == 1)
+        if (const int signal = g_deferred_signal.exchange(0)) ::raise(signal);
+    }
+  } resume;
   for (Entry& e : entries_) {
     std::error_code ec;
     fs::rename(e.staged.path, e.path, ec);
@@ -388,8 +403,27 @@ size_t StagedFiles::placed() const {
 }
 
 void remove_temporaries_on_signal() noexcept {
-  for (SignalSlot& slot : g_signal_slots)
-    if (slot.ready.load(std::memory_order_acquire)) (void)::unlink(slot.path);
+  char name[PATH_MAX];
+  for (SignalSlot& slot : g_signal_slots) {
+    // A name copied while its slot kept one version (even: whole and registered) is a name some
+    // write registered; one taken or released meanwhile is skipped.
+    const uint32_t before = slot.version.load(std::memory_order_acquire);
+    if ((before & 1u) != 0 || !slot.used.load(std::memory_order_acquire)) continue;
+    size_t n = 0;
+    while (n + 1 < sizeof name && slot.path[n] != '\0') {
+      name[n] = slot.path[n];
+      ++n;
+    }
+    name[n] = '\0';
+    std::atomic_thread_fence(std::memory_order_acquire);
+    if (slot.version.load(std::memory_order_relaxed) == before) (void)::unlink(name);
+  }
+}
+
+bool defer_signal_during_commit(int signal) noexcept {
+  if (g_commits.load(std::memory_order_acquire) == 0) return false;
+  g_deferred_signal.store(signal, std::memory_order_release);
+  return true;
 }
 
 fs::path follow_links(const fs::path& path) { return link_chain(path).back(); }

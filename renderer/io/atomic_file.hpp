@@ -69,9 +69,15 @@ bool remove_output_file(const std::filesystem::path& path);
 void discard_output_files(std::span<const std::filesystem::path> paths) noexcept;
 
 /// Removes the temporary files of the writes now in progress (interrupted, they would stay as
-/// hidden .FILE.tmp-PID-N files until a later write of the same file). Async-signal-safe: for a
-/// handler of SIGINT, SIGTERM or SIGHUP, which then lets the signal end the process.
+/// hidden .FILE.tmp-PID-N files until a later write of the same file). Async-signal-safe: called
+/// by the handler of the ending signals (validation::install_stop_handler), which then lets the
+/// signal end the process.
 void remove_temporaries_on_signal() noexcept;
+
+/// For the same handler: while a StagedFiles::commit runs, records `signal` to be raised again
+/// when the commit ends and returns true (the handler returns at once); otherwise false.
+/// Async-signal-safe.
+[[nodiscard]] bool defer_signal_during_commit(int signal) noexcept;
 
 /// The file a path names, its symbolic links followed (a dangling link gives the file it would
 /// create); `path` itself when it is no link. IoError for a loop of links.

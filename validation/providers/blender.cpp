@@ -288,7 +288,7 @@ class BlenderProvider final : public TruthProvider {
   std::string revision() const override { return kRevision; }
 
   void check_scene(const Scene& scene, const fs::path& scene_file) const override {
-    (void)export_lights(scene);  // InputError for what Cycles cannot reproduce
+    (void)export_lights(scene);  // InputError for a negative light colour
     if (scene_file.empty() || !fs::is_regular_file(scene_file))
       throw InputError(fmt::format("the blender provider imports the scene's glTF file, but '{}' is not a file; "
                                    "render a scene loaded from a .gltf/.glb file",
