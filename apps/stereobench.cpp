@@ -176,7 +176,7 @@ int main(int argc, char** argv) {
   } catch (const sb::cli::VerdictExit& verdict) {
     return after_flushing_stdout(verdict.code);
   } catch (const CLI::Success& e) {
-    return app.exit(e);  // --help, --version
+    return after_flushing_stdout(app.exit(e));  // --help, --version: 4 when they could not be written
   } catch (const CLI::ParseError& e) {
     // Usage errors read like every other error: one "stereobench: error:" line, then where to look.
     const std::string unknown = unknown_command_message(app, argc, argv);

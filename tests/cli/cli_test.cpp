@@ -33,7 +33,8 @@ TEST(Cli, OutputStandardOutputCannotTakeIsAnIoError) {
   ASSERT_TRUE(std::filesystem::exists("/dev/full")) << "the test writes to /dev/full";
   const std::string cache = (std::filesystem::path(SB_BINARY_DIR) / "Testing" / "scenes-cache").string();
   for (const std::string& command :
-       std::vector<std::string>{"scenes list", "scenes info box-wall --scenes-dir '" + cache + "'", "pipelines"}) {
+       std::vector<std::string>{"scenes list", "scenes info box-wall --scenes-dir '" + cache + "'", "pipelines",
+                                "--help", "render --help", "--version"}) {
     const CliRun r = test::run_shell("{ " + std::string(SB_CLI_PATH) + " " + command + " >/dev/full; }");
     EXPECT_EQ(r.code, 4) << command << ": " << r.out;
     EXPECT_NE(r.out.find("stereobench: error: cannot write to"), std::string::npos) << command << ": " << r.out;
