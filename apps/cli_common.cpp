@@ -166,17 +166,7 @@ void remove_earlier_output(const std::filesystem::path& path, const std::string&
   }
 }
 
-void remove_earlier_outputs(std::initializer_list<NamedPath> outputs) {
-  std::optional<IoError> first;
-  for (const NamedPath& o : outputs) {
-    try {
-      remove_earlier_output(*o.path, o.name);
-    } catch (const IoError& e) {
-      if (!first) first = e;  // the others are still removed
-    }
-  }
-  if (first) throw *first;
-}
+void remove_earlier_outputs(std::initializer_list<NamedPath> outputs) { remove_earlier_outputs_sparing({}, outputs); }
 
 void remove_earlier_outputs_sparing(std::initializer_list<NamedPath> inputs, std::initializer_list<NamedPath> outputs) {
   std::optional<IoError> first;
@@ -188,7 +178,7 @@ void remove_earlier_outputs_sparing(std::initializer_list<NamedPath> inputs, std
     try {
       remove_earlier_output(*o.path, o.name);
     } catch (const IoError& e) {
-      if (!first) first = e;
+      if (!first) first = e;  // the others are still removed
     }
   }
   if (first) throw *first;

@@ -101,10 +101,8 @@ void run_validate(const ValidateArgs& a) {
   // the summary last: a run that stops on the way (an image it cannot write, a full disk) leaves an
   // earlier run's summary, records and images as they were.
   io::StagedFiles set;
-  std::vector<fs::path> stale;  // an earlier run's files of this set that this one does not write
   validation::ImageFileOptions image_options;
   image_options.staged = &set;
-  image_options.stale = &stale;
   {
     const json shared_images = validation::write_target_images(out, scene.file_stem(), target, executor, image_options);
 
@@ -148,24 +146,7 @@ void run_validate(const ValidateArgs& a) {
         json{{"kind", "stereobench.validation_summary"}, {"records", records}}.dump(2) + "\n";
     set.add(summary, [&](const fs::path& tmp) { io::write_text_atomically(tmp, summary_text); });
   }
-  try {
-    set.commit();
-  } catch (const IoError& e) {
-    // Some new files in place beside earlier ones: the earlier summary goes, so that the mix does
-    // not look complete. With none placed, the earlier run's files stand as they were.
-    if (set.placed() == 0) throw;
-    std::string summary_fate = "is removed so that they do not look complete";
-    try {
-      (void)io::remove_output_file(summary);  // through a link, the file it names
-    } catch (const IoError& removal) {
-      summary_fate = fmt::format("could not be removed ({}): remove it", removal.what());
-    }
-    io::discard_output_files(stale);
-    throw IoError(fmt::format("{}; {} of this run's files are in place and the others not, and the summary {} {}; "
-                              "validate again",
-                              e.what(), set.placed(), summary.string(), summary_fate));
-  }
-  io::discard_output_files(stale);
+  set.commit();  // the summary, added last, is the set's marker
   fmt::print("\nwrote {} (one record per pipeline beside it, images under {})\n", summary.string(), out.string());
 }
 

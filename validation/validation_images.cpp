@@ -112,8 +112,8 @@ json write_pipeline_images(const std::filesystem::path& dir, const std::string& 
         {left_files[1], [&](const Path& to) { write_png(to, difference_image(v.left_srgb8, target.left->srgb8)); }});
     files["left_png"] = left_files[0].string();
     files["left_diff_png"] = left_files[1].string();
-  } else if (options.stale != nullptr) {
-    options.stale->insert(options.stale->end(), left_files.begin(), left_files.end());
+  } else if (options.staged != nullptr) {
+    for (const std::filesystem::path& file : left_files) options.staged->retire(file);
   } else {
     io::discard_output_files(left_files);
   }

@@ -5,7 +5,6 @@
 
 #include <filesystem>
 #include <string>
-#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -25,11 +24,9 @@ struct ImageFileOptions {
   bool exr = true;  ///< the EXR of the ground truth and of every right eye (large: every AOV)
   /// Where the files go: null, each in place as it is finished (on failure the set's files are
   /// removed, an earlier run's included); otherwise added to this set, which the caller commits,
-  /// so that a failure before the commit leaves an earlier run's files as they were.
+  /// so that a failure before the commit leaves an earlier run's files as they were (files of the
+  /// set not written again are retired with it).
   io::StagedFiles* staged = nullptr;
-  /// With `staged`: receives the files of the set this call does not write (an earlier run's
-  /// left-eye images), to be removed once the set is committed.
-  std::vector<std::filesystem::path>* stale = nullptr;
 };
 
 /// Writes the images shared by every pipeline of a target under `dir`: <stem>_truth-<provider>.exr

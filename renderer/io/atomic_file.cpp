@@ -387,19 +387,35 @@ void StagedFiles::commit() {
         if (const int signal = g_deferred_signal.exchange(0)) ::raise(signal);
     }
   } resume;
-  for (Entry& e : entries_) {
+  for (size_t k = 0; k < entries_.size(); ++k) {
+    Entry& e = entries_[k];
     std::error_code ec;
     fs::rename(e.staged.path, e.path, ec);
-    if (ec)
-      throw IoError(fmt::format("cannot write {}: the finished file cannot take its name ({}); any earlier file of that "
-                                "name is left as it was",
-                                e.path.string(), ec.message()));
-    e.placed = true;
+    if (!ec) {
+      e.placed = true;
+      continue;
+    }
+    const std::string failed = fmt::format(
+        "cannot write {}: the finished file cannot take its name ({}); any earlier file of that name is left as it was",
+        e.path.string(), ec.message());
+    if (k == 0) throw IoError(failed);
+    const fs::path& marker = entries_.back().path;  // not placed: it goes last
+    std::error_code removed;
+    fs::remove(marker, removed);
+    throw IoError(fmt::format("{}; {} of the set's {} files are in place and the others not: {}", failed, k,
+                              entries_.size(),
+                              removed ? fmt::format("remove {} ({}), then write the set again", marker.string(),
+                                                    removed.message())
+                                      : fmt::format("{} is removed so that the set does not look complete; write it "
+                                                    "again",
+                                                    marker.string())));
   }
+  discard_output_files(retired_);
 }
 
-size_t StagedFiles::placed() const {
-  return static_cast<size_t>(std::count_if(entries_.begin(), entries_.end(), [](const Entry& e) { return e.placed; }));
+void StagedFiles::retire(const fs::path& path) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  retired_.push_back(path);
 }
 
 void remove_temporaries_on_signal() noexcept {

@@ -32,7 +32,9 @@ void write_atomically(const std::filesystem::path& path,
 /// InputError), commit() then renames them into place in the order they were added. Until commit
 /// nothing at the final names changes, so a failure while adding (a full disk) leaves an earlier
 /// set as it was; a set destroyed uncommitted removes its temporary files. add() may be called
-/// from several threads at once (each file is written by the thread that adds it).
+/// from several threads at once (each file is written by the thread that adds it). The file added
+/// last is the set's marker (a stats or summary file that says the set is complete): placed last,
+/// and removed should the set end up half in place.
 class StagedFiles {
  public:
   StagedFiles();
@@ -43,16 +45,21 @@ class StagedFiles {
   /// Calls `write(tmp_path)` and flushes the file; on failure its temporary file is removed and
   /// the error passed on (IoError naming `path` for an untyped one).
   void add(const std::filesystem::path& path, const std::function<void(const std::filesystem::path& tmp_path)>& write);
-  /// Renames every file added into place, in order; IoError at the first that fails (the files
-  /// before it are in place, the others' temporaries are removed with the set).
+  /// An earlier file of the set that this one does not write again: removed once the set is in
+  /// place (best effort), never before.
+  void retire(const std::filesystem::path& path);
+  /// Renames every file added into place, in order, then removes the retired ones. IoError at the
+  /// first rename that fails: with none placed, every earlier file stands as it was; with some
+  /// placed, the marker's earlier file is removed too (its links followed), so that the mix does
+  /// not look complete, and the message says so (or that it could not be removed). The others'
+  /// temporaries are removed with the set.
   void commit();
-  /// How many files commit() has put in place (all of them once it returned).
-  [[nodiscard]] size_t placed() const;
 
  private:
   struct Entry;
   std::mutex mutex_;  ///< guards entries_ while files are added side by side
   std::vector<Entry> entries_;
+  std::vector<std::filesystem::path> retired_;
 };
 
 /// Whether write_atomically writes `path` in place (a device, pipe or socket, or a path through a

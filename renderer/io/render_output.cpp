@@ -222,26 +222,9 @@ RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::st
   set.add(f.exr, [&](const fs::path& tmp) { write_exr_stereo(tmp, result.left, result.right, meta); });
   for (const auto& [file, image] : pngs) set.add(file, [&](const fs::path& tmp) { write_png_preview(tmp, *image); });
   set.add(f.stats_json, [&](const fs::path& tmp) { write_text_atomically(tmp, stats.dump(2) + "\n"); });
-  try {
-    set.commit();
-  } catch (const IoError& e) {
-    // Some new files in place beside earlier ones: the stats JSON goes, so that the mix does not
-    // look complete. With none placed, the earlier set stands as it was.
-    if (set.placed() == 0) throw;
-    std::error_code ec;
-    fs::remove(f.stats_json, ec);
-    const bool kept = fs::exists(f.stats_json, ec);
-    throw IoError(fmt::format("{}; {} of this render's files are in place and the others not: {}, then render again",
-                              e.what(), set.placed(),
-                              kept ? fmt::format("remove {} (it could not be removed here)", f.stats_json.string())
-                                   : fmt::format("{} is removed so that the set does not look complete",
-                                                 f.stats_json.string())));
-  }
-  for (const std::string& name : earlier) {
-    if (std::find(names.begin(), names.end(), name) != names.end()) continue;
-    std::error_code ec;
-    fs::remove(dir / name, ec);
-  }
+  for (const std::string& name : earlier)
+    if (std::find(names.begin(), names.end(), name) == names.end()) set.retire(dir / name);
+  set.commit();  // the stats JSON, added last, is the set's marker
   return f;
 }
 

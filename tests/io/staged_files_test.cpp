@@ -1,0 +1,99 @@
+// Files written as one set: nothing changes before the commit, retired files go only once the set
+// is in place, and a set left half in place by a failed rename loses its marker (the file added
+// last), whose earlier version would otherwise say the mix is complete.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "renderer/error.hpp"
+#include "renderer/io/atomic_file.hpp"
+#include "support/scratch_dir.hpp"
+
+namespace sb::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+void write(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+
+/// Adds `text` as `path` to the set.
+void add(StagedFiles& set, const fs::path& path, const std::string& text) {
+  set.add(path, [&](const fs::path& tmp) { write_text_atomically(tmp, text); });
+}
+
+/// Regular files in `dir`, temporaries included.
+size_t files_in(const fs::path& dir) {
+  size_t n = 0;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir)) n += e.is_regular_file() ? 1 : 0;
+  return n;
+}
+
+TEST(StagedFiles, ACommittedSetReplacesTheEarlierOneAndRetiresWhatItDoesNotWrite) {
+  test::ScratchDir dir("staged");
+  write(dir / "a.txt", "old a");
+  write(dir / "gone.png", "old diagnostic image");
+  write(dir / "set.json", "old marker");
+  {
+    StagedFiles set;
+    add(set, dir / "a.txt", "new a");
+    add(set, dir / "set.json", "new marker");
+    set.retire(dir / "gone.png");
+    EXPECT_EQ(test::read_text(dir / "a.txt"), "old a") << "a file changed before the commit";
+    EXPECT_TRUE(fs::exists(dir / "gone.png")) << "a retired file went before the commit";
+    set.commit();
+  }
+  EXPECT_EQ(test::read_text(dir / "a.txt"), "new a");
+  EXPECT_EQ(test::read_text(dir / "set.json"), "new marker");
+  EXPECT_FALSE(fs::exists(dir / "gone.png"));
+  EXPECT_EQ(files_in(dir.path()), 2u);
+}
+
+TEST(StagedFiles, ARenameThatFailsFirstLeavesTheEarlierSetAndOneThatFailsLaterRemovesItsMarker) {
+  test::ScratchDir dir("staged-fail");
+  const auto earlier = [&] {
+    write(dir / "a.txt", "old a");
+    write(dir / "gone.png", "old diagnostic image");
+    write(dir / "set.json", "old marker");
+  };
+  // A folder appears at a file's name after the set was made: its rename fails.
+  for (const bool first : {true, false}) {
+    earlier();
+    {
+      StagedFiles set;
+      add(set, dir / "a.txt", "new a");
+      add(set, dir / "b.txt", "new b");
+      add(set, dir / "set.json", "new marker");
+      set.retire(dir / "gone.png");
+      const fs::path blocked = dir / (first ? "a.txt" : "b.txt");
+      fs::remove(blocked);
+      fs::create_directories(blocked / "inside");
+      try {
+        set.commit();
+        ADD_FAILURE() << "a rename onto a folder succeeded";
+      } catch (const IoError& e) {
+        const std::string msg = e.what();
+        EXPECT_NE(msg.find("cannot write " + blocked.string()), std::string::npos) << msg;
+        if (!first) {
+          EXPECT_NE(msg.find("1 of the set's 3 files are in place and the others not: " + (dir / "set.json").string() +
+                             " is removed"),
+                    std::string::npos)
+              << msg;
+        }
+      }
+    }
+    EXPECT_TRUE(fs::exists(dir / "gone.png")) << "retired although the set is not in place";
+    if (first) {
+      EXPECT_EQ(test::read_text(dir / "set.json"), "old marker");
+    } else {
+      EXPECT_EQ(test::read_text(dir / "a.txt"), "new a");
+      EXPECT_FALSE(fs::exists(dir / "set.json")) << "the earlier marker stands beside a half-placed set";
+    }
+    EXPECT_EQ(files_in(dir.path()), 2u) << "temporaries left";  // gone.png, and set.json or the new a.txt
+    fs::remove_all(dir / (first ? "a.txt" : "b.txt"));
+  }
+}
+
+}  // namespace
+}  // namespace sb::io
