@@ -53,8 +53,6 @@ class PixelReprojector {
     return c >= 0 ? c : kNoSource;
   }
 
-  [[nodiscard]] int width() const { return width_; }
-
   [[nodiscard]] const EyeCamera& left() const { return left_; }
   [[nodiscard]] const EyeCamera& right() const { return right_; }
   /// Each eye's primary rays, for every pixel.
