@@ -83,16 +83,7 @@ void run_path_command(const PathArgs& a) {
   if (a.camera_keys) run.path.camera_keys = parse_camera_keys(*a.camera_keys);
   run.path.gltf_animation = a.gltf_animation || !a.gltf_clip.empty();
   run.path.gltf_clip = a.gltf_clip;
-  if (run.path.gltf_animation && a.truth == "blender")
-    throw InputError("--gltf-animation with --truth blender: Blender renders the scene file at rest, not as it moves "
-                     "along the path; use --truth full or povray");
-  if (a.spin_deg) {
-    // Blender imports the scene file, which does not turn; full and povray render the moved scene.
-    if (a.truth == "blender")
-      throw InputError("--spin-deg with --truth blender: Blender renders the scene file, which does not turn; "
-                       "use --truth full or povray");
-    run.path.spin = Spin{parse_axis(a.spin_axis), std::nullopt, *a.spin_deg, a.spin_prefix};
-  }
+  if (a.spin_deg) run.path.spin = Spin{parse_axis(a.spin_axis), std::nullopt, *a.spin_deg, a.spin_prefix};
   run.path.validate();
   // Keys the path cannot reach are said, not passed over.
   if (run.path.camera_keys.size() > 1 && a.frames == 1)

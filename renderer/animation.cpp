@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -236,6 +237,11 @@ void SceneAnimator::apply(int frame) {
       Mesh& mesh = scene_.meshes[m];
       // The node's world transform at t places its own geometry; normals by its inverse transpose.
       const dmat4 w = played_.world(mesh.node, t);
+      // From the file's placement: a node scaled to nothing at rest has no inverse, and no
+      // transform takes its collapsed geometry to this frame's (every entry then NaN or infinite).
+      const dmat4 rest = played_.rest_world(mesh.node);
+      mesh.moved = glm::determinant(dmat3(rest)) != 0.0 ? w * glm::inverse(rest)
+                                                        : dmat4(std::numeric_limits<double>::quiet_NaN());
       const double det = glm::determinant(dmat3(w));
       for (size_t i = 0; i < mesh.local_positions.size(); ++i)
         mesh.positions[i] = vec3(dvec3(w * dvec4(dvec3(mesh.local_positions[i]), 1.0)));
@@ -259,8 +265,12 @@ void SceneAnimator::apply(int frame) {
   if (turning_.empty()) return;
   const double radians = degrees_to_radians(path_.spin->degrees_per_frame * frame);
   const dmat3 r = rotation(*unit_axis(path_.spin->axis), radians);
+  // p -> pivot + r (p - pivot), from the positions as loaded.
+  dmat4 turn(r);
+  turn[3] = dvec4(pivot_ - r * pivot_, 1.0);
   for (size_t k = 0; k < turning_.size(); ++k) {
     Mesh& mesh = scene_.meshes[turning_[k]];
+    mesh.moved = turn;
     const std::vector<vec3>& p0 = base_positions_[k];
     for (size_t i = 0; i < p0.size(); ++i) mesh.positions[i] = vec3(pivot_ + r * (dvec3(p0[i]) - pivot_));
     const std::vector<vec3>& n0 = base_normals_[k];

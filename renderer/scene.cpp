@@ -135,6 +135,12 @@ dmat4 NodeAnimation::world(int node, double time) const {
   return w;
 }
 
+dmat4 NodeAnimation::rest_world(int node) const {
+  dmat4 w(1.0);
+  for (int n = node; n >= 0; n = parent[static_cast<size_t>(n)]) w = local[static_cast<size_t>(n)].transform() * w;
+  return w;
+}
+
 size_t Scene::triangle_count() const {
   size_t n = 0;
   for (const Mesh& m : meshes) n += m.triangle_count();

@@ -54,6 +54,11 @@ struct Mesh {
   /// Whether its triangles are in reversed order, for a world transform that mirrors (negative
   /// determinant), so that they keep facing the way the file says.
   bool mirrored = false;
+  /// The affine world-space transform that takes it from where the scene file places it to where
+  /// it is now: the identity as loaded; a path's frame (renderer/animation.hpp) sets it with the
+  /// positions. A ground truth that imports the scene file itself (Blender) places the node with it.
+  /// Not finite where no transform does (a node scaled to nothing in the file).
+  dmat4 moved{1.0};
 
   [[nodiscard]] size_t triangle_count() const { return indices.size() / 3; }
   /// Whether triangle t has zero area (its vertices coincide or lie on one line): it covers no
@@ -164,6 +169,8 @@ struct NodeAnimation {
   /// The node's world transform at `time` (before the first key: the first; after the last: the
   /// last, as glTF clamps).
   [[nodiscard]] dmat4 world(int node, double time) const;
+  /// The node's world transform at rest (every node at its own transform, as the file places it).
+  [[nodiscard]] dmat4 rest_world(int node) const;
 
  private:
   [[nodiscard]] dmat4 local_at(int node, double time) const;

@@ -27,7 +27,7 @@ namespace {
 namespace fs = std::filesystem;
 
 /// Bumped whenever the export, the script or the settings change.
-constexpr const char* kRevision = "blender-export-5";
+constexpr const char* kRevision = "blender-export-6";
 /// Cut-out holes a camera or shadow ray may pass in Cycles (transparent bounces); ours pass any.
 constexpr int kTransparentBounces = 64;
 /// Environment variable naming the Blender executable (a path, or a name looked up on PATH).
@@ -139,6 +139,36 @@ std::string query_version(const fs::path& executable) {
 
 nlohmann::json vec_json(const vec3& v) { return {double(v.x), double(v.y), double(v.z)}; }
 nlohmann::json vec_json(const dvec3& v) { return {v.x, v.y, v.z}; }
+
+/// The nodes a path's frame has moved from where the scene file places them, each with the world
+/// transform (glTF space, 16 numbers column by column) that takes it there from the file's
+/// placement (Mesh::moved). Blender imports the file and moves a node's object as a whole, so
+/// InputError for a node whose primitives moved apart (a spin's mesh prefix naming some of them) or
+/// that no transform places (scaled to nothing in the file).
+nlohmann::json export_moved_nodes(const Scene& scene) {
+  nlohmann::json moved = nlohmann::json::array();
+  std::map<int, const Mesh*> seen;  // node -> its first mesh
+  for (const Mesh& m : scene.meshes) {
+    const double* v = glm::value_ptr(m.moved);
+    if (!std::all_of(v, v + 16, [](double x) { return std::isfinite(x); }))
+      throw InputError(fmt::format("scene '{}': node {} (mesh '{}') is scaled to nothing where the file places it, so "
+                                   "the blender provider, which imports the file, cannot move it to this frame's "
+                                   "pose; use the full or povray provider",
+                                   scene.name, m.node, m.name));
+    const auto [first, fresh] = seen.emplace(m.node, &m);
+    if (!fresh) {
+      if (first->second->moved != m.moved)
+        throw InputError(fmt::format("scene '{}': meshes '{}' and '{}' of node {} move apart in this frame (a spin's "
+                                     "mesh prefix names only some of them?); Blender imports a node's primitives as "
+                                     "one object and moves them together: choose a prefix that names all of them, or "
+                                     "use the full or povray provider",
+                                     scene.name, first->second->name, m.name, m.node));
+      continue;
+    }
+    if (m.moved != dmat4(1.0)) moved.push_back({{"node", m.node}, {"matrix", std::vector<double>(v, v + 16)}});
+  }
+  return moved;
+}
 
 /// Lights that contribute (positive intensity), with their Blender parameters: a spot is a point
 /// light whose emission the script shapes with the cone. InputError for a negative colour.
@@ -340,6 +370,7 @@ class BlenderProvider final : public TruthProvider {
 
     // Everything the script needs, from the in-memory scene and rig.
     params["scene_file"] = fs::absolute(request.scene_file).string();
+    params["moved_nodes"] = export_moved_nodes(scene);
     params["textures"] = export_textures(scene, work_dir);
     params["materials"] = nlohmann::json::array();
     for (const Material& m : scene.materials)

@@ -45,6 +45,29 @@ def import_scene():
         bpy.data.materials[name]["stereobench_material"] = int(material_idx)
 
     importer.create = staticmethod(create)
+    # Record the glTF node of every mesh object, so that a node a path's frame moves is found by
+    # index; and import no animation: its actions would pose the nodes at the current frame's keys,
+    # where the file places them at rest (as the in-memory scene has them before a path moves them).
+    from io_scene_gltf2.blender.imp import gltf2_blender_node as node_module
+    from io_scene_gltf2.blender.imp import gltf2_blender_scene as scene_module
+    node_importer = node_module.BlenderNode
+    scene_importer = scene_module.BlenderScene
+    for cls, method in ((node_importer, "create_object"), (scene_importer, "create_animations")):
+        if not hasattr(cls, method):
+            fail("the glTF importer of this Blender has no %s.%s; this script supports Blender 3.4"
+                 % (cls.__name__, method))
+    original_object = node_importer.create_object
+    original_animations = scene_importer.create_animations
+
+    def create_object(gltf, vnode_id):
+        obj = original_object(gltf, vnode_id)
+        mesh_node = gltf.vnodes[vnode_id].mesh_node_idx
+        if mesh_node is not None:
+            obj["stereobench_node"] = int(mesh_node)
+        return obj
+
+    node_importer.create_object = staticmethod(create_object)
+    scene_importer.create_animations = staticmethod(lambda gltf: None)
     # The importer sets glTF vertex normals as custom normals only with import_shading="NORMALS",
     # whose code uses numpy.bool, an alias that numpy 1.24 removed (Debian's Blender 3.4 runs on
     # the system numpy): restore the alias, which is the builtin bool.
@@ -56,11 +79,73 @@ def import_scene():
                                            merge_vertices=False, import_pack_images=False)
     finally:
         importer.create = staticmethod(original_create)
+        node_importer.create_object = staticmethod(original_object)
+        scene_importer.create_animations = staticmethod(original_animations)
     if "FINISHED" not in result:
         fail("the glTF importer did not finish on " + PARAMS["scene_file"])
-    for obj in list(bpy.data.objects):
-        if obj.type in {"LIGHT", "CAMERA"}:
-            bpy.data.objects.remove(obj, do_unlink=True)
+    bpy.context.view_layer.update()
+    # A mesh whose node hangs below a light's or the camera's keeps its place when they go.
+    removed = {obj for obj in bpy.data.objects if obj.type in {"LIGHT", "CAMERA"}}
+    place_objects({obj: obj.matrix_world.copy() for obj in bpy.data.objects
+                   if obj.type == "MESH" and has_ancestor_in(obj, removed)})
+    for obj in removed:
+        bpy.data.objects.remove(obj, do_unlink=True)
+
+
+def has_ancestor_in(obj, objects):
+    parent = obj.parent
+    while parent is not None:
+        if parent in objects:
+            return True
+        parent = parent.parent
+    return False
+
+
+def place_objects(targets):
+    # Unparents each object and gives it its world matrix: once none of them has a parent, setting
+    # one does not move another. A matrix with shear has no location, rotation and scale, which is
+    # all an object without a parent holds: such a target fails, naming the object.
+    for obj, matrix in targets.items():
+        obj.parent = None
+        obj.matrix_world = matrix
+    bpy.context.view_layer.update()
+    for obj, matrix in targets.items():
+        got = obj.matrix_world
+        scale = max(1.0, max(abs(matrix[r][c]) for r in range(4) for c in range(4)))
+        if max(abs(got[r][c] - matrix[r][c]) for r in range(4) for c in range(4)) > 1e-5 * scale:
+            fail("object '%s' cannot be placed as the scene has it: its world transform has shear, which an "
+                 "object without a parent cannot hold" % obj.name)
+
+
+def place_moved_nodes():
+    # The mesh objects of the nodes a path's frame has moved, and every mesh object below them, are
+    # placed where the in-memory scene has them: a moved node at its transform from the file's
+    # placement (glTF world space) times its place at rest, the others at rest.
+    from mathutils import Matrix
+    moved = {}
+    for m in PARAMS["moved_nodes"]:
+        v = m["matrix"]  # column by column
+        moved[m["node"]] = Matrix([[v[c * 4 + r] for c in range(4)] for r in range(4)])
+    if not moved:
+        return
+    by_node = {}
+    for obj in bpy.data.objects:
+        if "stereobench_node" in obj:
+            by_node[int(obj["stereobench_node"])] = obj
+    missing = sorted(set(moved) - set(by_node))
+    if missing:
+        fail("the importer made no object for the moved glTF node(s) " + ", ".join(map(str, missing)))
+    to_blender = Matrix(((1.0, 0.0, 0.0, 0.0), (0.0, 0.0, -1.0, 0.0), (0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)))
+    moving = {by_node[n] for n in moved}
+    targets = {}
+    for obj in bpy.data.objects:
+        if obj.type == "MESH" and (obj in moving or has_ancestor_in(obj, moving)):
+            rest = obj.matrix_world.copy()
+            node = obj.get("stereobench_node")
+            if obj in moving:
+                rest = to_blender @ moved[int(node)] @ to_blender.transposed() @ rest
+            targets[obj] = rest
+    place_objects(targets)
 
 
 def uv_map_name(texcoord):
@@ -421,6 +506,7 @@ def render_passes(lights, switches, background_strength):
 
 
 import_scene()
+place_moved_nodes()
 switches = setup_materials()
 background_strength = setup_world()
 lights = setup_lights()
