@@ -93,7 +93,9 @@ RenderScene::RenderScene(const Scene& scene, bool refittable)
 }
 
 double RenderScene::update_geometry() {
-  (void)checked_bounds(*scene_);
+  // The offset follows the moved bounds, as a scene prepared at this frame has it: a frame's image
+  // must not depend on which frame the worker prepared first.
+  ray_epsilon_ = shadow_offset(checked_bounds(*scene_));
   return rays_.update();
 }
 

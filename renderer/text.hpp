@@ -36,6 +36,30 @@ namespace sb {
   return out;
 }
 
+/// `s` with each control character written as \n, \t, \r or \xHH, for one line of text (a
+/// message, a comment in a generated script) that a newline in a name must not break.
+[[nodiscard]] inline std::string printable(std::string_view s) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  for (const char c : s) {
+    const auto u = static_cast<unsigned char>(c);
+    if (std::iscntrl(u) == 0) {
+      out += c;
+    } else if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\t') {
+      out += "\\t";
+    } else if (c == '\r') {
+      out += "\\r";
+    } else {
+      out += "\\x";
+      out += kHex[u >> 4];
+      out += kHex[u & 15u];
+    }
+  }
+  return out;
+}
+
 /// The strftime form of a UTC time in every record, provenance and submission file the suite
 /// writes: ISO 8601, "2026-11-21T20:00:00Z".
 inline constexpr const char* kUtcTimeFormat = "%Y-%m-%dT%H:%M:%SZ";

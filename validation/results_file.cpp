@@ -547,7 +547,14 @@ void require_unique_id(std::map<std::string, size_t>& seen, const std::string& i
 
 void rebase_image_paths(json& cell, const fs::path& from, const fs::path& to) {
   const fs::path a = fs::absolute(from).lexically_normal(), b = fs::absolute(to).lexically_normal();
-  if (a != b && cell.contains("images")) rebase_strings(cell["images"], a, b);
+  if (a == b) return;
+  if (cell.contains("images")) rebase_strings(cell["images"], a, b);
+  // Each pipeline's validation record names its images too.
+  if (const auto p = cell.find("pipelines"); p != cell.end() && p->is_object())
+    for (auto& [name, record] : p->items())
+      if (record.is_object())
+        if (const auto v = record.find("validation"); v != record.end() && v->is_object() && v->contains("images"))
+          rebase_strings((*v)["images"], a, b);
 }
 
 std::vector<json> collect_results(const std::vector<fs::path>& files, const fs::path& out,
@@ -614,7 +621,15 @@ std::string results_csv(const std::vector<json>& cells) {
   std::string out;
   for (const char* column : kCsvColumns) out += (out.empty() ? "" : ",") + std::string(column);
   out += "\r\n";
-  for (const json& cell : cells) {
+  // Rows in the cells' order, whichever order parallel jobs finished them in.
+  std::vector<const json*> ordered;
+  for (const json& cell : cells) ordered.push_back(&cell);
+  std::stable_sort(ordered.begin(), ordered.end(), [](const json* a, const json* b) {
+    const json x = value_at(*a, "cell_index"), y = value_at(*b, "cell_index");
+    return x.is_number_integer() && y.is_number_integer() && x.get<int64_t>() < y.get<int64_t>();
+  });
+  for (const json* each : ordered) {
+    const json& cell = *each;
     std::string params;
     const json scene_params = value_at(cell, "cell.scene_params");
     if (scene_params.is_object())

@@ -98,7 +98,8 @@ void rebase_image_paths(nlohmann::json& cell, const std::filesystem::path& from,
 /// The cells as JSON Lines text (one finite_json line each).
 [[nodiscard]] std::string results_text(const std::vector<nlohmann::json>& cells);
 
-/// The CSV header and one row per (cell, pipeline), RFC 4180 quoted, lines ending in CRLF.
+/// The CSV header and one row per (cell, pipeline), the cells in cell_index order, RFC 4180
+/// quoted, lines ending in CRLF.
 /// Columns: see kCsvColumns.
 [[nodiscard]] std::string results_csv(const std::vector<nlohmann::json>& cells);
 inline constexpr const char* kCsvColumns[] = {

@@ -53,14 +53,17 @@ std::string shell_quote(const std::string& s) {
   return out + "'";
 }
 
-/// A path written into an #SBATCH directive: sbatch splits directives at blanks and expands '%'
-/// patterns, so such characters cannot be carried.
-void check_directive_path(const fs::path& p, const std::string& what) {
+/// A path (and a file-name `pattern` of sbatch's inside it) as an #SBATCH directive's value: in
+/// double quotes, which carry blanks (sbatch splits an unquoted value at them). A double quote, a backslash, a '%' (sbatch expands '%' patterns in
+/// file names) or a control character cannot be carried.
+std::string directive_path(const fs::path& p, const std::string& what, const std::string& pattern = "") {
   const std::string s = p.string();
-  if (s.find_first_of(" \t\n\r'\"%\\") != std::string::npos)
-    throw InputError(fmt::format("{} '{}' holds a blank, quote, backslash or '%', which #SBATCH directives cannot "
-                                 "carry; choose a path without them",
-                                 what, s));
+  const bool control = std::any_of(s.begin(), s.end(), [](char c) { return std::iscntrl(static_cast<unsigned char>(c)) != 0; });
+  if (control || s.find_first_of("\"%\\") != std::string::npos)
+    throw InputError(fmt::format("{} '{}' holds a double quote, backslash, '%' or control character, which #SBATCH "
+                                 "directives cannot carry; choose a path without them",
+                                 what, printable(s)));
+  return "\"" + (pattern.empty() ? s : (p / pattern).string()) + "\"";
 }
 
 /// The last `n` lines of a text file ("(missing)" / "(empty)" when there are none).
@@ -164,8 +167,16 @@ fs::path slurm_tool(const std::string& name) {
 }
 
 void check_slurm_time_limit(const std::string& value) {
-  static const std::regex kTime(R"((\d+)|(\d+):(\d{1,2})|(\d+):(\d{1,2}):(\d{1,2})|(\d+)-(\d+)(:\d{1,2}(:\d{1,2})?)?)");
-  if (value == "infinite" || value == "UNLIMITED" || std::regex_match(value, kTime)) return;
+  static const std::regex kTime(
+      R"((\d+)|(\d+):(\d{1,2})|(\d+):(\d{1,2}):(\d{1,2})|(\d+)-(\d{1,2})(?::(\d{1,2})(?::(\d{1,2}))?)?)");
+  if (value == "infinite" || value == "UNLIMITED") return;
+  std::smatch m;
+  if (std::regex_match(value, m, kTime)) {
+    // sbatch refuses seconds and minutes past 59 after a larger field, and hours past 23 after days.
+    const auto at_most = [&](int group, int limit) { return !m[group].matched || std::stoi(m[group].str()) <= limit; };
+    if (at_most(3, 59) && at_most(5, 59) && at_most(6, 59) && at_most(8, 23) && at_most(9, 59) && at_most(10, 59))
+      return;
+  }
   throw InputError(fmt::format("--time-limit '{}' is not a Slurm time; use HH:MM:SS (e.g. 01:30:00), MM, MM:SS, "
                                "D-HH, D-HH:MM or D-HH:MM:SS",
                                value));
@@ -174,9 +185,10 @@ void check_slurm_time_limit(const std::string& value) {
 std::string sbatch_script(const SweepDefinition& d, const SlurmSweepOptions& o) {
   if (o.shards == 0) throw InputError("the number of Slurm array tasks (--shards) must be at least 1");
   const SlurmLayout l = slurm_layout(o.out_dir);
-  check_directive_path(l.dir, "the Slurm log folder");
   const fs::path workdir = o.workdir.empty() ? fs::current_path() : o.workdir;
-  check_directive_path(workdir, "the working directory");
+  const std::string output = directive_path(l.dir, "the Slurm log folder", "task-%a.out");
+  const std::string error = directive_path(l.dir, "the Slurm log folder", "task-%a.err");
+  const std::string chdir = directive_path(workdir, "the working directory");
   if (!o.partition.empty() && !std::regex_match(o.partition, std::regex(R"([A-Za-z0-9_.,-]+)")))
     throw InputError(fmt::format("--partition '{}' is not a Slurm partition name (letters, digits, '_', '.', '-')",
                                  o.partition));
@@ -189,17 +201,17 @@ std::string sbatch_script(const SweepDefinition& d, const SlurmSweepOptions& o) 
   const std::string n = std::to_string(o.shards);
   std::string s;
   s += "#!/bin/bash\n";
-  s += fmt::format("# Sweep '{}' ({}) as a Slurm job array of {} task{}: task I runs the cells with\n", d.name,
-                   fs::absolute(d.file).string(), n, o.shards == 1 ? "" : "s");
+  s += fmt::format("# Sweep '{}' ({}) as a Slurm job array of {} task{}: task I runs the cells with\n",
+                   printable(d.name), printable(fs::absolute(d.file).string()), n, o.shards == 1 ? "" : "s");
   s += fmt::format("# cell_index % {} == I into results-I.jsonl beside this script, its exit code into task-I.status.\n", n);
   s += "# Written and submitted by `stereobench sweep run --executor slurm` (docs/slurm.md), which with\n";
   s += "# --wait merges the shards into the sweep's results file once every task has ended.\n";
   s += "#SBATCH --job-name=" + job_name + "\n";
   s += fmt::format("#SBATCH --array=0-{}\n", o.shards - 1);
   s += "#SBATCH --ntasks=1\n";
-  s += "#SBATCH --output=" + (l.dir / "task-%a.out").string() + "\n";
-  s += "#SBATCH --error=" + (l.dir / "task-%a.err").string() + "\n";
-  s += "#SBATCH --chdir=" + workdir.string() + "\n";
+  s += "#SBATCH --output=" + output + "\n";
+  s += "#SBATCH --error=" + error + "\n";
+  s += "#SBATCH --chdir=" + chdir + "\n";
   if (!o.partition.empty()) s += "#SBATCH --partition=" + o.partition + "\n";
   if (!o.time_limit.empty()) s += "#SBATCH --time=" + o.time_limit + "\n";
   s += "set -u\n";

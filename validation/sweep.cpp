@@ -372,15 +372,6 @@ void parse_path(const Where& where, const toml::node& node, SweepDefinition& d) 
   } catch (const InputError& e) {
     where.fail(node, "path", e.what());
   }
-  // Blender imports the scene file, which does not move (the full and povray truths render the
-  // scene as animated in memory): a spin cannot use it.
-  if (path.spin || path.gltf_animation)
-    for (const std::string& truth : d.truths)
-      if (truth == "blender")
-        where.fail(node, path.spin ? "path.spin" : table.get("gltf_clip") ? "path.gltf_clip" : "path.gltf_animation",
-                   fmt::format("truth '{}' renders the scene file at rest, not as it moves along the path; a path "
-                               "with {} needs truths \"full\" or \"povray\"",
-                               truth, path.spin ? "a spin" : "the glTF animation"));
   d.path = path;
 }
 
@@ -469,8 +460,10 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
 
   if (const toml::node* n = sweep.get("name")) {
     d.name = string_at(where, *n, "sweep.name");
-    if (d.name.empty() || d.name.find_first_of("/\\\n") != std::string::npos)
-      where.fail(*n, "sweep.name", "must be a non-empty name without '/', '\\' or line breaks");
+    // It names the default output folder out/sweeps/<name>: "." and ".." would be another folder.
+    const bool control = std::any_of(d.name.begin(), d.name.end(), [](char c) { return std::iscntrl(static_cast<unsigned char>(c)) != 0; });
+    if (d.name.empty() || d.name == "." || d.name == ".." || control || d.name.find_first_of("/\\") != std::string::npos)
+      where.fail(*n, "sweep.name", "must be a non-empty name without '/', '\\' or control characters, other than '.' and '..'");
   }
   if (const toml::node* n = sweep.get("description")) d.description = string_at(where, *n, "sweep.description");
 
@@ -482,6 +475,10 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
       SweepScene s = parse_scene_entry(where, *e, "sweep.scenes");
       for (const SweepScene& seen : d.scenes) {
         if (seen.label == s.label) where.fail(*e, "sweep.scenes", fmt::format("lists '{}' twice", s.label));
+        if (!seen.builtin && !s.builtin && seen.file == s.file)
+          where.fail(*e, "sweep.scenes",
+                     fmt::format("lists one scene file twice: '{}' and '{}' are both {}", seen.label, s.label,
+                                 s.file.string()));
         if (same_builtin_scene(seen, s))
           where.fail(*e, "sweep.scenes",
                      fmt::format("lists one scene twice: '{}' and '{}' differ only by parameters at their defaults",
@@ -637,6 +634,22 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
     if (const toml::node* v = output.get("exr")) d.exr = bool_at(where, *v, "output.exr");
     if (d.exr && !d.images)
       where.fail(*output.get("exr"), "output.exr", "EXR images need output.images = true");
+  }
+
+  // The cells are expanded (and listed, merged, sharded) in memory, about 1 kB each.
+  {
+    const size_t interaxials = d.max_disparity_px.front().has_value() ? d.max_disparity_px.size() : d.interaxial_m.size();
+    const double cells = static_cast<double>(d.scenes.size()) * static_cast<double>(interaxials) *
+                         static_cast<double>(d.convergence_m.size()) * static_cast<double>(d.resolutions.size()) *
+                         static_cast<double>(d.lights.size()) * static_cast<double>(d.truths.size()) *
+                         static_cast<double>(d.path ? d.path->frames : 1);
+    if (cells > static_cast<double>(kMaxSweepCells))
+      throw InputError(fmt::format(
+          "{}: the sweep has {:.0f} cells ({} scene(s) x {} interaxial(s) x {} convergence(s) x {} resolution(s) x {} "
+          "light count(s) x {} truth(s) x {} frame(s)), more than the {} a sweep may hold; split it into several "
+          "definitions",
+          file.string(), cells, d.scenes.size(), interaxials, d.convergence_m.size(), d.resolutions.size(),
+          d.lights.size(), d.truths.size(), d.path ? d.path->frames : 1, kMaxSweepCells));
   }
 
   // The gate config `stereobench nightly` applies unless told otherwise.

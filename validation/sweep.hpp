@@ -99,6 +99,10 @@ struct SweepCell {
 /// The same from text; `file` names it in messages and anchors relative scene paths.
 [[nodiscard]] SweepDefinition parse_sweep(const std::string& text, const std::filesystem::path& file);
 
+/// The most cells a definition may expand to (parse_sweep refuses more): a million cells take about
+/// a gigabyte of memory as they are expanded, listed and merged.
+inline constexpr size_t kMaxSweepCells = 1'000'000;
+
 /// The cells in their fixed order: scenes outermost, then interaxial (or max disparity),
 /// convergence, resolution, lights, truth and, with a [path], the frame innermost (frames of one
 /// combination in order, "|frame=k" ending the id); `index` counts from 0 in that order.

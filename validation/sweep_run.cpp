@@ -13,6 +13,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -30,6 +31,7 @@
 #include "renderer/text.hpp"
 #include "scenes/catalog.hpp"
 #include "validation/benchmark.hpp"
+#include "validation/content_hash.hpp"
 #include "validation/results_file.hpp"
 #include "validation/truth.hpp"
 #include "validation/truth_cache.hpp"
@@ -158,6 +160,7 @@ class SceneCache {
   struct Entry {
     const RenderScene& prepared;
     fs::path file;
+    std::string content_sha256;  ///< hash_scene of the file as loaded (every light, at rest)
     size_t lights_in_file;
     const SceneAnimator* animator;  ///< set with a path
     std::optional<FrameUpdate> update;  ///< set with a path
@@ -168,6 +171,7 @@ class SceneCache {
     if (!loaded_ || file != file_) {
       reset();
       loaded_ = std::make_unique<Scene>(io::load_gltf(file));
+      content_sha256_ = hash_scene(*loaded_);
       if (warned_.insert(file).second)  // once per file, however often the cells switch scenes
         for (const std::string& w : loaded_->warnings) fmt::print(stderr, "warning: {}\n", w);
       file_ = file;
@@ -201,7 +205,7 @@ class SceneCache {
       else
         update = FrameUpdate{animate_s, 0.0, "static"};
     }
-    return {*prepared_, file_, loaded_->lights.size(), animator_.get(), update};
+    return {*prepared_, file_, content_sha256_, loaded_->lights.size(), animator_.get(), update};
   }
 
  private:
@@ -215,6 +219,7 @@ class SceneCache {
   }
 
   fs::path file_;
+  std::string content_sha256_;
   std::set<fs::path> warned_;  ///< files whose loader warnings were printed
   bool refit_ = true;
   std::unique_ptr<Scene> loaded_;
@@ -352,7 +357,8 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
             {"triangles", s.triangle_count()},
             {"lights", s.lights.size()},
             {"lights_in_file", scene.lights_in_file},
-            {"bvh_build_s", scene.prepared.bvh_build_seconds()}}},
+            {"bvh_build_s", scene.prepared.bvh_build_seconds()},
+            {"content_sha256", scene.content_sha256}}},
           {"rig", io::rig_to_json(rig)},
           {"animation", animation},
           {"baseline", d.baseline},
@@ -433,8 +439,29 @@ void claim_out_folder(const SweepDefinition& d, const SweepRunOptions& options) 
 /// image), a scene the truth cannot render (a spot light for POV-Ray) or a spin prefix that
 /// matches nothing is refused before the first cell runs, naming the definition and the cell,
 /// instead of stopping the sweep when that cell comes.
+/// The scene content (hash_scene as recorded) each scene's finished cells of `results` were
+/// measured on, by scene label: the first such cell's hash and id.
+std::map<std::string, std::pair<std::string, std::string>> measured_scenes(const std::vector<SweepCell>& cells,
+                                                                          const fs::path& results) {
+  std::map<std::string, std::pair<std::string, std::string>> out;
+  std::error_code ec;
+  if (!fs::exists(results, ec)) return out;
+  std::map<std::string, const SweepCell*> by_id;
+  for (const SweepCell& c : cells) by_id.emplace(c.id, &c);
+  for (const json& line : read_results(results).cells) {
+    const auto scene = line.find("scene");
+    if (scene == line.end() || !scene->is_object() || !scene->contains("content_sha256")) continue;  // older lines
+    const auto cell = by_id.find(line["cell_id"].get<std::string>());
+    if (cell != by_id.end() && (*scene)["content_sha256"].is_string())
+      out.try_emplace(cell->second->scene.label, (*scene)["content_sha256"].get<std::string>(), cell->first);
+  }
+  return out;
+}
+
 void check_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, const std::vector<size_t>& todo,
-                 const fs::path& scenes_dir, const std::map<std::string, std::unique_ptr<TruthProvider>>& providers) {
+                 const fs::path& scenes_dir, const std::map<std::string, std::unique_ptr<TruthProvider>>& providers,
+                 const fs::path& results) {
+  const auto measured = measured_scenes(cells, results);
   std::map<std::string, fs::path> file_of;  // by scene label
   std::map<fs::path, std::vector<size_t>> by_file;
   for (size_t i : todo) {
@@ -445,6 +472,19 @@ void check_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, 
   const std::vector<BenchEntry> entries = bench_config(d).entries();  // as run_cell runs them
   for (const auto& [file, indices] : by_file) {
     Scene scene = io::load_gltf(file);
+    // Cells measured on this scene as it was: new cells beside them must see the same content.
+    std::optional<std::string> content;
+    for (size_t i : indices)
+      if (const auto it = measured.find(cells[i].scene.label); it != measured.end()) {
+        if (!content) content = hash_scene(scene);
+        if (*content != it->second.first)
+          throw InputError(fmt::format(
+              "{}: cell '{}' was measured on scene '{}' with content sha256 {}, but {} now holds {}: the scene "
+              "changed since those cells ran, and the results would mix the two; give another --out, or delete "
+              "the results file to start over",
+              results.string(), it->second.second, cells[i].scene.label, it->second.first.substr(0, 12),
+              file.string(), content->substr(0, 12)));
+      }
     const std::vector<Light> lights = scene.lights;
     for (size_t i : indices) {
       try {
@@ -484,7 +524,7 @@ void prepare_sweep(const SweepDefinition& d, const std::vector<SweepCell>& cells
       throw ToolError(fmt::format("{}: truth '{}' is unavailable: {}", d.file.string(), cells[i].truth, *why));
   }
   check_out_folders(options);
-  check_cells(d, cells, todo, options.scenes_dir, providers);
+  check_cells(d, cells, todo, options.scenes_dir, providers, options.results);
   claim_out_folder(d, options);
 }
 

@@ -59,7 +59,9 @@ struct SweepPlan {
 /// it and why otherwise), the output folder writable and not another definition's (a marker file
 /// gives it to this definition; InputError if it names another), every scene resolvable
 /// (built-in scenes generated now, once), and, each scene loaded once, every cell's rig and a
-/// path's spin possible for it (InputError naming the definition and the cell).
+/// path's spin possible for it (InputError naming the definition and the cell), and each scene's
+/// content the one the results file's finished cells of it were measured on (InputError naming
+/// the cell, the scene and both hashes when the file changed since).
 void prepare_sweep(const SweepDefinition& definition, const std::vector<SweepCell>& cells,
                    const std::vector<size_t>& todo, const SweepRunOptions& options);
 

@@ -149,11 +149,16 @@ void expect_update_matches_fresh_build(bool refit) {
   const StereoRig rig = test::rig_at(scene, 96, 54);
   const Executor executor(2);
   const VisibleSurfaces before = trace_visible_surfaces(prepared, rig.eye(Eye::right), executor);
+  const float offset_before = prepared.ray_epsilon();
   animator.apply(2);
   EXPECT_GE(prepared.update_geometry(), 0.0);
   const VisibleSurfaces updated = trace_visible_surfaces(prepared, rig.eye(Eye::right), executor);
   const RenderScene fresh(scene);
   const VisibleSurfaces rebuilt = trace_visible_surfaces(fresh, rig.eye(Eye::right), executor);
+  // The shadow-ray offset follows the moved bounds (the turned wall reaches further out), as a
+  // scene prepared at this frame has it: shading must not depend on the frame prepared first.
+  EXPECT_NE(offset_before, fresh.ray_epsilon()) << "the turn must change the bounds to test the offset";
+  EXPECT_EQ(prepared.ray_epsilon(), fresh.ray_epsilon());
   EXPECT_EQ(updated.prim, rebuilt.prim);
   EXPECT_EQ(updated.depth, rebuilt.depth);
   EXPECT_NE(updated.prim, before.prim) << "the scene turned 40 degrees; the image must change";

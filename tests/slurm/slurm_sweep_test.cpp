@@ -128,8 +128,8 @@ TEST(SlurmScript, JobArrayRunsOneShardPerTask) {
   o.run_args = {"--jobs", "1", "--cache", "", "--scenes-dir", "/data/it's scenes"};
   const std::string s = validation::sbatch_script(d, o);
   for (const char* line : {"#!/bin/bash\n", "#SBATCH --array=0-2\n", "#SBATCH --job-name=sb-sweep-slurm-four\n",
-                           "#SBATCH --output=/data/sweeps/four/slurm/task-%a.out\n",
-                           "#SBATCH --error=/data/sweeps/four/slurm/task-%a.err\n", "#SBATCH --chdir=/data\n",
+                           "#SBATCH --output=\"/data/sweeps/four/slurm/task-%a.out\"\n",
+                           "#SBATCH --error=\"/data/sweeps/four/slurm/task-%a.err\"\n", "#SBATCH --chdir=\"/data\"\n",
                            "#SBATCH --partition=debug\n", "#SBATCH --time=00:10:00\n"})
     EXPECT_NE(s.find(line), std::string::npos) << line << "\n" << s;
   EXPECT_NE(s.find("'/opt/sb/bin/stereobench' sweep run '/defs/four.toml' --out '/data/sweeps/four'"),
@@ -170,10 +170,29 @@ TEST(SlurmScript, BadOptionsAreInputErrors) {
   const validation::SweepDefinition d = validation::parse_sweep(kFourCells, "/defs/four.toml");
   validation::SlurmSweepOptions o;
   o.stereobench = "/opt/stereobench";
-  o.out_dir = "/data/my sweeps";  // a blank cannot be carried by an #SBATCH directive
-  o.workdir = "/data";
+  o.out_dir = "/data/my sweeps";  // a blank is carried in double quotes
+  o.workdir = "/data/work dir";
   o.shards = 2;
+  const std::string script = validation::sbatch_script(d, o);
+  EXPECT_NE(script.find("#SBATCH --output=\"/data/my sweeps/slurm/task-%a.out\"\n"), std::string::npos) << script;
+  EXPECT_NE(script.find("#SBATCH --chdir=\"/data/work dir\"\n"), std::string::npos) << script;
+  // A double quote, a backslash, a '%' or a newline cannot be carried.
+  for (const char* bad : {"/data/my \"sweeps\"", "/data/a\\b", "/data/100%", "/data/a\nb"}) {
+    o.out_dir = bad;
+    EXPECT_THROW((void)validation::sbatch_script(d, o), InputError) << bad;
+  }
+  o.out_dir = "/data/sweeps";
+  o.workdir = "/data/a\nb";
   EXPECT_THROW((void)validation::sbatch_script(d, o), InputError);
+  o.workdir = "/data";
+  // A newline in the definition's path stays inside the script's comment.
+  const validation::SweepDefinition newline = validation::parse_sweep(kFourCells, "/defs/four\necho INJECTED.toml");
+  const std::string commented = validation::sbatch_script(newline, o);
+  EXPECT_NE(commented.find("(/defs/four\\necho INJECTED.toml)"), std::string::npos) << commented;
+  // Every line up to the first command is a comment or a directive: sbatch reads all directives.
+  std::istringstream lines(commented);
+  for (std::string line; std::getline(lines, line) && line != "set -u";)
+    EXPECT_EQ(line.rfind('#', 0), 0u) << line << "\n" << commented;
   o.out_dir = "/data/sweeps";
   o.shards = 0;
   EXPECT_THROW((void)validation::sbatch_script(d, o), InputError);
@@ -183,7 +202,7 @@ TEST(SlurmScript, BadOptionsAreInputErrors) {
   o.partition.clear();
   for (const char* ok : {"10", "10:30", "01:30:00", "2-12", "2-12:30", "2-12:30:00", "infinite"})
     EXPECT_NO_THROW(validation::check_slurm_time_limit(ok)) << ok;
-  for (const char* bad : {"", "1h", "01:30:00:00", "-5", "1-", "abc"})
+  for (const char* bad : {"", "1h", "01:30:00:00", "-5", "1-", "abc", "1:99:99", "10:60", "2-24", "2-12:60"})
     EXPECT_THROW(validation::check_slurm_time_limit(bad), InputError) << bad;
 }
 
@@ -239,8 +258,10 @@ TEST_F(SlurmCluster, SweepThroughSlurmEqualsTheLocalExecutor) {
   ASSERT_EQ(local.code, 0) << local.out;
 
   start = std::chrono::steady_clock::now();
-  const test::CliRun slurm = test::run_cli("sweep run " + quoted(dir / "four.toml") + " --out " + quoted(dir / "slurm") +
-                                           common + " --executor slurm --shards 2 --time-limit 00:05:00 --wait");
+  // A blank in the output folder's path reaches sbatch's directives (in quotes) and the task's command.
+  const fs::path out = dir / "slurm out";
+  const test::CliRun slurm = test::run_cli("sweep run " + quoted(dir / "four.toml") + " --out " + quoted(out) + common +
+                                           " --executor slurm --shards 2 --time-limit 00:05:00 --wait");
   const double slurm_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf("local executor %.1f s, slurm executor (2 tasks, submit to merge) %.1f s\n", local_s, slurm_s);
   ASSERT_EQ(slurm.code, 0) << slurm.out << "\nslurmctld log:\n"
@@ -250,7 +271,7 @@ TEST_F(SlurmCluster, SweepThroughSlurmEqualsTheLocalExecutor) {
   EXPECT_NE(slurm.out.find("2/2 tasks ended"), std::string::npos) << slurm.out;
 
   // The job array: its script, one results file and log per task, each holding its shard's cells.
-  const fs::path sd = dir / "slurm" / "slurm";
+  const fs::path sd = out / "slurm";
   EXPECT_NE(test::read_text(sd / "sweep.sbatch").find("#SBATCH --array=0-1\n"), std::string::npos);
   const json submission = json::parse(test::read_text(sd / "submission.json"));
   EXPECT_EQ(submission["shards"], 2);
@@ -266,11 +287,11 @@ TEST_F(SlurmCluster, SweepThroughSlurmEqualsTheLocalExecutor) {
   }
 
   // The merge equals the local run: the same cells, and per (cell, pipeline) the same metrics.
-  const std::vector<json> merged = validation::read_results(dir / "slurm" / "results.jsonl").cells;
+  const std::vector<json> merged = validation::read_results(out / "results.jsonl").cells;
   ASSERT_EQ(merged.size(), 4u);
   for (size_t i = 0; i < merged.size(); ++i) EXPECT_EQ(merged[i]["cell_index"], i);
   const auto a = measured_by_id(dir / "local" / "results.jsonl");
-  const auto b = measured_by_id(dir / "slurm" / "results.jsonl");
+  const auto b = measured_by_id(out / "results.jsonl");
   ASSERT_EQ(a.size(), 4u);
   std::set<std::string> ids_a, ids_b;
   for (const auto& [id, m] : a) ids_a.insert(id);
@@ -281,10 +302,16 @@ TEST_F(SlurmCluster, SweepThroughSlurmEqualsTheLocalExecutor) {
     EXPECT_GE(m.size(), 5u) << id;  // cell, rig, baseline and at least two pipelines
     for (const auto& [key, value] : m.items()) EXPECT_EQ(b.at(id)[key], value) << id << " " << key;
   }
-  // The images the lines name exist beside the merged file.
+  // The images the lines name exist beside the merged file: the cell's, and each pipeline's
+  // validation record's (the shards wrote them relative to their own files).
   for (const auto& [name, files] : merged.front()["images"]["pipelines"].items())
     for (const auto& [kind, path] : files.items())
-      EXPECT_TRUE(fs::exists(dir / "slurm" / path.get<std::string>())) << name << " " << kind;
+      EXPECT_TRUE(fs::exists(out / path.get<std::string>())) << name << " " << kind;
+  for (const auto& [name, record] : merged.front()["pipelines"].items())
+    for (const auto& [kind, path] : record["validation"]["images"].items())
+      if (path.is_string()) {
+        EXPECT_TRUE(fs::exists(out / path.get<std::string>())) << name << " " << kind << " " << path;
+      }
 }
 
 TEST_F(SlurmCluster, FailedTasksAreReportedAndResubmissionContinues) {

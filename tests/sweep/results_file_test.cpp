@@ -280,6 +280,19 @@ TEST(ResultsFile, BadLinesAndDuplicatesRejected) {
                        "definition validates plain-rt; every cell of a sweep validates every pipeline");
 }
 
+TEST(ResultsFile, RebasingMovesTheCellsAndEachPipelinesImagePaths) {
+  json c = cell(0, "a");
+  c["images"] = {{"truth_png", "cells/0000/scene_truth-full.png"},
+                 {"pipelines", {{"plain-rt", {{"right_png", "cells/0000/plain-rt_right.png"}}}}}};
+  c["pipelines"]["plain-rt"]["validation"]["images"] = {{"right_png", "cells/0000/plain-rt_right.png"},
+                                                        {"truth_exr", nullptr}};
+  rebase_image_paths(c, "/data/sweep/slurm", "/data/sweep");
+  EXPECT_EQ(c["images"]["truth_png"], "slurm/cells/0000/scene_truth-full.png");
+  EXPECT_EQ(c["images"]["pipelines"]["plain-rt"]["right_png"], "slurm/cells/0000/plain-rt_right.png");
+  EXPECT_EQ(c["pipelines"]["plain-rt"]["validation"]["images"]["right_png"], "slurm/cells/0000/plain-rt_right.png");
+  EXPECT_TRUE(c["pipelines"]["plain-rt"]["validation"]["images"]["truth_exr"].is_null());
+}
+
 TEST(ResultsFile, CollectMergesShards) {
   test::ScratchDir dir;
   append_result(dir / "s0.jsonl", cell(2, "c"));
@@ -332,6 +345,12 @@ TEST(ResultsFile, CsvRowsAndQuoting) {
   const std::string path_csv = results_csv({f});
   EXPECT_NE(path_csv.find(",frame,bvh_update_s,"), std::string::npos);
   EXPECT_NE(path_csv.find(",1,2,0.038,full,"), std::string::npos) << path_csv;
+  // Rows follow cell_index, not the order parallel jobs wrote the lines in.
+  const std::string ordered = results_csv({cell(2, "c"), cell(0, "a"), cell(1, "b")});
+  const size_t a = ordered.find("\r\n0,a,"), b = ordered.find("\r\n1,b,"), cc = ordered.find("\r\n2,c,");
+  ASSERT_NE(cc, std::string::npos) << ordered;
+  EXPECT_LT(a, b);
+  EXPECT_LT(b, cc);
 }
 
 }  // namespace
