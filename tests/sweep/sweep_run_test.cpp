@@ -635,6 +635,51 @@ TEST(SweepRun, TwoDefinitionsStartedTogetherIntoOneFolderDoNotBothRun) {
   EXPECT_EQ(json::parse(test::read_text(dir / "out" / ".stereobench-sweep.json"))["sweep"], "a");
 }
 
+TEST(SweepRun, AResumeRefusesNewCellsOfASceneThatChanged) {
+  // Two cells on a scene file; the first measured, then the file regenerated with a larger box.
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli("scenes generate box-wall --out " + quoted(dir / "gen")).code, 0);
+  fs::copy_file(dir / "gen" / "box-wall.gltf", dir / "scene.gltf");
+  std::ofstream(dir / "two.toml") << R"([sweep]
+name = "two"
+scenes = ["scene.gltf"]
+pipelines = ["plain-rt", "repro-rt"]
+interaxial_m = [0.04, 0.064]
+resolutions = ["64x36"]
+[timing]
+repetitions = 1
+warmup = 0
+)";
+  const std::string run = "sweep run " + quoted(dir / "two.toml") + " --out " + quoted(dir / "out") + " --threads 1";
+  ASSERT_EQ(test::run_cli(run).code, 0);
+  const fs::path results = dir / "out" / "results.jsonl";
+  const std::vector<std::string> lines = lines_of(results);
+  ASSERT_EQ(lines.size(), 2u);
+  const std::string recorded = json::parse(lines[0])["scene"]["content_sha256"];
+  EXPECT_EQ(recorded.size(), 64u);
+  std::ofstream(results, std::ios::trunc) << lines[0] << "\n";
+
+  ASSERT_EQ(test::run_cli("scenes generate box-wall --param size=0.9 --out " + quoted(dir / "gen")).code, 0);
+  fs::path changed;
+  for (const auto& e : fs::directory_iterator(dir / "gen"))
+    if (e.path().extension() == ".gltf" && e.path().filename() != "box-wall.gltf") changed = e.path();
+  ASSERT_FALSE(changed.empty());
+  fs::copy_file(changed, dir / "scene.gltf", fs::copy_options::overwrite_existing);
+  const test::CliRun refused = test::run_cli(run);
+  EXPECT_EQ(refused.code, 3) << refused.out;
+  EXPECT_NE(refused.out.find("was measured on scene 'scene.gltf' with content sha256 " + recorded.substr(0, 12)),
+            std::string::npos)
+      << refused.out;
+  EXPECT_NE(refused.out.find("the scene changed since those cells ran"), std::string::npos) << refused.out;
+  EXPECT_EQ(lines_of(results).size(), 1u) << "no cell ran";
+
+  // The scene as it was: the resume runs the cell left.
+  fs::copy_file(dir / "gen" / "box-wall.gltf", dir / "scene.gltf", fs::copy_options::overwrite_existing);
+  const test::CliRun resumed = test::run_cli(run);
+  EXPECT_EQ(resumed.code, 0) << resumed.out;
+  EXPECT_EQ(lines_of(results).size(), 2u);
+}
+
 TEST(SweepRun, AnOutFolderThatCannotBeMadeIsNamed) {
   // A folder that cannot be created is named as such, not as a lock file that does not exist.
   test::ScratchDir dir;
