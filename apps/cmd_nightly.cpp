@@ -311,6 +311,19 @@ void run_nightly(const NightlyArgs& a) {
     refuse_foreign_run(history, history_file, run_id, results_in_history, o.results, run_dir);
     if (history_holds(history, run_id)) {
       fmt::print(stderr, "note: {} already holds run {}; not appended again\n", history_file.string(), run_id);
+      // A resumed run gated anew (another gate config, changed thresholds): the line keeps what it
+      // recorded, which the trends show; said, so that the files' disagreement is not a surprise.
+      for (const json& r : history.runs)
+        if (r["run_id"] == run_id) {
+          const json recorded = r.value("gate", json::object());
+          if (recorded.value("verdict", "") != gate_verdict(gate))
+            fmt::print(stderr,
+                       "warning: run {} is recorded in {} with the gate verdict '{}' (exit {}); this evaluation "
+                       "gives '{}' (exit {}), which the run's gate files and nightly.json hold. A history line "
+                       "is never rewritten: the trends keep the recorded verdict\n",
+                       run_id, history_file.string(), recorded.value("verdict", "?"),
+                       recorded.value("exit_code", -1), gate_verdict(gate), exit_code(gate.worst));
+        }
     } else {
       append_history(history_file, history_entry(run, cells, gate));
       history = read_history(history_file);
@@ -327,9 +340,11 @@ void run_nightly(const NightlyArgs& a) {
   json trend_runs = json::array();
   for (const json& r : history.runs)
     if (r.value("sweep", "") == d.name) trend_runs.push_back(r);
-  if (trend_runs.size() < history.runs.size())
-    fmt::print(stderr, "note: the trends leave out {} runs of other sweeps in {}\n",
-               history.runs.size() - trend_runs.size(), history_file.string());
+  if (trend_runs.size() < history.runs.size()) {
+    options.history_note = fmt::format("The trends leave out {} runs of other sweeps in {}.",
+                                       history.runs.size() - trend_runs.size(), history_file.string());
+    fmt::print(stderr, "note: {}\n", options.history_note);
+  }
   options.history = std::move(trend_runs);
   const reports::ReportSummary s = reports::write_report(report_results, options);
   for (const std::string& w : s.warnings) fmt::print(stderr, "warning: {}\n", w);

@@ -54,6 +54,10 @@ std::string number(double v, const char* format) {
   return fmt::format(fmt::runtime(format), v);
 }
 
+/// An MSE for the table: three decimals, or two significant digits below 0.001, so that a
+/// non-zero MSE (its PSNR finite) never reads 0.000.
+std::string mse_text(double v) { return v > 0.0 && v < 0.001 ? number(v, "{:.1e}") : number(v, "{:.3f}"); }
+
 void run_validate(const ValidateArgs& a) {
   const RigOverrides overrides = a.rig.overrides();
   const std::vector<PipelineEntry> chosen = chosen_pipelines(a.pipelines);
@@ -126,14 +130,14 @@ void run_validate(const ValidateArgs& a) {
       records.push_back(record);
       const validation::HoleStatistics& h = v.holes;
       fmt::print("{:<{}} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10.1f}\n", v.pipeline, name_w,
-                 number(v.whole.psnr, "{:.2f}"), number(v.whole.ssim, "{:.4f}"), number(v.whole.mse, "{:.3f}"),
+                 number(v.whole.psnr, "{:.2f}"), number(v.whole.ssim, "{:.4f}"), mse_text(v.whole.mse),
                  number(100.0 * v.whole.error_fraction, "{:.3f}"), number(100.0 * h.hole_fraction, "{:.3f}"),
                  number(h.scores.recall, "{:.4f}"), number(h.scores.precision, "{:.4f}"),
                  v.result.timings.total() * 1e3);
       if (v.left)
         left_lines.push_back(fmt::format(
             "{:<{}} {:>8} {:>7} {:>9} {:>7}  ({:.3f} % of its pixels not rendered by the left eye)", v.pipeline,
-            name_w, number(v.left->psnr, "{:.2f}"), number(v.left->ssim, "{:.4f}"), number(v.left->mse, "{:.3f}"),
+            name_w, number(v.left->psnr, "{:.2f}"), number(v.left->ssim, "{:.4f}"), mse_text(v.left->mse),
             number(100.0 * v.left->error_fraction, "{:.3f}"),
             100.0 * static_cast<double>(v.left_synthesized) / static_cast<double>(v.result.left.pixel_count())));
     }

@@ -331,6 +331,8 @@ json report_data(const ResultsFile& results, const std::string& title, const jso
                {"interaxial_m", rig["interaxial_m"]},
                {"convergence_m", rig["convergence_m"]},
                {"max_disparity_px", rig["max_disparity_px"]},
+               // The sweep's own interaxial axis: a disparity in pixels, or metres (null: the scene's).
+               {"axis_max_disparity_px", get_or_null(cell, "max_disparity_px")},
                {"vfov_deg", get_or_null(rig, "vfov_deg")},
                {"lights", get_or_null(cell, "lights")},
                {"truth", cell["truth"]},
@@ -456,9 +458,12 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
     }
     ++summary.images;
     if (options.images == ImageMode::link) {
-      const fs::path relative = fs::relative(fs::absolute(source), fs::absolute(out), ec);
-      if (ec || relative.empty())
-        throw IoError(fmt::format("cannot express {} relative to {}: {}", source.string(), out.string(), ec.message()));
+      // Lexically, as a browser resolves a relative link from the page's path as given: through a
+      // linked folder in --out, a path with links resolved would climb out of another folder.
+      const fs::path relative =
+          fs::absolute(source).lexically_normal().lexically_relative(fs::absolute(out).lexically_normal());
+      if (relative.empty())
+        throw IoError(fmt::format("cannot express {} relative to {}", source.string(), out.string()));
       return relative.generic_string();
     }
     copy_atomically(source, out / "images" / name);
@@ -473,7 +478,26 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
     title = "stereobench report: " + joined;
   }
   json data = report_data(results, title, papers, image_path);
+  // A sweep still running, stopped, or one shard of several: its figures cover part of it.
+  std::map<std::string, std::pair<int64_t, std::set<int64_t>>> cells_of;  // sweep -> (cell_count, indices)
+  for (const auto& c : results.cells) {
+    const json& line = c.json;
+    const auto count = line.find("cell_count");  // optional in a results line
+    if (count == line.end()) continue;
+    auto& [total, indices] = cells_of[line["sweep"].get<std::string>()];
+    total = std::max(total, count->get<int64_t>());
+    indices.insert(line["cell_index"].get<int64_t>());
+  }
+  for (const auto& [sweep, seen] : cells_of)
+    if (static_cast<int64_t>(seen.second.size()) < seen.first)
+      summary.warnings.push_back(fmt::format("{}: {} of the {} cells of sweep '{}' are in the results: the sweep is "
+                                             "unfinished (still running, stopped, or one shard of several); the "
+                                             "figures cover these cells only",
+                                             results.path.string(), seen.second.size(), seen.first, sweep));
+  // The page lists every warning the terminal shows: skipped lines, missing images, missing cells.
+  data["warnings"] = summary.warnings;
   if (!options.history.is_null()) data["history"] = options.history;
+  if (!options.history_note.empty()) data["history_note"] = options.history_note;
   summary.paper_experiment = data["paper"].is_object() ? data["paper"]["experiment"].get<std::string>() : "";
   summary.pipeline_names = data["pipelines"];
   summary.cells = data["cells"];

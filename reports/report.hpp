@@ -34,6 +34,9 @@ struct ReportOptions {
   /// The nightly runs of a history file (validation/history.hpp, one object per run in file order);
   /// an array, even an empty one, adds data.history and the page's Trends section. Null: none.
   nlohmann::json history;
+  /// A note shown with the trends (e.g. how many runs of other sweeps sharing the history file
+  /// they leave out); empty: none.
+  std::string history_note;
 };
 
 /// What write_report produced.

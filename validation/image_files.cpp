@@ -68,6 +68,14 @@ Image read_exr_image(const fs::path& path, std::string_view eye, std::string& ta
   return eye == "left" ? std::move(pair->first) : std::move(pair->second);
 }
 
+/// The planes of an image read from a file other than its alpha: what carries colour or grey.
+std::vector<const Plane*> colour_planes(const Image& image) {
+  std::vector<const Plane*> out;
+  for (const Plane& p : image.planes())
+    if (p.name() != planes::alpha) out.push_back(&p);
+  return out;
+}
+
 /// 8-bit codes of an sRGB-encoded sample scaled to [0, 1] (8-bit exactly, 16-bit rounded).
 uint8_t code_of(float encoded) {
   const float c = encoded > 0.0f ? (encoded < 1.0f ? encoded : 1.0f) : 0.0f;
@@ -85,13 +93,14 @@ Srgb8File read_srgb8_file(const fs::path& path, std::string_view eye) {
       file.encoding = "openexr, linear float encoded to sRGB";
       return file;
     }
-    // A grey EXR: its one channel (Y, or any single name) counts as R = G = B.
-    const auto& all = image.planes();
-    if (all.size() != 1 || all.front().channels() != 1 || all.front().type() != PlaneType::f32)
+    // A grey EXR: its one channel (Y, or any single name) counts as R = G = B; an alpha channel
+    // beside it is not read.
+    const std::vector<const Plane*> colour = colour_planes(image);
+    if (colour.size() != 1 || colour.front()->channels() != 1 || colour.front()->type() != PlaneType::f32)
       throw InputError(fmt::format("{} has neither R, G, B channels nor a single grey channel (planes: {}); the "
                                    "metrics compare colour or grey images",
                                    path.string(), image.plane_list()));
-    const std::span<const float> grey = all.front().f32();
+    const std::span<const float> grey = colour.front()->f32();
     Image linear(image.width(), image.height());
     float* rgb = linear.add_plane(planes::rgb).data_f32();
     for (std::size_t i = 0; i < grey.size(); ++i) rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = grey[i];
@@ -152,8 +161,16 @@ RegionMask read_region_mask(const fs::path& path, std::string_view eye) {
       mark(rgb->f32(), rgb->channels(), rgb->channels());
       return mask;
     }
-    for (const Plane& p : image.planes())
-      if (p.type() == PlaneType::f32) mark(p.f32(), p.channels(), p.channels());
+    // Without R, G, B: every other channel but alpha, float or integer (an id mask).
+    for (const Plane* p : colour_planes(image)) {
+      if (p->type() == PlaneType::f32) {
+        mark(p->f32(), p->channels(), p->channels());
+      } else {
+        const std::span<const uint32_t> ids = p->u32();
+        std::vector<float> values(ids.begin(), ids.end());
+        mark(values, p->channels(), p->channels());
+      }
+    }
     return mask;
   }
   const io::DecodedImage d = io::read_image(path);

@@ -59,10 +59,9 @@ PipelineValidation validate_pipeline(const ValidationTarget& target, const Pipel
   const Image& right = v.result.right;
   const int w = right.width(), h = right.height();
   v.right_srgb8 = encode_srgb8(right, fmt::format("{}'s right eye", v.pipeline));
-  std::vector<uint8_t> reprojected(right.pixel_count());
-  const uint32_t* source = right.data_u32(planes::source);
-  for (size_t i = 0; i < reprojected.size(); ++i)
-    reprojected[i] = source[i] == static_cast<uint32_t>(Source::reprojected) ? 1 : 0;
+  v.not_reprojected = not_reprojected_mask(right);
+  std::vector<uint8_t> reprojected(v.not_reprojected.size());
+  for (size_t i = 0; i < reprojected.size(); ++i) reprojected[i] = v.not_reprojected[i] != 0 ? 0 : 1;
   v.hole_mask = hole_mask_from_sources(right);
   std::vector<uint8_t> disoccluded(target.disocclusions.mask.size());
   for (size_t i = 0; i < disoccluded.size(); ++i) disoccluded[i] = target.disocclusions.mask[i] != 0 ? 1 : 0;

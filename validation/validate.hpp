@@ -64,6 +64,9 @@ struct PipelineValidation {
   /// pixels = 0 and null metrics.
   std::vector<std::pair<std::string, ImageMetrics>> regions;
   std::vector<uint8_t> hole_mask;
+  /// The pixels not tagged reprojected: what holes.not_reprojected scores, and what the hole
+  /// overlay (holes.png) draws against the true disocclusions, so that picture and numbers agree.
+  std::vector<uint8_t> not_reprojected;
   HoleStatistics holes;
   SsimMap ssim;
   double seconds_metrics = 0.0;  ///< time to measure (not part of the pipeline's timings)

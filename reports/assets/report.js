@@ -94,6 +94,15 @@
     return Math.round(c.interaxial_m * 1e6) / 1e3;
   }
 
+  /**
+   * The sweep's interaxial axis as it was given: the maximum disparity in pixels (Al-Hagri's e),
+   * whose metres change with the resolution, or the interaxial in millimetres.
+   */
+  const disparityAxis = cells.length > 0 && cells.every((c) => typeof c.axis_max_disparity_px === 'number');
+  const interaxialKey = disparityAxis ? (c) => c.axis_max_disparity_px : interaxialMm;
+  const interaxialUnit = disparityAxis ? 'px' : 'mm';
+  const interaxialTitle = disparityAxis ? 'interaxial e (max disparity, px)' : 'interaxial e (mm)';
+
   function lightsLabel(c) {
     return c.lights === null || c.lights === undefined ? 'all' : String(c.lights);
   }
@@ -182,7 +191,7 @@
   const axisDefs = {
     scene: (c) => c.scene + (Object.keys(c.scene_params || {}).length ? ` ${JSON.stringify(c.scene_params)}` : ''),
     resolution: resolutionLabel,
-    interaxial: (c) => `e = ${interaxialMm(c)} mm`,
+    interaxial: (c) => `e = ${interaxialKey(c)} ${interaxialUnit}`,
     convergence: (c) => `c = ${fmt(c.convergence_m, 2)} m`,
     lights: (c) => `lights ${lightsLabel(c)}`,
     truth: (c) => `truth ${c.truth}`,
@@ -302,7 +311,7 @@
     const truths = distinct(cells.map((c) => c.truth));
     const scenes = distinct(cells.map((c) => c.scene));
     const resolutions = distinct(cells.map(resolutionLabel));
-    const interaxials = distinct(cells.map(interaxialMm)).sort((a, b) => a - b);
+    const interaxials = distinct(cells.map(interaxialKey)).sort((a, b) => a - b);
     const v = data.versions || {};
     const rows = [
       ['Sweep', data.sweeps.join(', ') + (data.description ? ` — ${data.description}` : '')],
@@ -312,7 +321,7 @@
       ['Ground truth', truths.join(', ')],
       ['Scenes', scenes.join(', ')],
       ['Resolutions', resolutions.join(', ')],
-      ['Interaxial', interaxials.map((e) => `${e} mm`).join(', ')],
+      [disparityAxis ? 'Interaxial (max disparity)' : 'Interaxial', interaxials.map((e) => `${e} ${interaxialUnit}`).join(', ')],
       ['Machine', `${(data.hosts || []).join(', ') || '—'}; ${data.threads ?? '—'} threads, ${data.jobs ?? '—'} job(s)`],
       ['Run', `${data.started ? `${data.started} to ${data.finished || '—'}; ` : ''}cells' wall time ${fmt(data.cells_wall_s, 1)} s (summed over cells)`],
       ['Versions', Object.entries(v).map(([k, x]) => `${k} ${x}`).join('; ') || '—'],
@@ -382,7 +391,7 @@
       axis: 'resolution', key: (c) => resolutionLabel(c), order: (k) => { const [w, h] = k.split('×').map(Number); return w * h; },
       label: (k) => k, xTitle: 'resolution (per eye)',
     };
-    const byInteraxial = { axis: 'interaxial', key: interaxialMm, order: (k) => k, label: (k) => `${k}`, linear: true, xTitle: 'interaxial e (mm)' };
+    const byInteraxial = { axis: 'interaxial', key: interaxialKey, order: (k) => k, label: (k) => `${k}`, linear: true, xTitle: interaxialTitle };
     const disparities = cells.map((c) => c.max_disparity_px);
     const dispNote = `Maximum disparity (at infinity) ${fmt(minOf(disparities), 1)}–${fmt(maxOf(disparities), 1)} px.`;
     const charts = [
@@ -630,7 +639,7 @@
     const tracers = paper.tracers.map((t) => t.pipeline).filter((p) => pipelines.includes(p));
     const axes = {
       resolution: { axis: 'resolution', key: resolutionLabel, order: (k) => { const [w, h] = k.split('×').map(Number); return w * h; }, label: (k) => k, xTitle: 'image dimensions' },
-      interaxial: { axis: 'interaxial', key: interaxialMm, order: (k) => k, label: (k) => String(k), linear: true, xTitle: 'interaxial e (mm)' },
+      interaxial: { axis: 'interaxial', key: interaxialKey, order: (k) => k, label: (k) => String(k), linear: true, xTitle: interaxialTitle },
       lights: { axis: 'lights', key: lightsLabel, order: (k) => (k === 'all' ? 1e9 : Number(k)), label: (k) => k, xTitle: 'lights' },
     };
     const grid = el('div', { class: 'charts' });
@@ -865,6 +874,7 @@
     const runs = data.history;
     if (!Array.isArray(runs)) return null;
     const node = el('section', { 'aria-labelledby': 'trends-h' }, el('h2', { id: 'trends-h' }, 'Trends'));
+    if (data.history_note) node.append(el('p', { class: 'note' }, data.history_note));
     if (runs.length === 0) {
       node.append(el('p', { class: 'note' }, 'The history file holds no run yet.'));
       return { id: 'trends', title: 'Trends', node };

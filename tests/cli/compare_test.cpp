@@ -327,6 +327,21 @@ TEST_F(Compare, GreyExrCountsAsGrey) {
   r = compare(q(path("grey.exr")) + " " + q(path("a.png")));
   EXPECT_EQ(r.code, 3) << r.out;
   EXPECT_NE(r.out.find("has 1 colour channel(s)"), std::string::npos) << r.out;
+  // Grey with an alpha channel: the alpha is not read, as in a grey + alpha PNG.
+  float* a = grey.add_plane(std::string(planes::alpha), 1, PlaneType::f32).data_f32();
+  std::fill(a, a + codes.size(), 0.5f);
+  io::write_exr(path("grey-alpha.exr"), grey);
+  r = compare(q(path("grey-alpha.exr")) + " " + q(path("grey.png")) + " --fail-psnr 1000");
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("inf dB"), std::string::npos) << r.out;
+  // As a mask it is its grey channel: alpha 0.5 everywhere would make the whole image the region.
+  Image ids(48, 32);
+  uint32_t* id = ids.add_plane("id", 1, PlaneType::u32).data_u32();
+  for (size_t i = 0; i < codes.size(); ++i) id[i] = i < 48 ? 7u : 0u;  // the top row
+  io::write_exr(path("ids.exr"), ids);
+  r = compare(q(path("grey.exr")) + " " + q(path("grey.png")) + " --mask " + q(path("ids.exr")));
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("48 of 1536 pixels"), std::string::npos) << "an integer mask channel counts: " << r.out;
 }
 
 TEST(CompareHelp, ExplainsMetricsAndExitCodes) {

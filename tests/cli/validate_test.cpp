@@ -2,12 +2,14 @@
 // pipeline against the built-in ground truth; bad input and a missing provider tool.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
 
 #include <nlohmann/json.hpp>
 
+#include "renderer/io/image_io.hpp"
 #include "support/run_cli.hpp"
 #include "support/scratch_dir.hpp"
 
@@ -48,6 +50,27 @@ TEST(Validate, WritesRecordsImagesAndTable) {
   for (const auto& [name, path] : repro["images"].items()) EXPECT_TRUE(fs::exists(path.get<std::string>())) << name;
   const json summary = json::parse(test::read_text(out / "box-wall_full_summary.json"));
   EXPECT_EQ(summary["records"].size(), 3u);
+
+  // The hole overlay draws the mask the recall and precision beside it score: found (green) the
+  // true positives, missed (red) the rest of the true disocclusions, flagged in vain (blue) the
+  // rest of the pixels not reprojected. Tinted pixels have a channel of at least 0.75 (sRGB 225),
+  // the others none above 0.3 (sRGB 149).
+  for (const char* p : {"plain-rt", "repro-rt", "fw-warp"}) {
+    const json record = json::parse(test::read_text(out / (std::string("box-wall_full_") + p + ".json")));
+    const json& scored = record["holes"]["not_reprojected"];
+    const io::DecodedImage overlay = io::read_image(record["images"]["holes_png"].get<std::string>());
+    ASSERT_EQ(overlay.channels, 3) << p;
+    size_t found = 0, missed = 0, wasted = 0;
+    for (size_t i = 0; i < overlay.values.size(); i += 3) {
+      const float red = overlay.values[i], green = overlay.values[i + 1], blue = overlay.values[i + 2];
+      if (std::max({red, green, blue}) < 200.0f / 255.0f) continue;
+      (red > green && red > blue ? missed : green > blue ? found : wasted) += 1;
+    }
+    const auto tp = scored["true_positives"].get<size_t>();
+    EXPECT_EQ(found, tp) << p;
+    EXPECT_EQ(missed, record["holes"]["true_disocclusions"]["pixels"].get<size_t>() - tp) << p;
+    EXPECT_EQ(wasted, scored["pixels"].get<size_t>() - tp) << p;
+  }
 }
 
 TEST(Validate, ExternalTruthIsRenderedOnceThenCached) {

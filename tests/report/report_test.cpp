@@ -173,6 +173,16 @@ TEST(Report, SmokeSweepReportsPassTheBrowserCheck) {
   EXPECT_EQ(embedded_data(dir / "report" / "index.html")["cells"][0]["images"]["left"],
             "../smoke/" + lines[0]["images"]["left_png"].get<std::string>());
   std::printf("%s", check_in_browser(dir / "report" / "index.html", dir / "report-linked.png", true).c_str());
+  // Through a linked folder in --out the links are made from the path as given, as the browser
+  // resolves them (not from the folder the link points to, three levels deeper).
+  fs::create_directories(dir / "deep" / "a" / "b");
+  fs::create_directory_symlink(dir / "deep" / "a" / "b", dir / "lnk");
+  const test::CliRun linked = test::run_cli("report " + quoted(sweep / "shuffled.jsonl") + " --out " +
+                                            quoted(dir / "lnk" / "rep") + " --link-images");
+  ASSERT_EQ(linked.code, 0) << linked.out;
+  const std::string left = embedded_data(dir / "lnk" / "rep" / "index.html")["cells"][0]["images"]["left"];
+  EXPECT_EQ(left, "../../smoke/" + lines[0]["images"]["left_png"].get<std::string>());
+  EXPECT_TRUE(fs::exists((dir / "lnk" / "rep" / left).lexically_normal())) << left;
 
   // Every paper preset: the paper's numbers beside ours.
   for (const char* preset : {"wissmann-table2", "kim-table2", "kim-table3", "al-hagri-interaxial"}) {
@@ -279,11 +289,18 @@ TEST(Report, WarnsOnTornTailAndMissingImagesAndGuardsForeignFolders) {
   json with_images = minimal_line("b", 1);
   with_images["pipelines"]["repro-rt"]["validation"].erase("stage_eyes");  // as written before stages named eyes
   with_images["images"] = {{"left_png", "cells/0001/left.png"}, {"pipelines", {{"plain-rt", {{"right_png", "cells/0001/r.png"}}}}}};
-  write_text(dir / "results.jsonl", minimal_line("a", 0).dump() + "\n" + with_images.dump() + "\n{\"kind\": \"stereob");
+  // Two of the sweep's three cells: it is unfinished.
+  json first = minimal_line("a", 0);
+  first["cell_count"] = 3;
+  with_images["cell_count"] = 3;
+  write_text(dir / "results.jsonl", first.dump() + "\n" + with_images.dump() + "\n{\"kind\": \"stereob");
   const test::CliRun r = test::run_cli("report " + quoted(dir / "results.jsonl") + " --out " + quoted(dir / "out"));
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("results.jsonl:3: unterminated last line"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("image cells/0001/left.png is missing"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("2 of the 3 cells of sweep 'tiny' are in the results: the sweep is unfinished"),
+            std::string::npos)
+      << r.out;
   EXPECT_NE(r.out.find("2 cell(s) x 2 pipeline(s), 0 image(s)"), std::string::npos) << r.out;
   const json data = embedded_data(dir / "out" / "index.html");
   EXPECT_TRUE(data["cells"][1]["images"]["left"].is_null());
@@ -296,7 +313,8 @@ TEST(Report, WarnsOnTornTailAndMissingImagesAndGuardsForeignFolders) {
   EXPECT_DOUBLE_EQ(repro["right_over_left"].get<double>(), 0.5);
   EXPECT_TRUE(data["cells"][1]["pipelines"]["repro-rt"]["right_over_left"].is_null());
   EXPECT_TRUE(data["cells"][0]["pipelines"]["plain-rt"]["hole_fraction"].is_null()) << "absent in the line: null, shown as —";
-  EXPECT_EQ(data["warnings"].size(), 1u) << "the torn line is reported in the page";
+  // The page lists what the terminal said: the torn line, both missing images, the missing cell.
+  EXPECT_EQ(data["warnings"].size(), 4u) << data["warnings"].dump();
   for (const char* asset : {"report.js", "report.css", "chart.umd.min.js"})
     EXPECT_TRUE(fs::exists(dir / "out" / "assets" / asset)) << asset;
 
