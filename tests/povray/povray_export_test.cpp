@@ -96,12 +96,20 @@ TEST(PovrayExport, BakesTexturesAndFlipsV) {
   const StereoRig rig(CameraPose::look_at({0.5, 0.5, 3.0}, {0.5, 0.5, 0.0}), RigParams{});
   const auto r = export_scene(s, rig.eye(Eye::right), dir.path());
   ASSERT_EQ(r.texture_files.size(), 1u);
+  // Clamped along s: one replicated texel on each side (4 x 2), mapped back onto [0, 1].
   const Image baked = io::read_exr(r.texture_files[0]);
-  EXPECT_FLOAT_EQ(baked.rgb_at(0, 0)[0], 0.5f);
-  EXPECT_FLOAT_EQ(baked.rgb_at(0, 0)[1], 0.25f);
-  EXPECT_FLOAT_EQ(baked.rgb_at(1, 0)[0], 0.0f);
+  ASSERT_EQ(baked.width(), 4);
+  ASSERT_EQ(baked.height(), 2);
+  for (const int x : {0, 1}) {
+    EXPECT_FLOAT_EQ(baked.rgb_at(x, 0)[0], 0.5f) << x;
+    EXPECT_FLOAT_EQ(baked.rgb_at(x, 0)[1], 0.25f) << x;
+  }
+  for (const int x : {2, 3}) EXPECT_FLOAT_EQ(baked.rgb_at(x, 0)[0], 0.0f) << x;
   const std::string sdl = test::read_text(r.sdl_file);
-  EXPECT_NE(sdl.find("uv_mapping image_map { exr \"texture_0.exr\" interpolate 2 }"), std::string::npos) << sdl;
+  EXPECT_NE(sdl.find("uv_mapping image_map { exr \"texture_0.exr\" interpolate 2 } scale <2, 1, 1> translate "
+                     "<-0.5, 0, 0>"),
+            std::string::npos)
+      << sdl;
   EXPECT_NE(sdl.find("uv_vectors { 4,\n    <0, 1>"), std::string::npos) << sdl;  // v = 1 - v
   ASSERT_EQ(r.warnings.size(), 1u);
   EXPECT_NE(r.warnings[0].find("clamps"), std::string::npos);

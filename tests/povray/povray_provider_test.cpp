@@ -270,6 +270,126 @@ TEST(PovrayCamera, CoverageMatchesFullExceptOnSilhouettes) {
   }
 }
 
+/// Pixels where two right eyes differ beyond the half-float output's rounding, and how many of
+/// them lie where `full`'s 3x3 neighbourhood is uniform (not on a silhouette or shadow edge).
+struct Disagreement {
+  std::size_t differ = 0, off_edges = 0;
+};
+
+Disagreement disagreement(const Image& pov, const Image& full) {
+  const int w = full.width(), h = full.height();
+  const auto differs = [](const std::array<float, 3>& a, const std::array<float, 3>& b) {
+    for (int c = 0; c < 3; ++c)
+      if (std::abs(a[c] - b[c]) > 1e-3f * std::max(std::abs(b[c]), 1e-3f) + kHalfFloatRelative * std::abs(b[c]))
+        return true;
+    return false;
+  };
+  Disagreement d;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const auto f = full.rgb_at(x, y);
+      if (!differs(pov.rgb_at(x, y), f)) continue;
+      ++d.differ;
+      bool uniform = true;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int nx = std::clamp(x + dx, 0, w - 1), ny = std::clamp(y + dy, 0, h - 1);
+          if (differs(full.rgb_at(nx, ny), f)) uniform = false;
+        }
+      d.off_edges += uniform ? 1 : 0;
+    }
+  return d;
+}
+
+TEST(PovrayScale, AMillimetreAndAThousandKilometreSceneMatchFull) {
+  // box-wall scaled by k about the origin, its rig with it and its light's intensity by k^2, so
+  // that full's image is the same at every k. POV-Ray's absolute tolerances (1e-3 for shadow rays,
+  // 1e7 for a ray's reach) lost the shadows at k = 1e-3 (1,110 pixels off) and everything at
+  // k = 1e6 and beyond; the export's power-of-two scale keeps them.
+  SB_REQUIRE_POVRAY(povray);
+  const test::ScratchDir dir;
+  const Scene base = test::load_builtin("box-wall");
+  const StereoRig base_rig = test::rig_at(base, 160, 90);
+  for (const double k : {1e-3, 1.0, 3e6}) {
+    Scene scene = base;
+    for (Mesh& m : scene.meshes)
+      for (vec3& p : m.positions) p *= static_cast<float>(k);
+    for (Light& l : scene.lights) {
+      l.position *= static_cast<float>(k);
+      l.intensity *= static_cast<float>(k * k);
+    }
+    RigParams params = base_rig.params();
+    params.interaxial *= k;
+    params.convergence *= k;
+    params.znear *= k;
+    params.zfar *= k;
+    CameraPose pose = base_rig.pose();
+    pose.position *= k;
+    const StereoRig rig(pose, params);
+    const RenderScene rs(scene);
+    const std::string label = fmt::format("k{:g}", k);
+    const TruthRender pov = render_truth(*povray, rs, rig, dir / (label + "-povray"));
+    const TruthRender full = render_truth(*validation::make_truth_provider("full"), rs, rig, dir / (label + "-full"));
+    const Disagreement d = disagreement(pov.right, full.right);
+    std::cout << fmt::format("[povray box-wall x {:g}] scale {}; {} pixels differ, {} off edges\n", k,
+                             pov.settings.at("scale").dump(), d.differ, d.off_edges);
+    // Measured with POV-Ray 3.7: 0 off edges at every k.
+    EXPECT_LE(d.off_edges, 5u) << k;
+  }
+}
+
+TEST(PovrayCutout, AClampedTextureMatchesFullUpToItsEdges) {
+  // The cut-out square's colour and coverage textures clamped to their edges (its UVs span
+  // exactly [0, 1]): POV-Ray's bilinear lookup wraps across the image's edge, which gave a band
+  // half a texel wide around the square (its colour blended with the far edge's) before the export
+  // padded the images with their edge texels. Measured with POV-Ray 3.7: 686 pixels differed
+  // without the padding, 0 with it.
+  SB_REQUIRE_POVRAY(povray);
+  const test::ScratchDir dir;
+  Scene scene = test::cutout_scene(dir, test::Front::cutout_texture);
+  for (Texture& t : scene.textures) {
+    t.repeat_s = t.repeat_t = false;
+    // Colours that differ across each edge (a ramp in x, one in y), so that a lookup wrapping
+    // across an edge shows.
+    for (int y = 0; y < t.height; ++y)
+      for (int x = 0; x < t.width; ++x) {
+        float* texel = &t.rgba[(static_cast<std::size_t>(y) * static_cast<std::size_t>(t.width) + static_cast<std::size_t>(x)) * 4];
+        texel[0] = 0.2f + 0.2f * static_cast<float>(x);
+        texel[1] = 0.2f + 0.2f * static_cast<float>(y);
+      }
+  }
+  for (Mesh& m : scene.meshes)  // the square's coordinates run over [-0.5, 0.5]: moved onto [0, 1]
+    if (m.name == "square")
+      for (vec2& uv : m.uvs) uv += vec2(0.5f);
+  const RenderScene rs(scene);
+  const StereoRig rig = test::rig_at(scene, 160, 120);
+  const TruthRender pov = render_truth(*povray, rs, rig, dir / "povray");
+  const TruthRender full = render_truth(*validation::make_truth_provider("full"), rs, rig, dir / "full");
+  const Disagreement d = disagreement(pov.right, full.right);
+  std::cout << fmt::format("[povray clamped cut-out] {} pixels differ, {} off edges\n", d.differ, d.off_edges);
+  EXPECT_LE(d.differ, 40u);
+  EXPECT_NE(test::read_text(dir / "povray" / "scene.pov").find(" scale <"), std::string::npos)
+      << "the padded images are mapped with a transform";
+  EXPECT_TRUE(pov.settings.at("export_warnings").empty()) << pov.settings.at("export_warnings").dump();
+}
+
+TEST(PovrayNames, ALineBreakInANameStaysInsideItsComment) {
+  SB_REQUIRE_POVRAY(povray);
+  const test::ScratchDir dir;
+  Scene scene = test::load_builtin("box-wall");
+  scene.lights.front().name = "lamp\nsphere { <0, 0.5, 0>, 0.5 pigment { rgb <0, 1, 0> } } //";
+  scene.meshes.front().name = "box\r\n#error \"boom\"";
+  const RenderScene rs(scene);
+  const StereoRig rig = test::rig_at(scene, 64, 36);
+  const TruthRender pov = render_truth(*povray, rs, rig, dir / "povray");
+  const TruthRender full = render_truth(*validation::make_truth_provider("full"), rs, rig, dir / "full");
+  const std::string sdl = test::read_text(dir / "povray" / "scene.pov");
+  EXPECT_NE(sdl.find("'lamp\\nsphere { <0, 0.5, 0>"), std::string::npos) << "escaped in its comment";
+  EXPECT_EQ(sdl.find("\nsphere"), std::string::npos) << "no SDL line made of a name";
+  EXPECT_EQ(sdl.find("\n#error"), std::string::npos);
+  EXPECT_EQ(disagreement(pov.right, full.right).off_edges, 0u) << "no green sphere in the truth";
+}
+
 // ---------------------------------------------------------------------------------------------
 // Determinism.
 

@@ -2,6 +2,7 @@
 #include "validation/providers/povray_export.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -15,6 +16,7 @@
 #include "renderer/image.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/image_io.hpp"
+#include "renderer/text.hpp"
 
 namespace sb::validation::povray {
 
@@ -118,13 +120,52 @@ nlohmann::json json_vec(const dvec3& v) { return nlohmann::json::array({v.x, v.y
 /// the surface exists where the bilinear lookup is at least 0.5 (the lookup is linear, so the shift
 /// commutes with it). POV-Ray reads image maps in half precision; centred on 0.5, a texel exactly
 /// at the cutoff stays exactly 0.5, where the alpha itself (e.g. 128/255) would be rounded.
-void write_coverage_texture(const Texture& texture, const Material& material, const std::filesystem::path& path) {
-  Image image(texture.width, texture.height);
+/// Texels added on each side of an axis that clamps to its edge: POV-Ray's bilinear lookup blends
+/// the image's first and last texels across its edge (it repeats the image), where clamping
+/// holds the edge texel; one replicated texel around the image gives the lookup the clamped
+/// neighbour within half a texel of the edge. A repeating axis gets none.
+struct Padding {
+  int s = 0, t = 0;
+  explicit Padding(const Texture& texture) : s(texture.repeat_s ? 0 : 1), t(texture.repeat_t ? 0 : 1) {}
+  [[nodiscard]] bool any() const { return s != 0 || t != 0; }
+};
+
+/// An image of `texture`'s size plus its padding, each texel `value(source texel index)`, the
+/// padding replicating the edge texels.
+template <class Value>
+Image padded_image(const Texture& texture, Value value) {
+  const Padding pad(texture);
+  const int w = texture.width + 2 * pad.s, h = texture.height + 2 * pad.t;
+  Image image(w, h);
   float* rgb = image.add_plane(planes::rgb).data_f32();
-  const std::size_t n = static_cast<std::size_t>(texture.width) * static_cast<std::size_t>(texture.height);
-  for (std::size_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c)
-      rgb[i * 3 + c] = texture.rgba[i * 4 + 3] * material.base_color.w - material.alpha_cutoff + 0.5f;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const int sx = std::clamp(x - pad.s, 0, texture.width - 1), sy = std::clamp(y - pad.t, 0, texture.height - 1);
+      const std::array<float, 3> v =
+          value(static_cast<std::size_t>(sy) * static_cast<std::size_t>(texture.width) + static_cast<std::size_t>(sx));
+      float* out = rgb + (static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)) * 3;
+      out[0] = v[0], out[1] = v[1], out[2] = v[2];
+    }
+  return image;
+}
+
+/// The pigment transform that maps texture coordinates onto the padded image: u' = (u W + p) / (W
+/// + 2p) along each padded axis (POV-Ray evaluates the pattern at the inverse transform); empty
+/// without padding.
+std::string padding_transform(const Texture& texture) {
+  const Padding pad(texture);
+  if (!pad.any()) return "";
+  const double w = texture.width, h = texture.height;
+  return fmt::format(" scale <{:.17g}, {:.17g}, 1> translate <{:.17g}, {:.17g}, 0>", (w + 2.0 * pad.s) / w,
+                     (h + 2.0 * pad.t) / h, 0.0 - pad.s / w, 0.0 - pad.t / h);  // 0 - 0 is +0, not -0
+}
+
+void write_coverage_texture(const Texture& texture, const Material& material, const std::filesystem::path& path) {
+  const float* rgba = texture.rgba.data();
+  const Image image = padded_image(texture, [&](std::size_t i) {
+    const float c = rgba[i * 4 + 3] * material.base_color.w - material.alpha_cutoff + 0.5f;
+    return std::array<float, 3>{c, c, c};
+  });
   io::write_exr(path, image);
 }
 
@@ -132,11 +173,10 @@ void write_coverage_texture(const Texture& texture, const Material& material, co
 /// half-float EXR (POV-Ray 3.7 reads EXR image maps through OpenEXR's half RGBA interface; the
 /// file has no alpha channel: a cut-out's coverage is a map of its own, write_coverage_texture).
 void write_baked_texture(const Texture& texture, const vec4& factor, const std::filesystem::path& path) {
-  Image image(texture.width, texture.height);
-  float* rgb = image.add_plane(planes::rgb).data_f32();
-  const std::size_t n = static_cast<std::size_t>(texture.width) * static_cast<std::size_t>(texture.height);
-  for (std::size_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = texture.rgba[i * 4 + c] * factor[c];
+  const float* rgba = texture.rgba.data();
+  const Image image = padded_image(texture, [&](std::size_t i) {
+    return std::array<float, 3>{rgba[i * 4] * factor[0], rgba[i * 4 + 1] * factor[1], rgba[i * 4 + 2] * factor[2]};
+  });
   io::ExrWriteOptions options;
   options.float_format = io::ExrFloatFormat::f16;
   io::write_exr(path, image, {}, options);
@@ -199,6 +239,7 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
 
   // Textured materials: one baked EXR each, for the materials some mesh with UVs uses.
   std::vector<std::string> texture_name(scene.materials.size());
+  std::vector<std::string> texture_transform(scene.materials.size());  // padding_transform per material
   for (const Mesh& mesh : scene.meshes) {
     if (mesh.material < 0 || mesh.uvs.empty() || mesh.triangle_count() == 0) continue;
     const auto m = static_cast<std::size_t>(mesh.material);
@@ -211,6 +252,7 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
           mesh.name, texture.name));
     if (!texture_name[m].empty()) continue;
     texture_name[m] = fmt::format("texture_{}.exr", m);
+    texture_transform[m] = padding_transform(texture);
     const std::filesystem::path file = dir / texture_name[m];
     write_baked_texture(texture, material.base_color, file);
     out.texture_files.push_back(file);
@@ -225,12 +267,27 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
   const Bounds3 bounds = scene.bounds();
   const dvec3 centre = bounds.empty() ? dvec3(0.0) : dvec3(bounds.center());
   const double radius = bounds.empty() ? 1.0 : 0.5 * glm::length(dvec3(bounds.extent()));
+  // POV-Ray's tolerances are absolute (a shadow ray ignores hits nearer than 1e-3, an intersection
+  // nearer than 1e-4, and rays end at 1e7 units), which lost the shadows of a scene a millimetre
+  // wide and the whole of one ten thousand kilometres wide. Positions are written scaled by the
+  // power of two that brings the largest coordinate of the scene and the camera to 512..2048
+  // units: exact on float coordinates, and the same image, as the shading depends on ratios of
+  // lengths only (a point light's falloff on d / fade_distance, both scaled).
+  double largest = std::max({std::abs(eye.origin.x), std::abs(eye.origin.y), std::abs(eye.origin.z)});
+  if (!bounds.empty())
+    for (const vec3& corner : {bounds.lo, bounds.hi})
+      largest = std::max({largest, std::abs(double(corner.x)), std::abs(double(corner.y)), std::abs(double(corner.z))});
+  const int scale_exponent = largest > 0.0 && std::isfinite(largest)
+                                 ? std::clamp(10 - static_cast<int>(std::lround(std::log2(largest))), -100, 100)
+                                 : 0;
+  const double scale = std::ldexp(1.0, scale_exponent);
+  const auto placed = [scale](const dvec3& p) { return scale * p; };
 
   // Camera: POV-Ray's perspective ray for pixel (i, j) of a W x H image is
   //   direction + ((i + 0.5) / W - 0.5) right + (0.5 - (j + 0.5) / H) up
   // (no normalisation, no handedness), so with right = (W / f) r, up = (H / f) u and direction
   // = -back + ((W/2 - cx) / f) r + ((cy - H/2) / f) u it is EyeCamera::ray_direction at the pixel
-  // centre, unnormalised. World coordinates are written unchanged.
+  // centre, unnormalised. Positions are written times `scale`, directions unchanged.
   const double w = eye.width, h = eye.height, f = eye.f_px;
   const dvec3 cam_right = (w / f) * eye.right;
   const dvec3 cam_up = (h / f) * eye.up;
@@ -238,8 +295,10 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
 
   io::write_atomically(out.sdl_file, [&](const std::filesystem::path& tmp) {
     SdlStream sdl(tmp);
-    sdl.print("// stereobench {}: scene '{}' ({}), right eye {}x{}\n", kExportRevision, scene.name, scene.path,
-              eye.width, eye.height);
+    // Names go into comments with their control characters escaped: a line break in a name would
+    // end the comment and run the rest as SDL.
+    sdl.print("// stereobench {}: scene '{}' ({}), right eye {}x{}\n", kExportRevision, printable(scene.name),
+              printable(scene.path), eye.width, eye.height);
     sdl.print("#version 3.7;\n");
     const bool ambient = scene.ambient != 0.0f;
     // A cut-out's holes pass camera and shadow rays (pigment rgbt 1), each pass one trace level.
@@ -248,13 +307,13 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
               cutouts ? kCutoutTraceLevel : 5);
     for (std::size_t m = 0; m < scene.materials.size(); ++m)
       if (scene.materials[m].alpha_mode == Material::AlphaMode::mask && !texture_name[m].empty())
-        sdl.print("#declare SB_Coverage_{} = function {{ pigment {{ image_map {{ exr \"coverage_{}.exr\" interpolate 2 }} }} "
+        sdl.print("#declare SB_Coverage_{} = function {{ pigment {{ image_map {{ exr \"coverage_{}.exr\" interpolate 2 }}{} }} "
                   "}}\n",
-                  m, m);
+                  m, m, texture_transform[m]);
     sdl.print("background {{ rgb <{:.9g}, {:.9g}, {:.9g}> }}\n", scene.background.x, scene.background.y,
               scene.background.z);
     sdl.print("camera {{\n  perspective\n  location {}\n  right {}\n  up {}\n  direction {}\n}}\n",
-              vec_d(eye.origin), vec_d(cam_right), vec_d(cam_up), vec_d(cam_direction));
+              vec_d(placed(eye.origin)), vec_d(cam_right), vec_d(cam_up), vec_d(cam_direction));
     sdl.print("#declare SB_Finish = finish {{ ambient {:.9g} emission 0 diffuse 1 brilliance 1 crand 0 "
               "specular 0 phong 0 reflection 0 }}\n",
               static_cast<double>(scene.ambient));
@@ -273,8 +332,8 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
         el.type = "directional";
         const dvec3 col = c / kPiD;
         el.colour[0] = col.x, el.colour[1] = col.y, el.colour[2] = col.z;
-        sdl.print("light_source {{ {} rgb {} parallel point_at {} }}  // '{}'\n", vec_d(location), vec_d(col),
-                  vec_d(location + dirn), light.name);
+        sdl.print("light_source {{ {} rgb {} parallel point_at {} }}  // '{}'\n", vec_d(placed(location)),
+                  vec_d(col), vec_d(placed(location) + dirn), printable(light.name));
       } else {
         const dvec3 position(light.position);
         el.type = "point";
@@ -287,8 +346,8 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
         // 2 / (1 + (d/fd)^2) = (2 fd^2 / d^2) / (1 + fd^2 / d^2): colour I / (2 pi fd^2).
         const dvec3 col = c / (2.0 * kPiD * el.fade_distance * el.fade_distance);
         el.colour[0] = col.x, el.colour[1] = col.y, el.colour[2] = col.z;
-        sdl.print("light_source {{ {} rgb {} fade_distance {:.17g} fade_power 2 }}  // '{}'\n", vec_d(position),
-                  vec_d(col), el.fade_distance, light.name);
+        sdl.print("light_source {{ {} rgb {} fade_distance {:.17g} fade_power 2 }}  // '{}'\n",
+                  vec_d(placed(position)), vec_d(col), scale * el.fade_distance, printable(light.name));
       }
       out.lights.push_back(el);
     }
@@ -304,8 +363,11 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
       // A cut-out without a texture to read is the factor's alpha everywhere: absent below the
       // cutoff (SceneGeometry::opaque_at), opaque otherwise.
       if (cutout && !textured && material->base_color.w < material->alpha_cutoff) continue;
-      sdl.print("mesh2 {{  // '{}'\n  vertex_vectors {{ {}", mesh.name, mesh.positions.size());
-      for (const vec3& p : mesh.positions) sdl.print(",\n    <{:.9g}, {:.9g}, {:.9g}>", p.x, p.y, p.z);
+      sdl.print("mesh2 {{  // '{}'\n  vertex_vectors {{ {}", printable(mesh.name), mesh.positions.size());
+      for (const vec3& p : mesh.positions) {
+        const dvec3 q = placed(dvec3(p));  // a float times a power of two: 9 digits still round-trip
+        sdl.print(",\n    <{:.9g}, {:.9g}, {:.9g}>", q.x, q.y, q.z);
+      }
       sdl.print("\n  }}\n");
       if (!mesh.normals.empty()) {
         sdl.print("  normal_vectors {{ {}", mesh.normals.size());
@@ -328,13 +390,13 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
         // (the material).
         sdl.print("  texture {{ uv_mapping function {{ select(SB_Coverage_{}(x, y, z).red - 0.5, 0, 1) }}\n"
                   "    texture_map {{\n      [0 pigment {{ rgbt 1 }}]\n"
-                  "      [1 pigment {{ uv_mapping image_map {{ exr \"{}\" interpolate 2 }} }} finish {{ SB_Finish }}]\n"
+                  "      [1 pigment {{ uv_mapping image_map {{ exr \"{}\" interpolate 2 }}{} }} finish {{ SB_Finish }}]\n"
                   "    }}\n  }}\n",
-                  mesh.material, *tex);
+                  mesh.material, *tex, texture_transform[static_cast<std::size_t>(mesh.material)]);
       } else if (textured) {
-        sdl.print("  texture {{ pigment {{ uv_mapping image_map {{ exr \"{}\" interpolate 2 }} }} "
+        sdl.print("  texture {{ pigment {{ uv_mapping image_map {{ exr \"{}\" interpolate 2 }}{} }} "
                   "finish {{ SB_Finish }} }}\n",
-                  *tex);
+                  *tex, texture_transform[static_cast<std::size_t>(mesh.material)]);
       } else {
         const vec4 c = material ? material->base_color : vec4(1.0f);
         sdl.print("  texture {{ pigment {{ rgb <{:.9g}, {:.9g}, {:.9g}> }} finish {{ SB_Finish }} }}\n", c.x, c.y, c.z);
@@ -359,7 +421,9 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
   }
   out.settings = {
       {"export_revision", kExportRevision},
-      {"coordinates", "world coordinates unchanged; camera given by explicit right/up/direction, no look_at"},
+      {"coordinates", "world coordinates times scale (a power of two); camera given by explicit right/up/direction, "
+                      "no look_at"},
+      {"scale", scale},
       {"camera",
        {{"location", json_vec(eye.origin)},
         {"right", json_vec(cam_right)},

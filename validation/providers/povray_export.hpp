@@ -17,7 +17,7 @@
 namespace sb::validation::povray {
 
 /// The export's revision: changes whenever the SDL written for a given scene and eye changes.
-inline constexpr const char* kExportRevision = "povray-export-2";
+inline constexpr const char* kExportRevision = "povray-export-3";
 /// max_trace_level of a scene with cut-outs: how many holes a camera or shadow ray may pass.
 inline constexpr int kCutoutTraceLevel = 64;
 
