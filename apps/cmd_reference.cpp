@@ -11,7 +11,9 @@
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "reference/store.hpp"
+#include "renderer/text.hpp"
 #include "renderer/error.hpp"
+#include "renderer/text.hpp"
 #include "renderer/io/atomic_file.hpp"
 
 namespace sb::cli {
@@ -129,9 +131,13 @@ int run_verify(const ReferenceArgs& a) {
     }
   }
   std::string tail;
+  // The command to run as it stands: with the store and scenes folder this run was given.
+  std::string update = "stereobench reference update --only-failing";
+  if (fs::path(a.store).lexically_normal() != reference::default_store_dir().lexically_normal())
+    update += " --store " + shell_quote(a.store);
+  if (!a.scenes_dir.empty()) update += " --scenes-dir " + shell_quote(a.scenes_dir);
   if (failures > specless)
-    tail += fmt::format("; {} did not (rewrite them with `stereobench reference update --only-failing`)",
-                        failures - specless);
+    tail += fmt::format("; {} did not (rewrite them with `{}`)", failures - specless, update);
   if (specless > 0)
     tail += fmt::format("; {} lost their spec with their provenance (remove each and make it again with `stereobench "
                         "reference generate`, see above)",
@@ -255,7 +261,8 @@ void register_reference_command(CLI::App& root, const std::string& command_line)
   const auto add_selection = [&](CLI::App* c) {
     add_common(c);
     c->add_option("ids", a->ids, "Reference ids (default: every reference in the store)");
-    c->add_flag("--no-render", a->no_render, "Check hashes only (image file and scene), do not render again");
+    c->add_flag("--no-render", a->no_render,
+                "Check hashes only (image file and scene), do not render again (update: with --only-failing)");
     c->add_option("--min-psnr", a->min_psnr,
                   "Accept a new render this close to the stored one (dB, 8-bit sRGB); default: identical");
   };

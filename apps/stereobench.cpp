@@ -19,26 +19,17 @@
 #include "renderer/io/gltf_loader.hpp"
 #include "renderer/io/image_io.hpp"
 #include "renderer/memory.hpp"
+#include "renderer/text.hpp"
 #include "sb_version.hpp"
 #include "validation/process.hpp"
 
 namespace {
 
-/// The command line as typed, arguments with spaces or quotes single-quoted (for provenance).
+/// The command line as typed, each argument a shell would split or expand single-quoted (for
+/// provenance).
 std::string command_line(int argc, char** argv) {
   std::string out;
-  for (int i = 0; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (i > 0) out += ' ';
-    const bool plain = !arg.empty() && arg.find_first_of(" \t'\"$\\") == std::string::npos;
-    if (plain) {
-      out += arg;
-      continue;
-    }
-    out += '\'';
-    for (char c : arg) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    out += '\'';
-  }
+  for (int i = 0; i < argc; ++i) out += (i > 0 ? " " : "") + sb::shell_quote(argv[i]);
   return out;
 }
 

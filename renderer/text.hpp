@@ -60,6 +60,20 @@ namespace sb {
   return out;
 }
 
+/// `word` as one word of a POSIX shell command line: as it is when it holds only characters no
+/// shell treats specially (letters, digits and _-./=:,+@%), else in single quotes, a ' inside
+/// written '\''; with `always`, quoted whatever it holds.
+[[nodiscard]] inline std::string shell_quote(std::string_view word, bool always = false) {
+  const bool plain = !always && !word.empty() && std::all_of(word.begin(), word.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) != 0 ||
+           std::string_view("_-./=:,+@%").find(c) != std::string_view::npos;
+  });
+  if (plain) return std::string(word);
+  std::string out = "'";
+  for (const char c : word) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
 /// The strftime form of a UTC time in every record, provenance and submission file the suite
 /// writes: ISO 8601, "2026-11-21T20:00:00Z".
 inline constexpr const char* kUtcTimeFormat = "%Y-%m-%dT%H:%M:%SZ";

@@ -15,6 +15,7 @@
 #include <toml++/toml.h>
 
 #include "renderer/error.hpp"
+#include "renderer/text.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/pipeline.hpp"
 #include "scenes/catalog.hpp"
@@ -174,17 +175,6 @@ std::string number_arg(double v) {
   return fmt::format("{}", v);
 }
 
-/// Quotes a command-line argument for a POSIX shell when it needs it.
-std::string shell_quote(const std::string& arg) {
-  const bool plain = !arg.empty() && std::all_of(arg.begin(), arg.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) ||
-           std::string_view("_-./=:,+@%").find(c) != std::string_view::npos;
-  });
-  if (plain) return arg;
-  std::string out = "'";
-  for (char c : arg) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
 
 /// A number of a record: std::nullopt when absent, NaN for null, +-inf for "inf"/"-inf";
 /// InputError for any other type.
@@ -296,6 +286,7 @@ GateConfig parse_gate_config(const std::string& text, const std::string& source)
     } else if (k == "regression") {
       if (!node.is_table()) config_error(source, node.source(), "[regression] must be a table");
       config.regression = read_regression(*node.as_table(), source);
+      config.regression_table = true;
     } else if (k == "rule") {
       if (!node.is_array_of_tables())
         config_error(source, node.source(), "rule must be an array of tables: write each as [[rule]]");
@@ -336,7 +327,8 @@ ThresholdValues thresholds_for(const GateConfig& config, const std::string& pipe
                                const std::string& cell_id, std::vector<bool>* rule_used,
                                std::map<std::string, std::string>* origins) {
   ThresholdValues values = config.defaults;
-  values[kToleranceKey] = config.regression.tolerance;
+  // The [regression] tolerance applies everywhere only when the table is there.
+  if (config.regression_table) values[kToleranceKey] = config.regression.tolerance;
   // Per key, the rule that set it last (none: [defaults]).
   std::map<std::string, size_t> set_by;
   for (size_t i = 0; i < config.rules.size(); ++i) {
@@ -606,7 +598,10 @@ std::string reproduce_command(const GateCell& cell, const std::string& pipeline,
     const json& t = entry.value("timing", json::object());
     if (const auto n = num(t, "repetitions"); n && *n >= 1)
       add("--repetitions", fmt::format("{}", static_cast<int>(*n)));
-    if (const auto w = num(t, "warmup"); w && *w >= 0) add("--warmup", fmt::format("{}", static_cast<int>(*w)));
+    // A sweep cell renders each pipeline once for its validation before timing, so its runs were
+    // warm even with warmup = 0; bench times from cold unless it warms up: one round at least.
+    if (const auto w = num(t, "warmup"); w && *w >= 0)
+      add("--warmup", fmt::format("{}", std::max(1, static_cast<int>(*w))));
     if (const auto threads = num(rec, "threads"); threads && *threads >= 1)
       add("--threads", fmt::format("{}", static_cast<int>(*threads)));
   } else {
@@ -777,7 +772,8 @@ std::string nothing_checked_message(const GateConfig& config, const GateResults&
   std::vector<std::string> parts;
   for (const auto& [why, count] : skip_reasons(checks))
     parts.push_back(fmt::format("{} x {}: {}", count, why.first, why.second));
-  const std::string why = parts.empty() ? "its rules turn every limit off for them"
+  const std::string why = parts.empty() ? "no limit of it applies to them (its rules turn them off, or name other "
+                                           "pipelines, scenes or cells)"
                                          : fmt::format("every one was skipped ({})", fmt::join(parts, "; "));
   return fmt::format("{}: none of its checks applies to {} ({} cell{}): {}; a pass would say "
                      "nothing. Give limits the records carry in [defaults] or a [[rule]], or a baseline for "

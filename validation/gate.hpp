@@ -97,6 +97,9 @@ struct GateConfig {
   ThresholdValues defaults;  ///< `[defaults]`
   std::vector<GateRule> rules;
   RegressionSettings regression;
+  /// Whether the file has a [regression] table: time regressions are then checked for every
+  /// (cell, pipeline); without it only where a [[rule]] sets regression_tolerance.
+  bool regression_table = false;
 
   /// Whether some table gives a threshold a value; without one, only time regressions against a
   /// baseline are checked. A limit counts only when given a value: [[rule]]s without one, or keys

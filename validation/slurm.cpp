@@ -46,12 +46,6 @@ std::string trimmed(std::string s) {
   return s;
 }
 
-/// Single-quoted for a POSIX shell.
-std::string shell_quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
 
 /// A path (and a file-name `pattern` of sbatch's inside it) as an #SBATCH directive's value: in
 /// double quotes, which carry blanks (sbatch splits an unquoted value at them). A double quote, a backslash, a '%' (sbatch expands '%' patterns in
@@ -220,11 +214,11 @@ std::string sbatch_script(const SweepDefinition& d, const SlurmSweepOptions& o) 
     s += fmt::format("threads={}\n", o.threads);
   else
     s += "threads=${SLURM_CPUS_PER_TASK:-${SLURM_CPUS_ON_NODE:-1}}  # the CPUs Slurm allocated to this task\n";
-  s += "slurm_dir=" + shell_quote(l.dir.string()) + "\n";
-  std::string cmd = shell_quote(fs::absolute(o.stereobench).string()) + " sweep run " +
-                    shell_quote(fs::absolute(d.file).string()) + " --out " + shell_quote(o.out_dir.string()) +
+  s += "slurm_dir=" + shell_quote(l.dir.string(), true) + "\n";
+  std::string cmd = shell_quote(fs::absolute(o.stereobench).string(), true) + " sweep run " +
+                    shell_quote(fs::absolute(d.file).string(), true) + " --out " + shell_quote(o.out_dir.string(), true) +
                     " \\\n    --shard \"$task/" + n + "\" --results \"$slurm_dir/results-$task.jsonl\" --threads \"$threads\"";
-  for (const std::string& a : o.run_args) cmd += " " + shell_quote(a);
+  for (const std::string& a : o.run_args) cmd += " " + shell_quote(a, true);
   s += cmd + "\n";
   s += "code=$?\n";
   s += "printf '%d\\n' \"$code\" > \"$slurm_dir/task-$task.status.tmp\" && "

@@ -58,6 +58,20 @@ const validation::GateCheck* find_check(const validation::GateReport& r, const s
   return nullptr;
 }
 
+TEST(GateEval, TimeRegressionsOnlyWhereTheConfigAsks) {
+  validation::Baseline baseline;
+  const std::vector<json> cells = passing_cells();
+  for (const char* p : {"plain-rt", "repro-rt"}) baseline.cells[cells[0]["cell_id"].get<std::string>()][p].samples_s = {0.01, 0.01, 0.01};
+  // No [regression] table and no rule's regression_tolerance: no time regression check at all.
+  const std::string thresholds_only = "[defaults]\nmin_psnr = 30\n";
+  validation::GateReport r = evaluate(cells, baseline, thresholds_only);
+  EXPECT_EQ(find_check(r, "repro-rt", "time_regression"), nullptr);
+  // A rule's tolerance turns it on for its cells alone.
+  r = evaluate(cells, baseline, thresholds_only + "[[rule]]\npipeline = \"repro-rt\"\nregression_tolerance = 0.2\n");
+  EXPECT_NE(find_check(r, "repro-rt", "time_regression"), nullptr);
+  EXPECT_EQ(find_check(r, "plain-rt", "time_regression"), nullptr);
+}
+
 TEST(GateEval, PassingCellsPass) {
   const validation::GateReport r = evaluate(passing_cells());
   EXPECT_EQ(r.worst, Verdict::skip);  // only the time regression is skipped (no baseline)
@@ -267,9 +281,18 @@ TEST(GateEval, AGateThatChecksNothingIsBadInputNotAPass) {
     EXPECT_NE(m.find("4 x time_regression: no baseline"), std::string::npos) << m;
     EXPECT_NE(m.find("--update-baseline"), std::string::npos) << m;
   }
-  // Limits only for a pipeline the results do not hold: only the (skipped) time regressions remain.
+  // Limits only for a pipeline the results do not hold: no check at all (without [regression] no
+  // time regression is checked either).
   try {
     (void)evaluate(passing_cells(), {}, "[[rule]]\npipeline = \"bidir-warp\"\nmin_psnr = 30\n");
+    ADD_FAILURE() << "a gate that checked nothing passed";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no limit of it applies to them"), std::string::npos) << e.what();
+  }
+  // With [regression] the time regressions remain, all skipped without a baseline.
+  try {
+    (void)evaluate(passing_cells(), {},
+                   "[regression]\n[[rule]]\npipeline = \"bidir-warp\"\nmin_psnr = 30\n");
     ADD_FAILURE() << "a gate that checked nothing passed";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("every one was skipped (4 x time_regression: no baseline)"), std::string::npos)
@@ -282,7 +305,7 @@ TEST(GateEval, AGateThatChecksNothingIsBadInputNotAPass) {
                    "regression_tolerance = false\n");
     ADD_FAILURE() << "a gate that checked nothing passed";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("(2 cells): its rules turn every limit off for them"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("(2 cells): no limit of it applies to them (its rules turn them off"), std::string::npos)
         << e.what();
   }
   // An unfinished sweep whose cells all skip fails its completeness check instead.
@@ -713,9 +736,9 @@ TEST(GateEval, TimesAreReproducedByBenchAndTheBaselineHasNoSpeedupCheck) {
   ASSERT_NE(speedup, nullptr);
   EXPECT_EQ(speedup->verdict, Verdict::fail);
   EXPECT_EQ(speedup->reproduce,
-            "stereobench bench --scene box-wall --pipelines repro-rt --baseline plain-rt --repetitions 3 --warmup 0 "
+            "stereobench bench --scene box-wall --pipelines repro-rt --baseline plain-rt --repetitions 3 --warmup 1 "
             "--threads 2 --resolution 320x180 --interaxial 0.064 --convergence 2")
-      << "a speed-up is measured by timing, not by validate";
+      << "a speed-up is measured by timing, not by validate; warm, as the cell's warmup 0 timed warm runs";
   const validation::GateCheck* regression = find_check(r, "repro-rt", "time_regression");
   ASSERT_NE(regression, nullptr);
   EXPECT_EQ(regression->reproduce, speedup->reproduce);

@@ -18,6 +18,7 @@
 #include "reference/store.hpp"
 #include "scenes/catalog.hpp"
 #include "renderer/io/file_lock.hpp"
+#include "renderer/text.hpp"
 #include "support/lock_wait.hpp"
 #include "support/run_cli.hpp"
 #include "support/scratch_dir.hpp"
@@ -144,8 +145,10 @@ TEST(ReferenceStore, DamagedProvenanceIsAFindingNotAStop) {
   EXPECT_NE(r.out.find("corrupt        " + pole), std::string::npos) << "verification went on past the first: " << r.out;
   EXPECT_NE(r.out.find("the recorded rig \"wide\" is not a rig record"), std::string::npos) << r.out;
   // The summary sends the entry whose spec is readable to update and the other to generate.
+  // The command given runs on this store with this scenes folder, as typed.
   EXPECT_NE(r.out.find("0 of 2 reference(s) verified; 1 did not (rewrite them with `stereobench reference update "
-                       "--only-failing`); 1 lost their spec with their provenance"),
+                       "--only-failing --store " + shell_quote((dir / "store").string()) + " --scenes-dir " +
+                       shell_quote(kScenes.string()) + "`); 1 lost their spec with their provenance"),
             std::string::npos)
       << r.out;
 
