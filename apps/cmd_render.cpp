@@ -1,5 +1,6 @@
 // `stereobench render` and `stereobench pipelines`: render a stereo pair with one pipeline and
 // write its images and statistics; list and describe the registered pipelines.
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -52,9 +53,12 @@ void print_timings(const StereoResult& r) {
     fmt::print("  {:<22} -{}: no stage serves the left eye alone\n", "right eye / left eye", shared);
 }
 
+/// A share as a percentage with two decimals, or "-" where it is undefined (NaN).
+std::string percent(double share) { return std::isnan(share) ? "-" : fmt::format("{:.2f} %", 100.0 * share); }
+
 void print_holes(const HoleAnalysis& h, size_t pixels) {
-  fmt::print("  {:<22} recall {:.2f} %, precision {:.2f} % ({} flagged, {} true positives)\n", "holes",
-             100.0 * h.scores.recall, 100.0 * h.scores.precision, h.scores.hole_pixels, h.scores.true_positives);
+  fmt::print("  {:<22} recall {}, precision {} ({} pixels, {} of them truly disoccluded)\n", "not reprojected",
+             percent(h.scores.recall), percent(h.scores.precision), h.scores.hole_pixels, h.scores.true_positives);
   fmt::print("  {:<22} {} = {:.3f} % of the right eye ({} outside the left frustum, {} hidden), {:.2f} ms\n",
              "true disocclusions", h.truth.count(), 100.0 * double(h.truth.count()) / double(pixels),
              h.truth.outside_frustum, h.truth.hidden, h.seconds * 1e3);

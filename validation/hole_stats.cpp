@@ -45,13 +45,6 @@ std::span<const char* const> hole_counter_names() {
   return names;
 }
 
-std::vector<uint8_t> not_reprojected_mask(const Image& eye) {
-  std::vector<uint8_t> mask(eye.pixel_count());
-  const uint32_t* source = eye.data_u32(planes::source);
-  for (size_t i = 0; i < mask.size(); ++i) mask[i] = source[i] != static_cast<uint32_t>(Source::reprojected) ? 1 : 0;
-  return mask;
-}
-
 HoleStatistics hole_statistics(const Image& right, const Counters& counters, const TrueDisocclusions& truth) {
   HoleStatistics s;
   s.pixels = right.pixel_count();

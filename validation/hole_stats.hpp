@@ -33,10 +33,6 @@ inline constexpr int kRegionBins = 16;
 /// components). InputError if the mask is not width x height.
 [[nodiscard]] RegionStats connected_regions(std::span<const uint8_t> mask, int width, int height);
 
-/// 1 where `eye`'s source tag is not `reprojected` (rendered for that eye, filled, or left as a
-/// hole), 0 elsewhere: the mask HoleStatistics scores against the true disocclusions.
-[[nodiscard]] std::vector<uint8_t> not_reprojected_mask(const Image& eye);
-
 /// Everything §6.3 reports for one right eye.
 struct HoleStatistics {
   uint64_t pixels = 0;

@@ -433,12 +433,6 @@ void claim_out_folder(const SweepDefinition& d, const SweepRunOptions& options) 
   io::write_text_atomically(marker, mine.dump(2) + "\n");
 }
 
-/// Every cell's rig resolved against its scene, its scene checked by its ground truth's provider,
-/// and a path's spin against the scene's meshes, each scene resolved (a built-in one generated)
-/// and loaded once: an impossible rig (a convergence so near that the disparity exceeds any
-/// image), a scene the truth cannot render (a spot light for POV-Ray) or a spin prefix that
-/// matches nothing is refused before the first cell runs, naming the definition and the cell,
-/// instead of stopping the sweep when that cell comes.
 /// The scene content (hash_scene as recorded) each scene's finished cells of `results` were
 /// measured on, by scene label: the first such cell's hash and id.
 std::map<std::string, std::pair<std::string, std::string>> measured_scenes(const std::vector<SweepCell>& cells,
@@ -458,6 +452,13 @@ std::map<std::string, std::pair<std::string, std::string>> measured_scenes(const
   return out;
 }
 
+/// Every cell's rig resolved against its scene, its scene checked by its ground truth's provider,
+/// and a path's spin against the scene's meshes, each scene resolved (a built-in one generated)
+/// and loaded once: an impossible rig (a convergence so near that the disparity exceeds any
+/// image), a scene the truth cannot render (a spot light for POV-Ray) or a spin prefix that
+/// matches nothing is refused before the first cell runs, naming the definition and the cell,
+/// instead of stopping the sweep when that cell comes; so is a scene whose content differs from
+/// the one the results file's finished cells of it were measured on.
 void check_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, const std::vector<size_t>& todo,
                  const fs::path& scenes_dir, const std::map<std::string, std::unique_ptr<TruthProvider>>& providers,
                  const fs::path& results) {

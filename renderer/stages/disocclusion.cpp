@@ -242,6 +242,14 @@ std::vector<uint8_t> hole_mask_from_sources(const Image& right) {
   return mask;
 }
 
+std::vector<uint8_t> not_reprojected_mask(const Image& eye) {
+  const std::span<const uint32_t> source = eye.plane(planes::source).u32();
+  std::vector<uint8_t> mask(source.size());
+  std::transform(source.begin(), source.end(), mask.begin(),
+                 [](uint32_t tag) { return tag != static_cast<uint32_t>(Source::reprojected) ? 1 : 0; });
+  return mask;
+}
+
 bool has_reprojected_pixels(const Image& image) {
   const std::span<const uint32_t> source = image.plane(planes::source).u32();
   return std::find(source.begin(), source.end(), static_cast<uint32_t>(Source::reprojected)) != source.end();
@@ -293,7 +301,7 @@ std::optional<HoleAnalysis> analyze_holes(const RenderScene& scene, const Stereo
   const auto start = std::chrono::steady_clock::now();
   HoleAnalysis a;
   a.truth = true_disocclusions(scene, rig, trace_visible_surfaces(scene, rig.eye(Eye::right), executor), executor);
-  const std::vector<uint8_t> holes = hole_mask_from_sources(right);
+  const std::vector<uint8_t> holes = not_reprojected_mask(right);
   a.scores = score_holes(holes, a.truth.mask);
   a.overlay = hole_overlay(right, holes, a.truth.mask);
   a.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

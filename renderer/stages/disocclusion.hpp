@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <vector>
@@ -73,6 +74,12 @@ struct TrueDisocclusions {
 /// own first pass), 0 elsewhere. InputError if the image has no "source" plane.
 [[nodiscard]] std::vector<uint8_t> hole_mask_from_sources(const Image& right);
 
+/// 1 where `eye`'s source tag is not `reprojected` (rendered for that eye, filled, or left as a
+/// hole), 0 elsewhere: the mask scored against the true disocclusions (a reprojected pixel there
+/// shows the wrong surface). For the pipelines that render nothing natively for the right eye it
+/// is hole_mask_from_sources. InputError without a "source" plane.
+[[nodiscard]] std::vector<uint8_t> not_reprojected_mask(const Image& eye);
+
 /// Whether any pixel's source tag is `reprojected` (InputError without a "source" plane).
 [[nodiscard]] bool has_reprojected_pixels(const Image& image);
 
@@ -81,8 +88,12 @@ struct HoleScores {
   uint64_t hole_pixels = 0;     ///< pixels the hole mask flags
   uint64_t true_pixels = 0;     ///< truly disoccluded pixels
   uint64_t true_positives = 0;  ///< flagged and truly disoccluded
-  double recall = 1.0;          ///< true_positives / true_pixels; 1 when nothing is disoccluded
-  double precision = 1.0;       ///< true_positives / hole_pixels; 1 when nothing is flagged
+  /// true_positives / true_pixels; NaN (undefined: null in records, "-" in tables) when nothing
+  /// is disoccluded.
+  double recall = std::numeric_limits<double>::quiet_NaN();
+  /// true_positives / hole_pixels; NaN when nothing is flagged (a pipeline that flags nothing is
+  /// not "precise").
+  double precision = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Scores `holes` against `truth` (both per pixel, non-zero = set). InputError if the sizes differ.
@@ -105,7 +116,8 @@ struct HoleAnalysis {
 };
 
 /// When the right eye has reprojected pixels: traces the rig's right eye (trace_visible_surfaces),
-/// computes the true disocclusions, scores the right eye's hole mask and draws the overlay.
+/// computes the true disocclusions, scores the pixels not reprojected (not_reprojected_mask, as
+/// validation scores them) and draws the overlay of that mask.
 /// Nothing when no pixel is reprojected: every pixel was rendered for that eye, so there are no
 /// holes to score.
 [[nodiscard]] std::optional<HoleAnalysis> analyze_holes(const RenderScene& scene, const StereoRig& rig,

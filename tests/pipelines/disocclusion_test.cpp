@@ -336,16 +336,25 @@ TEST(ScoreHoles, CountsAndRatiosOnHandMadeMasks) {
 
   const std::vector<uint8_t> none(6, 0), all(6, 1);
   const HoleScores empty = score_holes(none, none);
-  EXPECT_EQ(empty.recall, 1.0) << "nothing disoccluded: nothing to miss";
-  EXPECT_EQ(empty.precision, 1.0) << "nothing flagged: nothing wasted";
+  EXPECT_TRUE(std::isnan(empty.recall)) << "nothing disoccluded: recall undefined";
+  EXPECT_TRUE(std::isnan(empty.precision)) << "nothing flagged: precision undefined, not perfect";
   const HoleScores missed = score_holes(none, truth);
   EXPECT_EQ(missed.recall, 0.0);
-  EXPECT_EQ(missed.precision, 1.0);
+  EXPECT_TRUE(std::isnan(missed.precision));
   const HoleScores flag_all = score_holes(all, truth);
   EXPECT_EQ(flag_all.recall, 1.0);
   EXPECT_DOUBLE_EQ(flag_all.precision, 0.5);
 
   EXPECT_THROW((void)score_holes(std::vector<uint8_t>(5, 0), truth), InputError);
+
+  // What is scored is every pixel not reprojected: rendered for the eye, filled, or a hole.
+  Image tagged(5, 1);
+  uint32_t* tag = tagged.add_plane(planes::source).data_u32();
+  const Source tags[5] = {Source::reprojected, Source::traced, Source::rasterized, Source::hole,
+                          Source::reshaded_traced};
+  for (int i = 0; i < 5; ++i) tag[i] = static_cast<uint32_t>(tags[i]);
+  EXPECT_EQ(not_reprojected_mask(tagged), (std::vector<uint8_t>{0, 1, 1, 1, 1}));
+  EXPECT_EQ(hole_mask_from_sources(tagged), (std::vector<uint8_t>{0, 0, 0, 1, 1}));
 }
 
 /// A 7x1 image whose pixels carry each source tag once, in enum order, and radiance 2.0 (to be clamped).
@@ -407,7 +416,9 @@ TEST(HoleAnalysis, ScoresAFakeHoleMaskOnBoxWall) {
   const std::optional<HoleAnalysis> a = analyze_holes(rs, rig, fake, executor);
   ASSERT_TRUE(a);
   EXPECT_TRUE(a->truth.mask == truth.mask);
-  const HoleScores expected = score_holes(hole_mask_from_sources(fake), truth.mask);
+  // Only hole and reprojected tags: the pixels not reprojected are the hole mask.
+  EXPECT_EQ(not_reprojected_mask(fake), hole_mask_from_sources(fake));
+  const HoleScores expected = score_holes(not_reprojected_mask(fake), truth.mask);
   EXPECT_EQ(a->scores.hole_pixels, expected.hole_pixels);
   EXPECT_EQ(a->scores.true_positives, expected.true_positives);
   EXPECT_GT(a->scores.true_positives, 0u);

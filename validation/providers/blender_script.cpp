@@ -128,6 +128,7 @@ def place_moved_nodes():
         moved[m["node"]] = Matrix([[v[c * 4 + r] for c in range(4)] for r in range(4)])
     if not moved:
         return
+    bpy.context.view_layer.update()  # world matrices as the import left them
     by_node = {}
     for obj in bpy.data.objects:
         if "stereobench_node" in obj:
