@@ -14,6 +14,7 @@
 #include <fmt/ranges.h>
 
 #include "renderer/error.hpp"
+#include "renderer/text.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/image_io.hpp"
 #include "validation/process.hpp"
@@ -49,14 +50,7 @@ struct Command {
 
 /// Shell-quoted form of the command (for records and messages; not used to run it).
 std::string quoted(const Command& c) {
-  const auto q = [](const std::string& s) {
-    if (!s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789+-_=./,:") ==
-                          std::string::npos)
-      return s;
-    std::string out = "'";
-    for (char ch : s) out += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
-    return out + "'";
-  };
+  const auto q = [](const std::string& s) { return shell_quote(s); };
   std::string out;
   if (!c.options.cwd.empty()) out += "cd " + q(c.options.cwd.string()) + " && ";
   if (!c.options.unset_env.empty()) {
