@@ -341,9 +341,10 @@ void run_nightly(const NightlyArgs& a) {
   for (const json& r : history.runs)
     if (r.value("sweep", "") == d.name) trend_runs.push_back(r);
   if (trend_runs.size() < history.runs.size()) {
-    options.history_note = fmt::format("The trends leave out {} runs of other sweeps in {}.",
-                                       history.runs.size() - trend_runs.size(), history_file.string());
-    fmt::print(stderr, "note: {}\n", options.history_note);
+    const std::string left_out = fmt::format("trends leave out {} runs of other sweeps in {}",
+                                             history.runs.size() - trend_runs.size(), history_file.string());
+    options.history_note = fmt::format("The {}.", left_out);
+    fmt::print(stderr, "note: the {}\n", left_out);
   }
   options.history = std::move(trend_runs);
   const reports::ReportSummary s = reports::write_report(report_results, options);

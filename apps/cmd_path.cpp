@@ -114,6 +114,7 @@ void run_path_command(const PathArgs& a) {
 
   // The path checked against the scene before the first frame (run_path plays it on its own animator).
   const SceneAnimator animation(loaded.scene, run.path);
+  validation::check_path_truth(*provider, loaded.scene, run.path, loaded.file);
   fmt::print("path on {} ({} triangles): {} frames, {}{}; {}, truth {}\n", loaded.scene.name,
              loaded.scene.triangle_count(), a.frames,
              run.path.camera_keys.empty() ? "the scene's camera" : fmt::format("{} camera key{}", run.path.camera_keys.size(), run.path.camera_keys.size() == 1 ? "" : "s"),

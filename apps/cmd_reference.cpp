@@ -11,10 +11,10 @@
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "reference/store.hpp"
-#include "renderer/text.hpp"
 #include "renderer/error.hpp"
-#include "renderer/text.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/text.hpp"
+#include "scenes/catalog.hpp"
 
 namespace sb::cli {
 
@@ -135,7 +135,9 @@ int run_verify(const ReferenceArgs& a) {
   std::string update = "stereobench reference update --only-failing";
   if (fs::path(a.store).lexically_normal() != reference::default_store_dir().lexically_normal())
     update += " --store " + shell_quote(a.store);
-  if (!a.scenes_dir.empty()) update += " --scenes-dir " + shell_quote(a.scenes_dir);
+  if (!a.scenes_dir.empty() &&
+      fs::path(a.scenes_dir).lexically_normal() != scenes::default_scenes_dir().lexically_normal())
+    update += " --scenes-dir " + shell_quote(a.scenes_dir);
   if (failures > specless)
     tail += fmt::format("; {} did not (rewrite them with `{}`)", failures - specless, update);
   if (specless > 0)

@@ -163,9 +163,10 @@ void register_validate_command(CLI::App& root) {
       "Measure pipelines' right eyes against a ground-truth right eye: MSE, PSNR, SSIM, error pixels\n"
       "(whole image and per region: reprojected, filled, true disocclusions), hole statistics\n"
       "against the true disocclusions, and time. Writes a JSON record and images per pipeline\n"
-      "(right eye, difference and SSIM maps, hole mask) and prints a table. A pipeline that synthesizes\n"
-      "part of its left eye too (bidir-warp, bidir-warp-rt) has its left eye measured against plain-rt's\n"
-      "left eye, and writes that eye and its difference map. Schema: docs/results.md.");
+      "(right eye, difference and SSIM maps, the pixels not reprojected against the true\n"
+      "disocclusions) and prints a table. A pipeline that synthesizes part of its left eye too\n"
+      "(bidir-warp, bidir-warp-rt) has its left eye measured against plain-rt's left eye, and\n"
+      "writes that eye and its difference map. Schema: docs/results.md.");
   v->add_option("--scene,-s", a->scene, "Scene file (.gltf/.glb) or built-in scene name")->capture_default_str();
   v->add_option("--pipelines,-p", a->pipelines,
                 "Pipelines to validate: names, comma-separated or repeated, or 'all' (see `stereobench pipelines`);\n"

@@ -32,9 +32,9 @@ class RenderScene {
   [[nodiscard]] float ray_epsilon() const { return ray_epsilon_; }
 
   /// After the scene's vertex positions and normals changed in place (rigid animation: same
-  /// meshes and topology, see renderer/animation.hpp): updates the BVH (refit or rebuild). Returns
-  /// the seconds taken, and the ray offset from the moved bounds, as a scene prepared at the new
-  /// positions has it. Materials, textures and lights are read from the scene as they are.
+  /// meshes and topology, see renderer/animation.hpp): updates the BVH (refit or rebuild) and sets
+  /// the ray offset from the moved bounds, as a scene prepared at the new positions has it; returns
+  /// the seconds taken. Materials, textures and lights are read from the scene as they are.
   /// InputError when the moved geometry leaves the range a scene may span (kMaxSceneCoordinate).
   double update_geometry();
 

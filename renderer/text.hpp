@@ -36,6 +36,11 @@ namespace sb {
   return out;
 }
 
+/// Whether `s` holds a control character (a line break, a tab, an escape, ...).
+[[nodiscard]] inline bool has_control_character(std::string_view s) {
+  return std::any_of(s.begin(), s.end(), [](char c) { return std::iscntrl(static_cast<unsigned char>(c)) != 0; });
+}
+
 /// `s` with each control character written as \n, \t, \r or \xHH, for one line of text (a
 /// message, a comment in a generated script) that a newline in a name must not break.
 [[nodiscard]] inline std::string printable(std::string_view s) {

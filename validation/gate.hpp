@@ -101,8 +101,8 @@ struct GateConfig {
   /// (cell, pipeline); without it only where a [[rule]] sets regression_tolerance.
   bool regression_table = false;
 
-  /// Whether some table gives a threshold a value; without one, only time regressions against a
-  /// baseline are checked. A limit counts only when given a value: [[rule]]s without one, or keys
+  /// Whether some table gives a threshold a value; without one, only the time regressions that
+  /// [regression] or a rule's regression_tolerance asks for are checked. A limit counts only when given a value: [[rule]]s without one, or keys
   /// all turned off (= false), would pass anything as surely as an empty file.
   [[nodiscard]] bool sets_limits() const;
 };
@@ -210,7 +210,7 @@ struct ReproduceSettings {
 [[nodiscard]] ReproduceSettings registered_reproduce_settings();
 
 /// Applies the configuration to every pipeline of every cell. `baseline` may be empty (then every
-/// time-regression check is a skip, "no baseline"). InputError naming the file and line for a
+/// time-regression check the configuration asks for is a skip, "no baseline"). InputError naming the file and line for a
 /// record value of the wrong type.
 [[nodiscard]] GateReport evaluate_gate(const GateConfig& config, const GateResults& results, const Baseline& baseline,
                                        const ReproduceSettings& reproduce = {});

@@ -161,8 +161,12 @@ RegionMask read_region_mask(const fs::path& path, std::string_view eye) {
       mark(rgb->f32(), rgb->channels(), rgb->channels());
       return mask;
     }
-    // Without R, G, B: every other channel but alpha, float or integer (an id mask).
-    for (const Plane* p : colour_planes(image)) {
+    // Without R, G, B: every other channel but alpha, float or integer (an id mask); an image of
+    // an alpha channel alone is that channel.
+    std::vector<const Plane*> channels = colour_planes(image);
+    if (channels.empty())
+      for (const Plane& p : image.planes()) channels.push_back(&p);
+    for (const Plane* p : channels) {
       if (p->type() == PlaneType::f32) {
         mark(p->f32(), p->channels(), p->channels());
       } else {

@@ -95,4 +95,14 @@ void run_path(Scene& scene, const PathRun& run, const Executor& executor,
   }
 }
 
+void check_path_truth(const TruthProvider& truth, const Scene& scene, const PathSpec& path,
+                      const std::filesystem::path& scene_file) {
+  if (path.frames < 2) return;
+  Scene last = scene;
+  SceneAnimator animator(last, path);
+  if (!animator.moves_geometry()) return;
+  animator.apply(path.frames - 1);
+  truth.check_scene(last, scene_file);
+}
+
 }  // namespace sb::validation

@@ -38,4 +38,11 @@ struct PathRun {
 void run_path(Scene& scene, const PathRun& run, const Executor& executor,
               const std::function<void(const nlohmann::json& frame)>& on_frame);
 
+/// The truth's check of `scene` as the path's last frame moves it (a copy is animated): what a
+/// provider refuses only of a moved scene (Blender: a node whose primitives a spin moves apart)
+/// is found before the first frame runs. Nothing to do for a path of one frame or one that moves
+/// no geometry. InputError from the provider, or from the path itself.
+void check_path_truth(const TruthProvider& truth, const Scene& scene, const PathSpec& path,
+                      const std::filesystem::path& scene_file);
+
 }  // namespace sb::validation

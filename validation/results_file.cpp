@@ -624,10 +624,13 @@ std::string results_csv(const std::vector<json>& cells) {
   // Rows in the cells' order, whichever order parallel jobs finished them in.
   std::vector<const json*> ordered;
   for (const json& cell : cells) ordered.push_back(&cell);
-  std::stable_sort(ordered.begin(), ordered.end(), [](const json* a, const json* b) {
-    const json x = value_at(*a, "cell_index"), y = value_at(*b, "cell_index");
-    return x.is_number_integer() && y.is_number_integer() && x.get<int64_t>() < y.get<int64_t>();
-  });
+  // A cell without an integer index (read_results refuses one) would sort last.
+  const auto index_of = [](const json* cell) {
+    const json i = value_at(*cell, "cell_index");
+    return i.is_number_integer() ? i.get<int64_t>() : std::numeric_limits<int64_t>::max();
+  };
+  std::stable_sort(ordered.begin(), ordered.end(),
+                   [&](const json* a, const json* b) { return index_of(a) < index_of(b); });
   for (const json* each : ordered) {
     const json& cell = *each;
     std::string params;

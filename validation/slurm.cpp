@@ -46,14 +46,13 @@ std::string trimmed(std::string s) {
   return s;
 }
 
-
 /// A path (and a file-name `pattern` of sbatch's inside it) as an #SBATCH directive's value: in
-/// double quotes, which carry blanks (sbatch splits an unquoted value at them). A double quote, a backslash, a '%' (sbatch expands '%' patterns in
-/// file names) or a control character cannot be carried.
+/// double quotes, which carry blanks (sbatch splits an unquoted value at them). A double quote, a
+/// backslash, a '%' (sbatch expands '%' patterns in file names) or a control character cannot be
+/// carried.
 std::string directive_path(const fs::path& p, const std::string& what, const std::string& pattern = "") {
   const std::string s = p.string();
-  const bool control = std::any_of(s.begin(), s.end(), [](char c) { return std::iscntrl(static_cast<unsigned char>(c)) != 0; });
-  if (control || s.find_first_of("\"%\\") != std::string::npos)
+  if (has_control_character(s) || s.find_first_of("\"%\\") != std::string::npos)
     throw InputError(fmt::format("{} '{}' holds a double quote, backslash, '%' or control character, which #SBATCH "
                                  "directives cannot carry; choose a path without them",
                                  what, printable(s)));

@@ -56,7 +56,8 @@ void check_slurm_time_limit(const std::string& value);
 ///  --results <out_dir>/slurm/results-$SLURM_ARRAY_TASK_ID.jsonl --threads T <run_args>`
 /// with its stdout and stderr in <out_dir>/slurm/task-<I>.out/.err, and its exit code written to
 /// task-<I>.status when it ends. `shards` must be resolved (> 0). InputError for values sbatch
-/// directives cannot carry (paths with spaces, quotes or '%', bad partition or time).
+/// directives cannot carry (paths with a double quote, a backslash, '%' or a control character;
+/// blanks go in double quotes), a bad partition or time.
 [[nodiscard]] std::string sbatch_script(const SweepDefinition& definition, const SlurmSweepOptions& options);
 
 /// The options made complete and checked: paths absolute, the working directory set, `shards`

@@ -12,6 +12,7 @@
 #include <toml++/toml.h>
 
 #include "renderer/error.hpp"
+#include "renderer/text.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/pipeline.hpp"
 #include "renderer/rig.hpp"
@@ -461,9 +462,10 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
   if (const toml::node* n = sweep.get("name")) {
     d.name = string_at(where, *n, "sweep.name");
     // It names the default output folder out/sweeps/<name>: "." and ".." would be another folder.
-    const bool control = std::any_of(d.name.begin(), d.name.end(), [](char c) { return std::iscntrl(static_cast<unsigned char>(c)) != 0; });
-    if (d.name.empty() || d.name == "." || d.name == ".." || control || d.name.find_first_of("/\\") != std::string::npos)
-      where.fail(*n, "sweep.name", "must be a non-empty name without '/', '\\' or control characters, other than '.' and '..'");
+    if (d.name.empty() || d.name == "." || d.name == ".." || has_control_character(d.name) ||
+        d.name.find_first_of("/\\") != std::string::npos)
+      where.fail(*n, "sweep.name",
+                 "must be a non-empty name without '/', '\\' or control characters, other than '.' and '..'");
   }
   if (const toml::node* n = sweep.get("description")) d.description = string_at(where, *n, "sweep.description");
 

@@ -32,6 +32,7 @@
 #include "scenes/catalog.hpp"
 #include "validation/benchmark.hpp"
 #include "validation/content_hash.hpp"
+#include "validation/path_run.hpp"
 #include "validation/results_file.hpp"
 #include "validation/truth.hpp"
 #include "validation/truth_cache.hpp"
@@ -503,6 +504,9 @@ void check_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, 
     if (d.path) {
       try {
         (void)SceneAnimator(scene, *d.path);
+        std::set<std::string> truths;
+        for (size_t i : indices) truths.insert(cells[i].truth);
+        for (const std::string& truth : truths) check_path_truth(*providers.at(truth), scene, *d.path, file);
       } catch (const InputError& e) {
         throw InputError(fmt::format("{}: [path] on scene '{}': {}; fix the definition (no cell has run)",
                                      d.file.string(), cells[indices.front()].scene.label, e.what()));

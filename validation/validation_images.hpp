@@ -1,6 +1,6 @@
 // The images a validation writes (DESIGN §6, `stereobench validate`): the right eye, the ground
-// truth, the difference and SSIM maps, the hole mask against the true disocclusions, and the
-// true disocclusions themselves.
+// truth, the difference and SSIM maps, the pixels not reprojected against the true
+// disocclusions, and the true disocclusions themselves.
 #pragma once
 
 #include <filesystem>
@@ -40,7 +40,8 @@ nlohmann::json write_target_images(const std::filesystem::path& dir, const std::
 
 /// Writes a pipeline's images under `dir`: <stem>_right.exr (every AOV; unless options.exr is
 /// false) and _right.png, _diff.png (difference heat map), _ssim.png (SSIM map) and _holes.png
-/// (hole mask against the true disocclusions: green found, red missed, blue flagged needlessly),
+/// (the pixels not reprojected, as holes.not_reprojected scores them, against the true
+/// disocclusions: green found, red missed, blue flagged needlessly),
 /// and for a left eye synthesized in part (v.left) _left.png and _left_diff.png (its difference to
 /// plain-rt's left eye), side by side on the executor's threads. Returns {name: path}; on failure
 /// none of these files is left (an earlier run's included), unless options.staged holds them.

@@ -66,7 +66,7 @@ json result_to_json(const std::string& pipeline, const RenderScene& scene, const
 }
 
 json holes_to_json(const HoleAnalysis& a) {
-  return {{"hole_pixels", a.scores.hole_pixels},
+  return {{"not_reprojected_pixels", a.scores.hole_pixels},
           {"true_disocclusions", a.truth.count()},
           {"outside_frustum", a.truth.outside_frustum},
           {"hidden", a.truth.hidden},

@@ -32,8 +32,9 @@ namespace sb::io {
                                             const StereoRig& rig, const StereoResult& result, int threads,
                                             const PipelineOptions& options);
 
-/// A hole analysis as the "holes" object of a run's record: hole_pixels, true_disocclusions,
-/// outside_frustum, hidden, true_positives, recall, precision, analysis_s.
+/// A hole analysis as the "holes" object of a run's record: not_reprojected_pixels (the mask
+/// scored), true_disocclusions, outside_frustum, hidden, true_positives, recall, precision (null
+/// where undefined), analysis_s.
 [[nodiscard]] nlohmann::json holes_to_json(const HoleAnalysis& analysis);
 
 /// The viewable stereo images a render writes beside the eyes (DESIGN §4.2).

@@ -1,6 +1,7 @@
-// True disocclusions of the right eye and the scoring of a pipeline's hole mask against them
-// (DESIGN §6.3): which right-eye pixels show a surface the left eye cannot see, how much of that
-// a hole mask covers, and an overlay image to look at the difference. Shared by the pipelines,
+// True disocclusions of the right eye and the scoring of a mask of pixels against them (DESIGN
+// §6.3): which right-eye pixels show a surface the left eye cannot see, how much of that a mask
+// (a pipeline's hole mask, or every pixel it did not reproject) covers, and an overlay image to
+// look at the difference. Shared by the pipelines,
 // `stereobench render` and the validation layer.
 #pragma once
 
@@ -83,9 +84,9 @@ struct TrueDisocclusions {
 /// Whether any pixel's source tag is `reprojected` (InputError without a "source" plane).
 [[nodiscard]] bool has_reprojected_pixels(const Image& image);
 
-/// Recall and precision of a hole mask against the true disocclusions.
+/// Recall and precision of a mask against the true disocclusions.
 struct HoleScores {
-  uint64_t hole_pixels = 0;     ///< pixels the hole mask flags
+  uint64_t hole_pixels = 0;     ///< pixels the mask flags
   uint64_t true_pixels = 0;     ///< truly disoccluded pixels
   uint64_t true_positives = 0;  ///< flagged and truly disoccluded
   /// true_positives / true_pixels; NaN (undefined: null in records, "-" in tables) when nothing

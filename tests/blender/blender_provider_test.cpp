@@ -27,6 +27,7 @@
 #include "support/cutout_scene.hpp"
 #include "support/mini_gltf.hpp"
 #include "support/render_support.hpp"
+#include "support/run_cli.hpp"
 #include "support/scoped_env.hpp"
 #include "support/scratch_dir.hpp"
 #include "validation/truth.hpp"
@@ -391,6 +392,17 @@ TEST(BlenderPath, ASpinThatSplitsANodesPrimitivesIsRefusedNamingThem) {
         << e.what();
   }
   EXPECT_FALSE(fs::exists(dir / "blender" / "blender_render.py")) << "refused before Blender ran";
+  // A path is refused before its first frame: frame 0 (at rest) would have rendered.
+  const test::CliRun path =
+      test::run_cli("path --scene " + test::quoted(file) + " --frames 2 --spin-deg 30 --spin-prefix stack.1 "
+                    "--truth blender --pipelines plain-rt -r 64x36 --out " + test::quoted(dir / "path"));
+  EXPECT_EQ(path.code, 3) << path.out;
+  EXPECT_NE(path.out.find("move apart"), std::string::npos) << path.out;
+  if (fs::exists(dir / "path")) {
+    for (const auto& e : fs::recursive_directory_iterator(dir / "path")) {
+      EXPECT_NE(e.path().extension(), ".partial") << "no frame ran: " << e.path();
+    }
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -505,7 +505,7 @@ TEST(Cli, RenderScoresHolesOnlyWhenPixelsAreReprojected) {
   EXPECT_TRUE(std::filesystem::exists(dir / "box-wall_ideal-copy_holes.png"));
   const auto j = nlohmann::json::parse(test::read_text(dir / "box-wall_ideal-copy_stats.json"));
   const auto& holes = j.at("holes");
-  EXPECT_EQ(holes.at("hole_pixels").get<uint64_t>(), 0u);
+  EXPECT_EQ(holes.at("not_reprojected_pixels").get<uint64_t>(), 0u);
   EXPECT_GT(holes.at("true_disocclusions").get<uint64_t>(), 0u);
   EXPECT_EQ(holes.at("true_disocclusions").get<uint64_t>(),
             holes.at("outside_frustum").get<uint64_t>() + holes.at("hidden").get<uint64_t>());

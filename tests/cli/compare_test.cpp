@@ -342,6 +342,14 @@ TEST_F(Compare, GreyExrCountsAsGrey) {
   r = compare(q(path("grey.exr")) + " " + q(path("grey.png")) + " --mask " + q(path("ids.exr")));
   EXPECT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("48 of 1536 pixels"), std::string::npos) << "an integer mask channel counts: " << r.out;
+  // A mask of an alpha channel alone is that channel.
+  Image coverage(48, 32);
+  float* alpha = coverage.add_plane(std::string(planes::alpha), 1, PlaneType::f32).data_f32();
+  for (size_t i = 0; i < codes.size(); ++i) alpha[i] = i < 96 ? 1.0f : 0.0f;  // the top two rows
+  io::write_exr(path("alpha.exr"), coverage);
+  r = compare(q(path("grey.exr")) + " " + q(path("grey.png")) + " --mask " + q(path("alpha.exr")));
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("96 of 1536 pixels"), std::string::npos) << r.out;
 }
 
 TEST(CompareHelp, ExplainsMetricsAndExitCodes) {

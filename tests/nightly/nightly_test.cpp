@@ -449,7 +449,7 @@ TEST(NightlyTest, SweepsSharingAHistoryKeepTheirRunsApart) {
   EXPECT_TRUE(std::regex_match(b_id, std::regex(R"(\d{8}T\d{6}Z-2)"))) << b_id;
   EXPECT_TRUE(fs::is_directory(dir / "runs-b" / b_id));
   EXPECT_EQ(after.back()["results"], "runs-b/" + b_id + "/results.jsonl");
-  EXPECT_NE(b.out.find(fmt::format("The trends leave out {} runs of other sweeps", other_runs)), std::string::npos)
+  EXPECT_NE(b.out.find(fmt::format("note: the trends leave out {} runs of other sweeps", other_runs)), std::string::npos)
       << b.out;
   const json page = embedded_data(dir / "runs-b" / b_id / "report" / "index.html");
   EXPECT_NE(page["history_note"].get<std::string>().find(fmt::format("leave out {} runs of other sweeps", other_runs)),

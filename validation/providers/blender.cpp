@@ -319,6 +319,7 @@ class BlenderProvider final : public TruthProvider {
 
   void check_scene(const Scene& scene, const fs::path& scene_file) const override {
     (void)export_lights(scene);  // InputError for a negative light colour
+    (void)export_moved_nodes(scene);  // InputError for a node a path's frame cannot place
     if (scene_file.empty() || !fs::is_regular_file(scene_file))
       throw InputError(fmt::format("the blender provider imports the scene's glTF file, but '{}' is not a file; "
                                    "render a scene loaded from a .gltf/.glb file",

@@ -116,10 +116,6 @@ std::string vec_d(const dvec3& v) { return fmt::format("<{:.17g}, {:.17g}, {:.17
 
 nlohmann::json json_vec(const dvec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
 
-/// A cut-out's coverage map as a grey EXR: alpha x factor alpha - cutoff + 0.5 per texel, so that
-/// the surface exists where the bilinear lookup is at least 0.5 (the lookup is linear, so the shift
-/// commutes with it). POV-Ray reads image maps in half precision; centred on 0.5, a texel exactly
-/// at the cutoff stays exactly 0.5, where the alpha itself (e.g. 128/255) would be rounded.
 /// Texels added on each side of an axis that clamps to its edge: POV-Ray's bilinear lookup blends
 /// the image's first and last texels across its edge (it repeats the image), where clamping
 /// holds the edge texel; one replicated texel around the image gives the lookup the clamped
@@ -160,6 +156,10 @@ std::string padding_transform(const Texture& texture) {
                      (h + 2.0 * pad.t) / h, 0.0 - pad.s / w, 0.0 - pad.t / h);  // 0 - 0 is +0, not -0
 }
 
+/// A cut-out's coverage map as a grey EXR: alpha x factor alpha - cutoff + 0.5 per texel, so that
+/// the surface exists where the bilinear lookup is at least 0.5 (the lookup is linear, so the shift
+/// commutes with it). POV-Ray reads image maps in half precision; centred on 0.5, a texel exactly
+/// at the cutoff stays exactly 0.5, where the alpha itself (e.g. 128/255) would be rounded.
 void write_coverage_texture(const Texture& texture, const Material& material, const std::filesystem::path& path) {
   const float* rgba = texture.rgba.data();
   const Image image = padded_image(texture, [&](std::size_t i) {
@@ -182,11 +182,13 @@ void write_baked_texture(const Texture& texture, const vec4& factor, const std::
   io::write_exr(path, image, {}, options);
 }
 
-/// Whether any texture coordinate of `mesh` leaves [0, 1] along a clamped axis.
+/// Whether any texture coordinate of `mesh` leaves [0, 1] along a clamped axis by more than half
+/// a texel, beyond which the padded image (Padding) no longer holds the edge texel.
 bool reads_outside_clamp(const Mesh& mesh, const Texture& texture) {
+  const float margin_s = 0.5f / static_cast<float>(texture.width), margin_t = 0.5f / static_cast<float>(texture.height);
   for (const vec2& uv : mesh.uvs) {
-    if (!texture.repeat_s && (uv.x < 0.0f || uv.x > 1.0f)) return true;
-    if (!texture.repeat_t && (uv.y < 0.0f || uv.y > 1.0f)) return true;
+    if (!texture.repeat_s && (uv.x < -margin_s || uv.x > 1.0f + margin_s)) return true;
+    if (!texture.repeat_t && (uv.y < -margin_t || uv.y > 1.0f + margin_t)) return true;
   }
   return false;
 }
@@ -248,7 +250,8 @@ ExportResult export_scene(const Scene& scene, const EyeCamera& eye, const std::f
     const Texture& texture = scene.textures[static_cast<std::size_t>(material.base_color_texture)];
     if (reads_outside_clamp(mesh, texture))
       out.warnings.push_back(fmt::format(
-          "mesh '{}': texture '{}' clamps to its edge but is read outside [0, 1]; POV-Ray repeats it there",
+          "mesh '{}': texture '{}' clamps to its edge but is read more than half a texel outside [0, 1]; "
+          "POV-Ray repeats it there",
           mesh.name, texture.name));
     if (!texture_name[m].empty()) continue;
     texture_name[m] = fmt::format("texture_{}.exr", m);
