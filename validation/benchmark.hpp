@@ -1,5 +1,6 @@
 // Side-by-side timing of pipelines on one scene and rig: warm-up, then repetitions that run every
-// pipeline in turn (so machine noise hits all alike), summarised as median/min/max per stage and
+// pipeline in turn (so machine noise hits all alike), each repetition starting one pipeline further
+// along (so none always runs first), summarised as median/min/max per stage and
 // as speed-ups against a baseline measured in the same run (DESIGN §8).
 #pragma once
 
