@@ -17,6 +17,7 @@
 #include "renderer/io/image_io.hpp"
 #include "renderer/io/json_text.hpp"
 #include "sb_version.hpp"
+#include "validation/results_file.hpp"
 
 namespace sb::reports {
 
@@ -479,21 +480,14 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
   }
   json data = report_data(results, title, papers, image_path);
   // A sweep still running, stopped, or one shard of several: its figures cover part of it.
-  std::map<std::string, std::pair<int64_t, std::set<int64_t>>> cells_of;  // sweep -> (cell_count, indices)
-  for (const auto& c : results.cells) {
-    const json& line = c.json;
-    const auto count = line.find("cell_count");  // optional in a results line
-    if (count == line.end()) continue;
-    auto& [total, indices] = cells_of[line["sweep"].get<std::string>()];
-    total = std::max(total, count->get<int64_t>());
-    indices.insert(line["cell_index"].get<int64_t>());
-  }
-  for (const auto& [sweep, seen] : cells_of)
-    if (static_cast<int64_t>(seen.second.size()) < seen.first)
-      summary.warnings.push_back(fmt::format("{}: {} of the {} cells of sweep '{}' are in the results: the sweep is "
-                                             "unfinished (still running, stopped, or one shard of several); the "
-                                             "figures cover these cells only",
-                                             results.path.string(), seen.second.size(), seen.first, sweep));
+  std::vector<const json*> records;
+  for (const auto& c : results.cells) records.push_back(&c.json);
+  if (const auto coverage = validation::cell_coverage(records); coverage && coverage->present < coverage->expected)
+    summary.warnings.push_back(fmt::format("{}: {} of the {} cells of sweep '{}' are in the results: the sweep is "
+                                           "unfinished (still running, stopped, or one shard of several); the "
+                                           "figures cover these cells only",
+                                           results.path.string(), coverage->present, coverage->expected,
+                                           results.cells.front().json["sweep"].get<std::string>()));
   // The page lists every warning the terminal shows: skipped lines, missing images, missing cells.
   data["warnings"] = summary.warnings;
   if (!options.history.is_null()) data["history"] = options.history;

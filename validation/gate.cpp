@@ -666,39 +666,34 @@ namespace {
 /// early (killed, a full disk) must not pass. Nothing when the records do not say how many cells
 /// the sweep has.
 std::optional<GateCheck> completeness_check(const GateResults& results) {
-  std::set<uint64_t> indices;
-  uint64_t expected = 0;
+  std::vector<const json*> records;
   std::string definition;
   for (const GateCell& cell : results.cells) {
-    const json& r = cell.record;
-    const auto count = [&](const char* key) -> std::optional<uint64_t> {
-      if (!r.contains(key) || !r[key].is_number_integer() || r[key].get<int64_t>() < 0) return std::nullopt;
-      return r[key].get<uint64_t>();
-    };
-    const std::optional<uint64_t> index = count("cell_index"), total = count("cell_count");
-    if (!index || !total) return std::nullopt;
-    expected = std::max(expected, *total);
-    indices.insert(*index);
-    if (definition.empty() && r.value("definition", json()).is_string()) definition = r["definition"].get<std::string>();
+    records.push_back(&cell.record);
+    if (definition.empty() && cell.record.value("definition", json()).is_string())
+      definition = cell.record["definition"].get<std::string>();
   }
+  const std::optional<CellCoverage> coverage = cell_coverage(records);
+  if (!coverage) return std::nullopt;
+  const uint64_t expected = coverage->expected;
   GateCheck check;
   check.check = kCompleteCheck;
   check.cell_id = "(all cells)";
   check.pipeline = "(all)";
-  check.measured = static_cast<double>(indices.size());
+  check.measured = static_cast<double>(coverage->present);
   check.fail_limit = static_cast<double>(expected);
   check.reproduce = fmt::format("stereobench sweep run {} --out {}", definition.empty() ? "DEFINITION" : shell_quote(definition),
                                 shell_quote(results.file.parent_path().empty() ? "." : results.file.parent_path().string()));
   // sweep run resumes <out>/results.jsonl unless told otherwise.
   if (results.file.filename() != "results.jsonl") check.reproduce += " --results " + shell_quote(results.file.string());
-  if (indices.size() >= expected) {
+  if (coverage->present >= expected) {
     check.message = fmt::format("all {} cells of the sweep have results", expected);
     return check;
   }
   check.verdict = Verdict::fail;
   check.message = fmt::format("{} holds {} of the sweep's {} cells: the sweep did not finish; run it again with the "
                               "same --out to resume it",
-                              results.file.string(), indices.size(), expected);
+                              results.file.string(), coverage->present, expected);
   return check;
 }
 

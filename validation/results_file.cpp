@@ -12,6 +12,8 @@
 #include <cstring>
 #include <limits>
 #include <map>
+#include <optional>
+#include <set>
 #include <string_view>
 #include <utility>
 
@@ -543,6 +545,24 @@ void require_unique_id(std::map<std::string, size_t>& seen, const std::string& i
   if (auto [it, fresh] = seen.emplace(id, line_no); !fresh)
     throw InputError(
         fmt::format("{}: {} '{}' appears twice (also on line {}); {}", where, key, id, it->second, advice));
+}
+
+std::optional<CellCoverage> cell_coverage(const std::vector<const json*>& cells) {
+  std::set<uint64_t> indices;
+  CellCoverage c;
+  for (const json* r : cells) {
+    const auto count = [&](const char* key) -> std::optional<uint64_t> {
+      const auto it = r->find(key);
+      if (it == r->end() || !it->is_number_integer() || it->get<int64_t>() < 0) return std::nullopt;
+      return it->get<uint64_t>();
+    };
+    const std::optional<uint64_t> index = count("cell_index"), total = count("cell_count");
+    if (!index || !total) return std::nullopt;
+    c.expected = std::max(c.expected, *total);
+    indices.insert(*index);
+  }
+  c.present = indices.size();
+  return c;
 }
 
 void rebase_image_paths(json& cell, const fs::path& from, const fs::path& to) {

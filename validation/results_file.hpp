@@ -6,7 +6,9 @@
 #include <filesystem>
 #include <functional>
 #include <cstddef>
+#include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -62,6 +64,16 @@ struct ResultsFile {
 /// cell_id or cell_index that appears twice, and a cell of another sweep definition than the
 /// first line's (a results file holds one definition's cells). IoError when it cannot be read.
 [[nodiscard]] ResultsFile read_results(const std::filesystem::path& file);
+
+/// How much of its sweep a set of cell records holds: the distinct cell_index values and the
+/// largest cell_count among them.
+struct CellCoverage {
+  uint64_t present = 0;
+  uint64_t expected = 0;
+};
+/// The coverage of `cells` (records of one sweep); nothing when one of them does not say (a
+/// cell_index or cell_count absent or not a non-negative integer).
+[[nodiscard]] std::optional<CellCoverage> cell_coverage(const std::vector<const nlohmann::json*>& cells);
 
 /// Checks one parsed results line against the fields its readers use: kind, schema version, the
 /// cell's identity, scene, rig, baseline and, per pipeline, the metrics, hole figures and times
