@@ -81,6 +81,12 @@ CLI::Option* add_lights_option(CLI::App& app, std::optional<int>& lights) {
                         "(default: all)");
 }
 
+std::string table_number(double v, int decimals, double scale) {
+  if (std::isnan(v)) return "-";
+  if (std::isinf(v)) return "inf";
+  return fmt::format("{:.{}f}", v * scale, decimals);
+}
+
 std::string describe_lights(size_t used, size_t in_file) {
   if (used == in_file) return fmt::format("{} light{}", used, used == 1 ? "" : "s");
   return fmt::format("first {} of {} lights", used, in_file);

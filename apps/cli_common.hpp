@@ -44,6 +44,11 @@ CLI::Option* add_lights_option(CLI::App& app, std::optional<int>& lights);
 /// "5 lights", or "first 3 of 5 lights" when some were dropped.
 [[nodiscard]] std::string describe_lights(size_t used, size_t in_file);
 
+/// A number for a terminal table: `v` times `scale` with `decimals` decimals, "-" where it is
+/// undefined (NaN: absent, or a recall with nothing disoccluded) and "inf" where it is infinite
+/// (the PSNR of identical images).
+[[nodiscard]] std::string table_number(double v, int decimals, double scale = 1.0);
+
 /// Parses NAME=VALUE items (--option) into a map; InputError for an item without '='.
 [[nodiscard]] std::map<std::string, std::string> parse_key_values(const std::vector<std::string>& items,
                                                                   const char* option);

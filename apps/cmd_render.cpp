@@ -54,7 +54,7 @@ void print_timings(const StereoResult& r) {
 }
 
 /// A share as a percentage with two decimals, or "-" where it is undefined (NaN).
-std::string percent(double share) { return std::isnan(share) ? "-" : fmt::format("{:.2f} %", 100.0 * share); }
+std::string percent(double share) { return std::isnan(share) ? "-" : table_number(share, 2, 100.0) + " %"; }
 
 void print_holes(const HoleAnalysis& h, size_t pixels) {
   fmt::print("  {:<22} recall {}, precision {} ({} pixels, {} of them truly disoccluded)\n", "not reprojected",

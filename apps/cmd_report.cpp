@@ -43,11 +43,6 @@ double cell_median(const nlohmann::json& cells, const std::string& pipeline, con
 /// The report's "Summary per pipeline" on the terminal: medians over the cells.
 void print_summary_table(const reports::ReportSummary& s) {
   if (!s.pipeline_names.is_array() || !s.cells.is_array() || s.cells.empty()) return;
-  const auto number = [](double v, int precision, double scale = 1.0) {
-    if (std::isnan(v)) return std::string("-");
-    if (std::isinf(v)) return std::string("inf");
-    return fmt::format("{:.{}f}", v * scale, precision);
-  };
   std::vector<std::string> names;
   for (const nlohmann::json& name : s.pipeline_names) names.push_back(name.get<std::string>());
   const size_t name_w = pipeline_column(names);
@@ -55,11 +50,12 @@ void print_summary_table(const reports::ReportSummary& s) {
              "PSNR dB", "SSIM", "holes %", "time ms", "speed-up", "right/left %", s.cells.size());
   for (const std::string& p : names) {
     const double speedup = cell_median(s.cells, p, "speedup");
-    fmt::print("{:<{}} {:>8} {:>8} {:>8} {:>11} {:>9} {:>13}\n", p, name_w, number(cell_median(s.cells, p, "psnr"), 2),
-               number(cell_median(s.cells, p, "ssim"), 4), number(cell_median(s.cells, p, "hole_fraction"), 3, 100.0),
-               number(cell_median(s.cells, p, "time_s"), 2, 1000.0),
-               std::isnan(speedup) ? std::string("-") : number(speedup, 2) + "x",
-               number(cell_median(s.cells, p, "right_over_left"), 1, 100.0));
+    fmt::print("{:<{}} {:>8} {:>8} {:>8} {:>11} {:>9} {:>13}\n", p, name_w,
+               table_number(cell_median(s.cells, p, "psnr"), 2), table_number(cell_median(s.cells, p, "ssim"), 4),
+               table_number(cell_median(s.cells, p, "hole_fraction"), 3, 100.0),
+               table_number(cell_median(s.cells, p, "time_s"), 2, 1000.0),
+               std::isnan(speedup) ? std::string("-") : table_number(speedup, 2) + "x",
+               table_number(cell_median(s.cells, p, "right_over_left"), 1, 100.0));
   }
   // Left eyes synthesized in part (bidir-warp's), as the page's "Left eyes" section has them.
   bool header = false;
@@ -70,8 +66,8 @@ void print_summary_table(const reports::ReportSummary& s) {
       fmt::print("\n{:<{}} {:>8} {:>8} {:>13}   (left eyes synthesized in part, against plain-rt's left eye)\n",
                  "pipeline", name_w, "PSNR dB", "SSIM", "synthesized %");
     header = true;
-    fmt::print("{:<{}} {:>8} {:>8} {:>13}\n", p, name_w, number(cell_median(s.cells, p, "left_psnr"), 2),
-               number(cell_median(s.cells, p, "left_ssim"), 4), number(share, 1, 100.0));
+    fmt::print("{:<{}} {:>8} {:>8} {:>13}\n", p, name_w, table_number(cell_median(s.cells, p, "left_psnr"), 2),
+               table_number(cell_median(s.cells, p, "left_ssim"), 4), table_number(share, 1, 100.0));
   }
   fmt::print("\n");
 }

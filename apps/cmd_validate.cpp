@@ -48,15 +48,9 @@ std::vector<PipelineEntry> chosen_pipelines(const std::vector<std::string>& name
   return parse_pipeline_entries(expand_all_pipelines(split_list(names, "--pipelines"), "--pipelines"), "--pipelines");
 }
 
-std::string number(double v, const char* format) {
-  if (std::isnan(v)) return "-";
-  if (std::isinf(v)) return "inf";
-  return fmt::format(fmt::runtime(format), v);
-}
-
 /// An MSE for the table: three decimals, or two significant digits below 0.001, so that a
 /// non-zero MSE (its PSNR finite) never reads 0.000.
-std::string mse_text(double v) { return v > 0.0 && v < 0.001 ? number(v, "{:.1e}") : number(v, "{:.3f}"); }
+std::string mse_text(double v) { return v > 0.0 && v < 0.001 ? fmt::format("{:.1e}", v) : table_number(v, 3); }
 
 void run_validate(const ValidateArgs& a) {
   const RigOverrides overrides = a.rig.overrides();
@@ -130,15 +124,15 @@ void run_validate(const ValidateArgs& a) {
       records.push_back(record);
       const validation::HoleStatistics& h = v.holes;
       fmt::print("{:<{}} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10.1f}\n", v.pipeline, name_w,
-                 number(v.whole.psnr, "{:.2f}"), number(v.whole.ssim, "{:.4f}"), mse_text(v.whole.mse),
-                 number(100.0 * v.whole.error_fraction, "{:.3f}"), number(100.0 * h.hole_fraction, "{:.3f}"),
-                 number(h.scores.recall, "{:.4f}"), number(h.scores.precision, "{:.4f}"),
+                 table_number(v.whole.psnr, 2), table_number(v.whole.ssim, 4), mse_text(v.whole.mse),
+                 table_number(100.0 * v.whole.error_fraction, 3), table_number(100.0 * h.hole_fraction, 3),
+                 table_number(h.scores.recall, 4), table_number(h.scores.precision, 4),
                  v.result.timings.total() * 1e3);
       if (v.left)
         left_lines.push_back(fmt::format(
             "{:<{}} {:>8} {:>7} {:>9} {:>7}  ({:.3f} % of its pixels not rendered by the left eye)", v.pipeline,
-            name_w, number(v.left->psnr, "{:.2f}"), number(v.left->ssim, "{:.4f}"), mse_text(v.left->mse),
-            number(100.0 * v.left->error_fraction, "{:.3f}"),
+            name_w, table_number(v.left->psnr, 2), table_number(v.left->ssim, 4), mse_text(v.left->mse),
+            table_number(100.0 * v.left->error_fraction, 3),
             100.0 * static_cast<double>(v.left_synthesized) / static_cast<double>(v.result.left.pixel_count())));
     }
     if (!left_lines.empty()) {

@@ -51,8 +51,8 @@ HoleStatistics hole_statistics(const Image& right, const Counters& counters, con
   if (truth.mask.size() != s.pixels)
     throw InputError(fmt::format("the true disocclusion mask has {} pixels but the right eye {}x{} has {}",
                                  truth.mask.size(), right.width(), right.height(), s.pixels));
-  const std::vector<uint8_t> holes = hole_mask_from_sources(right);
-  s.hole_pixels = static_cast<uint64_t>(std::count(holes.begin(), holes.end(), uint8_t{1}));
+  s.hole_mask = hole_mask_from_sources(right);
+  s.hole_pixels = static_cast<uint64_t>(std::count(s.hole_mask.begin(), s.hole_mask.end(), uint8_t{1}));
   s.hole_fraction = s.pixels == 0 ? 0.0 : static_cast<double>(s.hole_pixels) / static_cast<double>(s.pixels);
 
   std::array<uint64_t, kSourceCount> by_tag{};
@@ -62,7 +62,7 @@ HoleStatistics hole_statistics(const Image& right, const Counters& counters, con
   for (size_t t = 0; t < kSourceCount; ++t)
     s.pixels_by_source[std::string(to_string(static_cast<Source>(t)))] = by_tag[t];
 
-  s.hole_regions = connected_regions(holes, right.width(), right.height());
+  s.hole_regions = connected_regions(s.hole_mask, right.width(), right.height());
   const auto snapshot = counters.snapshot();
   for (const char* name : hole_counter_names())
     if (auto it = snapshot.find(name); it != snapshot.end()) s.pipeline_counters[name] = it->second;
@@ -71,7 +71,8 @@ HoleStatistics hole_statistics(const Image& right, const Counters& counters, con
   s.outside_frustum = truth.outside_frustum;
   s.hidden = truth.hidden;
   s.disocclusion_regions = connected_regions(truth.mask, right.width(), right.height());
-  s.scores = score_holes(not_reprojected_mask(right), truth.mask);
+  s.not_reprojected = not_reprojected_mask(right);
+  s.scores = score_holes(s.not_reprojected, truth.mask);
   return s;
 }
 

@@ -54,6 +54,9 @@ struct HoleStatistics {
   /// those pixels that needed it (the rest is work a perfect hole mask would have saved). For a
   /// reprojecting pipeline that renders nothing natively for the right eye this is its hole mask.
   uint64_t true_disocclusions = 0;
+  /// The masks counted and scored, one value per pixel: the hole mask (hole_mask_from_sources) and
+  /// the pixels not reprojected (not_reprojected_mask), for the region metrics and the overlay.
+  std::vector<uint8_t> hole_mask, not_reprojected;
   uint64_t outside_frustum = 0;
   uint64_t hidden = 0;
   RegionStats disocclusion_regions;

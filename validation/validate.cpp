@@ -59,20 +59,18 @@ PipelineValidation validate_pipeline(const ValidationTarget& target, const Pipel
   const Image& right = v.result.right;
   const int w = right.width(), h = right.height();
   v.right_srgb8 = encode_srgb8(right, fmt::format("{}'s right eye", v.pipeline));
-  v.not_reprojected = not_reprojected_mask(right);
-  std::vector<uint8_t> reprojected(v.not_reprojected.size());
-  for (size_t i = 0; i < reprojected.size(); ++i) reprojected[i] = v.not_reprojected[i] != 0 ? 0 : 1;
-  v.hole_mask = hole_mask_from_sources(right);
+  v.holes = hole_statistics(right, v.result.counters, target.disocclusions);
+  std::vector<uint8_t> reprojected(v.holes.not_reprojected.size());
+  for (size_t i = 0; i < reprojected.size(); ++i) reprojected[i] = v.holes.not_reprojected[i] != 0 ? 0 : 1;
   std::vector<uint8_t> disoccluded(target.disocclusions.mask.size());
   for (size_t i = 0; i < disoccluded.size(); ++i) disoccluded[i] = target.disocclusions.mask[i] != 0 ? 1 : 0;
-  const RegionMask masks[] = {mask_of(w, h, std::move(reprojected)), mask_of(w, h, v.hole_mask),
+  const RegionMask masks[] = {mask_of(w, h, std::move(reprojected)), mask_of(w, h, v.holes.hole_mask),
                               mask_of(w, h, std::move(disoccluded))};
   const RegionMask* const regions[] = {nullptr, &masks[0], &masks[1], &masks[2]};
   const std::vector<ImageMetrics> metrics =
       compare_regions(v.right_srgb8, target.truth_srgb8, regions, metric_options, &v.ssim);
   v.whole = metrics[0];
   for (size_t r = 0; r < std::size(kRegionNames); ++r) v.regions.emplace_back(kRegionNames[r], metrics[r + 1]);
-  v.holes = hole_statistics(right, v.result.counters, target.disocclusions);
   // A left eye the pipeline did not render whole is measured too (against plain-rt's left eye).
   const uint32_t* left_source = v.result.left.data_u32(planes::source);
   for (size_t i = 0; i < v.result.left.pixel_count(); ++i)

@@ -63,10 +63,8 @@ struct PipelineValidation {
   /// take from a source image (hole_mask_from_sources); true disocclusions. An empty region has
   /// pixels = 0 and null metrics.
   std::vector<std::pair<std::string, ImageMetrics>> regions;
-  std::vector<uint8_t> hole_mask;
-  /// The pixels not tagged reprojected: what holes.not_reprojected scores, and what the hole
-  /// overlay (holes.png) draws against the true disocclusions, so that picture and numbers agree.
-  std::vector<uint8_t> not_reprojected;
+  /// With the masks it scored: the hole overlay (holes.png) draws holes.not_reprojected against
+  /// the true disocclusions, so that picture and numbers agree.
   HoleStatistics holes;
   SsimMap ssim;
   double seconds_metrics = 0.0;  ///< time to measure (not part of the pipeline's timings)

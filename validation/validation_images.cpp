@@ -98,7 +98,7 @@ json write_pipeline_images(const std::filesystem::path& dir, const std::string& 
       {path("diff.png"), [&](const Path& to) { write_png(to, difference_image(v.right_srgb8, target.truth_srgb8)); }},
       {path("ssim.png"), [&](const Path& to) { write_png(to, ssim_image(v.ssim)); }},
       {path("holes.png"), [&](const Path& to) {
-         io::write_png_preview(to, hole_overlay(v.result.right, v.not_reprojected, target.disocclusions.mask));
+         io::write_png_preview(to, hole_overlay(v.result.right, v.holes.not_reprojected, target.disocclusions.mask));
        }}};
   // A left eye synthesized in part (measured against plain-rt's): the pipeline's own left eye and
   // its difference to plain-rt's. They belong to the set either way: an earlier run's under these

@@ -1,6 +1,8 @@
 // Hole statistics: connected regions, counts per source tag, and scores against the truth.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "renderer/error.hpp"
 #include "renderer/stages/eye_image.hpp"
 #include "validation/hole_stats.hpp"
@@ -64,6 +66,8 @@ TEST(HoleStatistics, CountsTagsRegionsAndScores) {
   // Not reprojected: (1,0), (2,0), (0,1) rasterized, (2,1); truly disoccluded: (1,0), (0,1), (1,1).
   EXPECT_EQ(s.true_disocclusions, 3u);
   EXPECT_EQ(s.scores.hole_pixels, 4u);
+  EXPECT_EQ(std::count(s.not_reprojected.begin(), s.not_reprojected.end(), uint8_t{1}), 4);  // the mask scored
+  EXPECT_EQ(std::count(s.hole_mask.begin(), s.hole_mask.end(), uint8_t{1}), 3);
   EXPECT_EQ(s.scores.true_positives, 2u);
   EXPECT_DOUBLE_EQ(s.scores.recall, 2.0 / 3.0);
   EXPECT_DOUBLE_EQ(s.scores.precision, 0.5);
