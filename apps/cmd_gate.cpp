@@ -13,6 +13,7 @@
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/io/file_lock.hpp"
 #include "validation/gate.hpp"
 #include "validation/junit.hpp"
 
@@ -43,6 +44,14 @@ void run_update(const GateArgs& a, const fs::path& file) {
                                          : validation::RegressionSettings{}.min_repetitions;
   const validation::GateResults results = validation::load_gate_results(a.results);
   for (const std::string& w : results.warnings) fmt::print(stderr, "warning: {}\n", w);
+  // Updates of one baseline take turns: each reads the entries the one before it wrote (two at
+  // once lost one's entries). The lock file goes with the lock.
+  std::error_code ec;
+  if (file.has_parent_path()) fs::create_directories(file.parent_path(), ec);  // else the lock names the problem
+  io::FileLock lock = io::FileLock::acquire(file.string() + ".lock", [&] {
+    fmt::print(stderr, "waiting for another update of {} to finish\n", file.string());
+  });
+  lock.remove_when_released();
   // Damaged entries are mended by rewriting them; one the update leaves alone stops it.
   std::vector<validation::DamagedEntry> damaged;
   validation::Baseline baseline = fs::exists(file) ? validation::load_baseline(file, &damaged) : validation::Baseline{};

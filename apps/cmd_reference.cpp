@@ -176,8 +176,11 @@ int run_update(const ReferenceArgs& a) {
   } else {
     targets = chosen_ids(store, a.ids);
   }
-  // An entry whose spec cannot be read cannot be made again: named, and the others still rewritten.
-  std::vector<std::string> unreadable;
+  // An entry whose spec cannot be read, or whose scene is gone, cannot be made again: named, and
+  // the others still rewritten.
+  std::vector<std::string> unreadable, unrenderable;
+  // Folders whose spec makes a reference of another id: that one is written, the folder stays.
+  std::vector<std::string> misnamed;
   size_t written_count = 0;
   for (const std::string& id : targets) {
     reference::ReferenceSpec spec;
@@ -187,16 +190,34 @@ int run_update(const ReferenceArgs& a) {
       unreadable.push_back(fmt::format("{} ({})", id, e.what()));
       continue;
     }
-    const std::string written = store.generate(spec, a.scenes_dir, a.command_line, executor);
+    std::string written;
+    try {
+      written = store.generate(spec, a.scenes_dir, a.command_line, executor);
+    } catch (const InputError& e) {
+      unrenderable.push_back(fmt::format("{} ({})", id, e.what()));
+      continue;
+    }
     fmt::print("updated {}\n", (store.root() / written).string());
     ++written_count;
+    if (written != id) misnamed.push_back(fmt::format("{} (its spec's reference was written to {})", id, written));
   }
   fmt::print("{} reference(s) rewritten\n", written_count);
+  std::vector<std::string> problems;
   if (!unreadable.empty())
-    throw InputError(fmt::format("{} reference(s) could not be rewritten, their provenance gives no spec to render "
-                                 "them from; remove each and run `stereobench reference generate` with its "
-                                 "scene and rig:\n  {}",
-                                 unreadable.size(), fmt::join(unreadable, "\n  ")));
+    problems.push_back(fmt::format("{} reference(s) could not be rewritten, their provenance gives no spec to render "
+                                   "them from; remove each and run `stereobench reference generate` with its "
+                                   "scene and rig:\n  {}",
+                                   unreadable.size(), fmt::join(unreadable, "\n  ")));
+  if (!unrenderable.empty())
+    problems.push_back(fmt::format("{} reference(s) could not be rendered again from their spec; restore what the "
+                                   "message names (the scene file, the --scenes-dir), or remove the entry:\n  {}",
+                                   unrenderable.size(), fmt::join(unrenderable, "\n  ")));
+  if (!misnamed.empty())
+    problems.push_back(fmt::format("{} folder(s) of the store are not named by the id their spec makes, so the "
+                                   "rewritten reference lies under its own id and the folder is unchanged; remove "
+                                   "each folder:\n  {}",
+                                   misnamed.size(), fmt::join(misnamed, "\n  ")));
+  if (!problems.empty()) throw InputError(fmt::format("{}", fmt::join(problems, "\n")));
   if (!unchecked.empty())
     throw ToolError(fmt::format("{} reference(s) could not be checked, so not updated, because their tool is "
                                 "missing; install it and run the update again:\n  {}",

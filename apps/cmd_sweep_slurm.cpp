@@ -28,7 +28,7 @@ void SweepSlurmCli::add_to(CLI::App& run) {
   options_.push_back(run.add_option("--time-limit", time_limit,
                                     "slurm: time limit per task, HH:MM:SS (default: the partition's)"));
   options_.push_back(run.add_option("--sbatch-arg", sbatch_args,
-                                    "slurm: extra sbatch option, repeatable (e.g. --sbatch-arg=--mem=8G)")
+                                    "slurm: extra sbatch option, repeatable (e.g. --sbatch-arg=--mem=8G); written into the job script as an #SBATCH directive, so resubmitting the script by hand keeps it")
                          ->allow_extra_args(false));
   options_.push_back(run.add_flag("--wait", wait,
                                   "slurm: wait for every task, then merge the shards into the results file"));

@@ -100,7 +100,9 @@ void refuse_non_decimal_numbers(CLI::App& app) {
 }
 
 /// When parsing stopped for want of a subcommand: the first word after the commands given that
-/// names none of the next level's, with those names ("" when every word is a command or option).
+/// names none of the next level's, with those names; or, when the words given end at a command
+/// that needs one of its own (`stereobench sweep`), those commands. "" when a word is an option
+/// or every word is a command that needs none.
 std::string unknown_command_message(const CLI::App& app, int argc, char** argv) {
   const CLI::App* level = &app;
   std::string path = "stereobench";
@@ -118,7 +120,10 @@ std::string unknown_command_message(const CLI::App& app, int argc, char** argv) 
     level = next;
     path += " " + word;
   }
-  return "";
+  if (level->get_require_subcommand_min() == 0) return "";
+  std::vector<std::string> names;
+  for (const CLI::App* s : level->get_subcommands([](const CLI::App*) { return true; })) names.push_back(s->get_name());
+  return fmt::format("{} needs a command: {}; `{} COMMAND --help` explains each", path, fmt::join(names, ", "), path);
 }
 
 /// The exit code once standard output has taken everything printed: `code`, or 4 with a message

@@ -55,6 +55,17 @@ bool warn_level_looser(const MetricCheck& c, const ThresholdValues& values) {
   throw InputError(fmt::format("{}:{}: {}", source, where.begin.line, what));
 }
 
+/// A config value as the file gives it, for messages: a string quoted, a number or boolean as
+/// written, an array or table by its kind.
+std::string toml_text(const toml::node& node) {
+  if (node.is_array()) return "an array";
+  if (node.is_table()) return "a table";
+  if (const auto* s = node.as_string()) return fmt::format("\"{}\"", printable(s->get()));
+  std::ostringstream out;
+  node.visit([&](auto&& value) { out << value; });
+  return out.str();
+}
+
 /// A threshold value: a non-negative finite number, or `false` to turn the check off.
 std::optional<double> threshold_value(const toml::node& node, const std::string& key, const std::string& source) {
   if (node.is_boolean()) {
@@ -64,7 +75,8 @@ std::optional<double> threshold_value(const toml::node& node, const std::string&
     return std::nullopt;
   }
   if (!node.is_number())
-    config_error(source, node.source(), fmt::format("{} must be a number (or false to turn the check off)", key));
+    config_error(source, node.source(),
+                 fmt::format("{} = {} must be a number (or false to turn the check off)", key, toml_text(node)));
   const double v = *node.value<double>();
   if (!std::isfinite(v) || v < 0.0)
     config_error(source, node.source(), fmt::format("{} = {} is not a non-negative finite number", key, v));
@@ -110,7 +122,8 @@ RegressionSettings read_regression(const toml::table& table, const std::string& 
     if (k == "tolerance" || k == "alpha") {
       const std::optional<double> v = node.value<double>();
       if (!v || !std::isfinite(*v) || *v < 0.0)
-        config_error(source, node.source(), fmt::format("[regression] {} must be a non-negative number", k));
+        config_error(source, node.source(),
+                     fmt::format("[regression] {} = {} must be a non-negative number", k, toml_text(node)));
       if (k == "alpha" && !(*v > 0.0 && *v < 1.0))
         config_error(source, node.source(), fmt::format("[regression] alpha = {} must lie in (0, 1)", *v));
       (k == "tolerance" ? r.tolerance : r.alpha) = *v;
@@ -288,6 +301,8 @@ GateConfig parse_gate_config(const std::string& text, const std::string& source)
       config.regression = read_regression(*node.as_table(), source);
       config.regression_table = true;
     } else if (k == "rule") {
+      if (node.is_array() && node.as_array()->empty())
+        config_error(source, node.source(), "rule = [] holds no rule; write each rule as a [[rule]] table");
       if (!node.is_array_of_tables())
         config_error(source, node.source(), "rule must be an array of tables: write each as [[rule]]");
       for (const toml::node& item : *node.as_array()) {
@@ -308,10 +323,14 @@ GateConfig parse_gate_config(const std::string& text, const std::string& source)
                    fmt::format("unknown key '{}'; a gate config has [defaults], [regression] and [[rule]] tables", k));
     }
   }
-  if (!config.sets_limits() && !root.contains("regression"))
-    throw InputError(fmt::format("{}: the gate config sets no threshold and no [regression]: it would pass anything; "
-                                 "give a limit a value in [defaults] or a [[rule]] (see docs/gate.md)",
-                                 source));
+  const bool rule_regression = std::any_of(config.rules.begin(), config.rules.end(), [](const GateRule& r) {
+    const auto t = r.values.find(kToleranceKey);
+    return t != r.values.end() && t->second.has_value();
+  });
+  if (!config.sets_limits() && !config.regression_table && !rule_regression)
+    throw InputError(fmt::format("{}: the gate config sets no threshold, no [regression] and no rule's {}: it would "
+                                 "pass anything; give a limit a value in [defaults] or a [[rule]] (see docs/gate.md)",
+                                 source, kToleranceKey));
   return config;
 }
 
@@ -868,7 +887,7 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
       } else {
         const double now = median(samples), before = median(base->samples_s);
         check.measured = now / before - 1.0;
-        const std::string change = fmt::format("median {:.4g} s vs baseline {:.4g} s ({:+.1f} %, tolerance {:.0f} %)",
+        const std::string change = fmt::format("median {:.4g} s vs baseline {:.4g} s ({:+.3g} %, tolerance {:.3g} %)",
                                                now, before, 100.0 * check.measured, 100.0 * *tolerance);
         const int n_now = static_cast<int>(samples.size()), n_base = static_cast<int>(base->samples_s.size());
         if (n_now < reg.min_repetitions || n_base < reg.min_repetitions) {

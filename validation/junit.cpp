@@ -11,8 +11,16 @@ namespace sb::validation {
 std::string xml_escape(std::string_view text, bool attribute) {
   std::string out;
   out.reserve(text.size());
-  for (const char ch : text) {
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char ch = text[i];
     const auto c = static_cast<unsigned char>(ch);
+    // U+FFFE and U+FFFF (UTF-8 EF BF BE, EF BF BF) are no XML characters either.
+    if (c == 0xEF && i + 2 < text.size() && static_cast<unsigned char>(text[i + 1]) == 0xBF &&
+        (static_cast<unsigned char>(text[i + 2]) & 0xFE) == 0xBE) {
+      out += '?';
+      i += 2;
+      continue;
+    }
     switch (ch) {
       case '&':
         out += "&amp;";

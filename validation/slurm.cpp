@@ -59,6 +59,29 @@ std::string directive_path(const fs::path& p, const std::string& what, const std
   return "\"" + (pattern.empty() ? s : (p / pattern).string()) + "\"";
 }
 
+/// An extra sbatch option (--sbatch-arg) as an #SBATCH directive's text, so that the script
+/// carries it and `sbatch sweep.sbatch` by hand submits the job as it was submitted. A value with
+/// blanks is written in double quotes (--comment="two words"); a double quote, a backslash or a
+/// control character cannot be carried, nor a blank outside a --name=value option's value.
+std::string sbatch_directive(const std::string& arg) {
+  if (arg.empty() || arg[0] != '-')
+    throw InputError(fmt::format("--sbatch-arg '{}' is not an sbatch option (it must start with '-', e.g. "
+                                 "--sbatch-arg=--mem=4G)",
+                                 printable(arg)));
+  if (has_control_character(arg) || arg.find_first_of("\"\\") != std::string::npos)
+    throw InputError(fmt::format("--sbatch-arg '{}' holds a double quote, backslash or control character, which "
+                                 "#SBATCH directives cannot carry",
+                                 printable(arg)));
+  const size_t blank = arg.find_first_of(" \t");
+  if (blank == std::string::npos) return arg;
+  const size_t equals = arg.find('=');
+  if (!arg.starts_with("--") || equals == std::string::npos || equals > blank)
+    throw InputError(fmt::format("--sbatch-arg '{}' holds a blank outside an option's value; give one option per "
+                                 "--sbatch-arg, as --name=value (e.g. --sbatch-arg=--mem=4G)",
+                                 arg));
+  return arg.substr(0, equals + 1) + "\"" + arg.substr(equals + 1) + "\"";
+}
+
 /// The last `n` lines of a text file ("(missing)" / "(empty)" when there are none).
 std::string tail_of(const fs::path& file, size_t n) {
   std::ifstream in(file);
@@ -207,6 +230,8 @@ std::string sbatch_script(const SweepDefinition& d, const SlurmSweepOptions& o) 
   s += "#SBATCH --chdir=" + chdir + "\n";
   if (!o.partition.empty()) s += "#SBATCH --partition=" + o.partition + "\n";
   if (!o.time_limit.empty()) s += "#SBATCH --time=" + o.time_limit + "\n";
+  // After the directives above, so that a user's option overrides them as on sbatch's command line.
+  for (const std::string& a : o.sbatch_args) s += "#SBATCH " + sbatch_directive(a) + "\n";
   s += "set -u\n";
   s += "task=${SLURM_ARRAY_TASK_ID:?this script runs as a task of a Slurm job array: submit it with sbatch}\n";
   if (o.threads > 0)
@@ -238,12 +263,7 @@ SlurmSweepOptions resolve_slurm_options(const SweepDefinition& d, SlurmSweepOpti
   if (o.shards > kMaxSlurmShards)
     throw InputError(fmt::format("--shards {} exceeds Slurm's default MaxArraySize ({} tasks); use fewer shards",
                                  o.shards, kMaxSlurmShards + 1));
-  for (const std::string& a : o.sbatch_args)
-    if (a.empty() || a[0] != '-')
-      throw InputError(fmt::format("--sbatch-arg '{}' is not an sbatch option (it must start with '-', e.g. "
-                                   "--sbatch-arg=--mem=4G)",
-                                   a));
-  (void)sbatch_script(d, o);
+  (void)sbatch_script(d, o);  // refuses what the script cannot carry
   return o;
 }
 
@@ -297,9 +317,8 @@ SlurmSubmission submit_sweep(const SweepDefinition& d, SlurmSweepOptions o) {
   SlurmSubmission sub;
   sub.shards = o.shards;
   sub.layout = l;
-  std::vector<std::string> args{"--parsable"};
-  args.insert(args.end(), o.sbatch_args.begin(), o.sbatch_args.end());
-  args.push_back(l.script.string());
+  // The extra sbatch options are the script's directives, so a resubmission by hand keeps them.
+  const std::vector<std::string> args{"--parsable", l.script.string()};
   sub.sbatch_command = {sbatch.string()};
   sub.sbatch_command.insert(sub.sbatch_command.end(), args.begin(), args.end());
   const ProcessResult r = run_slurm_command(sbatch, args);

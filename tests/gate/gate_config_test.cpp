@@ -67,6 +67,16 @@ TEST(GateConfig, BadValuesAreRejected) {
   EXPECT_NE(config_error("[regression]\nmin_repetitions = 1000000000000\n")
                 .find("min_repetitions = 1000000000000 must be an integer from 1 to 1000000"),
             std::string::npos);
+  // The value given is named, whatever its type.
+  EXPECT_NE(config_error("[defaults]\nmin_psnr = \"30\"\n").find("min_psnr = \"30\" must be a number"),
+            std::string::npos);
+  EXPECT_NE(config_error("[defaults]\nmin_psnr = [30]\n").find("min_psnr = an array must be a number"),
+            std::string::npos);
+  EXPECT_NE(config_error("[regression]\ntolerance = \"x\"\n").find("[regression] tolerance = \"x\" must be"),
+            std::string::npos);
+  EXPECT_NE(config_error("[regression]\ntolerance = -0.5\n").find("[regression] tolerance = -0.5 must be"),
+            std::string::npos);
+  EXPECT_NE(config_error("rule = []\n").find("rule = [] holds no rule"), std::string::npos);
   EXPECT_NE(config_error("[[rule]]\npipeline = 3\n").find("pipeline"), std::string::npos);
   EXPECT_NE(config_error("rule = 1\n").find("[[rule]]"), std::string::npos);
   // A syntax error names the line and column.
@@ -86,8 +96,12 @@ TEST(GateConfig, BadValuesAreRejected) {
   EXPECT_NE(config_error("[defaults]\nwarn_recall = 1.01\n").find("warn_recall"), std::string::npos);
   // Tables that give no limit a value pass anything, as an empty file would (both used to be accepted).
   for (const char* none : {"[[rule]]\npipeline = \"repro-*\"\n", "[defaults]\nmin_psnr = false\n",
-                           "[defaults]\nmin_psnr = false\n[[rule]]\nregression_tolerance = 0.1\n"})
-    EXPECT_NE(config_error(none).find("sets no threshold and no [regression]"), std::string::npos) << none;
+                           "[defaults]\nmin_psnr = false\n[[rule]]\nregression_tolerance = false\n"})
+    EXPECT_NE(config_error(none).find("sets no threshold, no [regression] and no rule's regression_tolerance"),
+              std::string::npos)
+        << none;
+  // A rule's regression_tolerance asks for the time regressions of its cells: a check.
+  EXPECT_EQ(config_error("[defaults]\nmin_psnr = false\n[[rule]]\nregression_tolerance = 0.1\n"), "");
 }
 
 TEST(GateConfig, RulesOverrideDefaultsInFileOrder) {

@@ -13,6 +13,8 @@
 
 #include "gate/gate_fixture.hpp"
 #include "renderer/error.hpp"
+#include "renderer/io/file_lock.hpp"
+#include "support/lock_wait.hpp"
 #include "support/run_cli.hpp"
 #include "support/scratch_dir.hpp"
 #include "validation/gate.hpp"
@@ -66,10 +68,13 @@ TEST(GateEval, TimeRegressionsOnlyWhereTheConfigAsks) {
   const std::string thresholds_only = "[defaults]\nmin_psnr = 30\n";
   validation::GateReport r = evaluate(cells, baseline, thresholds_only);
   EXPECT_EQ(find_check(r, "repro-rt", "time_regression"), nullptr);
-  // A rule's tolerance turns it on for its cells alone.
-  r = evaluate(cells, baseline, thresholds_only + "[[rule]]\npipeline = \"repro-rt\"\nregression_tolerance = 0.2\n");
-  EXPECT_NE(find_check(r, "repro-rt", "time_regression"), nullptr);
-  EXPECT_EQ(find_check(r, "plain-rt", "time_regression"), nullptr);
+  // A rule's tolerance turns it on for its cells alone, also as the config's only check (that
+  // config was refused as one that "would pass anything").
+  for (const std::string& before : {thresholds_only, std::string()}) {
+    r = evaluate(cells, baseline, before + "[[rule]]\npipeline = \"repro-rt\"\nregression_tolerance = 0.2\n");
+    EXPECT_NE(find_check(r, "repro-rt", "time_regression"), nullptr);
+    EXPECT_EQ(find_check(r, "plain-rt", "time_regression"), nullptr);
+  }
 }
 
 TEST(GateEval, PassingCellsPass) {
@@ -446,6 +451,33 @@ TEST(GateEval, BaselineUpdateTouchesOnlyWhatIsNamed) {
   EXPECT_NE(run.out.find("set repetitions = 5 or more in the [timing] table of the sweep's definition"),
             std::string::npos)
       << run.out;
+}
+
+TEST(GateEval, BaselineUpdatesTakeTurns) {
+  // Two updates of one baseline at once each read the file and wrote it back, so the one that
+  // wrote last dropped the other's entries. An update now waits for the one before it.
+  ScratchDir dir;
+  write_results(dir / "results.jsonl", passing_cells());
+  const std::filesystem::path baseline = dir / "baseline.json";
+  const std::string update = "gate --update-baseline --results " + quoted(dir / "results.jsonl") + " --baseline " +
+                             quoted(baseline) + " --only ";
+  io::FileLock held = io::FileLock::acquire(baseline.string() + ".lock");
+  start_cli_in_background(update + "plain-rt", dir / "first.log");
+  ASSERT_TRUE(wait_for_lock_waiter(baseline.string() + ".lock")) << read_text(dir / "first.log");
+  // While the first waits, another update writes repro-rt's entries.
+  held.release();
+  const CliRun second = run_cli(update + "repro-rt");
+  EXPECT_EQ(second.code, 0) << second.out;
+  const CliRun first = wait_for_background(dir / "first.log");
+  EXPECT_EQ(first.code, 0) << first.out;
+  EXPECT_NE(first.out.find("waiting for another update of " + baseline.string()), std::string::npos) << first.out;
+  const validation::Baseline both = validation::load_baseline(baseline);
+  for (const auto& [cell, entries] : both.cells) {
+    EXPECT_TRUE(entries.count("plain-rt")) << cell;
+    EXPECT_TRUE(entries.count("repro-rt")) << cell;
+  }
+  EXPECT_EQ(both.cells.size(), 2u);
+  EXPECT_FALSE(std::filesystem::exists(baseline.string() + ".lock")) << "the lock file stays behind";
 }
 
 TEST(GateCli, ExitCodesAndOutputs) {

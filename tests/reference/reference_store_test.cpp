@@ -379,6 +379,55 @@ TEST(ReferenceStore, AnEntryThatContradictsItsFolderIsCorrupt) {
   EXPECT_NE(r.out.find("its spec makes the reference '" + pole + "', but the entry lies in folder '" + renamed + "'"),
             std::string::npos)
       << r.out;
+  // update writes that reference under its own id and says that the folder stays as it was,
+  // instead of reporting it mended.
+  fs::remove_all(store / pole);
+  const test::CliRun update = test::run_cli(ref(dir, "update") + " --only-failing --no-render");
+  EXPECT_EQ(update.code, 3) << update.out;
+  EXPECT_NE(update.out.find("not named by the id their spec makes"), std::string::npos) << update.out;
+  EXPECT_NE(update.out.find(renamed + " (its spec's reference was written to " + pole + ")"), std::string::npos)
+      << update.out;
+  EXPECT_TRUE(fs::exists(store / pole / "provenance.json"));
+}
+
+TEST(ReferenceStore, SceneNamesGiveVisibleFoldersAndAMissingSceneDoesNotStopAnUpdate) {
+  // A scene's name from its file goes into the id as a folder name of the store itself: never a
+  // hidden folder (listed by nothing), a path, or a name too long for the file system.
+  test::ScratchDir dir;
+  const json original = json::parse(test::read_text(scenes::resolve_scene("box-wall", kScenes)));
+  const std::pair<std::string, std::string> names[] = {
+      {".hidden", "_hidden_full_"},
+      {"../../escaped", "_._.._escaped_full_"},
+      {"sub/dir name", "sub_dir_name_full_"},
+      {std::string(300, 'n'), std::string(96, 'n') + "_full_"},
+      {"", "named4_full_"},  // a scene without a name is named by its file
+  };
+  const std::string args = " --resolution 16x9 --threads 1";
+  for (size_t i = 0; i < std::size(names); ++i) {
+    json scene = original;
+    scene["scenes"][0]["name"] = names[i].first;
+    const fs::path file = dir / fmt::format("named{}.gltf", i);
+    std::ofstream(file) << scene.dump();
+    const test::CliRun r = test::run_cli(ref(dir, "generate") + " --scene " + quoted(file) + args);
+    EXPECT_EQ(r.code, 0) << names[i].first << ": " << r.out;
+  }
+  const ReferenceStore store(dir / "store");
+  const std::vector<std::string> ids = store.ids();
+  ASSERT_EQ(ids.size(), std::size(names)) << fmt::format("{}", fmt::join(ids, ", "));
+  for (const auto& [name, start] : names)
+    EXPECT_TRUE(std::any_of(ids.begin(), ids.end(), [&](const std::string& id) { return id.starts_with(start); }))
+        << start;
+  EXPECT_FALSE(fs::exists(dir / "escaped_full_16x9_e64.0mm_c4.08m"));
+
+  // One entry's scene file gone: the others are still rewritten, and the run names that one.
+  fs::remove(dir / "named0.gltf");
+  const test::CliRun update = test::run_cli(ref(dir, "update"));
+  EXPECT_EQ(update.code, 3) << update.out;
+  EXPECT_NE(update.out.find(fmt::format("{} reference(s) rewritten", std::size(names) - 1)), std::string::npos)
+      << update.out;
+  EXPECT_NE(update.out.find("1 reference(s) could not be rendered again from their spec"), std::string::npos)
+      << update.out;
+  EXPECT_NE(update.out.find("_hidden_full_"), std::string::npos) << update.out;
 }
 
 TEST(ReferenceStore, AnotherSceneOfTheSameNameDoesNotReplaceAnEntry) {

@@ -200,6 +200,19 @@ TEST(SlurmScript, BadOptionsAreInputErrors) {
   o.partition = "debug;rm";
   EXPECT_THROW((void)validation::sbatch_script(d, o), InputError);
   o.partition.clear();
+  // Extra sbatch options are directives after the script's own (which they override as on the
+  // command line), a value with blanks in double quotes; what a directive cannot carry is refused.
+  o.sbatch_args = {"--mem=8G", "--hold", "-c4", "--comment=two words"};
+  const std::string extra = validation::sbatch_script(d, o);
+  const size_t chdir = extra.find("#SBATCH --chdir=");
+  const size_t mem = extra.find("#SBATCH --mem=8G\n#SBATCH --hold\n#SBATCH -c4\n#SBATCH --comment=\"two words\"\n");
+  EXPECT_NE(mem, std::string::npos) << extra;
+  EXPECT_LT(chdir, mem) << extra;
+  for (const char* bad : {"mem=8G", "", "--comment=a\"b", "--comment=a\\b", "--comment=a\nb", "-c 4", "--mem 8G"}) {
+    o.sbatch_args = {bad};
+    EXPECT_THROW((void)validation::sbatch_script(d, o), InputError) << bad;
+  }
+  o.sbatch_args.clear();
   for (const char* ok : {"10", "10:30", "01:30:00", "2-12", "2-12:30", "2-12:30:00", "infinite"})
     EXPECT_NO_THROW(validation::check_slurm_time_limit(ok)) << ok;
   for (const char* bad : {"", "1h", "01:30:00:00", "-5", "1-", "abc", "1:99:99", "10:60", "2-24", "2-12:60"})
