@@ -178,10 +178,11 @@ std::string presets_help() {
       "Presets (--preset NAME) reproduce the benchmark tables of Al-Hagri's thesis (Table 5) and of\n"
       "Kim's paper (Tables 2 and 3). Every number is measured in this run: in each repetition a row's\n"
       "pipelines run in turn, times are medians over the repetitions and speed-ups are paired per\n"
-      "repetition against the baseline; --json writes every row (rewritten after each). e is the\n"
-      "disparity at infinity in pixels (--max-disparity). --repetitions, --warmup, --threads, --option\n"
-      "and --vfov apply to every row, --convergence where the preset leaves it open; --preset-rows K\n"
-      "runs the first K rows of each series (a quick version).\n";
+      "repetition against the baseline; --json writes every row (rewritten after each; a file, not\n"
+      "'-'). In Al-Hagri's presets e is the disparity at infinity in pixels (--max-disparity); Kim's\n"
+      "give it in millimetres (--interaxial). --repetitions, --warmup, --threads, --option and --vfov\n"
+      "apply to every row, --convergence where the preset leaves it open; --preset-rows K runs the\n"
+      "first K rows of each series (a quick version).\n";
   const auto wrap = [&text](const std::string& words_text) {
     std::string line = "     ";
     std::stringstream words(words_text);

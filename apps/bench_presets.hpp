@@ -175,17 +175,13 @@ struct MeasuredPeak {
   return static_cast<uint64_t>(std::max(estimate, base));
 }
 
-/// Index of the crossover row: the first row from which `method_ms` is below `baseline_ms` in that
-/// row and every later one (rows in increasing complexity); nullopt when there is none. InputError
-/// for vectors of different sizes.
-[[nodiscard]] inline std::optional<size_t> crossover_row(const std::vector<double>& baseline_ms,
-                                                         const std::vector<double>& method_ms) {
-  if (baseline_ms.size() != method_ms.size())
-    throw InputError("crossover_row: " + std::to_string(baseline_ms.size()) + " baseline times but " +
-                     std::to_string(method_ms.size()) + " method times; pass one of each per row");
+/// Index of the crossover row: the first row from which the method's speed-up over the baseline
+/// (the median of the ratios paired per repetition, the figure the table prints) is above 1 in
+/// that row and every later one (rows in increasing complexity); nullopt when there is none.
+[[nodiscard]] inline std::optional<size_t> crossover_row(const std::vector<double>& speedups) {
   std::optional<size_t> first;
-  for (size_t i = baseline_ms.size(); i-- > 0;) {
-    if (!(method_ms[i] < baseline_ms[i])) break;
+  for (size_t i = speedups.size(); i-- > 0;) {
+    if (!(speedups[i] > 1.0)) break;
     first = i;
   }
   return first;

@@ -32,6 +32,7 @@
 #include "sb_version.hpp"
 #include "scenes/catalog.hpp"
 #include "validation/content_hash.hpp"
+#include "validation/image_files.hpp"
 #include "validation/metric_images.hpp"
 #include "validation/truth.hpp"
 #include "validation/truth_cache.hpp"
@@ -46,6 +47,7 @@ namespace {
 constexpr const char* kProvenance = "provenance.json";
 constexpr const char* kImage = "right.exr";
 constexpr const char* kPreview = "right.png";
+constexpr const char* kKind = "stereobench.reference";
 /// Stands in the provenance for the provider's scratch folder, which is removed once stored.
 constexpr const char* kWorkPlaceholder = "$WORK";
 
@@ -446,6 +448,9 @@ std::optional<std::string> inconsistent_provenance(const json& prov, const std::
     if (o == nullptr || !o->is_object() || !o->contains(key) || !o->at(key).is_string()) return std::nullopt;
     return o->at(key).get<std::string>();
   };
+  const std::optional<std::string> kind = text(nullptr, "kind");
+  if (kind != kKind)
+    return fmt::format("its kind is {}, not '{}'", kind ? "'" + *kind + "'" : "(none)", kKind);
   const std::optional<std::string> recorded_id = text(nullptr, "id");
   if (recorded_id != id)
     return fmt::format("it records id {} but lies in folder '{}'", recorded_id ? "'" + *recorded_id + "'" : "(none)", id);
@@ -596,7 +601,7 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
     validation::write_png(staged / kPreview, validation::encode_srgb8(right, "the reference"));
     fs::remove_all(staged / "work", ec);
     const json provenance = {
-        {"kind", "stereobench.reference"},
+        {"kind", kKind},
         {"version", 1},
         {"id", id},
         {"spec", spec_to_json(stored)},
@@ -756,8 +761,29 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
                            p.rig->params().height, (root_ / id).string());
     return r;
   }
+  // The preview is what people look at: it must show the stored image (its bytes are not
+  // recorded, so its pixels are compared with the image's sRGB encoding).
+  const fs::path preview_file = root_ / id / kPreview;
+  const std::string preview_fix = fmt::format("`stereobench reference update {}` writes it again", id);
+  try {
+    const validation::Srgb8Image preview = validation::read_srgb8_file(preview_file).image;
+    const validation::Srgb8Image expected = validation::encode_srgb8(stored, "the stored reference");
+    if (preview.width != expected.width || preview.height != expected.height || preview.rgb != expected.rgb) {
+      r.status = Status::corrupt;
+      r.detail = fmt::format("{} does not show {} ({}); {}", preview_file.string(), image_file.string(),
+                             preview.width != expected.width || preview.height != expected.height
+                                 ? fmt::format("it is {}x{}", preview.width, preview.height)
+                                 : std::string("its pixels differ"),
+                             preview_fix);
+      return r;
+    }
+  } catch (const Error& e) {
+    r.status = Status::corrupt;
+    r.detail = fmt::format("the preview cannot be read: {}; {}", e.what(), preview_fix);
+    return r;
+  }
   if (!options.rerender) {
-    r.detail = "image, scene and rig match their records (not rendered again)";
+    r.detail = "image, preview, scene and rig match their records (not rendered again)";
     return r;
   }
   const std::unique_ptr<validation::TruthProvider> provider = validation::make_truth_provider(spec.provider);

@@ -843,9 +843,11 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
         const std::optional<double> value = record_number(entry, mc.pointer, where + ": pipelines." + pipeline);
         check.measured = value ? *value : kNaN;
         if (!value || std::isnan(*value)) {
-          check.verdict = Verdict::skip;
+          check.verdict = mc.may_be_missing ? Verdict::skip : Verdict::fail;
           check.message =
-              fmt::format("no {} in the record ({} is {})", mc.label, mc.pointer, value ? "null" : "absent");
+              fmt::format("no {} in the record ({} is {}){}", mc.label, mc.pointer, value ? "null" : "absent",
+                          mc.may_be_missing ? ""
+                                            : "; the record is damaged or of another version: run the cell again");
           add(std::move(check));
           continue;
         }

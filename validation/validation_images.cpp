@@ -122,6 +122,14 @@ json write_pipeline_images(const std::filesystem::path& dir, const std::string& 
     files["right_exr"] = path("right.exr").string();
     paths.push_back(path("right.exr"));
   }
+  // Diagnostic images an option asked for (repro-*'s grid=true, bidir-warp's partials=true), as
+  // render writes them: <stem>_<name>.png, recorded as <name>_png.
+  for (const auto& [name, image] : v.result.extras) {
+    const Path file = dir / fmt::format("{}_{}.png", stem, name);
+    writers.push_back({file, [&image](const Path& to) { io::write_png_preview(to, image); }});
+    files[name + "_png"] = file.string();
+    paths.push_back(file);
+  }
   write_side_by_side(writers, paths, executor, options);
   files["right_png"] = path("right.png").string();
   files["diff_png"] = path("diff.png").string();

@@ -178,7 +178,13 @@ Temporary new_temporary(const fs::path& path) {
   static std::atomic<unsigned> counter{0};
   fs::path tmp = path.parent_path() / fmt::format("{}{}-{}", temporary_prefix(path), ::getpid(), counter++);
   SignalRegistration on_signal(tmp);  // before the file exists: a signal on the way finds its name
-  UniqueFd lock = lock_temporary(tmp, path);
+  UniqueFd lock;
+  {
+    // So does the staging name lock_temporary makes first (a signal between its creation and its
+    // rename left it behind).
+    const SignalRegistration staging_on_signal(tmp.parent_path() / (tmp.filename().string() + ".new"));
+    lock = lock_temporary(tmp, path);
+  }
   return Temporary{std::move(tmp), std::move(lock), std::move(on_signal)};
 }
 
@@ -387,6 +393,18 @@ void StagedFiles::commit() {
         if (const int signal = g_deferred_signal.exchange(0)) ::raise(signal);
     }
   } resume;
+  if (entries_.empty()) return;
+  // The marker's earlier file goes before any file is replaced: a run that stops among the renames
+  // (killed, or a rename refused) leaves a set without its marker, never new files beside an old
+  // marker that lists them as one set.
+  const fs::path& marker = entries_.back().path;
+  if (entries_.size() > 1) {
+    try {
+      (void)remove_output_file(marker);
+    } catch (const IoError& e) {
+      throw IoError(fmt::format("{}; no file of the set was replaced", e.what()));
+    }
+  }
   for (size_t k = 0; k < entries_.size(); ++k) {
     Entry& e = entries_[k];
     std::error_code ec;
@@ -395,20 +413,12 @@ void StagedFiles::commit() {
       e.placed = true;
       continue;
     }
-    const std::string failed = fmt::format(
-        "cannot write {}: the finished file cannot take its name ({}); any earlier file of that name is left as it was",
-        e.path.string(), ec.message());
-    if (k == 0) throw IoError(failed);
-    const fs::path& marker = entries_.back().path;  // not placed: it goes last
-    std::error_code removed;
-    fs::remove(marker, removed);
-    throw IoError(fmt::format("{}; {} of the set's {} files are in place and the others not: {}", failed, k,
-                              entries_.size(),
-                              removed ? fmt::format("remove {} ({}), then write the set again", marker.string(),
-                                                    removed.message())
-                                      : fmt::format("{} is removed so that the set does not look complete; write it "
-                                                    "again",
-                                                    marker.string())));
+    const std::string failed =
+        fmt::format("cannot write {}: the finished file cannot take its name ({})", e.path.string(), ec.message());
+    if (entries_.size() == 1) throw IoError(failed + "; any earlier file of that name is left as it was");
+    throw IoError(fmt::format("{}; {} of the set's {} files are in place and the others not, and {} is removed so "
+                              "that the set does not look complete: write it again",
+                              failed, k, entries_.size(), marker.string()));
   }
   discard_output_files(retired_);
 }

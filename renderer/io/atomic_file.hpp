@@ -48,10 +48,11 @@ class StagedFiles {
   /// An earlier file of the set that this one does not write again: removed once the set is in
   /// place (best effort), never before.
   void retire(const std::filesystem::path& path);
-  /// Renames every file added into place, in order, then removes the retired ones. IoError at the
-  /// first rename that fails: with none placed, every earlier file stands as it was; with some
-  /// placed, the marker's earlier file is removed too (its links followed), so that the mix does
-  /// not look complete, and the message says so (or that it could not be removed). The others'
+  /// Removes the earlier file of the marker (the file added last; its links followed) when the set
+  /// has more than one file, then renames every file added into place, in order, the marker last,
+  /// then removes the retired ones. So a set whose marker is in place is whole, whenever the run
+  /// stopped. IoError when the marker's earlier file cannot be removed (nothing is replaced), or
+  /// at the first rename that fails (the message says how many files are in place); the others'
   /// temporaries are removed with the set.
   void commit();
 

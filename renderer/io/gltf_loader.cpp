@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cstdio>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -315,6 +317,15 @@ AllowedFiles check_external_files(const json& doc, const fs::path& dir, const st
       if (!fs::is_regular_file(p, ec))
         throw InputError(fmt::format("{}: {}: '{}' is {}, not a regular file; fix the uri", file, where, p.string(),
                                      fs::is_directory(p, ec) ? "a folder" : "a device, pipe or socket"));
+      // One that cannot be opened (permissions) is named here, with the reason, not by the
+      // loader's own words later ("File read error", or an image without data).
+      if (std::FILE* f = std::fopen(p.c_str(), "rb")) {
+        std::fclose(f);
+      } else {
+        const int err = errno;
+        throw IoError(fmt::format("{}: {}: cannot read '{}': {}; make it readable for this user", file, where,
+                                  p.string(), std::strerror(err)));
+      }
       if (std::string(top) == "buffers") {
         const uint64_t need = e.at("byteLength").get<uint64_t>();
         const uint64_t have = fs::file_size(p, ec);

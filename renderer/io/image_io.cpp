@@ -987,7 +987,8 @@ void write_png_preview(const fs::path& path, const Image& image, std::string_vie
       for (std::size_t i = begin; i < begin + row_values; ++i) codes[i] = linear_to_srgb8(src[i]);
     }
   });
-  const std::vector<unsigned char> png = encode_png(codes.data(), image.width(), image.height(), channels);
+  const std::vector<unsigned char> png =
+      encode_png(codes.data(), image.width(), image.height(), channels, PngColour::srgb);
   write_file_atomically(path, png);
 }
 
@@ -996,11 +997,11 @@ void write_png_rgb8(const fs::path& path, const std::vector<uint8_t>& rgb, int w
     throw InputError(fmt::format("cannot write {}: {} bytes given for a {}x{} RGB image (needs width*height*3 = {})",
                                  path.string(), rgb.size(), width, height,
                                  static_cast<long long>(width) * static_cast<long long>(height) * 3));
-  const std::vector<unsigned char> png = encode_png(rgb.data(), width, height, 3);
+  const std::vector<unsigned char> png = encode_png(rgb.data(), width, height, 3, PngColour::srgb);
   write_file_atomically(path, png);
 }
 
-std::vector<unsigned char> encode_png(const uint8_t* pixels, int width, int height, int channels) {
+std::vector<unsigned char> encode_png(const uint8_t* pixels, int width, int height, int channels, PngColour colour) {
   if (width <= 0 || height <= 0 || width > kMaxImageDimension || height > kMaxImageDimension)
     throw InputError(fmt::format("encode_png: image size {}x{} is invalid; both sides must be in 1..{}", width, height,
                                  kMaxImageDimension));
@@ -1016,6 +1017,7 @@ std::vector<unsigned char> encode_png(const uint8_t* pixels, int width, int heig
   spec.attribute("png:compressionLevel", 6);
   // The pixels carry straight (unpremultiplied) alpha, as glTF expects: store them unchanged.
   spec.attribute("oiio:UnassociatedAlpha", 1);
+  if (colour == PngColour::srgb) spec.attribute("oiio:ColorSpace", "sRGB");
   if (!out->set_ioproxy(&proxy) || !out->open("memory.png", spec))
     throw IoError(fmt::format("encode_png: cannot start PNG encoding of a {}x{}x{} image: {}", width, height, channels,
                               oiio_error(out.get())));

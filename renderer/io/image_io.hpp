@@ -82,19 +82,25 @@ struct ChannelInfo {
 [[nodiscard]] std::vector<ChannelInfo> read_channel_info(const std::filesystem::path& path);
 
 /// Writes a 1- or 3-channel float plane as an 8-bit PNG: each value clamped to [0, 1], encoded
-/// with the exact sRGB OETF and rounded to the nearest code (linear_to_srgb8). Written
-/// atomically; InputError for a missing, uint32 or wrongly shaped plane, IoError on write failure.
+/// with the exact sRGB OETF and rounded to the nearest code (linear_to_srgb8), tagged sRGB.
+/// Written atomically; InputError for a missing, uint32 or wrongly shaped plane, IoError on write failure.
 void write_png_preview(const std::filesystem::path& path, const Image& image, std::string_view plane = planes::rgb);
 
-/// Writes already-encoded 8-bit RGB pixels (row-major, row 0 at the top, w*h*3 bytes) as a PNG,
-/// atomically.
+/// Writes already-encoded 8-bit sRGB pixels (row-major, row 0 at the top, w*h*3 bytes) as a PNG
+/// tagged sRGB, atomically.
 void write_png_rgb8(const std::filesystem::path& path, const std::vector<uint8_t>& rgb, int width, int height);
+
+/// Whether a PNG says what its codes mean: `srgb` writes the sRGB chunk (with its gAMA and cHRM
+/// fallbacks), for images meant to be looked at; `untagged` writes none (textures of generated
+/// scenes, whose bytes the scenes' hashes cover, and data such as masks).
+enum class PngColour { untagged, srgb };
 
 /// Encodes 8-bit pixels (row-major, interleaved, 1-4 channels; with 2 or 4 channels the last is
 /// straight, unpremultiplied alpha, stored as given) as PNG bytes in memory. The same
 /// pixels always give the same bytes (no time stamps or software tags). InputError for a bad
 /// shape, IoError if encoding fails.
-[[nodiscard]] std::vector<unsigned char> encode_png(const uint8_t* pixels, int width, int height, int channels);
+[[nodiscard]] std::vector<unsigned char> encode_png(const uint8_t* pixels, int width, int height, int channels,
+                                                    PngColour colour = PngColour::untagged);
 
 /// A decoded image: interleaved samples as float, row 0 at the top.
 struct DecodedImage {

@@ -199,8 +199,8 @@ RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::st
   check_no_folder_at(f.all(), "write to another folder");
   // Every file is made whole under its temporary name first, and only then are all renamed into
   // place, the stats JSON last (it marks a complete set): a failure on the way (a full disk) leaves
-  // an earlier render's set as it was. Should a rename fail after others, the stats JSON is
-  // removed, so that no mixed set is left looking complete.
+  // an earlier render's set as it was. The earlier stats JSON goes before the first rename, so
+  // that a run stopped among the renames leaves no mixed set looking complete.
   ImageMetadata meta;
   meta["stereobench/record"] = record.dump();
   std::vector<std::pair<fs::path, const Image*>> pngs{{f.left_png, &result.left}, {f.right_png, &result.right}};

@@ -38,6 +38,9 @@ class BidirWarpRt final : public Pipeline {
     }
     add_counts(r.counters, right, "right", true);
     add_counts(r.counters, left, "left", true);
+    // The crack fill counted the holes it left before they were traced: none is left now.
+    r.counters.set("holes_left", hole_list(r.right).size());
+    r.counters.set("holes_left_in_left", hole_list(r.left).size());
     return r;
   }
 };

@@ -125,7 +125,8 @@ std::vector<OptionSpec> bidir_option_specs(bool traced) {
            "where the other eye does not show that triangle at the point's place (the z-test Kim's §5 proposes "
            "against occlusion artifacts)"},
           {"partials", "false",
-           "also output each eye's partial image (<stem>_left_partial.png, <stem>_right_partial.png)"}};
+           "also output each eye's partial image (<stem>_left_partial.png, <stem>_right_partial.png; render, validate and "
+           "sweep cells write them)"}};
 }
 
 BidirSettings BidirSettings::from(const std::string& pipeline, const PipelineOptions& options) {

@@ -16,7 +16,7 @@ std::vector<OptionSpec> grid_warp_option_specs(bool with_detection) {
   std::vector<OptionSpec> specs{
       {"threshold_arcmin", "1.0",
        "binocular-parallax difference (minutes of arc) above which a 16x16 cell is subdivided to native resolution"},
-      {"grid_overlay", "false", "also output the warping grid drawn over the left eye (<stem>_grid.png)"},
+      {"grid_overlay", "false", "also output the warping grid drawn over the left eye (<stem>_grid.png; render, validate and sweep cells write it)"},
       tile_option_spec()};
   if (with_detection) {
     specs.push_back({"discontinuity_px", "0.05",

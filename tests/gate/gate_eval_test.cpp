@@ -93,6 +93,30 @@ TEST(GateEval, PassingCellsPass) {
   EXPECT_EQ(find_check(r, "plain-rt", "speedup"), nullptr);
 }
 
+TEST(GateEval, AQualityMetricTheRecordLacksFailsAndAnUndefinedRecallIsSkipped) {
+  // A null PSNR (a damaged record) used to be skipped, so the gate passed with no PSNR read.
+  std::vector<json> cells = passing_cells();
+  cells[0]["pipelines"]["repro-rt"]["validation"]["metrics"]["psnr"] = nullptr;
+  cells[1]["pipelines"]["repro-rt"]["validation"]["metrics"]["ssim"] = nullptr;
+  cells[0]["pipelines"]["repro-rt"]["validation"]["holes"]["not_reprojected"]["recall"] = nullptr;
+  const validation::GateReport r = evaluate(cells);
+  const validation::GateCheck* psnr = find_check(r, "repro-rt", "psnr", 0);
+  ASSERT_NE(psnr, nullptr);
+  EXPECT_EQ(psnr->verdict, Verdict::fail);
+  EXPECT_NE(psnr->message.find("no PSNR in the record (/validation/metrics/psnr is null); the record is damaged"),
+            std::string::npos)
+      << psnr->message;
+  const validation::GateCheck* ssim = find_check(r, "repro-rt", "ssim", 1);
+  ASSERT_NE(ssim, nullptr);
+  EXPECT_EQ(ssim->verdict, Verdict::fail);
+  EXPECT_NE(ssim->message.find("no SSIM in the record (/validation/metrics/ssim is null)"), std::string::npos)
+      << ssim->message;
+  const validation::GateCheck* recall = find_check(r, "repro-rt", "disocclusion_recall", 0);
+  ASSERT_NE(recall, nullptr);
+  EXPECT_EQ(recall->verdict, Verdict::skip);
+  EXPECT_EQ(r.worst, Verdict::fail);
+}
+
 TEST(GateEval, ThresholdAboveTheMeasuredValueFails) {
   // repro-rt measured 45 dB; a minimum of 45.5 dB must fail.
   const std::string config = kConfig + "[[rule]]\npipeline = \"repro-rt\"\nscene = \"box-wall\"\nmin_psnr = 45.5\n";

@@ -142,6 +142,11 @@ TEST(BidirWarpRt, TracesItsCracksSoAVanishingDisparityReproducesTheTruth) {
   EXPECT_GT(kim.counters.get("pixels_filled_crack"), 0u);
   EXPECT_EQ(traced.counters.get("pixels_traced_right"), traced.counters.get("hole_pixels"))
       << "every hole, cracks included, is traced";
+  // ... so none is left, as its counters say (they kept the crack fill's count of the holes it left).
+  const StereoResult wide = test::render_with("bidir-warp-rt", prepared, test::rig_at(scene, 160, 90), 2);
+  EXPECT_GT(wide.counters.get("pixels_traced_right"), 0u);
+  EXPECT_EQ(wide.counters.get("holes_left"), 0u);
+  EXPECT_EQ(wide.counters.get("holes_left_in_left"), 0u);
 }
 
 TEST(BidirZtest, OcclusionOptionIsChecked) {

@@ -18,6 +18,7 @@
 #include "reference/store.hpp"
 #include "scenes/catalog.hpp"
 #include "renderer/io/file_lock.hpp"
+#include "renderer/io/image_io.hpp"
 #include "renderer/text.hpp"
 #include "support/lock_wait.hpp"
 #include "support/run_cli.hpp"
@@ -355,6 +356,7 @@ TEST(ReferenceStore, AnEntryThatContradictsItsFolderIsCorrupt) {
       {"id", {box, "it records id 'box-wall_full_64x36_e64.0mm_c4.08m' but lies in folder"}},
       {"image", {json{{"file", "../../elsewhere.exr"}}, "it names image file '../../elsewhere.exr'"}},
       {"provider", {json{{"name", "nope"}}, "provider.name 'nope' is not its spec's provider 'full'"}},
+      {"kind", {json("whatever"), "its kind is 'whatever', not 'stereobench.reference'"}},
   };
   for (const auto& [key, edit] : edits) {
     json p = original;
@@ -367,8 +369,22 @@ TEST(ReferenceStore, AnEntryThatContradictsItsFolderIsCorrupt) {
     expect_corrupt(verify_all(), edit.second);
   }
 
-  // A folder renamed away from the id its spec gives, provenance edited to match.
+  // The preview people look at must show the stored image: repainted, or gone, it is corrupt.
   std::ofstream(store / pole / "provenance.json", std::ios::trunc) << original.dump(2);
+  const fs::path preview = store / pole / "right.png";
+  fs::copy_file(preview, dir / "preview.png");
+  {
+    std::vector<uint8_t> red(48 * 32 * 3, 0);
+    for (size_t i = 0; i < red.size(); i += 3) red[i] = 255;
+    io::write_png_rgb8(preview, red, 48, 32);
+  }
+  expect_corrupt(verify_all(), preview.string() + " does not show");
+  fs::remove(preview);
+  expect_corrupt(verify_all(), "the preview cannot be read");
+  fs::copy_file(dir / "preview.png", preview);
+  EXPECT_EQ(verify_all().code, 0);
+
+  // A folder renamed away from the id its spec gives, provenance edited to match.
   const std::string renamed = "thin-pole_full_renamed";
   fs::rename(store / pole, store / renamed);
   json moved = original;
