@@ -232,26 +232,12 @@ json without_scratch_path(const json& value, const fs::path& scratch) {
   return out;
 }
 
-/// The scene's name as the start of a folder name: letters, digits and "-_.+" kept, any other
-/// byte (a '/', a blank, a control character, UTF-8) written as '_', a leading '.' too (the store
-/// passes over hidden folders), at most kMaxIdSceneName bytes (the id stays a legal file name),
-/// "scene" for an empty name. A name of those characters alone is unchanged.
-constexpr size_t kMaxIdSceneName = 96;
-std::string id_scene_name(const std::string& name) {
-  std::string out = name.substr(0, kMaxIdSceneName);
-  for (char& c : out) {
-    const bool ascii_alnum = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
-    if (!ascii_alnum && c != '-' && c != '_' && c != '.' && c != '+') c = '_';
-  }
-  if (!out.empty() && out[0] == '.') out[0] = '_';
-  return out.empty() ? "scene" : out;
-}
-
-/// The entry's folder name: scene, provider, size, interaxial and convergence; the field of view
-/// and the light count where they are not the scene's (`lights_in_file`: the scene's own count).
+/// The entry's folder name: scene (its file_stem: a name safe in a path, never hidden), provider,
+/// size, interaxial and convergence; the field of view and the light count where they are not the
+/// scene's (`lights_in_file`: the scene's own count).
 std::string reference_id(const Scene& scene, const ReferenceSpec& spec, const StereoRig& rig, size_t lights_in_file) {
   const RigParams& p = rig.params();
-  std::string id = fmt::format("{}_{}_{}x{}_e{:.1f}mm_c{:.3g}m", id_scene_name(scene.name), spec.provider, p.width,
+  std::string id = fmt::format("{}_{}_{}x{}_e{:.1f}mm_c{:.3g}m", scene.file_stem(), spec.provider, p.width,
                                p.height, p.interaxial * 1e3, p.convergence);
   // The scene camera's field of view goes without saying; any other is part of the id.
   if (p.vfov != resolve_rig(scene, {}).params().vfov) id += fmt::format("_v{:.4g}deg", radians_to_degrees(p.vfov));

@@ -92,7 +92,8 @@ void remove_stale_temporaries(const fs::path& path) {
 /// that no other write can find it unlocked. The descriptor is closed with the object.
 UniqueFd lock_temporary(const fs::path& tmp, const fs::path& path) {
   const fs::path staging = tmp.parent_path() / (tmp.filename().string() + ".new");
-  UniqueFd fd{::open(staging.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644)};
+  // 0666 before the umask, as other tools create files.
+  UniqueFd fd{::open(staging.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666)};
   if (!fd.valid())
     throw IoError(fmt::format("cannot write {}: cannot create a file in {} ({}); give a path in a folder you can "
                               "write, or make room there",
@@ -420,7 +421,18 @@ void StagedFiles::commit() {
                               "that the set does not look complete: write it again",
                               failed, k, entries_.size(), marker.string()));
   }
+  // The renames themselves on disk (each file was flushed before).
+  std::vector<fs::path> folders;
+  for (const Entry& e : entries_)
+    if (const fs::path f = folder_of(e.path); std::find(folders.begin(), folders.end(), f) == folders.end())
+      folders.push_back(f);
+  for (const fs::path& f : folders) sync_folder(f);
   discard_output_files(retired_);
+}
+
+void sync_folder(const fs::path& folder) noexcept {
+  const UniqueFd dir(::open(folder.empty() ? "." : folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+  if (dir.valid()) (void)::fsync(dir.get());
 }
 
 void StagedFiles::retire(const fs::path& path) {

@@ -91,6 +91,10 @@ void remove_temporaries_on_signal() noexcept;
 /// create); `path` itself when it is no link. IoError for a loop of links.
 [[nodiscard]] std::filesystem::path follow_links(const std::filesystem::path& path);
 
+/// Flushes a folder's entries to disk (the renames into it), best effort: a folder that cannot be
+/// opened or flushed is passed over.
+void sync_folder(const std::filesystem::path& folder) noexcept;
+
 /// Writes bytes atomically (see write_atomically).
 void write_file_atomically(const std::filesystem::path& path, std::span<const unsigned char> bytes);
 /// Writes text atomically (see write_atomically).

@@ -23,7 +23,7 @@ std::optional<FileLock> FileLock::lock(const fs::path& path, bool wait) {
     FileLock out;
     out.path_ = path;
     out.fd_.reset(folder ? ::open(path.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC)
-                         : ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644));
+                         : ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666));  // the umask decides
     if (!out.fd_.valid())
       throw IoError(fmt::format("cannot open {}, the lock {}: {}; every user of that folder must be able to write it "
                                 "(check its permissions), or give a folder you can write",

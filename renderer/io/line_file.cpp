@@ -18,7 +18,7 @@ namespace sb::io {
 namespace fs = std::filesystem;
 
 LineFile::LineFile(fs::path partial) : path_(std::move(partial)) {
-  fd_.reset(::open(path_.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644));
+  fd_.reset(::open(path_.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0666));  // the umask decides
   if (!fd_.valid())
     throw IoError(fmt::format("cannot write {}: {}; give a folder you can write, or make room there", path_.string(),
                               std::strerror(errno)));
@@ -60,9 +60,7 @@ void LineFile::finish(const fs::path& final_path) {
     throw IoError(fmt::format("cannot rename {} to {}: {}", path_.string(), target.string(), ec.message()));
   finished_ = true;
   fd_.reset();  // the lock goes with the file's last descriptor
-  const fs::path folder = target.parent_path().empty() ? fs::path(".") : target.parent_path();
-  const UniqueFd dir(::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
-  if (dir.valid()) (void)::fsync(dir.get());  // the rename itself on disk; best effort
+  sync_folder(target.parent_path());  // the rename itself on disk; best effort
 }
 
 }  // namespace sb::io

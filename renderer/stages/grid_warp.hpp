@@ -30,7 +30,8 @@ inline constexpr int kGridCell = 16;
 /// pixel centres: the lattice columns x0(cx)..x1(cx) and rows y0(cy)..y1(cy), where x1 is the
 /// first column of the next cell, so neighbouring cells share their edges. Around the image the
 /// lattice has one more column and row on each side (-1 and W, -1 and H) that lie on the image's
-/// edges and carry the border pixels' depth, so that the mesh covers the whole source image and
+/// edges and carry the border pixels' depth (extrapolated half a pixel outwards where the border
+/// pixel and the next one inwards lie on one surface), so that the mesh covers the whole source image and
 /// no more — no pixel centre is lost on its outer boundary — and the half pixel at the border
 /// reads the border pixel, as a texture lookup clamped to the edge does. The depth range of a cell covers every pixel of its lattice
 /// span, i.e. every depth its triangles interpolate between.

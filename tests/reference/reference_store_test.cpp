@@ -415,7 +415,7 @@ TEST(ReferenceStore, SceneNamesGiveVisibleFoldersAndAMissingSceneDoesNotStopAnUp
       {".hidden", "_hidden_full_"},
       {"../../escaped", "_._.._escaped_full_"},
       {"sub/dir name", "sub_dir_name_full_"},
-      {std::string(300, 'n'), std::string(96, 'n') + "_full_"},
+      {std::string(300, 'n'), std::string(64, 'n') + "_full_"},
       {"", "named4_full_"},  // a scene without a name is named by its file
   };
   const std::string args = " --resolution 16x9 --threads 1";
