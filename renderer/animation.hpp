@@ -65,6 +65,8 @@ class SceneAnimator {
   [[nodiscard]] bool moves_geometry() const { return !turning_.empty(); }
   /// The meshes that move along the path (turning, or on animated nodes).
   [[nodiscard]] size_t turning_meshes() const { return turning_.size(); }
+  /// Their indices in the scene's meshes (ascending): the meshes whose BVH data a frame changes.
+  [[nodiscard]] const std::vector<size_t>& moving_mesh_indices() const { return turning_; }
   /// The lights that move along the path (on animated nodes).
   [[nodiscard]] size_t moving_lights() const { return lights_.size(); }
   /// What plays: the clip's label ("'walk'", "#2"), or "every clip" (empty without gltf_animation).

@@ -92,11 +92,11 @@ RenderScene::RenderScene(const Scene& scene, bool refittable)
   texture_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-double RenderScene::update_geometry() {
+double RenderScene::update_geometry(std::span<const size_t> moved) {
   // The offset follows the moved bounds, as a scene prepared at this frame has it: a frame's image
   // must not depend on which frame the worker prepared first.
   ray_epsilon_ = shadow_offset(checked_bounds(*scene_));
-  return rays_.update();
+  return rays_.update(moved);
 }
 
 }  // namespace sb

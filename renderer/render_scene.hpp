@@ -2,6 +2,7 @@
 // built once and shared by every pipeline and every repetition.
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include "renderer/embree/ray_scene.hpp"
@@ -31,12 +32,13 @@ class RenderScene {
   /// offset of shadow-ray origins.
   [[nodiscard]] float ray_epsilon() const { return ray_epsilon_; }
 
-  /// After the scene's vertex positions and normals changed in place (rigid animation: same
-  /// meshes and topology, see renderer/animation.hpp): updates the BVH (refit or rebuild) and sets
-  /// the ray offset from the moved bounds, as a scene prepared at the new positions has it; returns
-  /// the seconds taken. Materials, textures and lights are read from the scene as they are.
-  /// InputError when the moved geometry leaves the range a scene may span (kMaxSceneCoordinate).
-  double update_geometry();
+  /// After the vertex positions and normals of meshes `moved` changed in place (rigid animation:
+  /// same meshes and topology, see renderer/animation.hpp): updates their BVH data, refits or
+  /// rebuilds the BVH and sets the ray offset from the moved bounds, as a scene prepared at the
+  /// new positions has it; returns the seconds taken. Materials, textures and lights are read from
+  /// the scene as they are. InputError when the moved geometry leaves the range a scene may span
+  /// (kMaxSceneCoordinate).
+  double update_geometry(std::span<const size_t> moved);
 
  private:
   float ray_epsilon_;  ///< first: computed from the range-checked bounds before the BVH is built

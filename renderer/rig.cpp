@@ -92,7 +92,11 @@ CameraPose CameraPose::look_at(const dvec3& eye, const dvec3& target, const dvec
   dmat4 m(1.0);
   dvec3 back = glm::normalize(eye - target);
   dvec3 right = glm::cross(up, back);
-  if (glm::length(right) < 1e-12) right = glm::cross(dvec3(0, 0, 1), back);
+  // Looking along `up` (straight down or up): the right vector a view tilted there from the
+  // default one (looking down −z, right +x) keeps, +x made orthogonal to the view. (It was
+  // z × back, −x looking down: a path through the overhead point rolled 180° at that frame.)
+  if (glm::length(right) < 1e-12) right = dvec3(1, 0, 0) - back.x * back;
+  if (glm::length(right) < 1e-12) right = glm::cross(dvec3(0, 0, 1), back);  // `up` along x
   right = glm::normalize(right);
   m[0] = dvec4(right, 0.0);
   m[1] = dvec4(glm::cross(back, right), 0.0);

@@ -39,9 +39,17 @@ std::array<double, 4> sample(const NodeAnimation::Channel& ch, double t, int wid
   if (last || ch.interpolation == NodeAnimation::Interpolation::step) return out;
   if (ch.interpolation == NodeAnimation::Interpolation::linear) {
     if (ch.property == NodeAnimation::Property::rotation) {
-      const dquat a(key_value(ch, k, 4, 3), key_value(ch, k, 4, 0), key_value(ch, k, 4, 1), key_value(ch, k, 4, 2));
-      const dquat b(key_value(ch, k + 1, 4, 3), key_value(ch, k + 1, 4, 0), key_value(ch, k + 1, 4, 1),
-                    key_value(ch, k + 1, 4, 2));
+      // Keys made unit first: normalized integer keys (BYTE, SHORT) are unit only to their
+      // quantization, and glm's slerp of longer ones is neither the rotation between them nor at
+      // the right angle along the way.
+      const auto unit = [](const dquat& q) {
+        const double n = glm::length(q);
+        return n > 0.0 ? q / n : q;
+      };
+      const dquat a = unit(dquat(key_value(ch, k, 4, 3), key_value(ch, k, 4, 0), key_value(ch, k, 4, 1),
+                                 key_value(ch, k, 4, 2)));
+      const dquat b = unit(dquat(key_value(ch, k + 1, 4, 3), key_value(ch, k + 1, 4, 0), key_value(ch, k + 1, 4, 1),
+                                 key_value(ch, k + 1, 4, 2)));
       const dquat q = glm::slerp(a, glm::dot(a, b) < 0.0 ? -b : b, u);  // the shorter way round
       return {q.x, q.y, q.z, q.w};
     }

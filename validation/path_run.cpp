@@ -51,7 +51,9 @@ void run_path(Scene& scene, const PathRun& run, const Executor& executor,
     const double animate_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     // Frame 0's BVH is the one just built; later frames update it.
     const double bvh_s = frame == 0 ? prepared.bvh_build_seconds()
-                                    : (animator.moves_geometry() ? prepared.update_geometry() : 0.0);
+                                    : (animator.moves_geometry()
+                                           ? prepared.update_geometry(animator.moving_mesh_indices())
+                                           : 0.0);
     const CameraPose pose = animator.camera_at(frame, run.pose);
     const StereoRig rig(pose, run.rig);
     const ValidationTarget target =

@@ -202,7 +202,8 @@ class SceneCache {
       animator_->apply(*frame);
       const double animate_s = seconds_since(t0);
       if (animator_->moves_geometry())
-        update = FrameUpdate{animate_s, prepared_->update_geometry(), refit ? "refit" : "rebuild"};
+        update = FrameUpdate{animate_s, prepared_->update_geometry(animator_->moving_mesh_indices()),
+                             refit ? "refit" : "rebuild"};
       else
         update = FrameUpdate{animate_s, 0.0, "static"};
     }

@@ -49,9 +49,10 @@ class RayScene {
   /// Occlusion of up to 16 ray segments: blocked[i] = 1 when anything lies within [tnear, tfar].
   void occluded(std::span<const RayQuery> rays, std::span<uint8_t> blocked) const;
 
-  /// After the scene's vertex positions changed in place (same meshes, same topology): copies
-  /// them into the BVH's buffers and refits (refittable) or rebuilds it. Returns the seconds taken.
-  double update();
+  /// After the vertex positions of meshes `moved` changed in place (same meshes, same topology):
+  /// copies theirs into the BVH's buffers and refits (refittable) or rebuilds it; the other meshes'
+  /// data is left as it is. Returns the seconds taken.
+  double update(std::span<const size_t> moved);
 
   [[nodiscard]] double build_seconds() const { return build_seconds_; }
   /// Peak bytes Embree allocated for the scene (BVH and geometry buffers).

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <string>
 #include <vector>
@@ -26,6 +27,8 @@ namespace sb {
 
 /// No reprojection reached the pixel (or the source pixel saw nothing).
 inline constexpr int32_t kNoSource = -1;
+/// PixelReprojector::column of a miss (every other value, negative ones included, is a column).
+inline constexpr int32_t kMissColumn = std::numeric_limits<int32_t>::min();
 
 /// Whether a left pixel's linear depth is the background's (a miss), which is not reprojected.
 [[nodiscard]] inline bool is_miss(float depth) { return !(depth > 0.0f) || !std::isfinite(depth); }
@@ -42,15 +45,15 @@ class PixelReprojector {
   /// f·e·(1/c − 1/z) along the row, so the column is target_column(x, disparity) of the row warp.
   [[nodiscard]] int32_t target(int x, int y, float depth) const {
     const int32_t c = column(x, y, depth);
-    return c < width_ ? c : kNoSource;
+    return c >= 0 && c < width_ ? c : kNoSource;
   }
 
-  /// target() without the right edge: a column >= the width for a hit beyond it (Algorithm 1 takes
-  /// note of those); kNoSource for a miss or a column left of the image.
+  /// target() without the image's edges: a column >= the width for a hit beyond the right edge,
+  /// a negative one for a hit left of the image (Algorithm 1 takes note of both); kMissColumn for
+  /// a miss.
   [[nodiscard]] int32_t column(int x, int /*y*/, float depth) const {
-    if (is_miss(depth)) return kNoSource;
-    const int c = target_column(x, motion_(depth));
-    return c >= 0 ? c : kNoSource;
+    if (is_miss(depth)) return kMissColumn;
+    return target_column(x, motion_(depth));
   }
 
   [[nodiscard]] const EyeCamera& left() const { return left_; }

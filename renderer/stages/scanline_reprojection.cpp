@@ -1,6 +1,7 @@
 // Algorithm 1 of Al-Hagri's thesis (after Adelson and Hodges) for one band of scan-lines.
 #include "renderer/stages/scanline_reprojection.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <vector>
 
@@ -18,34 +19,41 @@ void reproject_row(const PixelReprojector& reprojector, const float* left_depth,
   source.assign(static_cast<size_t>(width), kNoSource);
   std::vector<uint8_t> bad(static_cast<size_t>(width), 0);
   int32_t old_r = -1;
+  bool landed = false;  // whether a reprojection came before in this row
   // Whether a background pixel came since the last reprojection.
   bool background_between = false;
   for (int x = 0; x < width; ++x) {
     const float depth = left_depth[static_cast<size_t>(y) * width + x];
     const int32_t r = reprojector.column(x, y, depth);
     background_between |= is_miss(depth);
-    if (r == kNoSource) continue;
+    if (r == kMissColumn) continue;
     if (r >= width) {
       // Algorithm 1's else branch: a hit beyond the right edge sets oldR to w − 1, so that a
       // farther surface landing inside again opens no gap over pixels already hit.
       old_r = width - 1;
+      landed = true;
       continue;
     }
     // A jump of more than one pixel after an earlier reprojection leaves a gap: its pixels are NoHit,
     // whatever reached them before. The thesis calls the gap bad when the two reprojections come
     // from horizontally adjacent pixels; across a background pixel (not reprojected here) they do
-    // not, and the gap's pixels count as missed.
-    if (old_r >= 0 && r - old_r > 1)
-      for (int32_t k = old_r + 1; k < r; ++k) {
+    // not, and the gap's pixels count as missed. A hit left of the image is a reprojection too
+    // (rep < w in Algorithm 1): it moves oldR, and the gap up to the next landing inside starts at
+    // column 0. Passing over it left a farther surface reprojected earlier where a nearer one,
+    // landing left of the image, opens a gap (spheres at 100 px of disparity: 287 such pixels).
+    if (landed && r - old_r > 1)
+      for (int32_t k = std::max(old_r + 1, 0); k < r; ++k) {
         source[static_cast<size_t>(k)] = kNoSource;
         if (!background_between) bad[static_cast<size_t>(k)] = 1;
       }
     background_between = false;
+    old_r = r;
+    landed = true;
+    if (r < 0) continue;
     // Later pixels (larger source x) overwrite: the nearer surface for a right eye to the right.
     if (source[static_cast<size_t>(r)] != kNoSource) ++counts.overlapped;
     source[static_cast<size_t>(r)] = x;
     bad[static_cast<size_t>(r)] = 0;
-    old_r = r;
   }
   for (int x = 0; x < width; ++x) {
     if (source[static_cast<size_t>(x)] != kNoSource) continue;

@@ -178,6 +178,30 @@ TEST(ThinPole, GapBesideThePoleIsRetracedNotSmeared) {
   }
 }
 
+TEST(ScanlineReprojection, AHitLeftOfTheImageOpensTheGapUpToTheNextLanding) {
+  // spheres at 400x400 and 100 px of disparity, right row 106: left pixels 7..18 (a sphere at
+  // 10.8 m) land on columns 29..39; left pixels 65..116 (a sphere at 3.5 m) land left of the
+  // image, and 117 lands on 135. Algorithm 1 moves oldR with every hit inside w, the ones left of
+  // the image too, so that landing opens the gap 0..134, and the farther sphere at 29..39 is
+  // traced again: the right eye sees the nearer sphere (4.8 m) there. Passing over the hits left
+  // of the image left the farther sphere in place (287 such pixels in this image).
+  const Scene scene = test::load_builtin("spheres");
+  const RenderScene prepared(scene);
+  const StereoRig rig = rig_with_disparity(scene, 400, 400, 100.0);
+  const StereoResult truth = test::render_with("plain-rt", prepared, rig);
+  const float* z_truth = truth.right.data_f32(planes::depth);
+  for (const std::string pipeline : {"rt-adelson", "rt-es-isler"}) {
+    const StereoResult r = test::render_with(pipeline, prepared, rig);
+    const float* z = r.right.data_f32(planes::depth);
+    size_t behind = 0;
+    for (int x = 29; x <= 39; ++x) {
+      const size_t i = 106 * 400 + static_cast<size_t>(x);
+      behind += z[i] > 1.02f * z_truth[i] ? 1 : 0;
+    }
+    EXPECT_EQ(behind, 0u) << pipeline << ": pixels of row 106 show a surface behind the one the right eye sees";
+  }
+}
+
 TEST(ScanlineCounts, ABadGapLiesBetweenReprojectionsOfAdjacentPixels) {
   // At a disparity of a thousandth of a pixel every surface pixel reprojects onto its own column:
   // no two adjacent pixels land apart, so nothing is a bad gap. The sky between spheres is not

@@ -183,5 +183,17 @@ TEST(Rig, ResolutionNamesAndErrors) {
     EXPECT_THROW((void)parse_resolution(bad), InputError) << bad;
 }
 
+TEST(Rig, LookingStraightDownKeepsTheRightVectorOfAViewTiltedThere) {
+  // A view tilted down from the default one (looking down -z, right +x) keeps right = +x up to
+  // the overhead point; there the fallback gave -x, rolling a path's image 180 degrees at that frame.
+  const CameraPose tilted = CameraPose::look_at(dvec3(0.0, 5.0, 0.0), dvec3(0.0, 0.0, -0.001));
+  const CameraPose overhead = CameraPose::look_at(dvec3(0.0, 5.0, 0.0), dvec3(0.0, 0.0, 0.0));
+  EXPECT_GT(tilted.right.x, 0.999);
+  EXPECT_GT(overhead.right.x, 0.999);
+  EXPECT_NEAR(glm::dot(overhead.up, tilted.up), 1.0, 1e-3);
+  // Straight up likewise.
+  EXPECT_GT(CameraPose::look_at(dvec3(0.0), dvec3(0.0, 5.0, 0.0)).right.x, 0.999);
+}
+
 }  // namespace
 }  // namespace sb
