@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cmath>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -175,13 +176,16 @@ struct MeasuredPeak {
   return static_cast<uint64_t>(std::max(estimate, base));
 }
 
+/// Whether a speed-up is above 1 as the tables print it (two decimals: 1.004 reads 1.00x).
+[[nodiscard]] inline bool speedup_above_one(double speedup) { return std::round(speedup * 100.0) > 100.0; }
+
 /// Index of the crossover row: the first row from which the method's speed-up over the baseline
 /// (the median of the ratios paired per repetition, the figure the table prints) is above 1 in
 /// that row and every later one (rows in increasing complexity); nullopt when there is none.
 [[nodiscard]] inline std::optional<size_t> crossover_row(const std::vector<double>& speedups) {
   std::optional<size_t> first;
   for (size_t i = speedups.size(); i-- > 0;) {
-    if (!(speedups[i] > 1.0)) break;
+    if (!speedup_above_one(speedups[i])) break;
     first = i;
   }
   return first;

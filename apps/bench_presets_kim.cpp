@@ -489,7 +489,7 @@ void run_kim_complexity(const PresetRun& run, const Executor& executor) {
     const std::optional<size_t> cross = crossover_row(bidir_speedups);
     std::vector<std::string> faster;
     for (size_t k = 0; k < measured_values.size(); ++k)
-      if (bidir_speedups[k] > 1.0) faster.push_back(measured_values[k]);
+      if (speedup_above_one(bidir_speedups[k])) faster.push_back(measured_values[k]);
     std::string range = measured_values.empty() ? std::string("no row measured")
                         : measured_values.size() == 1
                             ? measured_values.front()

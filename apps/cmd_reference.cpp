@@ -209,20 +209,24 @@ int run_update(const ReferenceArgs& a) {
                                    "scene and rig:\n  {}",
                                    unreadable.size(), fmt::join(unreadable, "\n  ")));
   if (!unrenderable.empty())
-    problems.push_back(fmt::format("{} reference(s) could not be rendered again from their spec; restore what the "
-                                   "message names (the scene file, the --scenes-dir), or remove the entry:\n  {}",
+    problems.push_back(fmt::format("{} reference(s) could not be rendered again from their spec; mend what each "
+                                   "reason names (a scene file gone, another --scenes-dir, an entry of another "
+                                   "scene or rig under that id), or remove the entry:\n  {}",
                                    unrenderable.size(), fmt::join(unrenderable, "\n  ")));
   if (!misnamed.empty())
     problems.push_back(fmt::format("{} folder(s) of the store are not named by the id their spec makes, so the "
                                    "rewritten reference lies under its own id and the folder is unchanged; remove "
                                    "each folder:\n  {}",
                                    misnamed.size(), fmt::join(misnamed, "\n  ")));
-  if (!problems.empty()) throw InputError(fmt::format("{}", fmt::join(problems, "\n")));
+  // Every kind is named in one message; a missing tool makes it exit 4, the others 3.
   if (!unchecked.empty())
-    throw ToolError(fmt::format("{} reference(s) could not be checked, so not updated, because their tool is "
-                                "missing; install it and run the update again:\n  {}",
-                                unchecked.size(), fmt::join(unchecked, "\n  ")));
-  return 0;
+    problems.push_back(fmt::format("{} reference(s) could not be checked, so not updated, because their tool is "
+                                   "missing; install it and run the update again:\n  {}",
+                                   unchecked.size(), fmt::join(unchecked, "\n  ")));
+  if (problems.empty()) return 0;
+  const std::string message = fmt::format("{}", fmt::join(problems, "\n"));
+  if (!unchecked.empty()) throw ToolError(message);
+  throw InputError(message);
 }
 
 void run_list(const ReferenceArgs& a) {

@@ -843,11 +843,18 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
         const std::optional<double> value = record_number(entry, mc.pointer, where + ": pipelines." + pipeline);
         check.measured = value ? *value : kNaN;
         if (!value || std::isnan(*value)) {
-          check.verdict = mc.may_be_missing ? Verdict::skip : Verdict::fail;
-          check.message =
-              fmt::format("no {} in the record ({} is {}){}", mc.label, mc.pointer, value ? "null" : "absent",
-                          mc.may_be_missing ? ""
-                                            : "; the record is damaged or of another version: run the cell again");
+          // Undefined for this image (its count of measured pixels is 0): nothing to check.
+          bool undefined = false;
+          if (value && mc.defined_by != nullptr) {
+            const json::json_pointer count(mc.defined_by);
+            undefined = entry.contains(count) && entry.at(count).is_number() && entry.at(count).get<double>() == 0.0;
+          }
+          check.verdict = mc.may_be_missing || undefined ? Verdict::skip : Verdict::fail;
+          check.message = fmt::format(
+              "no {} in the record ({} is {}){}", mc.label, mc.pointer, value ? "null" : "absent",
+              undefined ? fmt::format(": undefined for this image ({} is 0)", mc.defined_by)
+              : mc.may_be_missing ? ""
+                                  : "; the record is damaged or of another version: run the cell again");
           add(std::move(check));
           continue;
         }

@@ -48,12 +48,17 @@ struct MetricCheck {
   /// Such a check is skipped; any other check fails on a record without its number, which is
   /// damaged or of another version (a PSNR the gate cannot read must not pass).
   bool may_be_missing = false;
+  /// A JSON pointer into the pipeline entry, or null: a count that is 0 where the metric is
+  /// undefined for the image itself (SSIM of an image smaller than its 11x11 window). A null value
+  /// with that count 0 is skipped, not failed.
+  const char* defined_by = nullptr;
 };
 
 /// Every threshold check, in report order. The time regression is separate (RegressionSettings).
 inline constexpr MetricCheck kMetricChecks[] = {
     {"psnr", "min_psnr", "warn_psnr", Direction::at_least, "/validation/metrics/psnr", "PSNR"},
-    {"ssim", "min_ssim", "warn_ssim", Direction::at_least, "/validation/metrics/ssim", "SSIM", 1.0},
+    {"ssim", "min_ssim", "warn_ssim", Direction::at_least, "/validation/metrics/ssim", "SSIM", 1.0, nullptr, false,
+     "/validation/metrics/ssim_pixels"},
     {"error_fraction", "max_error_fraction", "warn_error_fraction", Direction::at_most,
      "/validation/metrics/error_fraction", "error-pixel fraction", 1.0},
     {"hole_fraction", "max_hole_fraction", "warn_hole_fraction", Direction::at_most, "/validation/holes/hole_fraction",
@@ -63,7 +68,7 @@ inline constexpr MetricCheck kMetricChecks[] = {
     {"left_psnr", "min_left_psnr", "warn_left_psnr", Direction::at_least, "/validation/left_eye/metrics/psnr",
      "left eye's PSNR", std::numeric_limits<double>::infinity(), "/validation/left_eye", true},
     {"left_ssim", "min_left_ssim", "warn_left_ssim", Direction::at_least, "/validation/left_eye/metrics/ssim",
-     "left eye's SSIM", 1.0, "/validation/left_eye", true},
+     "left eye's SSIM", 1.0, "/validation/left_eye", true, "/validation/left_eye/metrics/ssim_pixels"},
     {"speedup", "min_speedup", "warn_speedup", Direction::at_least, "/timing/speedup_median", "median speed-up",
      std::numeric_limits<double>::infinity(), nullptr, true},
     {"right_share", "max_right_share", "warn_right_share", Direction::at_most, "/timing/right_over_left_median",

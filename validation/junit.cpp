@@ -1,6 +1,7 @@
 // JUnit XML from a gate report.
 #include "validation/junit.hpp"
 
+#include <cstdint>
 #include <map>
 #include <vector>
 
@@ -8,17 +9,60 @@
 
 namespace sb::validation {
 
+namespace {
+
+/// The UTF-8 sequence at the start of `s` (its first byte >= 0x80): its length in bytes (1 for a
+/// byte that starts none), and whether it is well formed (shortest form) and encodes a character
+/// XML 1.0 allows.
+struct Utf8Char {
+  size_t length = 1;
+  bool ok = false;
+};
+Utf8Char utf8_xml_char(std::string_view s) {
+  const auto byte = [&](size_t k) { return static_cast<unsigned char>(s[k]); };
+  const unsigned char b0 = byte(0);
+  size_t n = 0;
+  uint32_t cp = 0;
+  if (b0 >= 0xC2 && b0 <= 0xDF) {
+    n = 2;
+    cp = b0 & 0x1Fu;
+  } else if (b0 >= 0xE0 && b0 <= 0xEF) {
+    n = 3;
+    cp = b0 & 0x0Fu;
+  } else if (b0 >= 0xF0 && b0 <= 0xF4) {
+    n = 4;
+    cp = b0 & 0x07u;
+  } else {
+    return {};  // a continuation byte, an overlong lead (C0, C1) or beyond U+10FFFF
+  }
+  if (s.size() < n) return {};
+  for (size_t k = 1; k < n; ++k) {
+    if ((byte(k) & 0xC0) != 0x80) return {};
+    cp = (cp << 6) | (byte(k) & 0x3Fu);
+  }
+  const uint32_t least[] = {0, 0, 0x80, 0x800, 0x10000};
+  const bool allowed = cp >= least[n] && cp <= 0x10FFFF && !(cp >= 0xD800 && cp <= 0xDFFF) && cp != 0xFFFE &&
+                       cp != 0xFFFF;
+  return {n, allowed};
+}
+
+}  // namespace
+
 std::string xml_escape(std::string_view text, bool attribute) {
   std::string out;
   out.reserve(text.size());
   for (size_t i = 0; i < text.size(); ++i) {
     const char ch = text[i];
     const auto c = static_cast<unsigned char>(ch);
-    // U+FFFE and U+FFFF (UTF-8 EF BF BE, EF BF BF) are no XML characters either.
-    if (c == 0xEF && i + 2 < text.size() && static_cast<unsigned char>(text[i + 1]) == 0xBF &&
-        (static_cast<unsigned char>(text[i + 2]) & 0xFE) == 0xBE) {
-      out += '?';
-      i += 2;
+    if (c >= 0x80) {
+      // A UTF-8 sequence is kept when it encodes an XML character; a broken or cut-off one, an
+      // encoded surrogate, and U+FFFE / U+FFFF become '?' (the file declares UTF-8).
+      const Utf8Char u = utf8_xml_char(text.substr(i));
+      if (u.ok)
+        out.append(text.substr(i, u.length));
+      else
+        out += '?';
+      i += u.length - 1;
       continue;
     }
     switch (ch) {

@@ -264,7 +264,7 @@ ResultsWriterLock::ResultsWriterLock(const fs::path& results, const std::vector<
   // Through links to the file itself, so that two spellings of one results file share the lock.
   const fs::path real = fs::weakly_canonical(fs::absolute(io::follow_links(results), ec), ec);
   const fs::path path = lock_path(ec ? results : real);
-  fd_.reset(::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644));
+  fd_.reset(::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666));  // the umask decides
   if (!fd_.valid())
     throw IoError(fmt::format("cannot open {}, the lock file of {}: {}; give --out (or --results) a folder you can "
                               "write",
@@ -293,7 +293,7 @@ namespace {
 io::UniqueFd open_for_append(const fs::path& file, const char* kind) {
   std::error_code ec;
   if (file.has_parent_path()) fs::create_directories(file.parent_path(), ec);
-  io::UniqueFd fd(::open(file.c_str(), O_RDWR | O_APPEND | O_CREAT | O_CLOEXEC, 0644));
+  io::UniqueFd fd(::open(file.c_str(), O_RDWR | O_APPEND | O_CREAT | O_CLOEXEC, 0666));  // the umask decides
   if (fd.get() < 0) io_fail(file, "open", kind);
   return fd;
 }

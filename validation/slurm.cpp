@@ -61,8 +61,9 @@ std::string directive_path(const fs::path& p, const std::string& what, const std
 
 /// An extra sbatch option (--sbatch-arg) as an #SBATCH directive's text, so that the script
 /// carries it and `sbatch sweep.sbatch` by hand submits the job as it was submitted. A value with
-/// blanks is written in double quotes (--comment="two words"); a double quote, a backslash or a
-/// control character cannot be carried, nor a blank outside a --name=value option's value.
+/// a blank, a single quote or a '#' (which sbatch's directive reader takes as a quote or a
+/// comment) is written in double quotes (--comment="two words"); a double quote, a backslash or a
+/// control character cannot be carried, nor those characters outside a --name=value option's value.
 std::string sbatch_directive(const std::string& arg) {
   if (arg.empty() || arg[0] != '-')
     throw InputError(fmt::format("--sbatch-arg '{}' is not an sbatch option (it must start with '-', e.g. "
@@ -72,12 +73,13 @@ std::string sbatch_directive(const std::string& arg) {
     throw InputError(fmt::format("--sbatch-arg '{}' holds a double quote, backslash or control character, which "
                                  "#SBATCH directives cannot carry",
                                  printable(arg)));
-  const size_t blank = arg.find_first_of(" \t");
-  if (blank == std::string::npos) return arg;
+  const size_t special = arg.find_first_of(" \t'#");
+  if (special == std::string::npos) return arg;
   const size_t equals = arg.find('=');
-  if (!arg.starts_with("--") || equals == std::string::npos || equals > blank)
-    throw InputError(fmt::format("--sbatch-arg '{}' holds a blank outside an option's value; give one option per "
-                                 "--sbatch-arg, as --name=value (e.g. --sbatch-arg=--mem=4G)",
+  if (!arg.starts_with("--") || equals == std::string::npos || equals > special)
+    throw InputError(fmt::format("--sbatch-arg '{}' holds a blank, a single quote or a '#' outside an option's "
+                                 "value; give one option per --sbatch-arg, as --name=value (e.g. "
+                                 "--sbatch-arg=--mem=4G)",
                                  arg));
   return arg.substr(0, equals + 1) + "\"" + arg.substr(equals + 1) + "\"";
 }

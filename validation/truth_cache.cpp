@@ -35,7 +35,7 @@ class WorkFolderLock {
     if (dir.empty() || provider == "full") return;  // the built-in renderer writes no files
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
-    fd_.reset(::open((dir / ".stereobench-render.lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644));
+    fd_.reset(::open((dir / ".stereobench-render.lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666));  // the umask decides
     if (!fd_.valid()) return;
     struct flock whole {};
     whole.l_type = F_WRLCK;

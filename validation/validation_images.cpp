@@ -122,9 +122,13 @@ json write_pipeline_images(const std::filesystem::path& dir, const std::string& 
     files["right_exr"] = path("right.exr").string();
     paths.push_back(path("right.exr"));
   }
-  // Diagnostic images an option asked for (repro-*'s grid=true, bidir-warp's partials=true), as
-  // render writes them: <stem>_<name>.png, recorded as <name>_png.
+  // Diagnostic images an option asked for (repro-*'s grid_overlay=true, bidir-warp's
+  // partials=true), as render writes them: <stem>_<name>.png, recorded as <name>_png.
   for (const auto& [name, image] : v.result.extras) {
+    for (const char* taken : {"right", "diff", "ssim", "holes", "left", "left_diff"})
+      if (name == taken)
+        throw InputError(fmt::format("{}: its diagnostic image '{}' takes the name of a validation image", v.pipeline,
+                                     name));
     const Path file = dir / fmt::format("{}_{}.png", stem, name);
     writers.push_back({file, [&image](const Path& to) { io::write_png_preview(to, image); }});
     files[name + "_png"] = file.string();

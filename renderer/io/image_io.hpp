@@ -91,8 +91,8 @@ void write_png_preview(const std::filesystem::path& path, const Image& image, st
 void write_png_rgb8(const std::filesystem::path& path, const std::vector<uint8_t>& rgb, int width, int height);
 
 /// Whether a PNG says what its codes mean: `srgb` writes the sRGB chunk (with its gAMA and cHRM
-/// fallbacks), for images meant to be looked at; `untagged` writes none (textures of generated
-/// scenes, whose bytes the scenes' hashes cover, and data such as masks).
+/// fallbacks), for images meant to be looked at (previews, difference and mask pictures);
+/// `untagged` writes none (the textures of generated scenes, whose bytes the scenes' hashes cover).
 enum class PngColour { untagged, srgb };
 
 /// Encodes 8-bit pixels (row-major, interleaved, 1-4 channels; with 2 or 4 channels the last is

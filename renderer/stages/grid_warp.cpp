@@ -138,7 +138,9 @@ class Reprojector {
     if (grid_.width >= 2 && i >= grid_.width) extend(grid_.width - 2, cj);
     if (grid_.height >= 2 && j < 0) extend(ci, 1);
     if (grid_.height >= 2 && j >= grid_.height) extend(ci, grid_.height - 2);
-    return out;
+    // Never nearer than the near plane, the nearest depth a pixel has (vertical_displacement_bound
+    // relies on it).
+    return std::min(out, 1.0 / from_.znear);
   }
 
   /// The warped vertex of source pixel centre (i, j).

@@ -34,7 +34,8 @@ inline constexpr int kGridCell = 16;
 /// pixel and the next one inwards lie on one surface), so that the mesh covers the whole source image and
 /// no more — no pixel centre is lost on its outer boundary — and the half pixel at the border
 /// reads the border pixel, as a texture lookup clamped to the edge does. The depth range of a cell covers every pixel of its lattice
-/// span, i.e. every depth its triangles interpolate between.
+/// span, i.e. every depth its triangles interpolate between (a ring vertex's extrapolated depth
+/// aside, which lies at most half a pixel's change of 1/z beyond its border pixel's).
 struct WarpGrid {
   int width = 0;
   int height = 0;

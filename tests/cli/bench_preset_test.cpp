@@ -429,7 +429,7 @@ TEST(BenchPresetKim, ComplexityFirstRowSplitsRenderingAndWarping) {
   EXPECT_EQ(groups.at("plain-raster").at("warping_ms").get<double>(), 0.0);  // 2-pass: no warp stage
   for (const char* p : {"bidir-warp", "bw-warp", "fw-warp"}) EXPECT_GT(groups.at(p).at("warping_ms").get<double>(), 0.0) << p;
   // The crossover follows the row's speed-up, as printed.
-  const bool faster = j.at("rows").at(0).at("speedup_median").at("bidir-warp").get<double>() > 1.0;
+  const bool faster = cli::speedup_above_one(j.at("rows").at(0).at("speedup_median").at("bidir-warp").get<double>());
   const json& cross = j.at("crossover");
   if (faster) {
     EXPECT_EQ(cross.at("value"), "1e5");
@@ -462,6 +462,7 @@ TEST(BenchPresetKim, CrossoverIsWhereTheMethodStaysFaster) {
   EXPECT_EQ(cli::crossover_row({1.1, 1.05, 1.2}), std::optional<size_t>(0));
   EXPECT_EQ(cli::crossover_row({1.1, 0.95, 1.2}), std::optional<size_t>(2));  // must stay faster
   EXPECT_EQ(cli::crossover_row({1.1, 1.05, 1.0}), std::nullopt);  // equal is not faster
+  EXPECT_EQ(cli::crossover_row({1.1, 1.004}), std::nullopt);  // nor is what the table prints as 1.00x
   EXPECT_EQ(cli::crossover_row({}), std::nullopt);
 }
 

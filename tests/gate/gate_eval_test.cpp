@@ -115,6 +115,15 @@ TEST(GateEval, AQualityMetricTheRecordLacksFailsAndAnUndefinedRecallIsSkipped) {
   ASSERT_NE(recall, nullptr);
   EXPECT_EQ(recall->verdict, Verdict::skip);
   EXPECT_EQ(r.worst, Verdict::fail);
+  // An SSIM undefined for the image itself (narrower than its 11x11 window: no pixel measured)
+  // is skipped, not blamed on the record.
+  cells[1]["pipelines"]["repro-rt"]["validation"]["metrics"]["ssim_pixels"] = 0;
+  const validation::GateReport undefined = evaluate(cells);
+  const validation::GateCheck* small = find_check(undefined, "repro-rt", "ssim", 1);
+  ASSERT_NE(small, nullptr);
+  EXPECT_EQ(small->verdict, Verdict::skip);
+  EXPECT_NE(small->message.find("undefined for this image (/validation/metrics/ssim_pixels is 0)"), std::string::npos)
+      << small->message;
 }
 
 TEST(GateEval, ThresholdAboveTheMeasuredValueFails) {
@@ -475,6 +484,18 @@ TEST(GateEval, BaselineUpdateTouchesOnlyWhatIsNamed) {
   EXPECT_NE(run.out.find("set repetitions = 5 or more in the [timing] table of the sweep's definition"),
             std::string::npos)
       << run.out;
+}
+
+TEST(GateJunit, TextBecomesXmlCharactersOnly) {
+  // The file declares UTF-8: characters pass, anything that is no XML character (a control
+  // character, U+FFFE, an encoded surrogate, a broken or cut-off sequence) becomes '?'.
+  EXPECT_EQ(validation::xml_escape("a<b>&\"'", true), "a&lt;b&gt;&amp;&quot;&apos;");
+  EXPECT_EQ(validation::xml_escape("\xC3\xA9 \xE2\x82\xAC \xF0\x9F\x98\x80", false), "\xC3\xA9 \xE2\x82\xAC \xF0\x9F\x98\x80");
+  for (const char* bad : {"\xEF\xBF\xBE", "\xEF\xBF\xBF", "\xED\xA0\x80", "\x01"})
+    EXPECT_EQ(validation::xml_escape(bad, false), "?") << bad;
+  EXPECT_EQ(validation::xml_escape("\xC0\xAF", false), "??");        // overlong '/'
+  EXPECT_EQ(validation::xml_escape("x\xE2\x82", false), "x??");      // cut off
+  EXPECT_EQ(validation::xml_escape("\x80y", false), "?y");            // a lone continuation byte
 }
 
 TEST(GateEval, BaselineUpdatesTakeTurns) {

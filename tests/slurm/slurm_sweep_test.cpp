@@ -202,13 +202,16 @@ TEST(SlurmScript, BadOptionsAreInputErrors) {
   o.partition.clear();
   // Extra sbatch options are directives after the script's own (which they override as on the
   // command line), a value with blanks in double quotes; what a directive cannot carry is refused.
-  o.sbatch_args = {"--mem=8G", "--hold", "-c4", "--comment=two words"};
+  o.sbatch_args = {"--mem=8G", "--hold", "-c4", "--comment=two words", "--job-name=it's", "--comment=run#2"};
   const std::string extra = validation::sbatch_script(d, o);
   const size_t chdir = extra.find("#SBATCH --chdir=");
-  const size_t mem = extra.find("#SBATCH --mem=8G\n#SBATCH --hold\n#SBATCH -c4\n#SBATCH --comment=\"two words\"\n");
+  const size_t mem = extra.find(
+      "#SBATCH --mem=8G\n#SBATCH --hold\n#SBATCH -c4\n#SBATCH --comment=\"two words\"\n#SBATCH --job-name=\"it's\"\n"
+      "#SBATCH --comment=\"run#2\"\n");
   EXPECT_NE(mem, std::string::npos) << extra;
   EXPECT_LT(chdir, mem) << extra;
-  for (const char* bad : {"mem=8G", "", "--comment=a\"b", "--comment=a\\b", "--comment=a\nb", "-c 4", "--mem 8G"}) {
+  for (const char* bad :
+       {"mem=8G", "", "--comment=a\"b", "--comment=a\\b", "--comment=a\nb", "-c 4", "--mem 8G", "-J#1", "--x'y=1"}) {
     o.sbatch_args = {bad};
     EXPECT_THROW((void)validation::sbatch_script(d, o), InputError) << bad;
   }
