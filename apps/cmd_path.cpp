@@ -91,6 +91,11 @@ void run_path_command(const PathArgs& a) {
                "warning: with 1 frame the camera stands at the first of the {} camera keys; give --frames {} or more "
                "to move through them\n",
                run.path.camera_keys.size(), run.path.camera_keys.size());
+  else if (a.frames > 1 && static_cast<size_t>(a.frames) < run.path.camera_keys.size())
+    fmt::print(stderr,
+               "warning: {} frames pass through fewer points than the {} camera keys: keys between frames are not "
+               "shown; give --frames {} or more to stand at every key\n",
+               a.frames, run.path.camera_keys.size(), run.path.camera_keys.size());
   const RigOverrides overrides = a.rig.overrides();
   run.pipelines =
       parse_pipeline_entries(expand_all_pipelines(split_list(a.pipelines, "--pipelines"), "--pipelines"), "--pipelines");

@@ -167,6 +167,12 @@ TEST(PathCommand, BadInput) {
   EXPECT_NE(one.out.find("warning: with 1 frame the camera stands at the first of the 2 camera keys"),
             std::string::npos)
       << one.out;
+  // Fewer frames than keys pass some keys by; said as well.
+  const test::CliRun two = test::run_cli(args(dir) + " --frames 2 --pipelines plain-rt --camera-keys "
+                                         "'0,1,6>0,0.5,0;1,1,6>0,0.5,0;2,1,6>0,0.5,0'");
+  EXPECT_EQ(two.code, 0) << two.out;
+  EXPECT_NE(two.out.find("warning: 2 frames pass through fewer points than the 3 camera keys"), std::string::npos)
+      << two.out;
   // Camera keys that swap position and target: the camera would stand on its target at frame 1.
   const test::CliRun cross = test::run_cli(args(dir) + " --frames 3 --camera-keys '0,1,4>0,1,3;0,1,3>0,1,4'");
   EXPECT_EQ(cross.code, 3) << cross.out;
