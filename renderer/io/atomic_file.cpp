@@ -394,14 +394,12 @@ void StagedFiles::commit() {
         if (const int signal = g_deferred_signal.exchange(0)) ::raise(signal);
     }
   } resume;
-  if (entries_.empty()) return;
   // The marker's earlier file goes before any file is replaced: a run that stops among the renames
   // (killed, or a rename refused) leaves a set without its marker, never new files beside an old
   // marker that lists them as one set.
-  const fs::path& marker = entries_.back().path;
   if (entries_.size() > 1) {
     try {
-      (void)remove_output_file(marker);
+      (void)remove_output_file(entries_.back().path);
     } catch (const IoError& e) {
       throw IoError(fmt::format("{}; no file of the set was replaced", e.what()));
     }
@@ -419,7 +417,7 @@ void StagedFiles::commit() {
     if (entries_.size() == 1) throw IoError(failed + "; any earlier file of that name is left as it was");
     throw IoError(fmt::format("{}; {} of the set's {} files are in place and the others not, and {} is removed so "
                               "that the set does not look complete: write it again",
-                              failed, k, entries_.size(), marker.string()));
+                              failed, k, entries_.size(), entries_.back().path.string()));
   }
   // The renames themselves on disk (each file was flushed before).
   std::vector<fs::path> folders;
