@@ -51,7 +51,12 @@ RigOverrides RigCli::overrides() const {
   if (convergence)
     o.convergence = positive(*convergence, "--convergence", "give the zero-parallax distance in meters, e.g. 2.0");
   if (resolution) {
-    const ivec2 r = parse_resolution(*resolution);
+    ivec2 r{0, 0};
+    try {
+      r = parse_resolution(*resolution);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("--resolution: {}", e.what()));
+    }
     o.width = r.x;
     o.height = r.y;
   }

@@ -275,7 +275,7 @@ void register_reference_command(CLI::App& root, const std::string& command_line)
 
   CLI::App* gen = ref->add_subcommand(
       "generate",
-      "Render a reference right eye and store it under an id of scene name, provider, size, interaxial (0.1 mm) and "
+      "Render a reference right eye and store it under an id of the scene file's name, provider, size, interaxial (0.1 mm) and "
       "convergence (3 digits), with the field of view and light count where they are not the scene's; an entry of "
       "that id made from the same scene and rig is replaced, one made from another is refused");
   add_common(gen);

@@ -71,6 +71,25 @@ void refuse_folder_as_file(CLI::App& app) {
   for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) refuse_folder_as_file(*sub);
 }
 
+/// Folder options: '-' stands for standard output elsewhere (--json -, sweep csv's --out), which
+/// cannot hold a folder; taken as a folder name it would make a folder named '-'. Refused, with the
+/// way to mean such a folder.
+void refuse_dash_folder(CLI::App& app) {
+  for (const char* name : {"--out", "--scenes-dir", "--store"}) {
+    CLI::Option* folder = app.get_option_no_throw(name);
+    // sweep csv's --out is the one file among them: '-' is standard output there.
+    if (!folder || (std::string(name) == "--out" && app.get_name() == "csv")) continue;
+    folder->check(CLI::Validator(
+        [](const std::string& value) {
+          return value == "-" ? std::string("names a folder, and '-' (standard output) cannot be one; give a folder "
+                                            "name (./- for a folder named '-')")
+                              : std::string();
+        },
+        "", "a folder"));
+  }
+  for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) refuse_dash_folder(*sub);
+}
+
 /// Numeric options take decimal numbers only. The parser would also read C's other forms
 /// (0x10 as 16, 0b11, 0o17, 010 as octal 8, digit separators), so a resolution or hash pasted
 /// into --vfov or --repetitions would run silently with another value. Leading zeros are dropped
@@ -165,6 +184,7 @@ int main(int argc, char** argv) {
   sb::cli::register_path_command(app);
   refuse_empty_values(app);
   refuse_folder_as_file(app);
+  refuse_dash_folder(app);
   refuse_non_decimal_numbers(app);
 
   try {

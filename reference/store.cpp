@@ -338,18 +338,24 @@ void make_working_folder(const fs::path& root, const std::string& id, const char
 }
 
 /// Clears up after a generate (or verify) that was killed (SIGKILL, a job's time limit): its working
-/// folders that no lock holds are removed, except an entry moved aside (".ID.old-…") whose id
+/// folders and id lock files (".ID.lock") that no lock holds are removed, except an entry moved aside (".ID.old-…") whose id
 /// names no entry any more, which is moved back. Best effort: errors leave folders where they are.
 void remove_stale_folders(const fs::path& root) {
   // A folder being made (".ID.mk-XXXXXX") is locked and renamed within microseconds; one a minute
   // old was left by a kill in between.
   static const std::regex being_made(R"(\..+\.mk-[A-Za-z0-9]{6})");
+  static const std::regex lock_name(R"(\..+\.lock)");
   const auto now = fs::file_time_type::clock::now();
   std::error_code ec;
   for (fs::directory_iterator it(root, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();
     std::smatch m;
     std::error_code dir_ec;
+    if (std::regex_match(name, lock_name) && it->is_regular_file(dir_ec)) {
+      // An id's lock file left by a generate killed while it held it; one held now stays.
+      if (std::optional<io::FileLock> left = io::FileLock::try_acquire(it->path())) left->remove_when_released();
+      continue;
+    }
     const bool made_here = std::regex_match(name, being_made);
     if ((!made_here && !std::regex_match(name, m, working_name())) || !it->is_directory(dir_ec)) continue;
     const io::UniqueFd fd(::open(it->path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
@@ -532,9 +538,9 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
   const Prepared p = prepare(stored, scenes_dir);
   const Scene& scene = p.loaded.scene;
   const std::string id = reference_id(scene, stored, *p.rig, p.loaded.lights_in_file);
-  // The id names the scene by its name alone and the rig rounded: another file (or a built-in) of
-  // that name, or a rig that differs by less than the id shows, would silently take the entry's
-  // place. Regenerating from the same scene and spec replaces it (also when the scene's camera has
+  // The id names the scene by its file's name alone and the rig rounded: another file (or a
+  // built-in) of that name, or a rig that differs by less than the id shows, would silently take
+  // the entry's place. Regenerating from the same scene and spec replaces it (also when the scene's camera has
   // changed since, as `reference update` does), as does an entry whose provenance cannot be read.
   // The check and the replacement are made under a lock on the id (".ID.lock" in the store, removed
   // when done), so that a generate of the same id running meanwhile is waited for, and then checked
@@ -561,9 +567,9 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
     }
     if (before && stored_scene(before->scene) != stored.scene)
       throw InputError(fmt::format(
-          "reference '{}' in {} was made from scene {}, not {} (the id names only the scene's name, '{}'); give this "
+          "reference '{}' in {} was made from scene {}, not {} (the id names only the scene file's name, '{}'); give this "
           "one another --store, or remove {} to replace it",
-          id, root_.string(), before->scene, stored.scene, scene.name, (root_ / id).string()));
+          id, root_.string(), before->scene, stored.scene, scene.file_stem(), (root_ / id).string()));
     const json rig_now = rig_record(*p.rig);
     if (before && well_formed_rig(before_rig) && !same_record(before_rig, rig_now) &&
         !same_record(spec_to_json(*before), spec_to_json(stored)))

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <filesystem>
 
 #include <fmt/format.h>
 
@@ -197,7 +198,7 @@ Bounds3 Scene::bounds() const {
 
 std::string Scene::file_stem() const {
   constexpr size_t kMaxStem = 64;
-  std::string stem = name.substr(0, kMaxStem);
+  std::string stem = (path.empty() ? name : std::filesystem::path(path).stem().string()).substr(0, kMaxStem);
   for (char& c : stem) {
     const bool kept = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' ||
                       c == '_' || c == '-' || c == '+';

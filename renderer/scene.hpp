@@ -205,10 +205,11 @@ struct Scene {
   [[nodiscard]] bool has_cutouts() const;
   [[nodiscard]] size_t vertex_count() const;
   [[nodiscard]] Bounds3 bounds() const;
-  /// The name as the start of output file names: characters other than ASCII letters, digits and
-  /// ._-+ become '_', a leading '.' too, at most 64 bytes, "scene" when nothing is left. A name is
-  /// the file's own text ("/tmp/x", "../up", a newline): outputs stay in the folder they are
-  /// written to.
+  /// The start of output file names and reference ids: the stem of the file the scene was loaded
+  /// from (`path`; `name` for a scene made in memory). Exporters give every scene one name (Blender's
+  /// "Scene"), so two files' outputs in one folder would replace each other under `name`. Characters
+  /// other than ASCII letters, digits and ._-+ become '_', a leading '.' too, at most 64 bytes,
+  /// "scene" when nothing is left: outputs stay in the folder they are written to.
   [[nodiscard]] std::string file_stem() const;
 };
 

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -76,9 +77,9 @@ TEST(Cli, BadArgumentsExitWith3AndSayWhy) {
       {"scenes info " + scene + " --convergence 0", "--convergence 0 is not a positive"},
       {"scenes info " + scene + " --convergence inf", "--convergence inf is not a positive"},
       {"scenes info " + scene + " --max-disparity -3", "--max-disparity -3 is not a positive"},
-      {"scenes info " + scene + " --resolution 0x100", "resolution 0x100 is out of range"},
-      {"scenes info " + scene + " --resolution 16385x100", "resolution 16385x100 is out of range"},
-      {"scenes info " + scene + " --resolution banana", "resolution 'banana' is not WIDTHxHEIGHT"},
+      {"scenes info " + scene + " --resolution 0x100", "--resolution: resolution 0x100 is out of range"},
+      {"scenes info " + scene + " --resolution 16385x100", "--resolution: resolution 16385x100 is out of range"},
+      {"scenes info " + scene + " --resolution banana", "--resolution: resolution 'banana' is not WIDTHxHEIGHT"},
       {"scenes info " + scene + " --vfov 180", "--vfov 180 is out of range"},
       {"scenes info " + scene + " --interaxial 0.06 --max-disparity 20", "excludes"},
       {"scenes info " + scene + " --interaxial abc", "--interaxial"},
@@ -405,68 +406,68 @@ TEST(Cli, RenderWritesTheStereoImagesAskedFor) {
   }
 }
 
-TEST(Cli, ASceneNameNeverLeadsOutputsOutOfTheOutputFolder) {
-  // The scene's name (glTF scenes[0].name) starts every output file name. A file may name its
-  // scene anything: a path out of the folder, a dot file, a newline.
+TEST(Cli, OutputsAreNamedByTheSceneFileAndStayInTheOutputFolder) {
+  // The scene file's stem starts every output file name, whatever the scene calls itself inside
+  // (glTF scenes[0].name: Blender names every scene "Scene", and a file may give a path out of the
+  // folder, a dot file, a newline). A file name's own characters are made safe too.
   test::ScratchDir dir("names");
   const std::string common = " --scenes-dir '" + (dir / "scenes").string() + "' --resolution 32x18";
   ASSERT_EQ(run("scenes generate box-wall --out '" + (dir / "scenes").string() + "'").code, 0);
   auto doc = nlohmann::json::parse(test::read_text(dir / "scenes" / "box-wall.gltf"));
-  const std::pair<const char*, const char*> cases[] = {
-      {"../escaped", "_._escaped"}, {"/tmp/abs", "_tmp_abs"}, {".hidden\nline", "_hidden_line"}, {"", "box-wall-copy"}};
-  for (const auto& [name, stem] : cases) {
-    doc["scenes"][0]["name"] = name;
-    { std::ofstream(dir / "box-wall-copy.gltf") << doc.dump(); }
-    const std::string out = (dir / "out").string();
-    std::filesystem::remove_all(dir / "out");
-    const std::string scene = " --scene '" + (dir / "box-wall-copy.gltf").string() + "' --out '" + out + "'";
+  struct Case { const char* file; const char* inner; const char* stem; };
+  const Case cases[] = {{"kitchen.gltf", "Scene", "kitchen"},
+                        {"office.gltf", "Scene", "office"},
+                        {"copy.gltf", "../escaped", "copy"},
+                        {"plain.gltf", "/tmp/abs", "plain"},
+                        {".hidden\nline.gltf", ".hidden", "_hidden_line"},
+                        {"two words.gltf", "", "two_words"}};
+  const std::string out = (dir / "out").string();
+  for (const Case& c : cases) {
+    doc["scenes"][0]["name"] = c.inner;
+    { std::ofstream(dir / c.file) << doc.dump(); }
+    const std::string scene = " --scene '" + (dir / c.file).string() + "' --out '" + out + "'";
     const CliRun r = run("render --pipeline plain-rt" + scene + common);
     ASSERT_EQ(r.code, 0) << r.out;
-    EXPECT_TRUE(std::filesystem::exists(dir / "out" / (std::string(stem) + "_plain-rt_stats.json"))) << name;
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / (std::string(c.stem) + "_plain-rt_stats.json"))) << c.file;
     const CliRun v = run("validate --pipelines ideal-copy" + scene + common);
     ASSERT_EQ(v.code, 0) << v.out;
-    EXPECT_TRUE(std::filesystem::exists(dir / "out" / (std::string(stem) + "_full_summary.json"))) << name;
-    // Everything written lies in the output folder itself.
-    size_t files = 0;
-    for (const auto& e : std::filesystem::recursive_directory_iterator(dir / "out")) {
-      EXPECT_EQ(e.path().parent_path(), dir / "out") << e.path();
-      ++files;
-    }
-    EXPECT_GT(files, 8u);
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / (std::string(c.stem) + "_full_summary.json"))) << c.file;
   }
+  // Every file's outputs are there side by side (two scenes both called "Scene" used to share
+  // names, the second run's replacing the first's), and nothing lies outside the output folder.
+  std::set<std::string> summaries;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(dir / "out")) {
+    EXPECT_EQ(e.path().parent_path(), dir / "out") << e.path();
+    if (e.path().string().ends_with("_full_summary.json")) summaries.insert(e.path().filename().string());
+  }
+  EXPECT_EQ(summaries.size(), std::size(cases));
   for (const auto& e : std::filesystem::directory_iterator(dir.path()))
     EXPECT_TRUE(e.path().filename() == "scenes" || e.path().filename() == "out" ||
-                e.path().filename() == "box-wall-copy.gltf")
+                e.path().extension() == ".gltf")
         << "written beside the output folder: " << e.path();
 
   // A scene file that is one of the render's outputs, by name or through a link, is not replaced
-  // by it (the stats JSON used to take its place); a name no output takes renders.
-  doc["scenes"][0]["name"] = "box-wall";
-  const std::filesystem::path out = dir / "out";
-  const std::filesystem::path own = out / "box-wall_plain-rt_stats.json";
+  // by it (the stats JSON used to take its place). A stem is cut at 64 bytes, so a file of a long
+  // name can be named as its own output; a name no output takes renders.
+  const std::filesystem::path own = dir / "out" / (std::string(64, 'n') + "_plain-rt_stats.json");
   { std::ofstream(own) << doc.dump(); }
-  std::filesystem::create_symlink("out/box-wall_plain-rt_stats.json", dir / "linked.gltf");
-  for (const std::filesystem::path& scene : {own, dir / "linked.gltf"}) {
-    const CliRun over =
-        run("render --pipeline plain-rt --scene '" + scene.string() + "' --out '" + out.string() + "'" + common);
+  std::filesystem::create_symlink(own, dir / (std::string(64, 'n') + "_plain-rt_stats.gltf"));
+  for (const std::filesystem::path& scene : {own, dir / (std::string(64, 'n') + "_plain-rt_stats.gltf")}) {
+    const CliRun over = run("render --pipeline plain-rt --scene '" + scene.string() + "' --out '" + out + "'" + common);
     EXPECT_EQ(over.code, 3) << over.out;
     EXPECT_NE(over.out.find("the scene file is this render's output"), std::string::npos) << over.out;
     EXPECT_EQ(nlohmann::json::parse(test::read_text(own)), doc);
   }
-  std::filesystem::remove(dir / "linked.gltf");
   // ... and an output name that is a link to the scene.
-  std::filesystem::rename(own, dir / "elsewhere.gltf");
-  std::filesystem::create_symlink("../elsewhere.gltf", own);
-  const CliRun through = run("render --pipeline plain-rt --scene '" + (dir / "elsewhere.gltf").string() + "' --out '" +
-                             out.string() + "'" + common);
+  const std::filesystem::path elsewhere = dir / "elsewhere.gltf";
+  { std::ofstream(elsewhere) << doc.dump(); }
+  std::filesystem::create_symlink("../elsewhere.gltf", dir / "out" / "elsewhere_plain-rt_stats.json");
+  const CliRun through =
+      run("render --pipeline plain-rt --scene '" + elsewhere.string() + "' --out '" + out + "'" + common);
   EXPECT_EQ(through.code, 3) << through.out;
-  EXPECT_EQ(nlohmann::json::parse(test::read_text(dir / "elsewhere.gltf")), doc);
-  std::filesystem::remove(own);
-  std::filesystem::rename(dir / "elsewhere.gltf", own);
-  std::filesystem::rename(own, out / "box-wall_plain-rt_v2.gltf");
-  EXPECT_EQ(run("render --pipeline plain-rt --scene '" + (out / "box-wall_plain-rt_v2.gltf").string() + "' --out '" +
-                out.string() + "'" + common)
-                .code,
+  EXPECT_EQ(nlohmann::json::parse(test::read_text(elsewhere)), doc);
+  std::filesystem::remove(dir / "out" / "elsewhere_plain-rt_stats.json");
+  EXPECT_EQ(run("render --pipeline plain-rt --scene '" + elsewhere.string() + "' --out '" + out + "'" + common).code,
             0);
 }
 
@@ -618,6 +619,9 @@ TEST(Cli, RenderAndBenchRejectBadArguments) {
       {"render --scene box-wall --pipeline plain-rt --scenes-dir '' --out '" + dir.path().string() + "'",
        "--scenes-dir: is empty; give a name"},
       {"bench --scene box-wall --pipelines plain-rt --json ''" + bench_common, "--json: is empty; give a name"},
+      // '-' is standard output for file options; as a folder it made one named '-'.
+      {"render --scene box-wall --pipeline plain-rt --resolution 32x18 --out -", "--out: names a folder, and '-'"},
+      {"reference list --store -", "--store: names a folder, and '-'"},
       // An empty clip or BVH mode was taken as not given: a static path, a refit BVH.
       {"path --scene box-wall --frames 1 --gltf-clip ''" + common, "--gltf-clip: is empty"},
       {"path --scene box-wall --frames 1 --spin-deg 1 --bvh ''" + common, "--bvh: is empty"},

@@ -406,37 +406,37 @@ TEST(ReferenceStore, AnEntryThatContradictsItsFolderIsCorrupt) {
   EXPECT_TRUE(fs::exists(store / pole / "provenance.json"));
 }
 
-TEST(ReferenceStore, SceneNamesGiveVisibleFoldersAndAMissingSceneDoesNotStopAnUpdate) {
-  // A scene's name from its file goes into the id as a folder name of the store itself: never a
-  // hidden folder (listed by nothing), a path, or a name too long for the file system.
+TEST(ReferenceStore, SceneFileNamesGiveVisibleFoldersAndAMissingSceneDoesNotStopAnUpdate) {
+  // The scene file's stem goes into the id as a folder name of the store itself: never a hidden
+  // folder (listed by nothing) or a name too long for the file system. The name inside the file
+  // plays no part: Blender names every scene "Scene", and two such files would share one id.
   test::ScratchDir dir;
   const json original = json::parse(test::read_text(scenes::resolve_scene("box-wall", kScenes)));
   const std::pair<std::string, std::string> names[] = {
       {".hidden", "_hidden_full_"},
-      {"../../escaped", "_._.._escaped_full_"},
-      {"sub/dir name", "sub_dir_name_full_"},
-      {std::string(300, 'n'), std::string(64, 'n') + "_full_"},
-      {"", "named4_full_"},  // a scene without a name is named by its file
+      {"two words", "two_words_full_"},
+      {std::string(200, 'n'), std::string(64, 'n') + "_full_"},
+      {"kitchen", "kitchen_full_"},
+      {"office", "office_full_"},
   };
   const std::string args = " --resolution 16x9 --threads 1";
-  for (size_t i = 0; i < std::size(names); ++i) {
+  for (const auto& [stem, start] : names) {
     json scene = original;
-    scene["scenes"][0]["name"] = names[i].first;
-    const fs::path file = dir / fmt::format("named{}.gltf", i);
+    scene["scenes"][0]["name"] = "Scene";
+    const fs::path file = dir / (stem + ".gltf");
     std::ofstream(file) << scene.dump();
     const test::CliRun r = test::run_cli(ref(dir, "generate") + " --scene " + quoted(file) + args);
-    EXPECT_EQ(r.code, 0) << names[i].first << ": " << r.out;
+    EXPECT_EQ(r.code, 0) << stem << ": " << r.out;
   }
   const ReferenceStore store(dir / "store");
   const std::vector<std::string> ids = store.ids();
   ASSERT_EQ(ids.size(), std::size(names)) << fmt::format("{}", fmt::join(ids, ", "));
-  for (const auto& [name, start] : names)
+  for (const auto& [stem, start] : names)
     EXPECT_TRUE(std::any_of(ids.begin(), ids.end(), [&](const std::string& id) { return id.starts_with(start); }))
         << start;
-  EXPECT_FALSE(fs::exists(dir / "escaped_full_16x9_e64.0mm_c4.08m"));
 
   // One entry's scene file gone: the others are still rewritten, and the run names that one.
-  fs::remove(dir / "named0.gltf");
+  fs::remove(dir / ".hidden.gltf");
   const test::CliRun update = test::run_cli(ref(dir, "update"));
   EXPECT_EQ(update.code, 3) << update.out;
   EXPECT_NE(update.out.find(fmt::format("{} reference(s) rewritten", std::size(names) - 1)), std::string::npos)
@@ -448,8 +448,9 @@ TEST(ReferenceStore, SceneNamesGiveVisibleFoldersAndAMissingSceneDoesNotStopAnUp
 
 TEST(ReferenceStore, AnotherSceneOfTheSameNameDoesNotReplaceAnEntry) {
   test::ScratchDir dir;
-  // A copy of box-wall as a file of its own: the same scene name, hence the same id.
-  const fs::path copy = dir / "bw.gltf";
+  // A copy of box-wall as a file of its own in another folder: the same file name, hence the same id.
+  fs::create_directories(dir / "mine");
+  const fs::path copy = dir / "mine" / "box-wall.gltf";
   fs::copy_file(scenes::resolve_scene("box-wall", kScenes), copy);
   const std::string args = " --resolution 32x18 --threads 1";
   ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene " + quoted(copy) + args).code, 0);
@@ -521,13 +522,20 @@ TEST(ReferenceStore, WorkingFoldersOfAKilledRunAreClearedUp) {
   const int held = ::open((store / ".b_full_32x18.new-77-xyzXYZ").c_str(), O_RDONLY | O_DIRECTORY);
   ASSERT_GE(held, 0);
   ASSERT_EQ(::flock(held, LOCK_EX | LOCK_NB), 0);
+  // An id's lock file left by a killed generate, and one a running generate holds.
+  std::ofstream(store / ".a_full_32x18.lock").flush();
+  std::ofstream(store / ".b_full_32x18.lock").flush();
+  const int held_lock = ::open((store / ".b_full_32x18.lock").c_str(), O_RDWR);
+  ASSERT_GE(held_lock, 0);
+  ASSERT_EQ(::flock(held_lock, LOCK_EX | LOCK_NB), 0);
   // Replacing an entry swaps it with the new one, and clears up first.
   ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene box-wall" + args).code, 0);
   ::close(held);
+  ::close(held_lock);
   std::vector<std::string> left;
   for (const auto& e : fs::directory_iterator(store)) left.push_back(e.path().filename().string());
   std::sort(left.begin(), left.end());
-  EXPECT_EQ(left, (std::vector<std::string>{".b_full_32x18.new-77-xyzXYZ", ".backup.old-2024", ".notes",
+  EXPECT_EQ(left, (std::vector<std::string>{".b_full_32x18.lock", ".b_full_32x18.new-77-xyzXYZ", ".backup.old-2024", ".notes",
                                             "box-wall_full_32x18_e64.0mm_c4.08m", pole}));
   const test::CliRun verify = test::run_cli(ref(dir, "verify"));
   EXPECT_EQ(verify.code, 0) << verify.out;
