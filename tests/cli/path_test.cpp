@@ -56,7 +56,7 @@ TEST(PathCommand, TheScenesGltfAnimationMovesItsMeshAndCamera) {
                        "(BVH refit)"),
             std::string::npos)
       << r.out;
-  const std::vector<json> frames = frame_lines(dir / "out" / "path-animation-test_path.jsonl");
+  const std::vector<json> frames = frame_lines(dir / "out" / "moving_path.jsonl");
   ASSERT_EQ(frames.size(), 3u);
   for (int f = 0; f < 3; ++f) {
     EXPECT_EQ(frames[f]["animation"]["gltf_animation"], true);
@@ -70,7 +70,7 @@ TEST(PathCommand, TheScenesGltfAnimationMovesItsMeshAndCamera) {
   // One clip by name, which implies --gltf-animation; the record names it.
   const test::CliRun clip = test::run_cli(base + " --gltf-clip animation --pipelines plain-rt");
   ASSERT_EQ(clip.code, 0) << clip.out;
-  EXPECT_EQ(frame_lines(dir / "out" / "path-animation-test_path.jsonl")[0]["animation"]["gltf_clip"], "animation");
+  EXPECT_EQ(frame_lines(dir / "out" / "moving_path.jsonl")[0]["animation"]["gltf_clip"], "animation");
   // The truth of the same frame without the animation differs: the box and camera did move.
   EXPECT_NE(frames[0]["true_disocclusion_fraction"], frames[2]["true_disocclusion_fraction"]);
   // With camera keys or a spin the path has two masters; the file has no clip 'walk'.
