@@ -21,12 +21,16 @@ using namespace sb::validation;
 void SweepSlurmCli::add_to(CLI::App& run) {
   options_.push_back(run.add_option("--shards", shards,
                                     "slurm: array tasks, each running the cells with cell_index % N == task\n"
-                                    "(default: one task per cell)")
-                         ->check(CLI::Range(1, 1000000))
+                                    "(default: one task per cell, at most Slurm's default MaxArraySize)")
+                         ->check(CLI::Range(size_t{1}, kMaxSlurmShards))
                          ->default_str(""));  // unset means one task per cell; 0 is not a value to give
   options_.push_back(run.add_option("--partition", partition, "slurm: partition to submit to (default: the cluster's)"));
   options_.push_back(run.add_option("--time-limit", time_limit,
                                     "slurm: time limit per task, HH:MM:SS (default: the partition's)"));
+  options_.push_back(run.add_option("--max-running", max_running,
+                                    "slurm: at most M array tasks running at once (the array's %M throttle)")
+                         ->check(CLI::Range(size_t{1}, kMaxSlurmShards))
+                         ->default_str(""));
   options_.push_back(run.add_option("--sbatch-arg", sbatch_args,
                                     "slurm: extra sbatch option, repeatable (e.g. --sbatch-arg=--mem=8G); written into the job script as an #SBATCH directive, so resubmitting the script by hand keeps it")
                          ->allow_extra_args(false));
@@ -52,11 +56,12 @@ void run_sweep_slurm(const SweepSlurmCli& s, const SweepSlurmRequest& r) {
   const fs::path out = fs::absolute(r.out.empty() ? fs::path("out") / "sweeps" / d.name : fs::path(r.out));
   const fs::path results = fs::absolute(r.results.empty() ? out / "results.jsonl" : fs::path(r.results));
   const SlurmLayout layout = slurm_layout(out);
-  // A results file written by the local executor would be replaced by the merge of the shards,
-  // which know nothing of its cells.
-  if (fs::exists(results) && !fs::exists(layout.submission))
-    throw InputError(fmt::format("{} exists and was not written by the slurm executor; merging the Slurm shards "
-                                 "would replace it: use another --out (or --results), or remove it",
+  // A results file written by the local executor (also after a submission: a sweep finished
+  // locally) would be replaced by the merge of the shards, which know nothing of its cells.
+  if (fs::exists(results) && !merged_from_shards(layout, results))
+    throw InputError(fmt::format("{} exists and is not the file the slurm executor merged there (the local executor "
+                                 "wrote it, or it changed since); merging the Slurm shards would replace it: use "
+                                 "another --out (or --results), or remove it",
                                  results.string()));
 
   SlurmSweepOptions o;
@@ -66,6 +71,7 @@ void run_sweep_slurm(const SweepSlurmCli& s, const SweepSlurmRequest& r) {
   o.partition = s.partition;
   o.time_limit = s.time_limit;
   o.sbatch_args = s.sbatch_args;
+  o.max_running = s.max_running;
   o.threads = r.threads;
   o.run_args = {"--jobs", std::to_string(r.jobs), "--cache", r.cache.empty() ? "" : fs::absolute(r.cache).string()};
   if (!r.scenes_dir.empty()) o.run_args.insert(o.run_args.end(), {"--scenes-dir", fs::absolute(r.scenes_dir).string()});

@@ -16,9 +16,10 @@ struct SweepSlurmCli {
   std::string partition;
   std::string time_limit;
   std::vector<std::string> sbatch_args;
+  size_t max_running = 0;  ///< 0: no throttle
   bool wait = false;
 
-  /// Adds --shards, --partition, --time-limit, --sbatch-arg and --wait to `run`.
+  /// Adds --shards, --partition, --time-limit, --max-running, --sbatch-arg and --wait to `run`.
   void add_to(CLI::App& run);
   /// InputError when one of these options was given with another executor.
   void check_unused(const std::string& executor) const;

@@ -11,6 +11,7 @@
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/gltf_loader.hpp"
+#include "renderer/text.hpp"
 #include "sb_scenes_hash.hpp"
 #include "sb_version.hpp"
 #include "scenes/generators.hpp"
@@ -96,7 +97,7 @@ std::string variant_file_name(const GeneratorInfo& info, uint64_t seed, const st
 }
 
 bool is_scene_file_spec(const std::string& spec) {
-  const std::string ext = fs::path(spec).extension().string();
+  const std::string ext = lowercase(fs::path(spec).extension().string());  // exporters also write .GLB
   return ext == ".gltf" || ext == ".glb" || spec.find('/') != std::string::npos;
 }
 

@@ -19,6 +19,7 @@
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/json_text.hpp"
 #include "renderer/text.hpp"
+#include "validation/content_hash.hpp"
 #include "validation/process.hpp"
 #include "validation/results_file.hpp"
 
@@ -73,6 +74,23 @@ std::string sbatch_directive(const std::string& arg) {
     throw InputError(fmt::format("--sbatch-arg '{}' holds a double quote, backslash or control character, which "
                                  "#SBATCH directives cannot carry",
                                  printable(arg)));
+  // The directives the executor writes itself: the merge reads task I's files for I < --shards,
+  // and a user's directive after them would take their place (sbatch also takes a long option by
+  // any unambiguous start, so a start of one is refused too).
+  static const std::pair<const char*, char> owned[] = {
+      {"array", 'a'}, {"ntasks", 'n'}, {"output", 'o'}, {"error", 'e'}, {"chdir", 'D'}};
+  const std::string long_name = arg.starts_with("--") ? arg.substr(2, arg.find('=') - 2) : std::string();
+  for (const auto& [name, letter] : owned) {
+    const bool same = arg.starts_with("--") ? long_name.size() >= 2 && std::string_view(name).starts_with(long_name)
+                                            : arg.size() >= 2 && arg[1] == letter;
+    if (same)
+      throw InputError(fmt::format(
+          "--sbatch-arg '{}' sets --{}, which the sweep's job script sets itself (the array has one task per shard, "
+          "with its own log files and working directory); {}",
+          printable(arg), name,
+          std::string_view(name) == "array" ? "to run fewer tasks at once, give --max-running M (the array's %M)"
+                                            : "leave it out"));
+  }
   const size_t special = arg.find_first_of(" \t'#");
   if (special == std::string::npos) return arg;
   const size_t equals = arg.find('=');
@@ -225,7 +243,10 @@ std::string sbatch_script(const SweepDefinition& d, const SlurmSweepOptions& o) 
   s += "# Written and submitted by `stereobench sweep run --executor slurm` (docs/slurm.md), which with\n";
   s += "# --wait merges the shards into the sweep's results file once every task has ended.\n";
   s += "#SBATCH --job-name=" + job_name + "\n";
-  s += fmt::format("#SBATCH --array=0-{}\n", o.shards - 1);
+  if (o.max_running > 0)
+    s += fmt::format("#SBATCH --array=0-{}%{}\n", o.shards - 1, o.max_running);
+  else
+    s += fmt::format("#SBATCH --array=0-{}\n", o.shards - 1);
   s += "#SBATCH --ntasks=1\n";
   s += "#SBATCH --output=" + output + "\n";
   s += "#SBATCH --error=" + error + "\n";
@@ -263,8 +284,9 @@ SlurmSweepOptions resolve_slurm_options(const SweepDefinition& d, SlurmSweepOpti
     throw InputError(fmt::format("--shards {} is more than the {} cells of sweep '{}'; use at most {}", o.shards,
                                  cell_count, d.name, cell_count));
   if (o.shards > kMaxSlurmShards)
-    throw InputError(fmt::format("--shards {} exceeds Slurm's default MaxArraySize ({} tasks); use fewer shards",
-                                 o.shards, kMaxSlurmShards + 1));
+    throw InputError(fmt::format("--shards {} is more than the {} tasks Slurm's default MaxArraySize ({}) allows "
+                                 "in one array; use at most {} shards",
+                                 o.shards, kMaxSlurmShards, kMaxSlurmShards, kMaxSlurmShards));
   (void)sbatch_script(d, o);  // refuses what the script cannot carry
   return o;
 }
@@ -454,7 +476,24 @@ size_t collect_slurm_results(const SweepDefinition& d, const SlurmSubmission& su
                                  d.name, list));
   }
   io::write_text_atomically(results, results_text(cells));
+  json record = io::parse_json(io::read_file(sub.layout.submission));
+  record["merged"] = {{"results", fs::absolute(results).lexically_normal().string()}, {"sha256", hash_file(results)}};
+  io::write_text_atomically(sub.layout.submission, record.dump(2) + "\n");
   return cells.size();
+}
+
+bool merged_from_shards(const SlurmLayout& layout, const fs::path& results) {
+  std::error_code ec;
+  if (!fs::exists(layout.submission, ec)) return false;
+  try {
+    const json record = io::parse_json(io::read_file(layout.submission));
+    const json merged = record.value("merged", json());
+    return merged.is_object() &&
+           merged.value("results", "") == fs::absolute(results).lexically_normal().string() &&
+           merged.value("sha256", "") == hash_file(results);
+  } catch (const std::exception&) {
+    return false;  // unreadable: nothing shows the file is a merge
+  }
 }
 
 }  // namespace sb::validation

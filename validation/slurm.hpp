@@ -38,14 +38,16 @@ struct SlurmSweepOptions {
   std::string partition;              ///< empty: the cluster's default partition
   std::string time_limit;             ///< per task, a Slurm time ("HH:MM:SS", "D-HH:MM", "MM"); empty: the partition's
   std::vector<std::string> sbatch_args;  ///< extra sbatch options, each one argument ("--mem=4G")
+  /// At most this many tasks running at once (the array's "%M" throttle); 0: as many as Slurm runs.
+  size_t max_running = 0;
   /// Options of `sweep run` every task gets after its shard options (--cache, --scenes-dir, --jobs).
   std::vector<std::string> run_args;
   /// Threads per cell in each task; 0: the CPUs Slurm allocated to the task.
   int threads = 0;
 };
 
-/// Slurm's default MaxArraySize is 1001 (task ids 0..1000).
-inline constexpr size_t kMaxSlurmShards = 1000;
+/// Slurm's default MaxArraySize is 1001: task ids 0..1000, 1001 tasks.
+inline constexpr size_t kMaxSlurmShards = 1001;
 
 /// Checks a Slurm time limit (MM, MM:SS, HH:MM:SS, D-HH, D-HH:MM, D-HH:MM:SS, or "infinite");
 /// InputError naming the value otherwise.
@@ -57,7 +59,8 @@ void check_slurm_time_limit(const std::string& value);
 /// with its stdout and stderr in <out_dir>/slurm/task-<I>.out/.err, and its exit code written to
 /// task-<I>.status when it ends. `shards` must be resolved (> 0). InputError for values sbatch
 /// directives cannot carry (paths with a double quote, a backslash, '%' or a control character;
-/// blanks go in double quotes), a bad partition or time.
+/// blanks go in double quotes), a bad partition or time, and for an extra sbatch option that sets
+/// what the executor relies on (the array, the task count, the log files, the working directory).
 [[nodiscard]] std::string sbatch_script(const SweepDefinition& definition, const SlurmSweepOptions& options);
 
 /// The options made complete and checked: paths absolute, the working directory set, `shards`
@@ -118,8 +121,14 @@ struct SlurmArrayProgress {
 
 /// Merges the tasks' results files into `results` (atomically), checking that together they hold
 /// every cell of the definition exactly once; the image paths of every line, relative to the folder
-/// of its shard file, are rewritten relative to the folder of `results`. Returns the number of
-/// cells. InputError naming the missing cells or conflicting duplicates.
+/// of its shard file, are rewritten relative to the folder of `results`. The submission record
+/// keeps the merged file's path and sha256 (merged_from_shards). Returns the number of cells.
+/// InputError naming the missing cells or conflicting duplicates.
+/// Whether `results` is, byte for byte, the file the last merge of the submission in `layout`
+/// wrote: a merge may replace only such a file, not one the local executor (or anything else)
+/// wrote there.
+[[nodiscard]] bool merged_from_shards(const SlurmLayout& layout, const std::filesystem::path& results);
+
 size_t collect_slurm_results(const SweepDefinition& definition, const SlurmSubmission& submission,
                              const std::filesystem::path& results, std::vector<std::string>* warnings = nullptr);
 

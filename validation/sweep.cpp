@@ -187,6 +187,12 @@ std::vector<const toml::node*> axis_entries(const Where& where, const toml::node
     if (a->empty())
       where.fail(node, path,
                  "is empty; give at least one value, or leave the key out for its default (docs/sweeps.md)");
+    // Refused before its entries are read and checked: such an axis alone makes too many cells.
+    if (a->size() > kMaxSweepCells)
+      where.fail(node, path,
+                 fmt::format("lists {} values, more than the {} cells a sweep may hold; split it into several "
+                             "definitions",
+                             a->size(), kMaxSweepCells));
     for (const toml::node& e : *a) out.push_back(&e);
   } else {
     out.push_back(&node);
@@ -206,13 +212,13 @@ double positive_at(const Where& where, const toml::node& node, const std::string
 std::vector<std::optional<double>> positive_axis(const Where& where, const toml::node& node, const std::string& path,
                                                  const char* hint, double largest) {
   std::vector<std::optional<double>> out;
+  std::set<double> seen;
   for (const toml::node* e : axis_entries(where, node, path)) {
     const double v = positive_at(where, *e, path, hint);
     if (v > largest)
       where.fail(*e, path, fmt::format("{} is beyond the largest value a rig takes, {:g}; {}", number_text(v), largest,
                                        hint));
-    for (const auto& seen : out)
-      if (*seen == v) where.fail(*e, path, fmt::format("lists {} twice", number_text(v)));
+    if (!seen.insert(v).second) where.fail(*e, path, fmt::format("lists {} twice", number_text(v)));
     out.push_back(v);
   }
   return out;
@@ -235,6 +241,8 @@ SweepScene parse_scene_entry(const Where& where, const toml::node& node, const s
   s.name = text;
   s.file = where.beside(text);
   std::error_code ec;
+  if (fs::is_directory(s.file, ec))
+    where.fail(node, path, fmt::format("scene file {} is a folder; give a .gltf/.glb file", s.file.string()));
   if (!fs::is_regular_file(s.file, ec))
     where.fail(node, path,
                fmt::format("scene file {} does not exist (paths are relative to the definition's folder); give an "
@@ -377,11 +385,6 @@ void parse_path(const Where& where, const toml::node& node, SweepDefinition& d) 
 }
 
 /// Two entries that generate the same built-in scene ("spheres" and "spheres:count=1000").
-bool same_builtin_scene(const SweepScene& a, const SweepScene& b) {
-  if (!a.builtin || !b.builtin || a.name != b.name) return false;
-  const scenes::GeneratorInfo& info = scenes::find_generator(a.name);
-  return scenes::resolve_params(info, a.params) == scenes::resolve_params(info, b.params);
-}
 
 }  // namespace
 
@@ -473,18 +476,27 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
   d.scenes = {parse_builtin_scene("spheres")};
   if (const toml::node* n = sweep.get("scenes")) {
     d.scenes.clear();
+    // What each scene seen is known by: its label, its file, its generator with every parameter
+    // resolved (looked up, not compared pair by pair: an axis may be long).
+    std::set<std::string> labels;
+    std::map<fs::path, std::string> files;
+    std::map<std::pair<std::string, std::map<std::string, double>>, std::string> generated;
     for (const toml::node* e : axis_entries(where, *n, "sweep.scenes")) {
       SweepScene s = parse_scene_entry(where, *e, "sweep.scenes");
-      for (const SweepScene& seen : d.scenes) {
-        if (seen.label == s.label) where.fail(*e, "sweep.scenes", fmt::format("lists '{}' twice", s.label));
-        if (!seen.builtin && !s.builtin && seen.file == s.file)
+      if (!labels.insert(s.label).second) where.fail(*e, "sweep.scenes", fmt::format("lists '{}' twice", s.label));
+      if (!s.builtin) {
+        const auto [it, fresh] = files.emplace(s.file, s.label);
+        if (!fresh)
           where.fail(*e, "sweep.scenes",
-                     fmt::format("lists one scene file twice: '{}' and '{}' are both {}", seen.label, s.label,
+                     fmt::format("lists one scene file twice: '{}' and '{}' are both {}", it->second, s.label,
                                  s.file.string()));
-        if (same_builtin_scene(seen, s))
+      } else {
+        const auto [it, fresh] = generated.emplace(
+            std::make_pair(s.name, scenes::resolve_params(scenes::find_generator(s.name), s.params)), s.label);
+        if (!fresh)
           where.fail(*e, "sweep.scenes",
                      fmt::format("lists one scene twice: '{}' and '{}' differ only by parameters at their defaults",
-                                 seen.label, s.label));
+                                 it->second, s.label));
       }
       d.scenes.push_back(std::move(s));
     }
@@ -540,6 +552,7 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
                                     "give zero-parallax distances in meters, e.g. 2.0", kMaxSceneCoordinate);
   if (const toml::node* n = sweep.get("resolutions")) {
     d.resolutions.clear();
+    std::set<std::string> seen;
     for (const toml::node* e : axis_entries(where, *n, "sweep.resolutions")) {
       const std::string given = string_at(where, *e, "sweep.resolutions");
       ivec2 size{0, 0};
@@ -549,20 +562,19 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
         where.fail(*e, "sweep.resolutions", err.what());
       }
       SweepResolution r{fmt::format("{}x{}", size.x, size.y), size.x, size.y};
-      for (const auto& seen : d.resolutions)
-        if (seen->label == r.label)
-          where.fail(*e, "sweep.resolutions", fmt::format("lists {} twice ('{}' is {})", r.label, given, r.label));
+      if (!seen.insert(r.label).second)
+        where.fail(*e, "sweep.resolutions", fmt::format("lists {} twice ('{}' is {})", r.label, given, r.label));
       d.resolutions.emplace_back(r);
     }
   }
   if (const toml::node* n = sweep.get("lights")) {
     d.lights.clear();
+    std::set<int64_t> seen;
     for (const toml::node* e : axis_entries(where, *n, "sweep.lights")) {
       const int64_t v = integer_at(where, *e, "sweep.lights");
       if (v < 1 || v > 100000)
         where.fail(*e, "sweep.lights", fmt::format("{} is outside 1..100000 (a count of the scene's lights)", v));
-      for (const auto& seen : d.lights)
-        if (*seen == v) where.fail(*e, "sweep.lights", fmt::format("lists {} twice", v));
+      if (!seen.insert(v).second) where.fail(*e, "sweep.lights", fmt::format("lists {} twice", v));
       d.lights.emplace_back(static_cast<int>(v));
     }
   }
@@ -605,6 +617,11 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
       std::vector<PipelineEntry> runs;  // the pipeline and its variants
       for (const std::string& entry : d.pipelines)
         if (entry_pipeline_name(entry) == pipeline) runs.push_back(parse_pipeline_entry(entry));
+      if (runs.empty() && pipeline != entry_pipeline_name(pipeline))
+        where.fail(key.source(), path,
+                   fmt::format("a table of options is named by a pipeline, not a variant: a variant's options are "
+                               "fixed in its entry ('{}'), and [options.{}] applies to {} and all its variants",
+                               pipeline, entry_pipeline_name(pipeline), entry_pipeline_name(pipeline)));
       if (runs.empty())
         where.fail(key.source(), path,
                    fmt::format("options for a pipeline the sweep does not run; its pipelines: {}",

@@ -75,7 +75,11 @@ int threads_per_cell(const SweepRunOptions& options) {
 
 std::vector<size_t> shard_cells(size_t cell_count, const Shard& shard) {
   std::vector<size_t> out;
-  for (size_t i = shard.index; i < cell_count; i += shard.count) out.push_back(i);
+  // Stops before a step past the end, which a count near SIZE_MAX would wrap round to cell 0.
+  for (size_t i = shard.index; i < cell_count; i += shard.count) {
+    out.push_back(i);
+    if (cell_count - i <= shard.count) break;
+  }
   return out;
 }
 
@@ -90,6 +94,12 @@ SweepPlan plan_sweep(const SweepDefinition& definition, const fs::path& results,
   if (!existing.cells.empty()) {
     const json& first = existing.cells.front();
     const std::string sweep = first["sweep"], sha = first.value("definition_sha256", "");
+    if (sweep != definition.name && sha == definition.sha256)
+      throw InputError(fmt::format(
+          "{} holds cells of sweep '{}', and this definition ({}) has the same content but is named '{}' (without "
+          "sweep.name a sweep is named by its file): resume with the definition under its first name, {}.toml, or "
+          "give another --out",
+          results.string(), sweep, definition.file.string(), definition.name, sweep));
     if (sweep != definition.name || sha != definition.sha256)
       throw InputError(fmt::format(
           "{} holds cells of sweep '{}' (definition sha256 {}), not of this definition '{}' ({}, sha256 {}); "
@@ -400,6 +410,12 @@ void check_out_folders(const SweepRunOptions& options) {
   if (fs::is_directory(options.results, ec))
     throw InputError(fmt::format("--results {} is a folder; give the results file (JSON Lines), e.g. {}",
                                  options.results.string(), (options.results / "results.jsonl").string()));
+  // A results file there already is appended to after the first cell: one it cannot write would
+  // be found only once that cell's work is done.
+  if (fs::exists(options.results, ec) && ::access(options.results.c_str(), W_OK) != 0)
+    throw IoError(fmt::format("cannot write the results file {}: {}; make it writable, or give another --out (or "
+                              "--results)",
+                              options.results.string(), std::strerror(errno)));
 }
 
 /// Claims the output folder for this definition before any cell runs: a folder made for another

@@ -215,7 +215,26 @@ TEST(SlurmScript, BadOptionsAreInputErrors) {
     o.sbatch_args = {bad};
     EXPECT_THROW((void)validation::sbatch_script(d, o), InputError) << bad;
   }
+  // What the script sets itself and the merge relies on: an array of one task per shard, with
+  // task I's logs in its files, in the working directory. sbatch takes a long option by any
+  // unambiguous start, and options of other names starting alike stay allowed.
+  for (const char* owned : {"--array=0-3", "--array=0-1%1", "-a0-3", "--arr=0-3", "--output=x.out", "-ox.out",
+                            "--out=x", "--error=x.err", "-ex", "--chdir=/tmp", "-D/tmp", "--ntasks=2", "-n2"}) {
+    o.sbatch_args = {owned};
+    try {
+      (void)validation::sbatch_script(d, o);
+      ADD_FAILURE() << owned << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("which the sweep's job script sets itself"), std::string::npos) << e.what();
+    }
+  }
+  o.sbatch_args = {"--ntasks-per-node=1", "--nodes=1", "-N1", "--exclusive", "-A", "--export=NONE"};
+  EXPECT_NO_THROW((void)validation::sbatch_script(d, o));
+  // A throttle is the executor's own option: the array's %M.
   o.sbatch_args.clear();
+  o.max_running = 1;
+  EXPECT_NE(validation::sbatch_script(d, o).find("#SBATCH --array=0-1%1\n"), std::string::npos);
+  o.max_running = 0;
   for (const char* ok : {"10", "10:30", "01:30:00", "2-12", "2-12:30", "2-12:30:00", "infinite"})
     EXPECT_NO_THROW(validation::check_slurm_time_limit(ok)) << ok;
   for (const char* bad : {"", "1h", "01:30:00:00", "-5", "1-", "abc", "1:99:99", "10:60", "2-24", "2-12:60"})
@@ -352,6 +371,18 @@ TEST_F(SlurmCluster, FailedTasksAreReportedAndResubmissionContinues) {
   EXPECT_FALSE(fs::exists(dir / "out" / "results.jsonl"));
   EXPECT_EQ(validation::read_results(sd / "results-0.jsonl").cells.size(), 1u);
 
+  // The sweep finished by the local executor into the same folder: its results file is not the
+  // merge's to replace (it was, once any submission had been made there).
+  const test::CliRun local = test::run_cli("sweep run " + quoted(dir / "two.toml") + " --out " + quoted(dir / "out") +
+                                           " --scenes-dir " + quoted(dir / "scenes") + " --cache ''");
+  ASSERT_EQ(local.code, 0) << local.out;
+  const std::string local_results = test::read_text(dir / "out" / "results.jsonl");
+  const test::CliRun over = test::run_cli(run);
+  EXPECT_EQ(over.code, 3) << over.out;
+  EXPECT_NE(over.out.find("is not the file the slurm executor merged there"), std::string::npos) << over.out;
+  EXPECT_EQ(test::read_text(dir / "out" / "results.jsonl"), local_results);
+  fs::remove(dir / "out" / "results.jsonl");
+
   // Fixed and submitted again: task 0 has nothing left, task 1 runs its cell, the merge is complete.
   fs::remove(sd / "results-1.jsonl");
   const std::string line0 = test::read_text(sd / "results-0.jsonl");
@@ -359,6 +390,11 @@ TEST_F(SlurmCluster, FailedTasksAreReportedAndResubmissionContinues) {
   ASSERT_EQ(again.code, 0) << again.out;
   EXPECT_EQ(test::read_text(sd / "results-0.jsonl"), line0);
   EXPECT_NE(test::read_text(sd / "task-0.out").find("1 finished already, 0 to run"), std::string::npos);
+  EXPECT_EQ(validation::read_results(dir / "out" / "results.jsonl").cells.size(), 2u);
+  // The file its own merge wrote is the merge's to write again.
+  const std::string merged = test::read_text(dir / "out" / "results.jsonl");
+  const test::CliRun remerge = test::run_cli(run);
+  ASSERT_EQ(remerge.code, 0) << remerge.out;
   EXPECT_EQ(validation::read_results(dir / "out" / "results.jsonl").cells.size(), 2u);
 
   // A different sharding of the same folder is refused (its cells would be run twice).

@@ -144,6 +144,15 @@ TEST(SweepDefinition, OptionValuesAreCheckedBeforeAnyCellRuns) {
   EXPECT_NE(choice.find("def.toml:4: options.fw-warp.warp"), std::string::npos) << choice;
   const std::string depth = error_of("[sweep]\npipelines = [\"rt-buffer\"]\n[options.rt-buffer]\ndepth = 5000\n");
   EXPECT_NE(depth.find("depth=5000 is out of range"), std::string::npos) << depth;
+  // A table named by a variant (it was called options for a pipeline the sweep does not run, and
+  // the variant listed among the pipelines it runs).
+  const std::string variant =
+      error_of("[sweep]\npipelines = [\"fw-warp:warp=rows\"]\n[options.\"fw-warp:warp=rows\"]\nmax_crack = 1\n");
+  EXPECT_NE(variant.find("def.toml:3: options.fw-warp:warp=rows: a table of options is named by a pipeline, not a "
+                         "variant"),
+            std::string::npos)
+      << variant;
+  EXPECT_NE(variant.find("[options.fw-warp] applies to fw-warp and all its variants"), std::string::npos) << variant;
 }
 
 TEST(SweepDefinition, VariantsRunBesideTheirPipeline) {
@@ -214,6 +223,7 @@ TEST(SweepDefinition, BadValuesRejected) {
       {"[sweep]\nlights = [1000000]\n", "sweep.lights: 1000000 is outside 1..100000"},
       {"[sweep]\nresolutions = [\"huge\"]\n", "sweep.resolutions"},
       {"[sweep]\nresolutions = [\"hd\", \"1920x1080\"]\n", "lists 1920x1080 twice"},
+      {"[sweep]\nlights = [1, 2, 1]\n", "sweep.lights: lists 1 twice"},
       {"[sweep]\nscenes = [\"nowhere\"]\n", "unknown"},
       {"[sweep]\nscenes = [\"complexity:triangles=5\"]\n", "outside"},
       {"[sweep]\nscenes = [\"complexity:size=5\"]\n", "has no parameter 'size'"},
@@ -270,6 +280,21 @@ TEST(SweepDefinition, GltfScenesResolveAgainstTheDefinitionsFolder) {
   const SweepDefinition r = parse_sweep("[sweep]\nscenes = [\"../defs/scenes/a.gltf\"]\n", relative);
   ASSERT_EQ(r.scenes.size(), 1u);
   EXPECT_EQ(r.scenes[0].file, fs::absolute(dir / "defs" / "scenes" / "a.gltf").lexically_normal());
+  // An upper-case extension is a scene file too (it was taken for a generator's name), and a
+  // folder is not one.
+  { std::ofstream(dir / "defs" / "scenes" / "UP.GLB") << "glTF"; }
+  const SweepDefinition upper = parse_sweep("[sweep]\nscenes = [\"UP.GLB\"]\n", dir / "defs" / "scenes" / "x.toml");
+  ASSERT_EQ(upper.scenes.size(), 1u);
+  EXPECT_FALSE(upper.scenes[0].builtin);
+  EXPECT_EQ(upper.scenes[0].file, dir / "defs" / "scenes" / "UP.GLB");
+  fs::create_directories(dir / "defs" / "folder.gltf");
+  try {
+    (void)parse_sweep("[sweep]\nscenes = [\"folder.gltf\"]\n", dir / "defs" / "x.toml");
+    ADD_FAILURE() << "a folder was taken as a scene file";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("folder.gltf is a folder; give a .gltf/.glb file"), std::string::npos)
+        << e.what();
+  }
   // One file under two spellings is one scene listed twice.
   try {
     (void)parse_sweep("[sweep]\nscenes = [\"scenes/a.gltf\", \"./scenes/../scenes/a.gltf\"]\n", dir / "defs" / "x.toml");

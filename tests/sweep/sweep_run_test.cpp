@@ -21,6 +21,7 @@
 #include "support/run_cli.hpp"
 #include "support/scratch_dir.hpp"
 #include "validation/results_file.hpp"
+#include "validation/sweep_run.hpp"
 
 extern char** environ;
 
@@ -550,6 +551,12 @@ TEST(SweepRun, BadDefinitionAndShardAreUsageErrors) {
   std::ofstream(dir / "ok.toml") << kTinySweep;
   const test::CliRun shard = test::run_cli("sweep run " + quoted(dir / "ok.toml") + " --shard 2/2 --out " + quoted(dir / "o"));
   EXPECT_EQ(shard.code, 3) << shard.out;
+  // A shard count near SIZE_MAX: the step past the last cell wrapped round to cell 0, another
+  // shard's.
+  EXPECT_EQ(validation::shard_cells(6, validation::parse_shard("1/18446744073709551615")), std::vector<size_t>{1});
+  EXPECT_EQ(validation::shard_cells(6, validation::parse_shard("5/18446744073709551615")), std::vector<size_t>{5});
+  EXPECT_EQ(validation::shard_cells(7, validation::parse_shard("2/3")), (std::vector<size_t>{2, 5}));
+  EXPECT_EQ(validation::shard_cells(6, validation::parse_shard("0/1")), (std::vector<size_t>{0, 1, 2, 3, 4, 5}));
   // An output folder that cannot be one fails before any cell runs.
   std::ofstream(dir / "afile") << "x";
   const test::CliRun unusable =
@@ -569,6 +576,19 @@ TEST(SweepRun, BadDefinitionAndShardAreUsageErrors) {
   EXPECT_NE(same.out.find("--results " + (dir / "both").string() + " is a folder"), std::string::npos) << same.out;
   EXPECT_EQ(same.out.find("[1/6]"), std::string::npos) << "no cell may run: " << same.out;
   EXPECT_FALSE(fs::exists(dir / "both" / "cells"));
+  // The same definition under another file name is another sweep (the name is the file's): the
+  // message says so, rather than that the definition changed.
+  std::string nameless = kTinySweep;
+  nameless.erase(nameless.find("name = "), std::string("name = \"tiny\"\n").size());
+  std::ofstream(dir / "nameless.toml") << nameless;
+  const test::CliRun first = test::run_cli("sweep run " + quoted(dir / "nameless.toml") + " --shard 0/6 --out " +
+                                           quoted(dir / "named") + " --scenes-dir " + quoted(dir / "scenes"));
+  ASSERT_EQ(first.code, 0) << first.out;
+  fs::copy_file(dir / "nameless.toml", dir / "renamed.toml");
+  const test::CliRun renamed = test::run_cli("sweep run " + quoted(dir / "renamed.toml") + " --out " +
+                                             quoted(dir / "named") + " --scenes-dir " + quoted(dir / "scenes"));
+  EXPECT_EQ(renamed.code, 3) << renamed.out;
+  EXPECT_NE(renamed.out.find("has the same content but is named 'renamed'"), std::string::npos) << renamed.out;
   // A damaged marker (valid JSON, not an object) names no definition: refused as another's, not
   // an internal error.
   fs::create_directories(dir / "marked");
