@@ -2,7 +2,9 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
+#include <optional>
 #include <map>
 #include <string>
 #include <vector>
@@ -13,7 +15,9 @@
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
 #include "renderer/io/gltf_loader.hpp"
+#include "renderer/render_scene.hpp"
 #include "renderer/rig.hpp"
+#include "renderer/stages/primary_rays.hpp"
 #include "renderer/text.hpp"
 #include "scenes/catalog.hpp"
 #include "scenes/generators.hpp"
@@ -65,7 +69,8 @@ void generate_scenes(const GenerateArgs& args) {
   opt.params = parse_params(args.params);
   if (!opt.params.empty() && names.size() != 1)
     throw InputError("--param applies to one scene; generate the scenes one at a time");
-  for (const std::string& n : names) (void)scenes::find_generator(n);  // fail before writing anything
+  // Names and parameters are checked before anything is written (the folder included).
+  for (const std::string& n : names) (void)scenes::resolve_params(scenes::find_generator(n), opt.params);
   prepare_output_folder(args.out_dir, "--out");
   fmt::print("{:<15} {:>12} {:>10} {:>7} {:>12} {:>9}  {}\n", "scene", "triangles", "vertices", "lights", "bytes",
              "seconds", "file");
@@ -88,12 +93,53 @@ struct InfoArgs {
   RigCli rig;
 };
 
+/// The linear depths the centre camera sees, from primary rays through the centres of every
+/// `step`-th pixel in each direction (at most some 320 x 180 rays).
+struct DepthRange {
+  double nearest = 0.0, farthest = 0.0;
+  size_t hits = 0, rays = 0;
+  int step = 1;
+};
+
+DepthRange visible_depth_range(const Scene& scene, const StereoRig& rig) {
+  const RenderScene prepared(scene);
+  const EyeCamera centre = rig.eye(Eye::center);
+  const PrimaryRays primary(centre);
+  DepthRange r;
+  r.step = std::max(1, static_cast<int>(std::ceil(std::max(centre.width / 320.0, centre.height / 180.0))));
+  r.nearest = std::numeric_limits<double>::infinity();
+  std::vector<RayQuery> queries;
+  const auto flush = [&] {
+    std::vector<RayHit> hits(queries.size());
+    prepared.rays().intersect(queries, hits, (1u << queries.size()) - 1u);
+    for (size_t i = 0; i < queries.size(); ++i) {
+      ++r.rays;
+      if (hits[i].prim == kNoPrimitiveId) continue;
+      const double z = static_cast<double>(hits[i].t) * cos_to_axis(centre, queries[i].dir);
+      r.nearest = std::min(r.nearest, z);
+      r.farthest = std::max(r.farthest, z);
+      ++r.hits;
+    }
+    queries.clear();
+  };
+  for (int y = r.step / 2; y < centre.height; y += r.step)
+    for (int x = r.step / 2; x < centre.width; x += r.step) {
+      queries.push_back(primary(x, y));
+      if (queries.size() == static_cast<size_t>(kRayPacket)) flush();
+    }
+  if (!queries.empty()) flush();
+  return r;
+}
+
 void print_info(const InfoArgs& args) {
   const RigOverrides overrides = args.rig.overrides();  // check options before any work
   for (const std::string& spec : args.scenes) {
-    const fs::path path = scenes::resolve_scene(spec, args.scenes_dir);
     const auto t0 = std::chrono::steady_clock::now();
-    const Scene scene = io::load_gltf(path);
+    // As every command loads it: a damaged cached built-in scene is named with how to recover,
+    // and the loader's warnings go to stderr.
+    const scenes::LoadedScene loaded = scenes::load_scene(spec, args.scenes_dir, std::nullopt);
+    const Scene& scene = loaded.scene;
+    const fs::path& path = loaded.file;
     const double load_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const Bounds3 b = scene.bounds();
     size_t lights_by_type[3] = {0, 0, 0};
@@ -112,21 +158,16 @@ void print_info(const InfoArgs& args) {
     fmt::print("cameras    {}\n", scene.cameras.empty() ? std::string("none (rig frames the bounds)") : scene.cameras.front().name);
     const StereoRig rig = resolve_rig(scene, overrides);
     fmt::print("rig        {}\n", describe(rig));
-    // Disparity range over the vertices the centre camera sees.
-    const EyeCamera centre = rig.eye(Eye::center);
-    double zmin = 1e300, zmax = 0.0;
-    for (const Mesh& m : scene.meshes)
-      for (const vec3& p : m.positions) {
-        const dvec3 q = centre.project(dvec3(p));
-        if (q.z < rig.params().znear || q.x < 0.0 || q.y < 0.0 || q.x > centre.width || q.y > centre.height) continue;
-        zmin = std::min(zmin, q.z);
-        zmax = std::max(zmax, q.z);
-      }
-    if (zmax > 0.0)
-      fmt::print("disparity  {:.2f} px at the nearest visible vertex ({:.3f} m) .. {:.2f} px at the farthest ({:.3f} m)\n",
-                 rig.disparity_px(zmin), zmin, rig.disparity_px(zmax), zmax);
+    const DepthRange range = visible_depth_range(scene, rig);
+    if (range.hits > 0)
+      fmt::print("disparity  {:.2f} px at the nearest visible surface ({:.3f} m) .. {:.2f} px at the farthest "
+                 "({:.3f} m), over {} of {} rays (every {} px){}\n",
+                 rig.disparity_px(range.nearest), range.nearest, rig.disparity_px(range.farthest), range.farthest,
+                 range.hits, range.rays, range.step, range.hits < range.rays ? "; the rest see the sky" : "");
+    else
+      fmt::print("disparity  none: the centre camera sees no surface (no ray through every {} px hits one)\n",
+                 range.step);
     fmt::print("loaded in  {:.3f} s\n", load_s);
-    for (const std::string& w : scene.warnings) fmt::print("warning    {}\n", w);
     fmt::print("\n");
   }
 }

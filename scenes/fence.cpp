@@ -7,6 +7,7 @@
 #include <cmath>
 #include <string>
 
+#include "scenes/procedural.hpp"
 #include "scenes/scene_generator.hpp"
 #include "scenes/textures.hpp"
 
@@ -36,7 +37,10 @@ TextureImage chain_link_texture(int size, float wire) {
 void build(const GeneratorContext& ctx, GltfBuilder& b) {
   const float diamond = static_cast<float>(ctx.param("mesh_cm")) / 100.0f;
   const float wire = static_cast<float>(ctx.param("wire"));
-  const auto seed = static_cast<uint32_t>(ctx.seed);
+  // The textures take 32-bit seeds: one drawn from the whole 64-bit seed (a cast kept its low half,
+  // so seeds 2 and 2 + 2^32 gave one scene).
+  Rng rng(ctx.seed, 51);
+  const auto seed = static_cast<uint32_t>(rng.next());
   const float half_pi = 0.5f * static_cast<float>(kPi);
 
   const int tiles = b.add_material(

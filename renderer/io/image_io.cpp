@@ -935,7 +935,9 @@ Image read_exr(const fs::path& path) {
     std::vector<const InChannel*> unassigned;
     for (const InChannel& ch : file.channels)
       if (ch.eye == EyeTag::none) unassigned.push_back(&ch);
-    if (unassigned.empty() && !file.channels.empty())
+    // Channels of an eye beside unnamed ones are OpenEXR multi-view (the default view unnamed):
+    // a pair too, whose unnamed channels are one eye, not the whole image.
+    if (unassigned.size() < file.channels.size())
       throw InputError(fmt::format("{} holds a stereo pair (channels: {}); read it with read_exr_stereo", path.string(),
                                    channel_list(file)));
     if (unassigned.empty()) throw InputError(fmt::format("{} has no channels; {}", path.string(), kCorruptHint));

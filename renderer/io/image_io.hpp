@@ -64,7 +64,8 @@ void write_exr(const std::filesystem::path& path, const Image& image, const Imag
 
 /// Reads a single-image EXR (or any file OpenImageIO reads as float) with the channel mapping of
 /// read_exr_stereo: a plain R,G,B(,A) file gives "rgb" (and "alpha"), "Z" gives "depth".
-/// InputError if the file is missing, unreadable, or holds a stereo pair (use read_exr_stereo).
+/// InputError if the file is missing, unreadable, or holds a stereo pair (use read_exr_stereo): any
+/// channel tagged with an eye, also beside unnamed ones (OpenEXR multi-view's default view).
 [[nodiscard]] Image read_exr(const std::filesystem::path& path);
 
 /// The string attributes of an image file's header (first part), except OpenImageIO's internal

@@ -107,8 +107,8 @@ TEST(Cli, BadArgumentsExitWith3AndSayWhy) {
        "out: " + dir.path().string() + " is a folder; give the name of the file to write"},
       {"gate --results a.jsonl --junit '" + dir.path().string() + "'",
        "--junit: " + dir.path().string() + " is a folder"},
-      {"sweep run x.toml --executor slurm --shards -1", "--shards: Value -1 not in range 1 to 1000000"},
-      {"sweep run x.toml --executor slurm --shards 0", "--shards: Value 0 not in range 1 to 1000000"},
+      {"sweep run x.toml --executor slurm --shards -1", "--shards: Value -1 not in range 1 to 1001"},
+      {"sweep run x.toml --executor slurm --shards 0", "--shards: Value 0 not in range 1 to 1001"},
   };
   for (const Case& c : cases) {
     const CliRun r = run(c.args);
@@ -404,6 +404,24 @@ TEST(Cli, RenderWritesTheStereoImagesAskedFor) {
     EXPECT_NE(bad.out.find(says), std::string::npos) << value << ": " << bad.out;
     EXPECT_EQ(bad.out.find("plain-raster on box-wall"), std::string::npos) << "rendered first: " << bad.out;
   }
+}
+
+TEST(Cli, ScenesInfoGivesTheDisparityOfTheSurfacesTheCameraSees) {
+  // thin-pole: a pole at the convergence distance (2 m) before a wall at 4 m. The range used to
+  // come from the vertices inside the frame, which missed the pole (its vertices lie above and
+  // below the picture) and gave 4 m to 4 m.
+  test::ScratchDir dir("info");
+  const CliRun r = run("scenes info thin-pole --scenes-dir '" + (dir / "scenes").string() + "'");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const size_t at = r.out.find("at the nearest visible surface (");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const double nearest = std::stod(r.out.substr(at + std::string("at the nearest visible surface (").size()));
+  EXPECT_NEAR(nearest, 2.0, 0.01) << r.out;
+  EXPECT_NE(r.out.find("at the farthest (4.0"), std::string::npos) << r.out;
+  // A bad parameter is refused before the output folder is made.
+  const CliRun bad = run("scenes generate thin-pole --param nope=1 --out '" + (dir / "made").string() + "'");
+  EXPECT_EQ(bad.code, 3) << bad.out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "made"));
 }
 
 TEST(Cli, OutputsAreNamedByTheSceneFileAndStayInTheOutputFolder) {

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <utility>
@@ -279,6 +280,23 @@ TEST_F(Compare, StereoExrNeedsAnEye) {
   EXPECT_NE(r.out.find("inf dB"), std::string::npos) << r.out;
   r = compare(q(path("pair.exr")) + " " + q(path("a.png")) + " --eye left --fail-psnr 1000");
   EXPECT_EQ(r.code, 2) << r.out;
+
+  // OpenEXR multi-view, the default view unnamed: a pair too (its unnamed channels were taken for
+  // the whole image, whatever --eye said). Left a flat grey, right a.png's pattern.
+  if (std::system("command -v oiiotool >/dev/null 2>&1") == 0) {
+    ASSERT_EQ(std::system(("oiiotool --pattern constant:color=0.2,0.2,0.2 48x32 3 -d float " + q(path("a.png")) +
+                           " --ch R,G,B --colorconvert sRGB linear -d float --chappend "
+                           "--chnames R,G,B,right.R,right.G,right.B -o " + q(path("mv.exr")))
+                              .c_str()),
+              0);
+    r = compare(q(path("mv.exr")) + " " + q(path("a.png")));
+    EXPECT_EQ(r.code, 3) << r.out;
+    EXPECT_NE(r.out.find("--eye left|right"), std::string::npos) << r.out;
+    r = compare(q(path("mv.exr")) + " " + q(path("a.png")) + " --eye right --fail-psnr 50");
+    EXPECT_EQ(r.code, 0) << r.out;
+    r = compare(q(path("mv.exr")) + " " + q(path("a.png")) + " --eye left --fail-psnr 50");
+    EXPECT_EQ(r.code, 2) << r.out;
+  }
 
   // A damaged pair reports the damage, not that it is a pair.
   fs::copy_file(path("pair.exr"), path("cut.exr"));

@@ -294,6 +294,9 @@ TEST_F(ImageIoTest, MultiViewAndMultiPartStereoFilesAreRead) {
   const auto [left, right] = io::read_exr_stereo(multiview);
   EXPECT_EQ(left.rgb_at(1, 1), (std::array<float, 3>{1, 2, 3}));
   EXPECT_EQ(right.rgb_at(1, 1), (std::array<float, 3>{4, 5, 6}));
+  // It is a pair to every reader: read as one image it gave the default view and dropped the other.
+  EXPECT_TRUE(io::exr_holds_stereo_pair(multiview));
+  expect_error<InputError>([&] { (void)io::read_exr(multiview); }, "holds a stereo pair");
 
   // Two parts named left and right.
   const fs::path parts = path("parts.exr");

@@ -207,6 +207,10 @@ TEST_P(SceneDeterminism, SameSeedSameBytesOtherSeedOtherFile) {
     return std::pair{doc, test::read_binary_payload(p)};
   };
   EXPECT_EQ(content(dir / ("a" + ext)) == content(dir / ("c" + ext)), info.analytic);
+  // The whole 64-bit seed counts: 7 + 2^32 is another scene (fence kept the low 32 bits).
+  o.seed = 7 + (uint64_t{1} << 32);
+  (void)generate(name, o, dir / ("d" + ext));
+  EXPECT_EQ(content(dir / ("a" + ext)) == content(dir / ("d" + ext)), info.analytic);
 }
 
 INSTANTIATE_TEST_SUITE_P(AllGenerators, SceneDeterminism, ::testing::ValuesIn(kExpectedNames),
