@@ -432,7 +432,12 @@ double median(std::vector<double> values) {
   if (values.empty()) return kNaN;
   std::sort(values.begin(), values.end());
   const size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+  if (n % 2) return values[n / 2];
+  // One infinite middle value (a PSNR of identical images beside a finite one): the finite one,
+  // not their mean, which would call half the cells identical to the truth.
+  const double a = values[n / 2 - 1], b = values[n / 2];
+  if (std::isinf(a) != std::isinf(b)) return std::isinf(a) ? b : a;
+  return 0.5 * (a + b);
 }
 
 RankTest mann_whitney_greater(std::span<const double> x, std::span<const double> y) {

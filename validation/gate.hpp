@@ -180,7 +180,8 @@ struct RankTest {
 };
 [[nodiscard]] RankTest mann_whitney_greater(std::span<const double> x, std::span<const double> y);
 
-/// The median (mean of the two middle values for an even count); NaN for no values.
+/// The median (mean of the two middle values for an even count, or the finite one of them when
+/// the other is infinite); NaN for no values.
 [[nodiscard]] double median(std::vector<double> values);
 
 /// Rewrites the baseline entries of the selected (cell, pipeline) pairs with the results' timing

@@ -42,13 +42,17 @@
     return (n * (scale || 1)).toFixed(digits);
   }
 
-  /** Median of the numeric values (nulls ignored, ∞ sorts last); null when there is none. */
+  /** Median of the numeric values (nulls ignored, ∞ sorts last); null when there is none. Of two
+   * middle values one infinite, the finite one: a PSNR of ∞ (identical images) beside a finite
+   * one would otherwise make the median ∞, identical to the truth. */
   function median(values) {
     const xs = values.map(num).filter((x) => x !== null).sort((a, b) => a - b);
     if (xs.length === 0) return null;
     const m = xs.length >> 1;
     if (xs.length % 2 === 1 || xs[m - 1] === xs[m]) return xs[m];
-    return (xs[m - 1] + xs[m]) / 2;
+    const [a, b] = [xs[m - 1], xs[m]];
+    if (Number.isFinite(a) !== Number.isFinite(b)) return Number.isFinite(a) ? a : b;
+    return (a + b) / 2;
   }
 
   function minOf(values) {
@@ -867,6 +871,17 @@
     return { id: 'viewer', title: 'Image viewer', node };
   }
 
+  /** A link to a cell's viewer (#cell-NNNN: the tables' cell links, or the page opened at one)
+   * opens that cell, which loads its images, and shows it. */
+  function openLinkedCell() {
+    const id = decodeURIComponent(window.location.hash.slice(1));
+    const target = id ? document.getElementById(id) : null;
+    if (!target || !target.matches('details.cell')) return;
+    target.open = true;
+    target.scrollIntoView();
+  }
+  window.addEventListener('hashchange', openLinkedCell);
+
 
   /** Trends across the nightly runs of a history file (data.history, docs/nightly.md): per pipeline
    * the median PSNR and median time of each run, and the gate's verdict counts per run. */
@@ -954,5 +969,6 @@
   }
   document.getElementById('toc').append(toc);
   for (const draw of pendingCharts) draw();
+  openLinkedCell();
   document.documentElement.dataset.reportReady = 'true';
 })();

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "validation/gate.hpp"
@@ -86,6 +87,12 @@ TEST(RankTest, Median) {
   EXPECT_DOUBLE_EQ(median({3, 1, 2}), 2.0);
   EXPECT_DOUBLE_EQ(median({4, 1, 3, 2}), 2.5);
   EXPECT_TRUE(std::isnan(median({})));
+  // PSNRs, one of identical images: the finite middle value, not ∞ (which read as "identical").
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_DOUBLE_EQ(median({inf, 91.48}), 91.48);
+  EXPECT_DOUBLE_EQ(median({30.0, inf, 40.0, inf}), 40.0);
+  EXPECT_EQ(median({inf, inf}), inf);
+  EXPECT_EQ(median({inf, 30.0, inf}), inf);
 }
 
 }  // namespace

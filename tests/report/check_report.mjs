@@ -1,7 +1,7 @@
 // Checks a `stereobench report` page in headless Debian Chromium, opened from disk (file://):
 // no console error, page error, failed request or network request; one summary row per pipeline
 // and one cell-table row per (cell, pipeline); a left-eyes row per measured left eye (bidir-warp's),
-// with its PSNR; every chart canvas has data drawn inside its plot
+// with its PSNR; a cell link opens that cell's viewer; every chart canvas has data drawn inside its plot
 // area; in every cell and for every pipeline each viewer image loads, each mode button shows its
 // own view (all pipelines of the first cell, the first pipeline of the others), the slider follows
 // a drag, flicker alternates, the anaglyph is composed exactly; with a history (nightly runs), the
@@ -224,6 +224,22 @@ try {
       for (const c of trends.charts)
         if (c.points.some((n) => n !== runs)) problems.push(`trend chart "${c.title}": datasets of ${c.points.join(', ')} points for ${runs} runs`);
       report.trends = trends.charts.map((c) => `${c.title}: ${c.points.length} datasets of ${runs} points`);
+    }
+  }
+
+  // A cell link of the cells table opens that cell's viewer (its images load) and shows it.
+  if (data.cells.length > 1) {
+    const link = page.locator('a[href^="#cell-"]').last();
+    if (await link.count() === 0) {
+      problems.push('no cell link in the tables');
+    } else {
+      const href = await link.getAttribute('href');
+      await link.click();
+      await page.waitForFunction((id) => {
+        const d = document.getElementById(id);
+        return d && d.open && d.querySelector('.views').children.length > 0;
+      }, href.slice(1), { timeout: 5000 }).catch(() => problems.push(`the cell link ${href} did not open its viewer`));
+      await page.locator(href).evaluate((d) => { d.open = false; });
     }
   }
 
