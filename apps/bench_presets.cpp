@@ -11,6 +11,7 @@
 
 #include "apps/cli_common.hpp"
 #include "renderer/error.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/gltf_loader.hpp"
 #include "renderer/io/render_output.hpp"
@@ -301,7 +302,7 @@ void run_bench_preset(const PresetRun& run, const Executor& executor) {
 
   nlohmann::json out = preset_json(run, executor);
   const auto write_json = [&] {
-    if (!run.json_out.empty()) write_option_file("--json", run.json_out, out.dump(2) + "\n");
+    if (!run.json_out.empty()) write_option_file("--json", run.json_out, io::json_text(out, 2) + "\n");
   };
 
   RowScene current;

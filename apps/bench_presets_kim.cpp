@@ -17,6 +17,7 @@
 #include "apps/bench_presets.hpp"
 #include "apps/cli_common.hpp"
 #include "renderer/error.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/gltf_loader.hpp"
 #include "renderer/io/render_output.hpp"
@@ -262,7 +263,7 @@ void run_kim_focal(const PresetRun& run, const Executor& executor) {
   out["reference"] = kReference;
   out["metrics_version"] = validation::kMetricsVersion;
   const auto write_json = [&] {
-    if (!run.json_out.empty()) write_option_file("--json", run.json_out, out.dump(2) + "\n");
+    if (!run.json_out.empty()) write_option_file("--json", run.json_out, io::json_text(out, 2) + "\n");
   };
 
   const RenderContext ctx{executor};
@@ -356,7 +357,7 @@ void run_kim_complexity(const PresetRun& run, const Executor& executor) {
   nlohmann::json out = preset_json(run, executor);
   out["memory_usable_share"] = kMemoryUsableShare;
   const auto write_json = [&] {
-    if (!run.json_out.empty()) write_option_file("--json", run.json_out, out.dump(2) + "\n");
+    if (!run.json_out.empty()) write_option_file("--json", run.json_out, io::json_text(out, 2) + "\n");
   };
 
   for (const PresetSeries& series : preset.series) {

@@ -14,6 +14,7 @@
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/render_output.hpp"
 #include "scenes/catalog.hpp"
@@ -184,9 +185,9 @@ void run_bench_command(const BenchArgs& a) {
     j["peak_rss_mib"] = peak_rss_mib();
     j["versions"] = io::versions_json();
     if (a.json_out == "-") {
-      print_to_stdout(j.dump(2));
+      print_to_stdout(io::json_text(j, 2));
     } else {
-      write_option_file("--json", a.json_out, j.dump(2) + "\n");
+      write_option_file("--json", a.json_out, io::json_text(j, 2) + "\n");
       fmt::print(out, "wrote {}\n", a.json_out);
     }
   }

@@ -14,6 +14,7 @@
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/text.hpp"
 #include "validation/image_files.hpp"
@@ -197,9 +198,9 @@ int run_compare(const CompareArgs& a) {
     if (!a.ssim_map.empty())
       write_for_option("--ssim-map", [&] { validation::write_png(a.ssim_map, validation::ssim_image(ssim, region)); });
     if (a.json == "-")
-      print_to_stdout(record.dump(2));
+      print_to_stdout(io::json_text(record, 2));
     else if (!a.json.empty())
-      write_option_file("--json", a.json, record.dump(2) + "\n");
+      write_option_file("--json", a.json, io::json_text(record, 2) + "\n");
   } catch (const std::exception&) {
     // An output that cannot be written takes the others of this run with it.
     discard_outputs(outputs);

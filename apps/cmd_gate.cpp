@@ -12,6 +12,7 @@
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/file_lock.hpp"
 #include "validation/gate.hpp"
@@ -146,9 +147,10 @@ void run_gate(const GateArgs& a) {
         write_option_file("--junit", a.junit, validation::junit_xml(report, "stereobench gate " + a.results));
       if (!a.json_out.empty())
         write_option_file("--json", a.json_out,
-                          validation::gate_report_json(report, a.config, a.results,
-                                                       baseline_note.empty() ? baseline_file.string() : "")
-                                  .dump(2) +
+                          io::json_text(validation::gate_report_json(report, a.config, a.results,
+                                                                     baseline_note.empty() ? baseline_file.string()
+                                                                                           : ""),
+                                        2) +
                               "\n");
     });
   } catch (const IoError&) {

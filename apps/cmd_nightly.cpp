@@ -20,6 +20,7 @@
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/file_lock.hpp"
 #include "renderer/text.hpp"
@@ -337,16 +338,12 @@ void run_nightly(const NightlyArgs& a) {
   options.out_name = report_name;
   options.title = fmt::format("stereobench nightly: {} {}", d.name, run.date);
   // The trends are this sweep's: a history shared with other sweeps keeps their runs out.
-  json trend_runs = json::array();
-  for (const json& r : history.runs)
-    if (r.value("sweep", "") == d.name) trend_runs.push_back(r);
-  if (trend_runs.size() < history.runs.size()) {
-    const std::string left_out = fmt::format("trends leave out {} runs of other sweeps in {}",
-                                             history.runs.size() - trend_runs.size(), history_file.string());
-    options.history_note = fmt::format("The {}.", left_out);
-    fmt::print(stderr, "note: the {}\n", left_out);
+  SweepRuns trends = runs_of_sweep(history, d.name, history_file);
+  if (!trends.left_out.empty()) {
+    options.history_note = fmt::format("The {}.", trends.left_out);
+    fmt::print(stderr, "note: the {}\n", trends.left_out);
   }
-  options.history = std::move(trend_runs);
+  options.history = std::move(trends.runs);
   const reports::ReportSummary s = reports::write_report(report_results, options);
   for (const std::string& w : s.warnings) fmt::print(stderr, "warning: {}\n", w);
 
@@ -356,19 +353,19 @@ void run_nightly(const NightlyArgs& a) {
                     done_path = (run_dir / kRunDoneFile).string();
   write_all_or_none({{"gate JUnit", &junit_path}, {"gate JSON", &gate_json_path}, {"nightly.json", &done_path}}, [&] {
     io::write_text_atomically(junit_file, junit_xml(gate, "stereobench nightly " + o.results.string()));
-    io::write_text_atomically(gate_json_file, gate_report_json(gate, gate_file, o.results.string(),
-                                                               baseline_note.empty() ? baseline_file.string() : "")
-                                                      .dump(2) +
-                                                  "\n");
-    io::write_text_atomically(done_path,
-                              json{{"run_id", run_id},
-                                   {"date", run.date},
-                                   {"gate_verdict", gate_verdict(gate)},
-                                   {"exit_code", code},
-                                   {"history", history_file.string()},
-                                   {"report", s.index_html.string()}}
-                                      .dump(2) +
+    io::write_text_atomically(gate_json_file,
+                              io::json_text(gate_report_json(gate, gate_file, o.results.string(),
+                                                             baseline_note.empty() ? baseline_file.string() : ""),
+                                            2) +
                                   "\n");
+    io::write_text_atomically(done_path, io::json_text(json{{"run_id", run_id},
+                                                            {"date", run.date},
+                                                            {"gate_verdict", gate_verdict(gate)},
+                                                            {"exit_code", code},
+                                                            {"history", history_file.string()},
+                                                            {"report", s.index_html.string()}},
+                                                       2) +
+                                             "\n");
   });
   drop_run_claim(history_file, chosen.claim);
   fmt::print("history {} ({} runs)\nreport {}\ngate verdict: {} (exit {})\n", history_file.string(),

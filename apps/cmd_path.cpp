@@ -15,6 +15,7 @@
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/io/line_file.hpp"
 #include "scenes/catalog.hpp"
 #include "validation/path_run.hpp"
@@ -142,7 +143,7 @@ void run_path_command(const PathArgs& a) {
   std::vector<double> bvh_s;
   try {
     validation::run_path(loaded.scene, run, executor, [&](const json& f) {
-      out.append(f.dump());
+      out.append(io::json_text(f));
       // Frame 0 builds the BVH; later frames update it, unless the path moves no geometry ("static").
       if (f["frame"].get<int>() > 0 && f["bvh"] != "static") bvh_s.push_back(f["bvh_update_s"].get<double>());
       std::string line = fmt::format("frame {:>4}", f["frame"].get<int>());

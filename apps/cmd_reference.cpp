@@ -12,6 +12,7 @@
 #include "apps/commands.hpp"
 #include "reference/store.hpp"
 #include "renderer/error.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/text.hpp"
 #include "scenes/catalog.hpp"
@@ -112,7 +113,7 @@ int run_verify(const ReferenceArgs& a) {
       j.push_back({{"id", r.id}, {"status", reference::to_string(r.status)}, {"detail", r.detail},
                    {"bit_identical", r.bit_identical},
                    {"metrics", r.metrics ? validation::to_json(*r.metrics) : json(nullptr)}});
-    write_option_file("--json", a.json_out, j.dump(2) + "\n");
+    write_option_file("--json", a.json_out, io::json_text(j, 2) + "\n");
   }
   const int code = verdict(results);
   // What to do differs: a failed check is rewritten by update, unless the entry's spec is lost with

@@ -77,14 +77,24 @@ void run_report(const ReportArgs& a) {
   options.out_dir = a.out;
   options.title = a.title;
   options.images = a.link_images ? reports::ImageMode::link : reports::ImageMode::copy;
+  validation::HistoryFile h;
   if (!a.history.empty()) {
     if (!std::filesystem::exists(a.history))
       throw InputError(fmt::format("--history {}: file does not exist", a.history));
-    const validation::HistoryFile h = validation::read_history(a.history);
+    h = validation::read_history(a.history);
     for (const std::string& w : h.warnings) std::fprintf(stderr, "stereobench: warning: %s\n", w.c_str());
-    options.history = nlohmann::json(h.runs);
   }
   const reports::ResultsFile results = reports::read_results_file(a.results);
+  if (!a.history.empty()) {
+    // The trends are the results' sweep's, as nightly draws them.
+    validation::SweepRuns trends =
+        validation::runs_of_sweep(h, results.cells.front().json.value("sweep", ""), a.history);
+    if (!trends.left_out.empty()) {
+      options.history_note = fmt::format("The {}.", trends.left_out);
+      std::fprintf(stderr, "stereobench: note: the %s\n", trends.left_out.c_str());
+    }
+    options.history = std::move(trends.runs);
+  }
   const reports::ReportSummary s = reports::write_report(results, options);
   for (const std::string& w : s.warnings) std::fprintf(stderr, "stereobench: warning: %s\n", w.c_str());
   print_summary_table(s);

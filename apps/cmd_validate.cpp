@@ -15,6 +15,7 @@
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "scenes/catalog.hpp"
 #include "validation/validation_images.hpp"
@@ -120,7 +121,7 @@ void run_validate(const ValidateArgs& a) {
       images.update(shared_images);
       const json record = validation::validation_record(target, v, executor.threads(), images);
       set.add(record_file(v.pipeline),
-              [&](const fs::path& tmp) { io::write_text_atomically(tmp, record.dump(2) + "\n"); });
+              [&](const fs::path& tmp) { io::write_text_atomically(tmp, io::json_text(record, 2) + "\n"); });
       records.push_back(record);
       const validation::HoleStatistics& h = v.holes;
       fmt::print("{:<{}} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10.1f}\n", v.pipeline, name_w,
@@ -141,7 +142,7 @@ void run_validate(const ValidateArgs& a) {
       for (const std::string& line : left_lines) fmt::print("{}\n", line);
     }
     const std::string summary_text =
-        json{{"kind", "stereobench.validation_summary"}, {"records", records}}.dump(2) + "\n";
+        io::json_text(json{{"kind", "stereobench.validation_summary"}, {"records", records}}, 2) + "\n";
     set.add(summary, [&](const fs::path& tmp) { io::write_text_atomically(tmp, summary_text); });
   }
   set.commit();  // the summary, added last, is the set's marker

@@ -41,7 +41,10 @@ void refuse_empty_values(CLI::App& app) {
     for (const char* name : names) {
       CLI::Option* option = app.get_option_no_throw(name);
       if (!option) continue;
-      const std::string message = fmt::format("is empty; give {}, or leave the option out for its default", what);
+      const std::string message =
+          option->get_required()
+              ? fmt::format("is empty; give {}", what)
+              : fmt::format("is empty; give {}, or leave the option out for its default", what);
       option->check(CLI::Validator(
           [message](const std::string& value) { return value.empty() ? message : std::string(); }, "", "non-empty"));
     }

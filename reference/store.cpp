@@ -631,7 +631,7 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
         {"date", utc_now()},
         {"stereobench_version", SB_VERSION_STRING},
         {"versions", io::versions_json()}};
-    io::write_text_atomically(staged / kProvenance, provenance.dump(2) + "\n");
+    io::write_text_atomically(staged / kProvenance, io::json_text(provenance, 2) + "\n");
     replace_folder(staged, root_ / id);
   } catch (...) {
     fs::remove_all(staged, ec);

@@ -95,7 +95,7 @@ json baseline_json(const Baseline& baseline) {
 }
 
 void save_baseline(const std::filesystem::path& file, const Baseline& baseline) {
-  io::write_text_atomically(file, baseline_json(baseline).dump(2) + "\n");
+  io::write_text_atomically(file, io::json_text(baseline_json(baseline), 2) + "\n");
 }
 
 }  // namespace sb::validation

@@ -188,6 +188,16 @@ HistoryFile read_history(const fs::path& file) {
   return out;
 }
 
+SweepRuns runs_of_sweep(const HistoryFile& history, const std::string& sweep, const fs::path& file) {
+  SweepRuns out;
+  for (const json& r : history.runs)
+    if (r.value("sweep", "") == sweep) out.runs.push_back(r);
+  if (out.runs.size() < history.runs.size())
+    out.left_out = fmt::format("trends leave out {} runs of other sweeps in {}", history.runs.size() - out.runs.size(),
+                               file.string());
+  return out;
+}
+
 void append_history(const fs::path& file, const json& entry) {
   check_history_line(entry, "history line for " + file.string());
   append_result(file, entry, "history file");

@@ -54,6 +54,16 @@ struct HistoryFile {
 };
 [[nodiscard]] HistoryFile read_history(const std::filesystem::path& file);
 
+/// The runs of one sweep in a history file (a history may be shared by several sweeps; trends are
+/// drawn per sweep), and, when it leaves runs out, how many and of which file ("trends leave out 3
+/// runs of other sweeps in FILE"; empty when none).
+struct SweepRuns {
+  nlohmann::json runs = nlohmann::json::array();
+  std::string left_out;
+};
+[[nodiscard]] SweepRuns runs_of_sweep(const HistoryFile& history, const std::string& sweep,
+                                      const std::filesystem::path& file);
+
 /// Appends one run's line atomically (append_result: one write under a lock, fsync). The line is
 /// checked first (check_history_line).
 void append_history(const std::filesystem::path& file, const nlohmann::json& entry);

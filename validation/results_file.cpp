@@ -198,6 +198,18 @@ void require_within(const json& root, const std::string& where, const std::strin
                                  where, prefix, dotted, v->dump(), lo, hi));
 }
 
+/// Checks that every member of an object of stage times (stage -> seconds), where present, is a
+/// time no measurement is outside of: a number in [0, max]. The object itself is `require`d.
+void require_times(const json& root, const std::string& where, const std::string& prefix, std::string_view dotted) {
+  const json* v = find(root, dotted);
+  if (v == nullptr || !v->is_object()) return;
+  for (const auto& [stage, t] : v->items())
+    if (!t.is_number() || !(t.get<double>() >= 0.0 && t.get<double>() <= std::numeric_limits<double>::max()))
+      throw InputError(fmt::format("{}: field '{}{}.{}' holds {}, not a time in seconds; the line is damaged or "
+                                   "edited by hand",
+                                   where, prefix, dotted, stage, t.dump().substr(0, 80)));
+}
+
 /// A field of a results line: its dotted path, what it may hold, whether it may be absent.
 struct Field {
   const char* path;
@@ -208,6 +220,8 @@ struct Field {
 /// The fields of a cell, in the order they are checked (a container before its members).
 constexpr Field kCellFields[] = {
     {"sweep", Kind::string},
+    {"definition_sha256", Kind::string, true},
+    {"wall_s", Kind::number_or_null, true},
     {"cell_id", Kind::string},
     {"cell_index", Kind::integer},
     {"cell_count", Kind::integer, true},
@@ -375,6 +389,7 @@ void check_cell_record(const json& line, const std::string& where) {
     throw InputError(fmt::format("{}: schema_version {} is not a known version (expected {})", where, version,
                                  kSweepSchemaVersion));
   for (const Field& f : kCellFields) require(line, where, "", f.path, f.kind, f.optional);
+  require_within(line, where, "", "wall_s", 0.0, std::numeric_limits<double>::max());
   if (line["cell_id"].get<std::string>().empty()) throw InputError(fmt::format("{}: cell_id is empty", where));
   // The gate keys baselines and rule globs by the id and reads the scene from the fields: the two
   // must tell the same cell.
@@ -420,6 +435,7 @@ void check_cell_record(const json& line, const std::string& where) {
                           "validation.holes.not_reprojected.recall", "validation.holes.not_reprojected.precision"})
       require_within(p, where, prefix, f, 0.0, 1.0);
     require_within(p, where, prefix, "validation.total_s", 0.0, kMax);
+    require_times(p, where, prefix, "validation.timings_s");
     // A left eye synthesized in part is measured as the right eye is.
     require(p, where, prefix, "validation.left_eye", Kind::object_or_null, true);
     if (const json* left = find(p, "validation.left_eye"); left != nullptr && left->is_object()) {
@@ -447,6 +463,16 @@ void check_cell_record(const json& line, const std::string& where) {
                                          "damaged or edited by hand",
                                          where, prefix, t.dump()));
       require(p, where, prefix, "timing.stages_median_s", Kind::object, true);
+      require_times(p, where, prefix, "timing.stages_median_s");
+      // min <= median <= max of the same samples.
+      const json* lo = find(p, "timing.min_s");
+      const json* mid = find(p, "timing.median_s");
+      const json* hi = find(p, "timing.max_s");
+      if (lo && mid && hi && lo->is_number() && mid->is_number() && hi->is_number() &&
+          !(lo->get<double>() <= mid->get<double>() && mid->get<double>() <= hi->get<double>()))
+        throw InputError(fmt::format("{}: fields '{}timing.min_s', 'median_s' and 'max_s' are {}, {} and {}, not in "
+                                     "order; the line is damaged or edited by hand",
+                                     where, prefix, lo->dump(), mid->dump(), hi->dump()));
       // Every repetition leaves one sample: the medians and the rank test are taken over them.
       const json* samples = find(p, "timing.samples_s");
       const json* repetitions = find(p, "timing.repetitions");

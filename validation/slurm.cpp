@@ -369,7 +369,7 @@ SlurmSubmission submit_sweep(const SweepDefinition& d, SlurmSweepOptions o) {
                        {"script", l.script.string()},
                        {"sbatch_command", sub.sbatch_command},
                        {"submitted", utc_now()}};
-  io::write_text_atomically(l.submission, record.dump(2) + "\n");
+  io::write_text_atomically(l.submission, io::json_text(record, 2) + "\n");
   return sub;
 }
 
@@ -478,7 +478,7 @@ size_t collect_slurm_results(const SweepDefinition& d, const SlurmSubmission& su
   io::write_text_atomically(results, results_text(cells));
   json record = io::parse_json(io::read_file(sub.layout.submission));
   record["merged"] = {{"results", fs::absolute(results).lexically_normal().string()}, {"sha256", hash_file(results)}};
-  io::write_text_atomically(sub.layout.submission, record.dump(2) + "\n");
+  io::write_text_atomically(sub.layout.submission, io::json_text(record, 2) + "\n");
   return cells.size();
 }
 

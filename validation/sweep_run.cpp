@@ -448,7 +448,7 @@ void claim_out_folder(const SweepDefinition& d, const SweepRunOptions& options) 
         options.out_dir.string(), theirs.value("sweep", "?"), theirs.value("definition", "?"),
         theirs.value("definition_sha256", "?").substr(0, 12), d.name, d.file.string(), d.sha256.substr(0, 12)));
   }
-  io::write_text_atomically(marker, mine.dump(2) + "\n");
+  io::write_text_atomically(marker, io::json_text(mine, 2) + "\n");
 }
 
 /// The scene content (hash_scene as recorded) each scene's finished cells of `results` were

@@ -204,7 +204,7 @@ void TruthCache::store(const std::string& key, const TruthRender& render) const 
                   {"settings", render.settings},  {"command", render.command},
                   {"seconds", render.seconds},    {"image_sha256", hash_image(rgb)},
                   {"key", key}};
-  io::write_text_atomically(meta, j.dump(2) + "\n");
+  io::write_text_atomically(meta, io::json_text(j, 2) + "\n");
 }
 
 ResolvedTruth resolve_truth(const TruthProvider& provider, const TruthRequest& request, const TruthCache* cache) {

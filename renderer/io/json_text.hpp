@@ -31,4 +31,10 @@ class JsonTextError : public std::runtime_error {
 /// double, or nesting deeper than kMaxJsonDepth.
 [[nodiscard]] nlohmann::json parse_json(std::string_view text);
 
+/// `value` as JSON text (`indent` as nlohmann's dump), with bytes that are not UTF-8 (a file name
+/// of another encoding, given on the command line) written as U+FFFD instead of throwing.
+[[nodiscard]] inline std::string json_text(const nlohmann::json& value, int indent = -1) {
+  return value.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 }  // namespace sb::io

@@ -458,6 +458,15 @@ TEST(NightlyTest, SweepsSharingAHistoryKeepTheirRunsApart) {
   const json trends = page["history"];
   ASSERT_EQ(trends.size(), 2u) << trends.dump();
   for (const json& r : trends) EXPECT_EQ(r["sweep"], "nightly-tiny");
+  // `report --history` draws the same trends (it drew every sweep's runs, without a word).
+  const test::CliRun rep = test::run_cli("report " + quoted(dir / "runs-b" / b_id / "results.jsonl") + " --out " +
+                                         quoted(dir / "rep-b") + " --history " + history);
+  ASSERT_EQ(rep.code, 0) << rep.out;
+  EXPECT_NE(rep.out.find(fmt::format("note: the trends leave out {} runs of other sweeps", other_runs)),
+            std::string::npos)
+      << rep.out;
+  const json again = embedded_data(dir / "rep-b" / "index.html");
+  EXPECT_EQ(again["history"], trends);
 
   // An unfinished run folder named as another sweep's recorded run: resuming it is refused before
   // any cell runs.

@@ -210,6 +210,27 @@ TEST(ResultsFile, BadLinesAndDuplicatesRejected) {
     expect_refused(broken, "checked.jsonl:2: field 'pipelines.plain-rt.timing.samples_s' holds " + sample.dump() +
                             ", not a time in seconds");
   }
+  // Stage times, the cell's wall time and the order of min, median and max (a negative stage time
+  // reached the per-stage bars), and the definition's hash a string (a number was an internal error).
+  for (const json& t : {json(-0.5), json("fast"), json(nullptr)}) {
+    json stage = cell(1, "b");
+    stage["pipelines"]["plain-rt"]["timing"]["stages_median_s"] = {{"hole_fill", t}};
+    expect_refused(stage, "checked.jsonl:2: field 'pipelines.plain-rt.timing.stages_median_s.hole_fill' holds " +
+                              t.dump() + ", not a time in seconds");
+    json validated = cell(1, "b");
+    validated["pipelines"]["plain-rt"]["validation"]["timings_s"] = {{"trace", t}};
+    expect_refused(validated, "field 'pipelines.plain-rt.validation.timings_s.trace' holds " + t.dump());
+  }
+  json wall = cell(1, "b");
+  wall["wall_s"] = -3.0;
+  expect_refused(wall, "checked.jsonl:2: field 'wall_s' is -3.0, outside [0,");
+  json unordered = cell(1, "b");
+  unordered["pipelines"]["plain-rt"]["timing"].update({{"min_s", 0.02}, {"max_s", 0.03}});
+  expect_refused(unordered, "'pipelines.plain-rt.timing.min_s', 'median_s' and 'max_s' are 0.02, 0.01 and 0.03, not "
+                            "in order");
+  json sha = cell(1, "b");
+  sha["definition_sha256"] = 7;
+  expect_refused(sha, "checked.jsonl:2: field 'definition_sha256' is 7 but must be a string");
   // cell_index within cell_count, and one cell_count per file.
   json beyond = cell(10, "z");
   expect_refused(beyond, "checked.jsonl:2: cell_index 10 is not below cell_count 10");

@@ -229,7 +229,7 @@ TEST(SweepRun, ShardsCollectedEqualAnUnshardedRun) {
   // Collecting a shard with a conflicting copy of a cell fails, naming the cell.
   std::vector<std::string> lines = lines_of(dir / "shard0" / "results.jsonl");
   json changed = json::parse(lines[0]);
-  changed["wall_s"] = -1.0;
+  changed["wall_s"] = changed["wall_s"].get<double>() + 1.0;
   std::ofstream(dir / "conflict.jsonl") << changed.dump() << "\n";
   const test::CliRun conflict = test::run_cli("sweep collect " + quoted(dir / "bad.jsonl") + " " +
                                               quoted(dir / "shard0" / "results.jsonl") + " " +
@@ -628,6 +628,21 @@ TEST(SweepRun, BadDefinitionAndShardAreUsageErrors) {
   EXPECT_EQ(fixed.code, 0) << fixed.out;
 }
 
+
+TEST(SweepRun, AFolderNameThatIsNotUtf8IsWrittenNotAnInternalError) {
+  // A definition in a folder named in another encoding: its path goes into the folder marker and
+  // the results lines as JSON, which holds UTF-8 only (the marker's write was an internal error).
+  test::ScratchDir dir;
+  const fs::path folder = dir / "latin\xe9";
+  fs::create_directories(folder);
+  std::ofstream(folder / "t.toml") << "[sweep]\nscenes = [\"box-wall\"]\npipelines = [\"plain-rt\"]\n"
+                                      "resolutions = [\"32x18\"]\n[timing]\nrepetitions = 1\nwarmup = 0\n";
+  const test::CliRun r = test::run_cli("sweep run " + quoted(folder / "t.toml") + " --out " + quoted(folder / "o") +
+                                       " --scenes-dir " + quoted(dir / "scenes") + " --cache ''");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(validation::read_results(folder / "o" / "results.jsonl").cells.size(), 1u);
+  EXPECT_NE(test::read_text(folder / "o" / ".stereobench-sweep.json").find("latin\ufffd"), std::string::npos);
+}
 
 TEST(SweepRun, TwoDefinitionsStartedTogetherIntoOneFolderDoNotBothRun) {
   // A sweep checks the folder's marker and writes its own under a lock on the folder. Held here,
