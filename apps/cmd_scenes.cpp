@@ -51,7 +51,7 @@ std::map<std::string, double> parse_params(const std::vector<std::string>& items
   for (const auto& [name, value] : parse_key_values(items, "--param")) {
     const std::optional<double> v = parse_finite(value);
     if (!v) throw InputError(fmt::format("--param {}: '{}' is not a finite decimal number", name, value));
-    out[name] = *v;
+    out[name] = *v == 0.0 ? 0.0 : *v;  // -0 is 0: one scene, one file name
   }
   return out;
 }

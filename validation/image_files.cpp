@@ -125,7 +125,14 @@ Srgb8File read_srgb8_file(const fs::path& path, std::string_view eye) {
   if (d.srgb) {
     file.image = {d.width, d.height, std::vector<uint8_t>(n * 3)};
     for (std::size_t i = 0; i < n; ++i)
-      for (std::size_t c = 0; c < 3; ++c) file.image.rgb[i * 3 + c] = code_of(sample(i, c));
+      for (std::size_t c = 0; c < 3; ++c) {
+        // A float file tagged sRGB may hold NaN, which has no code (it was taken as 0, black).
+        if (std::isnan(sample(i, c)))
+          throw InputError(fmt::format("{} has a NaN sample at pixel ({}, {}); the metrics need finite values",
+                                       path.string(), i % static_cast<std::size_t>(d.width),
+                                       i / static_cast<std::size_t>(d.width)));
+        file.image.rgb[i * 3 + c] = code_of(sample(i, c));
+      }
     file.encoding = fmt::format("{}, sRGB as stored", d.format);
   } else {
     Image linear(d.width, d.height);

@@ -415,15 +415,10 @@ SweepScene parse_builtin_scene(const std::string& text) {
         throw InputError(fmt::format("scene '{}': '{}' has no parameter '{}' (its parameters: {})", text, s.name, key,
                                      known.empty() ? std::string("none") : fmt::format("{}", fmt::join(known, ", "))));
       }
-      double value = 0.0;
-      size_t used = 0;
-      try {
-        value = std::stod(value_text, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != value_text.size() || !std::isfinite(value))
-        throw InputError(fmt::format("scene '{}': {}={} is not a number", text, key, value_text));
+      // Decimal only (stod would read 0x10 as 16); -0 is 0, one scene and one label.
+      const std::optional<double> parsed = parse_finite(value_text);
+      if (!parsed) throw InputError(fmt::format("scene '{}': {}={} is not a decimal number", text, key, value_text));
+      const double value = *parsed == 0.0 ? 0.0 : *parsed;
       if (value < param->min_value || value > param->max_value)
         throw InputError(fmt::format("scene '{}': {}={} is outside {}..{}", text, key, value_text,
                                      number_text(param->min_value), number_text(param->max_value)));

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -146,6 +147,21 @@ TEST_F(Compare, MismatchedAndMissingInputsAreBadInput) {
 
   r = compare(q(path("a.png")));
   EXPECT_EQ(r.code, 3) << r.out;  // B is required
+
+  // NaN in a float file tagged sRGB is refused as in an EXR (it was read as 0, black, and passed).
+  if (std::system("command -v oiiotool >/dev/null 2>&1") == 0) {
+    Image nan_image(48, 32);
+    float* v = nan_image.add_plane(planes::rgb).data_f32();
+    for (int i = 0; i < 48 * 32 * 3; ++i) v[i] = 0.5f;
+    v[(10 * 48 + 20) * 3 + 1] = std::numeric_limits<float>::quiet_NaN();
+    io::write_exr(path("nan.exr"), nan_image);
+    ASSERT_EQ(std::system(("oiiotool " + q(path("nan.exr")) + " -d float --iscolorspace sRGB -o " + q(path("nan.tif")))
+                              .c_str()),
+              0);
+    r = compare(q(path("a.png")) + " " + q(path("nan.tif")));
+    EXPECT_EQ(r.code, 3) << r.out;
+    EXPECT_NE(r.out.find("nan.tif has a NaN sample at pixel (20, 10)"), std::string::npos) << r.out;
+  }
 
   // A device is no image: /dev/zero was read without end (the run spun until killed).
   r = test::run_shell("timeout 30 " + std::string(SB_CLI_PATH) + " compare /dev/zero " + q(path("a.png")));

@@ -227,6 +227,8 @@ TEST(SweepDefinition, BadValuesRejected) {
       {"[sweep]\nscenes = [\"nowhere\"]\n", "unknown"},
       {"[sweep]\nscenes = [\"complexity:triangles=5\"]\n", "outside"},
       {"[sweep]\nscenes = [\"complexity:size=5\"]\n", "has no parameter 'size'"},
+      {"[sweep]\nscenes = [\"spheres:count=0x10\"]\n", "count=0x10 is not a decimal number"},
+      {"[sweep]\nscenes = [\"lit-plane:directional=0\", \"lit-plane:directional=-0\"]\n", "lists 'lit-plane:directional=0' twice"},
       {"[sweep]\nscenes = [\"missing/scene.gltf\"]\n", "does not exist"},
       {"[sweep]\nscenes = [\"spheres\", \"spheres\"]\n", "lists 'spheres' twice"},
       // The default count written out is the same scene (the cells used to run twice).
