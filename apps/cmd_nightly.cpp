@@ -233,6 +233,18 @@ void run_nightly(const NightlyArgs& a) {
                                  gate_file, baseline_file.string()));
   else
     baseline_note = fmt::format("no baseline file {}: time regressions not checked", baseline_file.string());
+  // A gate of time regressions alone with a baseline that holds none of this sweep's cells would
+  // check nothing either, found only once every cell has run.
+  if (!gate_config.sets_limits() && !baseline.empty()) {
+    bool matches = false;
+    for (const SweepCell& c : expand_cells(d))
+      for (const std::string& p : d.pipelines) matches = matches || baseline.find(c.id, p) != nullptr;
+    if (!matches)
+      throw InputError(fmt::format("{} sets no threshold, only [regression], and the baseline {} holds no (cell, "
+                                   "pipeline) of sweep '{}': the gate would check nothing; give thresholds, or a "
+                                   "baseline of this sweep (gate --update-baseline stores one)",
+                                   gate_file, baseline_file.string(), d.name));
+  }
 
   const int threads = checked_threads(a.threads);  // before a run folder is made
 

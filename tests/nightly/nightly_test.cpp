@@ -304,6 +304,17 @@ TEST(NightlyTest, MalformedHistoryIsBadInputNamingFileAndLine) {
   EXPECT_NE(reg_only.out.find("sets no threshold, only [regression], and there is no baseline file ci/baseline.json"),
             std::string::npos)
       << reg_only.out;
+  // ... and so would one with a baseline of another sweep's cells (found only after every cell ran).
+  write_text(dir / "other-baseline.json",
+             R"({"spheres|e=default|c=default|64x36|lights=all|full": {"plain-rt": {"samples_s": [0.1], )"
+             R"("median_s": 0.1, "recorded": "2026-01-01T00:00:00Z", "host": "h"}}})");
+  const test::CliRun foreign =
+      test::run_cli("nightly " + quoted(dir / "tiny.toml") + " --out " + quoted(dir / "runs") + " --history " +
+                    quoted(dir / "fresh.jsonl") + " --gate-config " + quoted(dir / "reg-only.toml") + " --baseline " +
+                    quoted(dir / "other-baseline.json") + " --scenes-dir " + quoted(dir / "scenes") +
+                    " --cache '' --threads 1");
+  EXPECT_EQ(foreign.code, 3) << foreign.out;
+  EXPECT_NE(foreign.out.find("holds no (cell, pipeline) of sweep"), std::string::npos) << foreign.out;
   run_folders = 0;
   for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs")) run_folders += e.is_directory() ? 1 : 0;
   EXPECT_EQ(run_folders, 0u);
