@@ -374,8 +374,9 @@ void run_nightly(const NightlyArgs& a) {
                                                             {"date", run.date},
                                                             {"gate_verdict", gate_verdict(gate)},
                                                             {"exit_code", code},
-                                                            {"history", history_file.string()},
-                                                            {"report", s.index_html.string()}},
+                                                            // absolute: read by CI steps started elsewhere
+                                                            {"history", fs::absolute(history_file).lexically_normal().string()},
+                                                            {"report", fs::absolute(s.index_html).lexically_normal().string()}},
                                                        2) +
                                              "\n");
   });

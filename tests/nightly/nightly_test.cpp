@@ -117,6 +117,10 @@ TEST(NightlyTest, TwoRunsGiveHistoryGateFilesAndTrends) {
     const json gate = json::parse(test::read_text(r / "gate.json"));
     EXPECT_EQ(gate["verdict"], "pass") << gate.dump(2);
     EXPECT_NE(test::read_text(r / "gate-junit.xml").find("<testsuites"), std::string::npos);
+    // Paths a CI step started elsewhere can open.
+    const json done = json::parse(test::read_text(r / "nightly.json"));
+    EXPECT_TRUE(fs::path(done["history"].get<std::string>()).is_absolute()) << done.dump();
+    EXPECT_TRUE(fs::is_regular_file(done["report"].get<std::string>())) << done.dump();
   }
 
   // Two history lines, one per run, in run order, with every field.
