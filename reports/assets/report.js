@@ -398,23 +398,33 @@
     const byInteraxial = { axis: 'interaxial', key: interaxialKey, order: (k) => k, label: (k) => `${k}`, linear: true, xTitle: interaxialTitle };
     const disparities = cells.map((c) => c.max_disparity_px);
     const dispNote = `Maximum disparity (at infinity) ${fmt(minOf(disparities), 1)}–${fmt(maxOf(disparities), 1)} px.`;
+    // A chart with no finite value in any cell (SSIM of images too small for its window, say) is
+    // not drawn, and the page says which.
+    const notDrawn = [];
+    const lineChart = (opts) => {
+      const chart = metricVsAxis(opts);
+      if (!chart) notDrawn.push(opts.title);
+      return chart;
+    };
     const charts = [
-      metricVsAxis(Object.assign({}, byResolution, { pipelines: others, title: 'Speed-up vs resolution',
+      lineChart(Object.assign({}, byResolution, { pipelines: others, title: 'Speed-up vs resolution',
         value: (c, p) => field(c, p, 'speedup'), yTitle: `speed-up over ${data.baseline}`, yExtra: { beginAtZero: true },
         caption: `Median speed-up over ${data.baseline} (measured side by side in each cell) by image size.` })),
-      metricVsAxis(Object.assign({}, byInteraxial, { pipelines, title: 'PSNR vs interaxial', value: (c, p) => field(c, p, 'psnr'),
+      lineChart(Object.assign({}, byInteraxial, { pipelines, title: 'PSNR vs interaxial', value: (c, p) => field(c, p, 'psnr'),
         yTitle: 'PSNR (dB)', omittedWhy: 'identical to the truth, PSNR ∞',
         caption: `Median PSNR of the right eye against the ground truth. ${dispNote}` })),
-      metricVsAxis(Object.assign({}, byInteraxial, { pipelines, title: 'SSIM vs interaxial', value: (c, p) => field(c, p, 'ssim'),
+      lineChart(Object.assign({}, byInteraxial, { pipelines, title: 'SSIM vs interaxial', value: (c, p) => field(c, p, 'ssim'),
         yTitle: 'SSIM', caption: `Median SSIM of the right eye against the ground truth. ${dispNote}` })),
-      metricVsAxis(Object.assign({}, byInteraxial, { pipelines, title: 'MSE vs interaxial', value: (c, p) => field(c, p, 'mse'),
+      lineChart(Object.assign({}, byInteraxial, { pipelines, title: 'MSE vs interaxial', value: (c, p) => field(c, p, 'mse'),
         yTitle: 'MSE (0–255 RGB)', yExtra: { beginAtZero: true }, caption: `Median MSE of the right eye against the ground truth. ${dispNote}` })),
-      metricVsAxis(Object.assign({}, byInteraxial, { pipelines, title: 'Hole fraction vs interaxial',
+      lineChart(Object.assign({}, byInteraxial, { pipelines, title: 'Hole fraction vs interaxial',
         value: (c, p) => { const h = num(field(c, p, 'hole_fraction')); return h === null ? null : 100 * h; },
         yTitle: 'hole pixels (%)', yExtra: { beginAtZero: true }, caption: `Median share of the right eye's pixels left as holes before filling. ${dispNote}` })),
       stageChart(),
       frameChart(),
     ].filter(Boolean);
+    if (notDrawn.length)
+      node.append(el('p', { class: 'note' }, `Not drawn, as no cell has a finite value for them: ${notDrawn.join(', ')}.`));
     grid.append(...charts);
     node.append(grid);
     return { id: 'charts', title: 'Charts', node };
