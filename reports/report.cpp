@@ -441,13 +441,12 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
   std::error_code resolved;
   if (fs::path real = fs::weakly_canonical(results.path, resolved); !resolved) results_file = std::move(real);
   const fs::path results_dir = results_file.has_parent_path() ? results_file.parent_path() : fs::path(".");
+  std::vector<std::pair<std::string, fs::path>> missing;  // (as the line names it, where it was looked for)
   const auto image_path = [&](const std::string& rel, const std::string& name) -> std::string {
     const fs::path source = results_dir / rel;
     std::error_code ec;
     if (!fs::is_regular_file(source, ec)) {
-      summary.warnings.push_back(fmt::format("{}: image {} is missing (looked for {}); the viewer shows it as "
-                                             "unavailable",
-                                             results.path.string(), rel, source.string()));
+      missing.emplace_back(rel, source);
       return "";
     }
     // Every image of a results line is a PNG the sweep wrote; anything else a path names (a
@@ -479,17 +478,37 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
     title = "stereobench report: " + joined;
   }
   json data = report_data(results, title, papers, image_path);
+  // Missing images: a few named one by one, many (a results file copied without its cells/
+  // folder) in one line. The page, which may be shared, does not name this machine's folders.
+  std::vector<std::string> page_warnings = summary.warnings;
+  constexpr size_t kNamedMissing = 5;
+  for (size_t i = 0; i < missing.size() && (missing.size() <= kNamedMissing || i < 3); ++i) {
+    summary.warnings.push_back(fmt::format("{}: image {} is missing (looked for {}); the viewer shows it as "
+                                           "unavailable",
+                                           results.path.string(), missing[i].first, missing[i].second.string()));
+    page_warnings.push_back(fmt::format("{}: image {} is missing; the viewer shows it as unavailable",
+                                        results.path.filename().string(), missing[i].first));
+  }
+  if (missing.size() > kNamedMissing) {
+    const std::string more = fmt::format("and {} more images are missing (of {} the results name); was the results "
+                                         "file moved without the cells/ folder beside it?",
+                                         missing.size() - 3, missing.size());
+    summary.warnings.push_back(fmt::format("{}: {}", results.path.string(), more));
+    page_warnings.push_back(fmt::format("{}: {}", results.path.filename().string(), more));
+  }
   // A sweep still running, stopped, or one shard of several: its figures cover part of it.
   std::vector<const json*> records;
   for (const auto& c : results.cells) records.push_back(&c.json);
-  if (const auto coverage = validation::cell_coverage(records); coverage && coverage->present < coverage->expected)
-    summary.warnings.push_back(fmt::format("{}: {} of the {} cells of sweep '{}' are in the results: the sweep is "
-                                           "unfinished (still running, stopped, or one shard of several); the "
-                                           "figures cover these cells only",
-                                           results.path.string(), coverage->present, coverage->expected,
-                                           results.cells.front().json["sweep"].get<std::string>()));
+  if (const auto coverage = validation::cell_coverage(records); coverage && coverage->present < coverage->expected) {
+    const std::string unfinished =
+        fmt::format("{} of the {} cells of sweep '{}' are in the results: the sweep is unfinished (still running, "
+                    "stopped, or one shard of several); the figures cover these cells only",
+                    coverage->present, coverage->expected, results.cells.front().json["sweep"].get<std::string>());
+    summary.warnings.push_back(fmt::format("{}: {}", results.path.string(), unfinished));
+    page_warnings.push_back(fmt::format("{}: {}", results.path.filename().string(), unfinished));
+  }
   // The page lists every warning the terminal shows: skipped lines, missing images, missing cells.
-  data["warnings"] = summary.warnings;
+  data["warnings"] = page_warnings;
   if (!options.history.is_null()) data["history"] = options.history;
   if (!options.history_note.empty()) data["history_note"] = options.history_note;
   summary.paper_experiment = data["paper"].is_object() ? data["paper"]["experiment"].get<std::string>() : "";

@@ -350,6 +350,24 @@ TEST(Report, WarnsOnTornTailAndMissingImagesAndGuardsForeignFolders) {
     for (const auto& e : fs::recursive_directory_iterator(dir / "leak" / "images")) copied += e.is_regular_file();
   EXPECT_EQ(copied, 0u) << "nothing copied";
   EXPECT_TRUE(embedded_data(dir / "leak" / "index.html")["cells"][0]["images"]["left"].is_null());
+
+  // Many images missing (a results file copied without its cells/ folder): three named, the rest
+  // counted in one line (one warning each used to flood the terminal and the page), and the page
+  // names no folder of this machine.
+  json many = minimal_line("a", 0);
+  many["images"] = {{"left_png", "cells/0000/left.png"}, {"truth_png", "cells/0000/truth.png"}, {"pipelines", json::object()}};
+  for (const char* p : {"plain-rt", "repro-rt"})
+    many["images"]["pipelines"][p] = {{"right_png", std::string("cells/0000/") + p + "_r.png"},
+                                      {"diff_png", std::string("cells/0000/") + p + "_d.png"},
+                                      {"ssim_png", std::string("cells/0000/") + p + "_s.png"}};
+  write_text(dir / "moved" / "results.jsonl", many.dump() + "\n");
+  const test::CliRun moved = test::run_cli("report " + quoted(dir / "moved" / "results.jsonl") + " --out " +
+                                           quoted(dir / "moved-report"));
+  ASSERT_EQ(moved.code, 0) << moved.out;
+  EXPECT_NE(moved.out.find("and 5 more images are missing (of 8 the results name)"), std::string::npos) << moved.out;
+  const json page = embedded_data(dir / "moved-report" / "index.html");
+  EXPECT_EQ(page["warnings"].size(), 4u) << page["warnings"].dump();
+  EXPECT_EQ(page["warnings"].dump().find(dir.path().string()), std::string::npos) << page["warnings"].dump();
 }
 
 TEST(Report, ImagesOfEveryPipelineKeepTheirOwnFolderAndALinkedResultsFileFindsThem) {
