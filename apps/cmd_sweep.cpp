@@ -81,11 +81,18 @@ class ProgressPrinter {
     const std::string eta = done > 0 ? clock_text(elapsed / double(done) * double(total_ - done)) : "--:--";
     constexpr size_t kBar = 24;
     const size_t filled = total_ > 0 ? done * kBar / total_ : kBar;
-    std::string line = fmt::format("[{}{}] {}/{} cells  elapsed {}  ETA {}  {}", std::string(filled, '#'),
-                                   std::string(kBar - filled, '-'), done, total_, clock_text(elapsed), eta, last);
+    const std::string counts = fmt::format("{}/{} cells  elapsed {}  ETA {}", done, total_, clock_text(elapsed), eta);
     winsize ws{};
     const size_t width = ::ioctl(STDERR_FILENO, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0 ? ws.ws_col : 100;
-    if (line.size() >= width) line.resize(width - 1);
+    // On a narrow terminal the bar goes first, so that the counts and the ETA stay; the last cell's
+    // id is cut to the width, between characters (ids may hold any UTF-8 of scene file names).
+    const std::string bar = fmt::format("[{}{}] ", std::string(filled, '#'), std::string(kBar - filled, '-'));
+    std::string line = (bar.size() + counts.size() < width ? bar : std::string()) + counts + "  " + last;
+    if (line.size() >= width) {
+      size_t cut = width - 1;
+      while (cut > 0 && (static_cast<unsigned char>(line[cut]) & 0xC0) == 0x80) --cut;
+      line.resize(cut);
+    }
     fmt::print(stderr, "\r{}\x1b[K", line);
   }
 
