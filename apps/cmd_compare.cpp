@@ -255,8 +255,9 @@ Metrics (DESIGN 6.2) are computed on 8-bit sRGB images:
          structural_similarity to 1e-4
   error pixels  pixels whose largest channel difference exceeds --error-threshold codes
 With --mask every metric is over the mask's non-zero pixels only (SSIM: those outside the border).
-A stereo EXR (left./right. layers) needs --eye to pick the eye (for A, B and the mask alike);
---eye is ignored for single-image files.
+A stereo EXR (left./right. layers, parts named left/right, or OpenEXR multi-view with the default
+view unnamed) needs --eye to pick the eye (for A, B and the mask alike); a file of one tagged eye
+reads with --eye for it; --eye is ignored for single-image files.
 Pictures: --diff maps each pixel's largest channel difference d on a fixed scale log2(1+d)/8 from
 black (0) through violet, red, orange and yellow to pale yellow (255); --ssim-map shows SSIM 1 as
 white and darkens through yellow, orange, red and violet to black at SSIM 0 (scale sqrt(1-SSIM));

@@ -47,25 +47,24 @@ void check_eye(std::string_view eye) {
 /// it holds a stereo pair (InputError without a choice).
 Image read_exr_image(const fs::path& path, std::string_view eye, std::string& taken_eye) {
   check_eye(eye);
-  std::optional<std::pair<Image, Image>> pair;
   try {
     return io::read_exr(path);
   } catch (const InputError&) {
-    // Either a stereo pair or an unreadable file. A pair that cannot be read reports its own fault
-    // (a truncated file, say), not that it is a pair.
+    // Either a file of eyes or an unreadable file. One of eyes that cannot be read reports its own
+    // fault (a truncated file, say), not that it holds eyes.
     bool stereo = false;
     try {
       stereo = io::exr_holds_stereo_pair(path);
     } catch (const Error&) {
     }
     if (!stereo) throw;
-    pair = io::read_exr_stereo(path);
   }
   if (eye.empty())
-    throw InputError(
-        fmt::format("{} is a stereo EXR (left and right eyes); choose one with --eye left|right", path.string()));
+    throw InputError(fmt::format("{} is a stereo EXR (its channels are of the left and right eyes); choose one "
+                                 "with --eye left|right",
+                                 path.string()));
   taken_eye = std::string(eye);
-  return eye == "left" ? std::move(pair->first) : std::move(pair->second);
+  return io::read_exr_eye(path, eye == "right");
 }
 
 /// The planes of an image read from a file other than its alpha: what carries colour or grey.

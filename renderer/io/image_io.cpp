@@ -921,6 +921,28 @@ std::pair<Image, Image> read_exr_stereo(const fs::path& path) {
   });
 }
 
+Image read_exr_eye(const fs::path& path, bool right) {
+  return guarded_read(path, [&] {
+    InputFile file = open_file(path);
+    const EyeTag wanted = right ? EyeTag::right : EyeTag::left;
+    std::vector<const InChannel*> mine, unassigned;
+    bool other = false;
+    for (const InChannel& ch : file.channels) {
+      if (ch.eye == wanted)
+        mine.push_back(&ch);
+      else if (ch.eye == EyeTag::none)
+        unassigned.push_back(&ch);
+      else
+        other = true;
+    }
+    if (mine.empty() && other) mine = unassigned;  // multi-view: the default view is this eye
+    if (mine.empty())
+      throw InputError(fmt::format("{} holds no {} eye (channels: {})", path.string(), right ? "right" : "left",
+                                   channel_list(file)));
+    return std::move(build_images(file, {plan_planes(mine)}).front());
+  });
+}
+
 bool exr_holds_stereo_pair(const fs::path& path) {
   return guarded_read(path, [&] {
     const InputFile file = open_file(path);

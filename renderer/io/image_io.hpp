@@ -62,6 +62,12 @@ void write_exr(const std::filesystem::path& path, const Image& image, const Imag
 /// named left/right): read_exr_stereo is the reader for it. Reads the header only.
 [[nodiscard]] bool exr_holds_stereo_pair(const std::filesystem::path& path);
 
+/// One eye of an EXR whose channels are tagged with eyes (exr_holds_stereo_pair): its own channels,
+/// or, where it has none and the other eye has some, the unnamed ones (OpenEXR multi-view's default
+/// view). A file holding that eye alone reads as well as a pair. InputError naming the channels
+/// when the file has no channel of that eye.
+[[nodiscard]] Image read_exr_eye(const std::filesystem::path& path, bool right);
+
 /// Reads a single-image EXR (or any file OpenImageIO reads as float) with the channel mapping of
 /// read_exr_stereo: a plain R,G,B(,A) file gives "rgb" (and "alpha"), "Z" gives "depth".
 /// InputError if the file is missing, unreadable, or holds a stereo pair (use read_exr_stereo): any

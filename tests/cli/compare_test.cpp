@@ -312,6 +312,16 @@ TEST_F(Compare, StereoExrNeedsAnEye) {
     EXPECT_EQ(r.code, 0) << r.out;
     r = compare(q(path("mv.exr")) + " " + q(path("a.png")) + " --eye left --fail-psnr 50");
     EXPECT_EQ(r.code, 2) << r.out;
+    // One eye alone, tagged: read with --eye for it (it was refused as a pair without its other eye).
+    ASSERT_EQ(std::system(("oiiotool " + q(path("a.png")) + " --ch R,G,B --colorconvert sRGB linear -d float "
+                           "--chnames left.R,left.G,left.B -o " + q(path("left-only.exr")))
+                              .c_str()),
+              0);
+    r = compare(q(path("left-only.exr")) + " " + q(path("a.png")) + " --eye left --fail-psnr 50");
+    EXPECT_EQ(r.code, 0) << r.out;
+    r = compare(q(path("left-only.exr")) + " " + q(path("a.png")) + " --eye right");
+    EXPECT_EQ(r.code, 3) << r.out;
+    EXPECT_NE(r.out.find("left-only.exr holds no right eye (channels: "), std::string::npos) << r.out;
   }
 
   // A damaged pair reports the damage, not that it is a pair.
