@@ -191,6 +191,18 @@ struct MeasuredPeak {
   return first;
 }
 
+/// The speed-up of `method` over `reference` in one row, paired per repetition, whichever baseline
+/// the row's speed-ups were taken against (kim-complexity's crossover is over plain-raster). Both
+/// must be among the row's pipelines (the preset checks its --pipelines).
+[[nodiscard]] inline double speedup_between(const sb::BenchResult& row, std::string_view reference,
+                                            std::string_view method) {
+  const auto named = [&](std::string_view name) -> const sb::PipelineBench& {
+    return *std::find_if(row.pipelines.begin(), row.pipelines.end(),
+                         [&](const sb::PipelineBench& b) { return b.name == name; });
+  };
+  return sb::paired_speedup(named(reference), named(method)).median;
+}
+
 /// The head of a preset's JSON file (preset, pipelines, baseline, repetitions, threads, versions),
 /// with "complete": false and no rows yet.
 [[nodiscard]] nlohmann::json preset_json(const PresetRun& run, const Executor& executor);

@@ -108,13 +108,15 @@ BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const Benc
     }
   const size_t base = static_cast<size_t>(
       std::find(config.pipelines.begin(), config.pipelines.end(), config.baseline) - config.pipelines.begin());
-  for (PipelineBench& b : result.pipelines) {
-    std::vector<double> ratios;
-    for (int rep = 0; rep < config.repetitions; ++rep)
-      ratios.push_back(result.pipelines[base].total_seconds[static_cast<size_t>(rep)] / b.total_seconds[static_cast<size_t>(rep)]);
-    b.speedup = summarize(ratios);
-  }
+  for (PipelineBench& b : result.pipelines) b.speedup = paired_speedup(result.pipelines[base], b);
   return result;
+}
+
+Summary paired_speedup(const PipelineBench& base, const PipelineBench& b) {
+  std::vector<double> ratios;
+  for (size_t rep = 0; rep < base.total_seconds.size() && rep < b.total_seconds.size(); ++rep)
+    ratios.push_back(base.total_seconds[rep] / b.total_seconds[rep]);
+  return summarize(ratios);
 }
 
 nlohmann::json bench_to_json(const BenchResult& r) {

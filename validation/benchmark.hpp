@@ -68,6 +68,10 @@ struct PipelineBench {
   [[nodiscard]] std::optional<Summary> right_over_left() const;
 };
 
+/// `base`'s total over `b`'s, paired per repetition (both of one run_bench) and summarized: the
+/// speed-up of `b` over `base`.
+[[nodiscard]] Summary paired_speedup(const PipelineBench& base, const PipelineBench& b);
+
 struct BenchResult {
   std::vector<PipelineBench> pipelines;
   std::string baseline;

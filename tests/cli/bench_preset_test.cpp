@@ -440,6 +440,46 @@ TEST(BenchPresetKim, ComplexityFirstRowSplitsRenderingAndWarping) {
   }
 }
 
+TEST(BenchPresetKim, TheCrossoverIsOverPlainRasterWhateverTheBaseline) {
+  // With bidir-warp itself as --baseline its speed-up in the table is 1x, and the crossover used it:
+  // "none" whatever the times. It is Table 3's, bidir-warp over plain-raster paired per repetition.
+  test::ScratchDir dir("kimcross");
+  const CliRun r = test::run_cli("bench --preset kim-complexity --preset-rows 1 --resolution 64x36 --repetitions 3 "
+                                 "--warmup 0 --pipelines plain-raster,bidir-warp --baseline bidir-warp --scenes-dir '" +
+                                 (dir / "scenes").string() + "' --json '" + (dir / "c.json").string() + "'");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const json j = json::parse(test::read_text(dir / "c.json"));
+  std::map<std::string, std::vector<double>> samples;
+  for (const json& p : j.at("rows")[0].at("bench").at("pipelines"))
+    samples[p.at("name").get<std::string>()] = p.at("total_samples_s").get<std::vector<double>>();
+  std::vector<double> ratios;
+  for (size_t k = 0; k < 3; ++k) ratios.push_back(samples.at("plain-raster")[k] / samples.at("bidir-warp")[k]);
+  std::sort(ratios.begin(), ratios.end());
+  const bool faster = cli::speedup_above_one(ratios[1]);
+  EXPECT_EQ(j.at("crossover").at("value").is_null(), !faster) << j.at("crossover").dump();
+  EXPECT_NE(r.out.find("the table's speed-ups are over --baseline bidir-warp"), std::string::npos) << r.out;
+}
+
+TEST(BenchPresetKim, SpeedupBetweenTwoPipelinesIgnoresTheRowsBaseline) {
+  // A row timed against rt-adelson: bidir-warp's speed-up over plain-raster comes from their own
+  // samples, paired per repetition (the crossover took the row's speed-up over the baseline).
+  BenchResult row;
+  row.baseline = "rt-adelson";
+  const auto add = [&](const char* name, std::vector<double> totals, double speedup) {
+    PipelineBench b;
+    b.name = name;
+    b.total_seconds = std::move(totals);
+    b.speedup.median = speedup;
+    row.pipelines.push_back(b);
+  };
+  add("rt-adelson", {0.9, 1.0, 1.1}, 1.0);
+  add("plain-raster", {0.2, 0.3, 0.2}, 4.0);
+  add("bidir-warp", {0.25, 0.2, 0.4}, 3.0);
+  // Ratios 0.8, 1.5, 0.5: median 0.8, below 1, although the row's figure for bidir-warp is 3.
+  EXPECT_DOUBLE_EQ(cli::speedup_between(row, "plain-raster", "bidir-warp"), 0.8);
+  EXPECT_DOUBLE_EQ(cli::speedup_between(row, "bidir-warp", "plain-raster"), 1.25);
+}
+
 TEST(BenchPresetKim, PeakEstimateExtrapolatesFromTheLargestMeasuredRows) {
   const uint64_t base = 100;
   // No row measured: the prior.
