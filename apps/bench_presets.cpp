@@ -276,6 +276,12 @@ StereoRig speed_row_rig(const Scene& scene, const PresetRun& run, const PresetRo
 
 }  // namespace
 
+void PresetRun::timing_starts() const {
+  if (json_cleared_) return;
+  remove_earlier_output(json_out, "--json");
+  json_cleared_ = true;
+}
+
 void run_bench_preset(const PresetRun& run, const Executor& executor) {
   const BenchPreset& preset = *run.preset;
   run.config.validate();  // before any scene is generated or loaded
@@ -328,6 +334,7 @@ void run_bench_preset(const PresetRun& run, const Executor& executor) {
       }
       if (i == 0) check_series_rigs(run, series, n, path, scene, speed_row_rig);
       const StereoRig rig = speed_row_rig(scene, run, row);
+      run.timing_starts();
       const BenchResult r = run_bench(prepared, rig, run.config, executor);
       print_table_row(layout, row.value, r);
 

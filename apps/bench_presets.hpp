@@ -88,6 +88,14 @@ struct PresetRun {
   RigOverrides overrides;
   std::string scenes_dir;
   std::string json_out;      ///< rewritten after every row; empty = none
+
+  /// Called as a row's timing starts: the first call removes an earlier --json file, so that a run
+  /// stopped from here on leaves none of another run's (one refused before, as a usage error or for
+  /// memory, keeps it); later calls do nothing.
+  void timing_starts() const;
+
+ private:
+  mutable bool json_cleared_ = false;
 };
 
 /// How many rows of `series` a run takes: the first `rows_per_series` (PresetRun's), or all of

@@ -308,6 +308,7 @@ void run_kim_focal(const PresetRun& run, const Executor& executor) {
         result.quality.emplace_back(name, validation::compare_images(image, ref->second));
         quality[name] = validation::to_json(result.quality.back().second);
       }
+      run.timing_starts();
       result.bench = run_bench(*prepared, rig, run.config, executor);
 
       nlohmann::json median_ms = nlohmann::json::object(), speedup = nlohmann::json::object();
@@ -432,6 +433,7 @@ void run_kim_complexity(const PresetRun& run, const Executor& executor) {
         const StereoRig rig = row_rig(scene, run, row);
         if (!header_printed) fmt::print("rig {}\n", describe(rig));
         print_header();
+        run.timing_starts();
         const BenchResult r = run_bench(prepared, rig, run.config, executor);
         const uint64_t peak = peak_resident_bytes();
         memory["peak_bytes"] = peak;

@@ -85,8 +85,11 @@ void run_preset_command(const BenchArgs& a) {
   run.preset = &find_bench_preset(a.preset);
   if (a.preset_rows < 0)
     throw InputError(fmt::format("--preset-rows {} must not be negative (0 = every row)", a.preset_rows));
-  if (a.json_out == "-")
-    throw InputError("--json - with --preset: the file is rewritten after every row; give a file name");
+  std::error_code ec;
+  if (a.json_out == "-" || (std::filesystem::exists(a.json_out, ec) && !std::filesystem::is_regular_file(a.json_out, ec)))
+    throw InputError(fmt::format("--json {} with --preset: the file is rewritten after every row, which {} cannot be; "
+                                 "give a file name",
+                                 a.json_out, a.json_out == "-" ? "standard output" : "a device or pipe"));
   run.overrides = a.rig.overrides();
   run.config = bench_config(a, preset_pipelines(*run.preset));
   // The JSON is rewritten after every row: it must not be a scene file a row reads (or its stamp,
@@ -99,7 +102,7 @@ void run_preset_command(const BenchArgs& a) {
       refuse_overwriting({{"a scene file of the preset", &file}, {"a scene file's stamp", &stamp}},
                          {{"--json", &a.json_out}});
     }
-  remove_earlier_output(a.json_out, "--json");
+  // An earlier --json file is removed as the first row's timing starts (PresetRun::timing_starts).
   run.rows_per_series = a.preset_rows;
   run.scenes_dir = a.scenes_dir;
   run.json_out = a.json_out;
@@ -116,11 +119,12 @@ void run_bench_command(const BenchArgs& a) {
   const scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
   const std::string scene_file = loaded.file.string(), stamp = scenes::stamp_path(loaded.file).string();
   refuse_overwriting({{"the scene file", &scene_file}, {"the scene file's stamp", &stamp}}, {{"--json", &a.json_out}});
-  // From here the run's own --json, or none: an earlier one is not left to be read as this run's.
-  remove_earlier_output(a.json_out, "--json");
   const Scene& scene = loaded.scene;
   const size_t lights_in_file = loaded.lights_in_file;
   const StereoRig rig = resolve_rig(scene, overrides);
+  check_bench(rig, config);
+  // From here the run's own --json, or none: an earlier one is not left to be read as this run's.
+  remove_earlier_output(a.json_out, "--json");
   const RenderScene prepared(scene);
   fmt::print(out, "scene {} ({} triangles, {}), {}, {} threads, {} warm-up + {} repetitions\n", scene.name,
              scene.triangle_count(), describe_lights(scene.lights.size(), lights_in_file), describe(rig),

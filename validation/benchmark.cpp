@@ -61,10 +61,15 @@ std::string given_options(const BenchConfig& config) {
   return text;
 }
 
+void check_bench(const StereoRig& rig, const BenchConfig& config) {
+  require_frame_memory(rig.params().width, rig.params().height, "benchmark");
+  for (const BenchEntry& e : config.entries()) e.entry.check_rig(e.options, rig);  // before any entry renders
+}
+
 BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const BenchConfig& config,
                       const Executor& executor, const std::function<void(const std::string&)>& progress) {
   const std::vector<BenchEntry> entries = config.entries();
-  require_frame_memory(rig.params().width, rig.params().height, "benchmark");
+  check_bench(rig, config);
 
   BenchResult result;
   result.baseline = config.baseline;
@@ -75,7 +80,6 @@ BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const Benc
     result.pipelines[i].name = entries[i].entry.name;
     result.pipelines[i].options = entries[i].options.values();
   }
-  for (const BenchEntry& e : entries) e.entry.check_rig(e.options, rig);  // before any entry renders
   const RenderContext ctx{executor};
   const auto render = [&](size_t i) { return entries[i].entry.pipeline->render(scene, rig, entries[i].options, ctx); };
   for (int w = 0; w < config.warmup; ++w)

@@ -79,6 +79,10 @@ struct BenchResult {
   int threads = 0;
 };
 
+/// What run_bench checks before anything renders: the frames fit in memory (require_frame_memory)
+/// and every entry can work with the rig (InputError, check_rig).
+void check_bench(const StereoRig& rig, const BenchConfig& config);
+
 /// Runs the benchmark. `progress` (may be empty) is called after every run with a short line.
 [[nodiscard]] BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const BenchConfig& config,
                                     const Executor& executor,

@@ -156,12 +156,26 @@ TEST(BenchPreset, BadPresetsAndLightCountsExitWith3AndSayWhy) {
       {"bench --scene box-wall --resolution 32x18 --option plain-rt.=4" + quick,
        {"--option plain-rt.=4: name it PIPELINE.OPTION=VALUE"}},
       {"bench --preset al-hagri-lights --json -" + quick, {"--json - with --preset"}},
+      {"bench --preset al-hagri-lights --json /dev/null" + quick,
+       {"--json /dev/null with --preset", "a device or pipe cannot be"}},
   };
   for (const Case& c : cases) {
     const CliRun r = test::run_cli(c.args);
     EXPECT_EQ(r.code, 3) << c.args << "\n" << r.out;
     for (const std::string& e : c.expect)
       EXPECT_NE(r.out.find(e), std::string::npos) << c.args << "\nexpected: " << e << "\ngot: " << r.out;
+  }
+  // A run refused before its timing starts keeps an earlier --json (it was removed first): a
+  // preset's pipelines, a rig a pipeline refuses.
+  const std::string keep = (dir / "keep.json").string();
+  for (const std::string& args :
+       {"bench --preset kim-complexity --pipelines bw-warp -n 1 -w 0" + sd,
+        "bench --scene box-wall --resolution 64x36 --pipelines rt-buffer --baseline rt-buffer --max-disparity 3000 -n 1 "
+        "-w 0" + sd}) {
+    { std::ofstream(keep) << "{\"earlier\": true}\n"; }
+    const CliRun r = test::run_cli(args + " --json '" + keep + "'");
+    EXPECT_EQ(r.code, 3) << args << "\n" << r.out;
+    EXPECT_EQ(test::read_text(keep), "{\"earlier\": true}\n") << args;
   }
   // Nothing of a preset is generated on bad input (box-wall is, by the --lights cases).
   EXPECT_FALSE(std::filesystem::exists(dir / "scenes" / "dragon_lights-10.glb"));
