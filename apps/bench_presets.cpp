@@ -181,7 +181,8 @@ std::string presets_help() {
       "pipelines run in turn, times are medians over the repetitions and speed-ups are paired per\n"
       "repetition against the baseline; --json writes every row (rewritten after each; a file, not\n"
       "'-'). In Al-Hagri's presets e is the disparity at infinity in pixels (--max-disparity); Kim's\n"
-      "give it in millimetres (--interaxial). --repetitions, --warmup, --threads, --option and --vfov\n"
+      "tables give it in millimetres (64 mm; the presets set it). --repetitions, --warmup, --threads,\n"
+      "--option and --vfov\n"
       "apply to every row, --convergence where the preset leaves it open; --preset-rows K runs the\n"
       "first K rows of each series (a quick version).\n";
   const auto wrap = [&text](const std::string& words_text) {

@@ -73,6 +73,7 @@ BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const Benc
 
   BenchResult result;
   result.baseline = config.baseline;
+  result.warmup = config.warmup;
   result.repetitions = config.repetitions;
   result.threads = executor.threads();
   result.pipelines.resize(entries.size());
@@ -87,8 +88,9 @@ BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const Benc
       (void)render(i);
       if (progress) progress(fmt::format("warm-up {}/{} {}", w + 1, config.warmup, entries[i].entry.name));
     }
-  // Each repetition starts one pipeline further along the list (a rotation), so that every
-  // pipeline runs in every place of a repetition as often as the others: the one run first was
+  // Each repetition starts one pipeline further along the list (a rotation), so that no pipeline
+  // always runs first (every one runs in every place equally often when the repetitions are a
+  // multiple of the pipelines; with fewer, the first few lead once each): the one run first was
   // measured up to 10 % slower in its first stage (bistro HD, five repetitions: plain-raster's
   // left_shading 1044 ms when first against repro-rt's 939 ms second for the same work, and
   // 1068 / 1088 ms with the order swapped), which favoured every pipeline listed after the baseline.
@@ -106,6 +108,7 @@ BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const Benc
       b.right_seconds.push_back(r.timings.eye_total(StageEye::right));
       b.both_seconds.push_back(r.timings.eye_total(StageEye::both));
       b.shared_stages = r.timings.shared_stages();
+      for (const StageTime& s : r.timings.stages()) b.stage_eyes[s.name] = stage_eye_name(s.eye);
       b.counters = r.counters.snapshot();
       if (progress)
         progress(fmt::format("repetition {}/{} {} {:.1f} ms", rep + 1, config.repetitions, b.name, r.timings.total() * 1e3));
@@ -124,7 +127,8 @@ Summary paired_speedup(const PipelineBench& base, const PipelineBench& b) {
 }
 
 nlohmann::json bench_to_json(const BenchResult& r) {
-  nlohmann::json out = {{"baseline", r.baseline}, {"repetitions", r.repetitions}, {"threads", r.threads}};
+  nlohmann::json out = {
+      {"baseline", r.baseline}, {"warmup", r.warmup}, {"repetitions", r.repetitions}, {"threads", r.threads}};
   auto summary = [](const Summary& s) { return nlohmann::json{{"median", s.median}, {"min", s.min}, {"max", s.max}}; };
   for (const PipelineBench& b : r.pipelines) {
     const std::optional<Summary> share = b.right_over_left();
@@ -137,6 +141,8 @@ nlohmann::json bench_to_json(const BenchResult& r) {
                                 {"total_s", summary(summarize(b.total_seconds))},
                                 {"total_samples_s", b.total_seconds},
                                 {"stages_s", stages},
+                                {"stage_order", b.stage_order},
+                                {"stage_eyes", b.stage_eyes},
                                 {"speedup_vs_baseline", summary(b.speedup)},
                                 {"eyes_s",
                                  {{"left", summary(summarize(b.left_seconds))},
