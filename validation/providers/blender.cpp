@@ -27,7 +27,7 @@ namespace {
 namespace fs = std::filesystem;
 
 /// Bumped whenever the export, the script or the settings change.
-constexpr const char* kRevision = "blender-export-6";
+constexpr const char* kRevision = "blender-export-7";  // 7: morph targets at their base shape, skins in their bind pose
 /// Cut-out holes a camera or shadow ray may pass in Cycles (transparent bounces); ours pass any.
 constexpr int kTransparentBounces = 64;
 /// Environment variable naming the Blender executable (a path, or a name looked up on PATH).
