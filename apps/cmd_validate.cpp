@@ -89,7 +89,9 @@ void run_validate(const ValidateArgs& a) {
       a.no_cache || a.cache.empty() ? std::nullopt
                                     : std::optional<validation::TruthCache>(validation::TruthCache(a.cache));
   const validation::ValidationTarget target = validation::prepare_target(
-      prepared, loaded.file, rig, *provider, cache ? &*cache : nullptr, out / "work" / provider->name(), executor);
+      // A folder per scene and provider: the command a record gives to render its truth again runs
+      // there, and another scene validated into the same --out would replace its files.
+      prepared, loaded.file, rig, *provider, cache ? &*cache : nullptr, out / "work" / scene_stem, executor);
   fmt::print("truth: {} ({}), {}{:.2f} s; true disocclusions {:.3f} % of the image\n", provider->name(),
              target.truth.render.tool_version, target.truth.cached ? "from the cache, rendered in " : "",
              target.truth.render.seconds,

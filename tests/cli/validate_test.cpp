@@ -106,6 +106,15 @@ TEST(Validate, EmptyCacheFolderTurnsTheCacheOff) {
   EXPECT_FALSE(record["truth"]["cached"].get<bool>());
   for (const auto& entry : fs::directory_iterator(dir.path()))
     EXPECT_EQ(entry.path().filename(), "out") << "left behind: " << entry.path();
+  // Another scene into the same --out renders in a work folder of its own: the first record's
+  // command, which renders its truth again, still finds its own scene there.
+  std::string other = args;
+  other.replace(other.find("--scene box-wall"), std::string("--scene box-wall").size(), "--scene thin-pole");
+  ASSERT_EQ(test::run_shell(other).code, 0);
+  const std::string command = record["truth"]["command"].get<std::string>();
+  EXPECT_NE(command.find((dir / "out" / "work" / "box-wall_povray").string()), std::string::npos) << command;
+  EXPECT_TRUE(fs::exists(dir / "out" / "work" / "box-wall_povray"));
+  EXPECT_TRUE(fs::exists(dir / "out" / "work" / "thin-pole_povray"));
 }
 
 TEST(Validate, PipelineOptionsApplyAndAreChecked) {
