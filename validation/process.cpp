@@ -29,6 +29,7 @@
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/unique_fd.hpp"
+#include "renderer/text.hpp"
 
 extern char** environ;
 
@@ -235,6 +236,19 @@ std::optional<fs::path> find_program(const std::string& name) {
     path.remove_prefix(colon + 1);
   }
   return std::nullopt;
+}
+
+std::string shell_command(const std::vector<std::string>& argv, const ProcessOptions& options) {
+  std::string out;
+  if (!options.cwd.empty()) out += "cd " + shell_quote(options.cwd.string()) + " && ";
+  if (!options.unset_env.empty() || !options.set_env.empty()) {
+    out += "env";
+    for (const std::string& u : options.unset_env) out += " -u " + u;
+    for (const auto& [k, v] : options.set_env) out += " " + k + "=" + shell_quote(v);
+    out += " ";
+  }
+  for (size_t i = 0; i < argv.size(); ++i) out += (i > 0 ? " " : "") + shell_quote(argv[i]);
+  return out;
 }
 
 ProcessResult run_process(const std::vector<std::string>& argv, const ProcessOptions& options) {

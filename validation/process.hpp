@@ -40,6 +40,11 @@ struct ProcessOptions {
   std::chrono::milliseconds kill_grace{2000};
 };
 
+/// The shell command that runs `argv` as run_process does with `options`, every word quoted: its
+/// folder (cd), the variables it removes and sets (env -u, K=V), then the program and its
+/// arguments. For records and messages that say how to run a tool again by hand.
+[[nodiscard]] std::string shell_command(const std::vector<std::string>& argv, const ProcessOptions& options);
+
 /// How a program ended and what it wrote.
 struct ProcessResult {
   int exit_code = -1;      ///< the exit status; -1 when a signal ended it

@@ -530,6 +530,11 @@ TEST(BlenderDeterminism, TwoRendersAreBitIdenticalAtAnyThreadCount) {
   EXPECT_EQ(b.settings.at("threads"), 2);
   EXPECT_FALSE(a.command.empty());
   EXPECT_NE(a.command.find("--factory-startup"), std::string::npos);
+  // The recorded command runs as it stands, from a folder with a blank in its name and a shell
+  // with a Python environment's variables (it was unquoted, and ran Blender in that environment).
+  const TruthRender c = render_truth(*provider, prepared, file, rig, work / "with blank", 1);
+  const test::CliRun again = test::run_shell("PYTHONPATH=/nowhere VIRTUAL_ENV=/nowhere " + c.command);
+  EXPECT_EQ(again.code, 0) << c.command << "\n" << again.out;
 }
 
 TEST(BlenderFailure, MissingExecutableIsUnavailableAndAToolError) {

@@ -50,18 +50,9 @@ struct Command {
 
 /// Shell-quoted form of the command (for records and messages; not used to run it).
 std::string quoted(const Command& c) {
-  const auto q = [](const std::string& s) { return shell_quote(s); };
-  std::string out;
-  if (!c.options.cwd.empty()) out += "cd " + q(c.options.cwd.string()) + " && ";
-  if (!c.options.unset_env.empty()) {
-    out += "env";
-    for (const std::string& u : c.options.unset_env) out += " -u " + u;
-    out += " ";
-  }
-  for (const auto& [k, v] : c.options.set_env) out += k + "=" + q(v) + " ";
-  out += q(c.executable.string());
-  for (const std::string& a : c.args) out += " " + q(a);
-  return out;
+  std::vector<std::string> argv{c.executable.string()};
+  argv.insert(argv.end(), c.args.begin(), c.args.end());
+  return shell_command(argv, c.options);
 }
 
 /// The distinct warning lines of a POV-Ray log (at most `limit`).
