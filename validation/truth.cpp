@@ -11,6 +11,19 @@
 
 namespace sb::validation {
 
+std::vector<std::string> truth_warnings(const TruthRender& render) {
+  std::vector<std::string> out;
+  const nlohmann::json& s = render.settings;
+  if (const auto it = s.find("export_warnings"); it != s.end() && it->is_array())
+    for (const nlohmann::json& w : *it)
+      if (w.is_string()) out.push_back(fmt::format("{} truth: {}", render.provider, w.get<std::string>()));
+  if (const auto it = s.find("textures_wrapped_on_both_axes"); it != s.end() && it->is_array() && !it->empty())
+    out.push_back(fmt::format("{} truth: texture(s) {} repeat along one axis and clamp along the other; Blender "
+                              "repeats them along both",
+                              render.provider, it->dump()));
+  return out;
+}
+
 Image rgb_plane_only(const Image& image) {
   Image out(image.width(), image.height());
   const Plane& src = image.plane(planes::rgb);

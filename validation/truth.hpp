@@ -76,6 +76,11 @@ class TruthProvider {
 /// InputError without an "rgb" plane.
 [[nodiscard]] Image rgb_plane_only(const Image& image);
 
+/// What a provider's settings say makes its truth differ from the scene (POV-Ray's
+/// export_warnings, Blender's textures_wrapped_on_both_axes), as lines for the terminal; also for
+/// a truth from the cache, whose settings are kept.
+[[nodiscard]] std::vector<std::string> truth_warnings(const TruthRender& render);
+
 /// The providers' names in their canonical order: full, blender, povray.
 [[nodiscard]] std::vector<std::string> truth_provider_names();
 /// A provider by name; InputError listing the names for an unknown one.

@@ -15,6 +15,7 @@
 #include "support/render_support.hpp"
 #include "support/scratch_dir.hpp"
 #include "validation/content_hash.hpp"
+#include "validation/truth.hpp"
 #include "validation/truth_cache.hpp"
 
 namespace sb::validation {
@@ -103,6 +104,23 @@ class TruthCacheTest : public ::testing::Test {
     return {prepared, scene.path, test::rig_at(scene, width, height), dir / "work", 1};
   }
 };
+
+TEST(TruthWarnings, WhatTheSettingsSayDiffersIsSaid) {
+  // Kept in the settings (and so also for a truth from the cache), and printed by validate: they
+  // explain a disagreement that was otherwise only in the JSON.
+  validation::TruthRender povray;
+  povray.provider = "povray";
+  povray.settings = {{"export_warnings", {"mesh 'quad': texture 'image0' clamps to its edge but is read outside"}}};
+  EXPECT_EQ(validation::truth_warnings(povray),
+            std::vector<std::string>{"povray truth: mesh 'quad': texture 'image0' clamps to its edge but is read outside"});
+  validation::TruthRender blender;
+  blender.provider = "blender";
+  blender.settings = {{"textures_wrapped_on_both_axes", {2}}};
+  ASSERT_EQ(validation::truth_warnings(blender).size(), 1u);
+  EXPECT_NE(validation::truth_warnings(blender)[0].find("texture(s) [2] repeat along one axis"), std::string::npos);
+  blender.settings = {{"textures_wrapped_on_both_axes", nlohmann::json::array()}, {"export_warnings", 3}};
+  EXPECT_TRUE(validation::truth_warnings(blender).empty());
+}
 
 TEST_F(TruthCacheTest, RendersOncePerContentAndKeysFollowTheRig) {
   CountingProvider provider;
