@@ -569,6 +569,19 @@ TEST(BlenderFailure, AnExecutableThatIsNotBlenderIsUnavailable) {
       << *why;
 }
 
+TEST(BlenderFailure, ABlenderOlderThanTheScriptNeedsIsUnavailable) {
+  // A Blender 2.79 ran the script and failed inside the import with "exited with code 1".
+  const test::ScratchDir dir;
+  const fs::path fake = dir / "blender";
+  { std::ofstream(fake) << "#!/bin/sh\necho 'Blender 2.79 (sub 7)'\n"; }
+  fs::permissions(fake, fs::perms::owner_all);
+  const ScopedEnv env("STEREOBENCH_BLENDER", fake.string());
+  const auto why = validation::make_truth_provider("blender")->unavailable_reason();
+  ASSERT_TRUE(why.has_value());
+  EXPECT_NE(why->find("Blender 2.79 (sub 7) (" + fake.string() + ") is older than Blender 3.4"), std::string::npos)
+      << *why;
+}
+
 TEST(BlenderFailure, MissingFromPathIsUnavailable) {
   const ScopedEnv unset("STEREOBENCH_BLENDER", std::nullopt);
   const ScopedEnv path("PATH", "/nonexistent");

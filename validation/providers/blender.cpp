@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <map>
 #include <mutex>
@@ -308,11 +309,19 @@ class BlenderProvider final : public TruthProvider {
   std::optional<std::string> unavailable_reason() const override {
     const Located found = locate_blender();
     if (!found.problem.empty()) return found.problem;
+    std::string version;
     try {  // an executable that is not Blender fails here, before anything renders
-      (void)query_version(found.executable);
+      version = query_version(found.executable);
     } catch (const Error& e) {
       return std::string(e.what());
     }
+    // The script drives the glTF importer of Blender 3.4 (Debian 12's) and later; an older one
+    // fails only inside the render with an importer error.
+    int major = 0, minor = 0;
+    if (std::sscanf(version.c_str(), "Blender %d.%d", &major, &minor) == 2 && (major < 3 || (major == 3 && minor < 4)))
+      return fmt::format("{} ({}) is older than Blender 3.4, which the export script needs; install 3.4 or later "
+                         "(`ci/install-deps.sh blender`), or point ${} at one",
+                         version, found.executable.string(), kExecutableVariable);
     return std::nullopt;
   }
   std::string tool_version() const override { return query_version(executable()); }
