@@ -11,9 +11,9 @@
 
 #include "apps/cli_common.hpp"
 #include "renderer/error.hpp"
-#include "renderer/io/json_text.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/gltf_loader.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/io/render_output.hpp"
 #include "scenes/catalog.hpp"
 #include "scenes/generators.hpp"
@@ -182,9 +182,8 @@ std::string presets_help() {
       "repetition against the baseline; --json writes every row (rewritten after each; a file, not\n"
       "'-'). In Al-Hagri's presets e is the disparity at infinity in pixels (--max-disparity); Kim's\n"
       "tables give it in millimetres (64 mm; the presets set it). --repetitions, --warmup, --threads,\n"
-      "--option and --vfov\n"
-      "apply to every row, --convergence where the preset leaves it open; --preset-rows K runs the\n"
-      "first K rows of each series (a quick version).\n";
+      "--option and --vfov apply to every row, --convergence where the preset leaves it open;\n"
+      "--preset-rows K runs the first K rows of each series (a quick version).\n";
   const auto wrap = [&text](const std::string& words_text) {
     std::string line = "     ";
     std::stringstream words(words_text);
@@ -277,7 +276,7 @@ StereoRig speed_row_rig(const Scene& scene, const PresetRun& run, const PresetRo
 
 }  // namespace
 
-void PresetRun::timing_starts() const {
+void PresetRun::output_starts() const {
   if (json_cleared_) return;
   remove_earlier_output(json_out, "--json");
   json_cleared_ = true;
@@ -309,6 +308,7 @@ void run_bench_preset(const PresetRun& run, const Executor& executor) {
 
   nlohmann::json out = preset_json(run, executor);
   const auto write_json = [&] {
+    run.output_starts();
     if (!run.json_out.empty()) write_option_file("--json", run.json_out, io::json_text(out, 2) + "\n");
   };
 
@@ -335,7 +335,7 @@ void run_bench_preset(const PresetRun& run, const Executor& executor) {
       }
       if (i == 0) check_series_rigs(run, series, n, path, scene, speed_row_rig);
       const StereoRig rig = speed_row_rig(scene, run, row);
-      run.timing_starts();
+      run.output_starts();
       const BenchResult r = run_bench(prepared, rig, run.config, executor);
       print_table_row(layout, row.value, r);
 

@@ -89,10 +89,10 @@ struct PresetRun {
   std::string scenes_dir;
   std::string json_out;      ///< rewritten after every row; empty = none
 
-  /// Called as a row's timing starts: the first call removes an earlier --json file, so that a run
-  /// stopped from here on leaves none of another run's (one refused before, as a usage error or for
-  /// memory, keeps it); later calls do nothing.
-  void timing_starts() const;
+  /// Called as a row's timing starts and before the JSON is written: the first call removes an
+  /// earlier --json file, so that a run stopped from here on leaves none of another run's (one
+  /// refused before, as a usage error or for memory, keeps it); later calls do nothing.
+  void output_starts() const;
 
  private:
   mutable bool json_cleared_ = false;

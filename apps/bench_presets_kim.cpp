@@ -18,9 +18,9 @@
 #include "apps/bench_presets.hpp"
 #include "apps/cli_common.hpp"
 #include "renderer/error.hpp"
-#include "renderer/io/json_text.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/gltf_loader.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/io/render_output.hpp"
 #include "renderer/memory.hpp"
 #include "scenes/catalog.hpp"
@@ -264,6 +264,7 @@ void run_kim_focal(const PresetRun& run, const Executor& executor) {
   out["reference"] = kReference;
   out["metrics_version"] = validation::kMetricsVersion;
   const auto write_json = [&] {
+    run.output_starts();
     if (!run.json_out.empty()) write_option_file("--json", run.json_out, io::json_text(out, 2) + "\n");
   };
 
@@ -308,7 +309,7 @@ void run_kim_focal(const PresetRun& run, const Executor& executor) {
         result.quality.emplace_back(name, validation::compare_images(image, ref->second));
         quality[name] = validation::to_json(result.quality.back().second);
       }
-      run.timing_starts();
+      run.output_starts();
       result.bench = run_bench(*prepared, rig, run.config, executor);
 
       nlohmann::json median_ms = nlohmann::json::object(), speedup = nlohmann::json::object();
@@ -359,6 +360,7 @@ void run_kim_complexity(const PresetRun& run, const Executor& executor) {
   nlohmann::json out = preset_json(run, executor);
   out["memory_usable_share"] = kMemoryUsableShare;
   const auto write_json = [&] {
+    run.output_starts();
     if (!run.json_out.empty()) write_option_file("--json", run.json_out, io::json_text(out, 2) + "\n");
   };
 
@@ -433,7 +435,7 @@ void run_kim_complexity(const PresetRun& run, const Executor& executor) {
         const StereoRig rig = row_rig(scene, run, row);
         if (!header_printed) fmt::print("rig {}\n", describe(rig));
         print_header();
-        run.timing_starts();
+        run.output_starts();
         const BenchResult r = run_bench(prepared, rig, run.config, executor);
         const uint64_t peak = peak_resident_bytes();
         memory["peak_bytes"] = peak;

@@ -55,7 +55,9 @@ RigOverrides RigCli::overrides() const {
     try {
       r = parse_resolution(*resolution);
     } catch (const InputError& e) {
-      throw InputError(fmt::format("--resolution: {}", e.what()));
+      // "resolution X is ..." as the option that gave it.
+      const std::string what = e.what();
+      throw InputError(what.rfind("resolution ", 0) == 0 ? "--" + what : "--resolution: " + what);
     }
     o.width = r.x;
     o.height = r.y;

@@ -14,8 +14,8 @@
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
-#include "renderer/io/json_text.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/io/render_output.hpp"
 #include "scenes/catalog.hpp"
 #include "validation/benchmark.hpp"
@@ -86,7 +86,9 @@ void run_preset_command(const BenchArgs& a) {
   if (a.preset_rows < 0)
     throw InputError(fmt::format("--preset-rows {} must not be negative (0 = every row)", a.preset_rows));
   std::error_code ec;
-  if (a.json_out == "-" || (std::filesystem::exists(a.json_out, ec) && !std::filesystem::is_regular_file(a.json_out, ec)))
+  const bool not_a_file =
+      std::filesystem::exists(a.json_out, ec) && !std::filesystem::is_regular_file(a.json_out, ec);
+  if (a.json_out == "-" || not_a_file)
     throw InputError(fmt::format("--json {} with --preset: the file is rewritten after every row, which {} cannot be; "
                                  "give a file name",
                                  a.json_out, a.json_out == "-" ? "standard output" : "a device or pipe"));
@@ -102,7 +104,8 @@ void run_preset_command(const BenchArgs& a) {
       refuse_overwriting({{"a scene file of the preset", &file}, {"a scene file's stamp", &stamp}},
                          {{"--json", &a.json_out}});
     }
-  // An earlier --json file is removed as the first row's timing starts (PresetRun::timing_starts).
+  // An earlier --json file is removed as the first row's timing starts or the JSON is first written
+  // (PresetRun::output_starts).
   run.rows_per_series = a.preset_rows;
   run.scenes_dir = a.scenes_dir;
   run.json_out = a.json_out;

@@ -12,9 +12,9 @@
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
-#include "renderer/io/json_text.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/file_lock.hpp"
+#include "renderer/io/json_text.hpp"
 #include "validation/gate.hpp"
 #include "validation/junit.hpp"
 

@@ -20,9 +20,9 @@
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
-#include "renderer/io/json_text.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/file_lock.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/text.hpp"
 #include "reports/report.hpp"
 #include "validation/gate.hpp"
@@ -235,7 +235,7 @@ void run_nightly(const NightlyArgs& a) {
     baseline_note = fmt::format("no baseline file {}: time regressions not checked", baseline_file.string());
   // A gate of time regressions alone with a baseline that holds none of this sweep's cells would
   // check nothing either, found only once every cell has run.
-  if (!gate_config.sets_limits() && !baseline.empty()) {
+  if (!gate_config.sets_limits() && baseline_note.empty()) {
     bool matches = false;
     for (const SweepCell& c : expand_cells(d))
       for (const std::string& p : d.pipelines) matches = matches || baseline.find(c.id, p) != nullptr;
@@ -370,15 +370,14 @@ void run_nightly(const NightlyArgs& a) {
                                                              baseline_note.empty() ? baseline_file.string() : ""),
                                             2) +
                                   "\n");
-    io::write_text_atomically(done_path, io::json_text(json{{"run_id", run_id},
-                                                            {"date", run.date},
-                                                            {"gate_verdict", gate_verdict(gate)},
-                                                            {"exit_code", code},
-                                                            // absolute: read by CI steps started elsewhere
-                                                            {"history", fs::absolute(history_file).lexically_normal().string()},
-                                                            {"report", fs::absolute(s.index_html).lexically_normal().string()}},
-                                                       2) +
-                                             "\n");
+    // The paths absolute: read by CI steps started in another folder.
+    const json done = {{"run_id", run_id},
+                       {"date", run.date},
+                       {"gate_verdict", gate_verdict(gate)},
+                       {"exit_code", code},
+                       {"history", fs::absolute(history_file).lexically_normal().string()},
+                       {"report", fs::absolute(s.index_html).lexically_normal().string()}};
+    io::write_text_atomically(done_path, io::json_text(done, 2) + "\n");
   });
   drop_run_claim(history_file, chosen.claim);
   fmt::print("history {} ({} runs)\nreport {}\ngate verdict: {} (exit {})\n", history_file.string(),

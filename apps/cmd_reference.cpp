@@ -12,8 +12,8 @@
 #include "apps/commands.hpp"
 #include "reference/store.hpp"
 #include "renderer/error.hpp"
-#include "renderer/io/json_text.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/text.hpp"
 #include "scenes/catalog.hpp"
 
@@ -276,9 +276,9 @@ void register_reference_command(CLI::App& root, const std::string& command_line)
 
   CLI::App* gen = ref->add_subcommand(
       "generate",
-      "Render a reference right eye and store it under an id of the scene file's name, provider, size, interaxial (0.1 mm) and "
-      "convergence (3 digits), with the field of view and light count where they are not the scene's; an entry of "
-      "that id made from the same scene and rig is replaced, one made from another is refused");
+      "Render a reference right eye and store it under an id of the scene file's name, provider, size, interaxial "
+      "(0.1 mm) and convergence (3 digits), with the field of view and light count where they are not the scene's; "
+      "an entry of that id made from the same scene and rig is replaced, one made from another is refused");
   add_common(gen);
   gen->add_option("--scene,-s", a->scene, "Scene file (.gltf/.glb) or built-in scene name")->capture_default_str();
   gen->add_option("--truth", a->truth, "Provider: full, blender or povray")->capture_default_str();

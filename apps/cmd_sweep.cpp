@@ -3,6 +3,7 @@
 #include <sys/ioctl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -18,6 +19,7 @@
 #include "renderer/io/atomic_file.hpp"
 #include "scenes/catalog.hpp"
 #include "validation/results_file.hpp"
+#include "validation/slurm.hpp"
 #include "validation/sweep.hpp"
 #include "validation/sweep_run.hpp"
 
@@ -252,6 +254,15 @@ void register_collect(CLI::App& sweep) {
                                    "ran, and their results paths)",
                                    inputs.size(), a->out));
     write_option_file("the merged results file", a->out, results_text(cells));
+    // The shards of a Slurm submission merged into the sweep's results file (as the executor
+    // advises when it does not wait): recorded as the executor's own merge, which a later run with
+    // --wait may then merge again.
+    const fs::path out_dir = fs::absolute(a->out).parent_path();
+    const SlurmLayout layout = slurm_layout(out_dir);
+    if (a->out != "-" && std::all_of(inputs.begin(), inputs.end(), [&](const fs::path& in) {
+          return fs::absolute(in).lexically_normal().parent_path() == layout.dir.lexically_normal();
+        }))
+      record_merge(layout, a->out);
     fmt::print("wrote {}: {} cells from {} files\n", a->out, cells.size(), inputs.size());
   });
 }

@@ -15,8 +15,8 @@
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
-#include "renderer/io/json_text.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/io/json_text.hpp"
 #include "scenes/catalog.hpp"
 #include "validation/validation_images.hpp"
 
@@ -88,9 +88,9 @@ void run_validate(const ValidateArgs& a) {
   const std::optional<validation::TruthCache> cache =
       a.no_cache || a.cache.empty() ? std::nullopt
                                     : std::optional<validation::TruthCache>(validation::TruthCache(a.cache));
+  // A work folder per scene and provider: the command a record gives to render its truth again
+  // runs there, and another scene validated into the same --out would replace its files.
   const validation::ValidationTarget target = validation::prepare_target(
-      // A folder per scene and provider: the command a record gives to render its truth again runs
-      // there, and another scene validated into the same --out would replace its files.
       prepared, loaded.file, rig, *provider, cache ? &*cache : nullptr, out / "work" / scene_stem, executor);
   fmt::print("truth: {} ({}), {}{:.2f} s; true disocclusions {:.3f} % of the image\n", provider->name(),
              target.truth.render.tool_version, target.truth.cached ? "from the cache, rendered in " : "",

@@ -24,8 +24,8 @@
 #include "renderer/io/file_lock.hpp"
 #include "renderer/io/image_io.hpp"
 #include "renderer/io/json_text.hpp"
-#include "renderer/io/unique_fd.hpp"
 #include "renderer/io/render_output.hpp"
+#include "renderer/io/unique_fd.hpp"
 #include "renderer/render_scene.hpp"
 #include "renderer/rig.hpp"
 #include "renderer/text.hpp"
@@ -338,8 +338,8 @@ void make_working_folder(const fs::path& root, const std::string& id, const char
 }
 
 /// Clears up after a generate (or verify) that was killed (SIGKILL, a job's time limit): its working
-/// folders and id lock files (".ID.lock") that no lock holds are removed, except an entry moved aside (".ID.old-…") whose id
-/// names no entry any more, which is moved back. Best effort: errors leave folders where they are.
+/// folders and id lock files (".ID.lock") that no lock holds are removed, except an entry moved
+/// aside (".ID.old-…") whose id names no entry any more, which is moved back. Best effort: errors leave folders where they are.
 void remove_stale_folders(const fs::path& root) {
   // A folder being made (".ID.mk-XXXXXX") is locked and renamed within microseconds; one a minute
   // old was left by a kill in between.
@@ -567,8 +567,8 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
     }
     if (before && stored_scene(before->scene) != stored.scene)
       throw InputError(fmt::format(
-          "reference '{}' in {} was made from scene {}, not {} (the id names only the scene file's name, '{}'); give this "
-          "one another --store, or remove {} to replace it",
+          "reference '{}' in {} was made from scene {}, not {} (the id names only the scene file's name, '{}'); give "
+          "this one another --store, or remove {} to replace it",
           id, root_.string(), before->scene, stored.scene, scene.file_stem(), (root_ / id).string()));
     const json rig_now = rig_record(*p.rig);
     if (before && well_formed_rig(before_rig) && !same_record(before_rig, rig_now) &&
@@ -728,9 +728,12 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
   // would be found under a name that `reference generate` never writes, and regenerated beside it.
   if (const std::string expected = reference_id(p.loaded.scene, spec, *p.rig, p.loaded.lights_in_file); expected != id) {
     r.status = Status::corrupt;
-    // Also an entry made before the id named a field of view other than the scene camera's.
-    r.detail = fmt::format("{}: its spec makes the reference '{}', but the entry lies in folder '{}'; rename the "
-                           "folder to '{}' (and its provenance's \"id\"), or remove it and regenerate",
+    // Also an entry of a store written when ids named a scene by the name inside its file, or
+    // before they named a field of view other than the scene camera's.
+    r.detail = fmt::format("{}: its spec makes the reference '{}' (the id names the scene file, the rig, and a field "
+                           "of view or light count other than the scene's), but the entry lies in folder '{}'; "
+                           "`stereobench reference update` writes it under that id, or rename the folder to '{}' "
+                           "(and its provenance's \"id\")",
                            prov_file.string(), expected, id, expected);
     return r;
   }

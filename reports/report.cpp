@@ -441,8 +441,18 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
   std::error_code resolved;
   if (fs::path real = fs::weakly_canonical(results.path, resolved); !resolved) results_file = std::move(real);
   const fs::path results_dir = results_file.has_parent_path() ? results_file.parent_path() : fs::path(".");
+  // The page, which may be shared, names files by the results file's name and the paths its
+  // lines give, never by this machine's folders; the terminal says where it looked.
+  const std::string results_name = results.path.filename().string();
+  std::vector<std::string> page_warnings;
+  for (const std::string& w : summary.warnings)  // the reader's: "RESULTS:LINE: ..."
+    page_warnings.push_back(w.rfind(results.path.string(), 0) == 0
+                                ? results_name + w.substr(results.path.string().size())
+                                : w);
   std::vector<std::pair<std::string, fs::path>> missing;  // (as the line names it, where it was looked for)
+  size_t named = 0;  // images the lines name
   const auto image_path = [&](const std::string& rel, const std::string& name) -> std::string {
+    ++named;
     const fs::path source = results_dir / rel;
     std::error_code ec;
     if (!fs::is_regular_file(source, ec)) {
@@ -454,6 +464,8 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
     if (io::image_file_format(source) != "png") {
       summary.warnings.push_back(fmt::format("{}: image {} ({}) is not a PNG file; left out of the report",
                                              results.path.string(), rel, source.string()));
+      page_warnings.push_back(
+          fmt::format("{}: image {} is not a PNG file; left out of the report", results_name, rel));
       return "";
     }
     ++summary.images;
@@ -479,22 +491,21 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
   }
   json data = report_data(results, title, papers, image_path);
   // Missing images: a few named one by one, many (a results file copied without its cells/
-  // folder) in one line. The page, which may be shared, does not name this machine's folders.
-  std::vector<std::string> page_warnings = summary.warnings;
+  // folder) in one line.
   constexpr size_t kNamedMissing = 5;
   for (size_t i = 0; i < missing.size() && (missing.size() <= kNamedMissing || i < 3); ++i) {
     summary.warnings.push_back(fmt::format("{}: image {} is missing (looked for {}); the viewer shows it as "
                                            "unavailable",
                                            results.path.string(), missing[i].first, missing[i].second.string()));
-    page_warnings.push_back(fmt::format("{}: image {} is missing; the viewer shows it as unavailable",
-                                        results.path.filename().string(), missing[i].first));
+    page_warnings.push_back(
+        fmt::format("{}: image {} is missing; the viewer shows it as unavailable", results_name, missing[i].first));
   }
   if (missing.size() > kNamedMissing) {
-    const std::string more = fmt::format("and {} more images are missing (of {} the results name); was the results "
-                                         "file moved without the cells/ folder beside it?",
-                                         missing.size() - 3, missing.size());
+    const std::string more = fmt::format("and {} more images are missing ({} of the {} the results name); was the "
+                                         "results file moved without the cells/ folder beside it?",
+                                         missing.size() - 3, missing.size(), named);
     summary.warnings.push_back(fmt::format("{}: {}", results.path.string(), more));
-    page_warnings.push_back(fmt::format("{}: {}", results.path.filename().string(), more));
+    page_warnings.push_back(fmt::format("{}: {}", results_name, more));
   }
   // A sweep still running, stopped, or one shard of several: its figures cover part of it.
   std::vector<const json*> records;
@@ -505,7 +516,7 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
                     "stopped, or one shard of several); the figures cover these cells only",
                     coverage->present, coverage->expected, results.cells.front().json["sweep"].get<std::string>());
     summary.warnings.push_back(fmt::format("{}: {}", results.path.string(), unfinished));
-    page_warnings.push_back(fmt::format("{}: {}", results.path.filename().string(), unfinished));
+    page_warnings.push_back(fmt::format("{}: {}", results_name, unfinished));
   }
   // The page lists every warning the terminal shows: skipped lines, missing images, missing cells.
   data["warnings"] = page_warnings;

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
+#include "renderer/io/render_output.hpp"
 #include "renderer/memory.hpp"
 
 namespace sb {
@@ -108,7 +109,7 @@ BenchResult run_bench(const RenderScene& scene, const StereoRig& rig, const Benc
       b.right_seconds.push_back(r.timings.eye_total(StageEye::right));
       b.both_seconds.push_back(r.timings.eye_total(StageEye::both));
       b.shared_stages = r.timings.shared_stages();
-      for (const StageTime& s : r.timings.stages()) b.stage_eyes[s.name] = stage_eye_name(s.eye);
+      b.stage_eyes = io::stage_eyes_to_json(r.timings);
       b.counters = r.counters.snapshot();
       if (progress)
         progress(fmt::format("repetition {}/{} {} {:.1f} ms", rep + 1, config.repetitions, b.name, r.timings.total() * 1e3));

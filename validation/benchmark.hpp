@@ -59,7 +59,7 @@ struct PipelineBench {
   /// (StageEye); left + right + both = total.
   std::vector<double> left_seconds, right_seconds, both_seconds;
   std::vector<std::string> shared_stages;  ///< the stages that serve both eyes, in order
-  std::map<std::string, std::string> stage_eyes;  ///< stage -> the eye it serves ("left", "right", "both")
+  nlohmann::json stage_eyes = nlohmann::json::object();  ///< stage -> the eye it serves (io::stage_eyes_to_json)
   std::map<std::string, uint64_t> counters;  ///< of the last repetition (counters are deterministic)
   Summary speedup;  ///< baseline total / this total, paired per repetition
   std::map<std::string, std::string> options;  ///< every option's value, defaults included

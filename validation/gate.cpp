@@ -15,9 +15,9 @@
 #include <toml++/toml.h>
 
 #include "renderer/error.hpp"
-#include "renderer/text.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/pipeline.hpp"
+#include "renderer/text.hpp"
 #include "scenes/catalog.hpp"
 #include "validation/results_file.hpp"
 

@@ -60,8 +60,8 @@ Image read_exr_image(const fs::path& path, std::string_view eye, std::string& ta
     if (!stereo) throw;
   }
   if (eye.empty())
-    throw InputError(fmt::format("{} is a stereo EXR (its channels are of the left and right eyes); choose one "
-                                 "with --eye left|right",
+    throw InputError(fmt::format("{} is a stereo EXR (its channels are tagged with eyes: left./right. layers, "
+                                 "views or parts); choose one with --eye left|right",
                                  path.string()));
   taken_eye = std::string(eye);
   return io::read_exr_eye(path, eye == "right");

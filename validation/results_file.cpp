@@ -54,7 +54,7 @@ json finite_json(const json& value) {
 namespace {
 
 std::string line_of(const json& cell) {
-  return finite_json(cell).dump(-1, ' ', false, json::error_handler_t::replace) + "\n";
+  return io::json_text(finite_json(cell)) + "\n";
 }
 
 [[noreturn]] void io_fail(const fs::path& file, const char* what, const char* kind = "results file") {

@@ -298,7 +298,9 @@ SlurmSubmission submit_sweep(const SweepDefinition& d, SlurmSweepOptions o) {
   const std::string script = sbatch_script(d, o);
   const SlurmLayout l = slurm_layout(o.out_dir);
 
-  // An earlier submission into this folder: still running, or sharded another way.
+  // An earlier submission into this folder: still running, or sharded another way. What it
+  // merged stays recorded: a resubmission merges into that file again.
+  json merged_before;
   if (fs::exists(l.submission)) {
     json before;
     try {
@@ -331,6 +333,7 @@ SlurmSubmission submit_sweep(const SweepDefinition& d, SlurmSweepOptions o) {
       throw InputError(fmt::format("{} holds results of another version of {} (definition_sha256 differs); use "
                                    "another --out",
                                    l.dir.string(), d.file.string()));
+    merged_before = before.value("merged", json());
   }
 
   fs::create_directories(l.dir);
@@ -369,7 +372,9 @@ SlurmSubmission submit_sweep(const SweepDefinition& d, SlurmSweepOptions o) {
                        {"script", l.script.string()},
                        {"sbatch_command", sub.sbatch_command},
                        {"submitted", utc_now()}};
-  io::write_text_atomically(l.submission, io::json_text(record, 2) + "\n");
+  json written = record;
+  if (merged_before.is_object()) written["merged"] = merged_before;
+  io::write_text_atomically(l.submission, io::json_text(written, 2) + "\n");
   return sub;
 }
 
@@ -476,10 +481,26 @@ size_t collect_slurm_results(const SweepDefinition& d, const SlurmSubmission& su
                                  d.name, list));
   }
   io::write_text_atomically(results, results_text(cells));
-  json record = io::parse_json(io::read_file(sub.layout.submission));
-  record["merged"] = {{"results", fs::absolute(results).lexically_normal().string()}, {"sha256", hash_file(results)}};
-  io::write_text_atomically(sub.layout.submission, io::json_text(record, 2) + "\n");
+  record_merge(sub.layout, results);
   return cells.size();
+}
+
+namespace {
+
+/// The merged file as the record names it: absolute, and as its JSON text holds it (bytes that are
+/// not UTF-8 replaced, as json_text writes them), so that the comparison sees what was written.
+std::string merged_name(const fs::path& results) {
+  return json::parse(io::json_text(json(fs::absolute(results).lexically_normal().string()))).get<std::string>();
+}
+
+}  // namespace
+
+void record_merge(const SlurmLayout& layout, const fs::path& results) {
+  std::error_code ec;
+  if (!fs::exists(layout.submission, ec)) return;
+  json record = io::parse_json(io::read_file(layout.submission));
+  record["merged"] = {{"results", merged_name(results)}, {"sha256", hash_file(results)}};
+  io::write_text_atomically(layout.submission, io::json_text(record, 2) + "\n");
 }
 
 bool merged_from_shards(const SlurmLayout& layout, const fs::path& results) {
@@ -488,8 +509,7 @@ bool merged_from_shards(const SlurmLayout& layout, const fs::path& results) {
   try {
     const json record = io::parse_json(io::read_file(layout.submission));
     const json merged = record.value("merged", json());
-    return merged.is_object() &&
-           merged.value("results", "") == fs::absolute(results).lexically_normal().string() &&
+    return merged.is_object() && merged.value("results", "") == merged_name(results) &&
            merged.value("sha256", "") == hash_file(results);
   } catch (const std::exception&) {
     return false;  // unreadable: nothing shows the file is a merge

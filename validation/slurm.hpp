@@ -119,16 +119,21 @@ struct SlurmArrayProgress {
                                                 const std::vector<SlurmTaskOutcome>& outcomes,
                                                 size_t tail_lines = 15);
 
-/// Merges the tasks' results files into `results` (atomically), checking that together they hold
-/// every cell of the definition exactly once; the image paths of every line, relative to the folder
-/// of its shard file, are rewritten relative to the folder of `results`. The submission record
-/// keeps the merged file's path and sha256 (merged_from_shards). Returns the number of cells.
-/// InputError naming the missing cells or conflicting duplicates.
-/// Whether `results` is, byte for byte, the file the last merge of the submission in `layout`
-/// wrote: a merge may replace only such a file, not one the local executor (or anything else)
-/// wrote there.
+/// Whether `results` is, byte for byte, the file the last merge of the shards in `layout` wrote
+/// (the submission record's `merged`, kept across resubmissions): a merge may replace only such a
+/// file, not one the local executor (or anything else) wrote there.
 [[nodiscard]] bool merged_from_shards(const SlurmLayout& layout, const std::filesystem::path& results);
 
+/// Records in the submission of `layout` (when there is one) that `results` is a merge of its
+/// shards: its path and sha256, which merged_from_shards checks. Called by collect_slurm_results,
+/// and by `sweep collect` when it merges a layout's shard files.
+void record_merge(const SlurmLayout& layout, const std::filesystem::path& results);
+
+/// Merges the tasks' results files into `results` (atomically), checking that together they hold
+/// every cell of the definition exactly once; the image paths of every line, relative to the folder
+/// of its shard file, are rewritten relative to the folder of `results`, and the merge is recorded
+/// (record_merge). Returns the number of cells. InputError naming the missing cells or conflicting
+/// duplicates.
 size_t collect_slurm_results(const SweepDefinition& definition, const SlurmSubmission& submission,
                              const std::filesystem::path& results, std::vector<std::string>* warnings = nullptr);
 

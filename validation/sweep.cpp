@@ -12,11 +12,12 @@
 #include <toml++/toml.h>
 
 #include "renderer/error.hpp"
-#include "renderer/text.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/pipeline.hpp"
 #include "renderer/rig.hpp"
 #include "renderer/scene.hpp"
+#include "renderer/text.hpp"
 #include "scenes/catalog.hpp"
 #include "scenes/generators.hpp"
 #include "validation/content_hash.hpp"
@@ -384,8 +385,6 @@ void parse_path(const Where& where, const toml::node& node, SweepDefinition& d) 
   d.path = path;
 }
 
-/// Two entries that generate the same built-in scene ("spheres" and "spheres:count=1000").
-
 }  // namespace
 
 SweepScene parse_builtin_scene(const std::string& text) {
@@ -466,6 +465,12 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
                  "must be a non-empty name without '/', '\\' or control characters, other than '.' and '..'");
   }
   if (const toml::node* n = sweep.get("description")) d.description = string_at(where, *n, "sweep.description");
+  // The name goes into every results line, the folder marker and nightly's history, which are
+  // JSON: a file name in another encoding could not be told apart from others there.
+  if (!io::is_utf8(d.name))
+    throw InputError(fmt::format("{}: the sweep is named by its file, whose name is not UTF-8; rename the file, or "
+                                 "give the sweep a name (name = \"...\" in [sweep])",
+                                 file.string()));
 
   // Scenes.
   d.scenes = {parse_builtin_scene("spheres")};

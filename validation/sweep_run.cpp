@@ -390,8 +390,8 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
 constexpr const char* kOutMarker = ".stereobench-sweep.json";
 
 /// Shows that the output folder and the results file's folder can be written (IoError otherwise),
-/// before any work.
-void check_out_folders(const SweepRunOptions& options) {
+/// before any work; with cells to run, also the results file they are appended to.
+void check_out_folders(const SweepRunOptions& options, bool cells_to_run) {
   for (const fs::path& dir : {options.out_dir, options.results.has_parent_path() ? options.results.parent_path()
                                                                                   : fs::path(".")}) {
     std::error_code ec;
@@ -412,7 +412,7 @@ void check_out_folders(const SweepRunOptions& options) {
                                  options.results.string(), (options.results / "results.jsonl").string()));
   // A results file there already is appended to after the first cell: one it cannot write would
   // be found only once that cell's work is done.
-  if (fs::exists(options.results, ec) && ::access(options.results.c_str(), W_OK) != 0)
+  if (cells_to_run && fs::exists(options.results, ec) && ::access(options.results.c_str(), W_OK) != 0)
     throw IoError(fmt::format("cannot write the results file {}: {}; make it writable, or give another --out (or "
                               "--results)",
                               options.results.string(), std::strerror(errno)));
@@ -545,7 +545,7 @@ void prepare_sweep(const SweepDefinition& d, const std::vector<SweepCell>& cells
     if (auto why = provider->unavailable_reason())
       throw ToolError(fmt::format("{}: truth '{}' is unavailable: {}", d.file.string(), cells[i].truth, *why));
   }
-  check_out_folders(options);
+  check_out_folders(options, !todo.empty());
   check_cells(d, cells, todo, options.scenes_dir, providers, options.results);
   claim_out_folder(d, options);
 }

@@ -31,6 +31,16 @@ class JsonTextError : public std::runtime_error {
 /// double, or nesting deeper than kMaxJsonDepth.
 [[nodiscard]] nlohmann::json parse_json(std::string_view text);
 
+/// Whether `text` is well-formed UTF-8 (what JSON text can hold as it is).
+[[nodiscard]] inline bool is_utf8(const std::string& text) {
+  try {
+    (void)nlohmann::json(text).dump();
+    return true;
+  } catch (const nlohmann::json::type_error&) {
+    return false;
+  }
+}
+
 /// `value` as JSON text (`indent` as nlohmann's dump), with bytes that are not UTF-8 (a file name
 /// of another encoding, given on the command line) written as U+FFFD instead of throwing.
 [[nodiscard]] inline std::string json_text(const nlohmann::json& value, int indent = -1) {

@@ -403,7 +403,7 @@
     const notDrawn = [];
     const lineChart = (opts) => {
       const chart = metricVsAxis(opts);
-      if (!chart) notDrawn.push(opts.title);
+      if (!chart && opts.pipelines.length > 0) notDrawn.push(opts.title);  // none but the baseline: nothing to say
       return chart;
     };
     const charts = [

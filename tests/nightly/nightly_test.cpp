@@ -24,8 +24,8 @@
 #include "renderer/error.hpp"
 #include "renderer/io/file_lock.hpp"
 #include "support/lock_wait.hpp"
-#include "support/run_cli.hpp"
 #include "support/report_support.hpp"
+#include "support/run_cli.hpp"
 #include "support/scratch_dir.hpp"
 #include "validation/history.hpp"
 

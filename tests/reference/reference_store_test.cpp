@@ -16,10 +16,10 @@
 #include <nlohmann/json.hpp>
 
 #include "reference/store.hpp"
-#include "scenes/catalog.hpp"
 #include "renderer/io/file_lock.hpp"
 #include "renderer/io/image_io.hpp"
 #include "renderer/text.hpp"
+#include "scenes/catalog.hpp"
 #include "support/lock_wait.hpp"
 #include "support/run_cli.hpp"
 #include "support/scratch_dir.hpp"
@@ -392,7 +392,9 @@ TEST(ReferenceStore, AnEntryThatContradictsItsFolderIsCorrupt) {
   std::ofstream(store / renamed / "provenance.json", std::ios::trunc) << moved.dump(2);
   const test::CliRun r = test::run_cli(ref(dir, "verify") + " --no-render " + renamed);
   EXPECT_EQ(r.code, 2) << r.out;
-  EXPECT_NE(r.out.find("its spec makes the reference '" + pole + "', but the entry lies in folder '" + renamed + "'"),
+  EXPECT_NE(r.out.find("its spec makes the reference '" + pole + "' (the id names the scene file"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("but the entry lies in folder '" + renamed + "'; `stereobench reference update` writes it"),
             std::string::npos)
       << r.out;
   // update writes that reference under its own id and says that the folder stays as it was,

@@ -18,8 +18,8 @@
 #include <nlohmann/json.hpp>
 
 #include "renderer/io/file_lock.hpp"
-#include "support/run_cli.hpp"
 #include "support/report_support.hpp"
+#include "support/run_cli.hpp"
 #include "support/scratch_dir.hpp"
 
 namespace sb {
@@ -364,7 +364,8 @@ TEST(Report, WarnsOnTornTailAndMissingImagesAndGuardsForeignFolders) {
   const test::CliRun moved = test::run_cli("report " + quoted(dir / "moved" / "results.jsonl") + " --out " +
                                            quoted(dir / "moved-report"));
   ASSERT_EQ(moved.code, 0) << moved.out;
-  EXPECT_NE(moved.out.find("and 5 more images are missing (of 8 the results name)"), std::string::npos) << moved.out;
+  EXPECT_NE(moved.out.find("and 5 more images are missing (8 of the 8 the results name)"), std::string::npos)
+      << moved.out;
   const json page = embedded_data(dir / "moved-report" / "index.html");
   EXPECT_EQ(page["warnings"].size(), 4u) << page["warnings"].dump();
   EXPECT_EQ(page["warnings"].dump().find(dir.path().string()), std::string::npos) << page["warnings"].dump();

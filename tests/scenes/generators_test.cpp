@@ -19,9 +19,9 @@
 #include "renderer/error.hpp"
 #include "renderer/io/gltf_loader.hpp"
 #include "scenes/catalog.hpp"
+#include "scenes/generators.hpp"
 #include "support/run_cli.hpp"
 #include "support/scratch_dir.hpp"
-#include "scenes/generators.hpp"
 
 namespace sb::scenes {
 namespace {

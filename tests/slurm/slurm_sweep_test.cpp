@@ -396,6 +396,20 @@ TEST_F(SlurmCluster, FailedTasksAreReportedAndResubmissionContinues) {
   const test::CliRun remerge = test::run_cli(run);
   ASSERT_EQ(remerge.code, 0) << remerge.out;
   EXPECT_EQ(validation::read_results(dir / "out" / "results.jsonl").cells.size(), 2u);
+  // ... also after a resubmission that failed (the new submission's record keeps what was merged),
+  // and after the shards were merged by hand with `sweep collect`, as the executor advises when it
+  // does not wait.
+  const std::string good_shard = test::read_text(sd / "results-1.jsonl");
+  std::ofstream(sd / "results-1.jsonl", std::ios::trunc) << "not json\n";
+  EXPECT_EQ(test::run_cli(run).code, 3);
+  std::ofstream(sd / "results-1.jsonl", std::ios::trunc) << good_shard;
+  const test::CliRun after_failure = test::run_cli(run);
+  EXPECT_EQ(after_failure.code, 0) << after_failure.out;
+  const test::CliRun collected = test::run_cli("sweep collect " + quoted(dir / "out" / "results.jsonl") + " " +
+                                               quoted(sd / "results-0.jsonl") + " " + quoted(sd / "results-1.jsonl"));
+  ASSERT_EQ(collected.code, 0) << collected.out;
+  const test::CliRun after_collect = test::run_cli(run);
+  EXPECT_EQ(after_collect.code, 0) << after_collect.out;
 
   // A different sharding of the same folder is refused (its cells would be run twice).
   const test::CliRun reshard = test::run_cli("sweep run " + quoted(dir / "two.toml") + " --out " + quoted(dir / "out") +

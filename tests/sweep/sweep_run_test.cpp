@@ -15,8 +15,8 @@
 #include <sstream>
 #include <thread>
 
-#include "scenes/gltf_builder.hpp"
 #include "renderer/io/file_lock.hpp"
+#include "scenes/gltf_builder.hpp"
 #include "support/lock_wait.hpp"
 #include "support/run_cli.hpp"
 #include "support/scratch_dir.hpp"
@@ -642,6 +642,13 @@ TEST(SweepRun, AFolderNameThatIsNotUtf8IsWrittenNotAnInternalError) {
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_EQ(validation::read_results(folder / "o" / "results.jsonl").cells.size(), 1u);
   EXPECT_NE(test::read_text(folder / "o" / ".stereobench-sweep.json").find("latin\ufffd"), std::string::npos);
+  // A definition named by such a file name would be named alike in every line: refused, saying how.
+  fs::copy_file(folder / "t.toml", folder / "caf\xe9.toml");
+  const test::CliRun named = test::run_cli("sweep run " + quoted(folder / "caf\xe9.toml") + " --out " +
+                                           quoted(folder / "o2") + " --scenes-dir " + quoted(dir / "scenes"));
+  EXPECT_EQ(named.code, 3) << named.out;
+  EXPECT_NE(named.out.find("whose name is not UTF-8; rename the file, or give the sweep a name"), std::string::npos)
+      << named.out;
 }
 
 TEST(SweepRun, TwoDefinitionsStartedTogetherIntoOneFolderDoNotBothRun) {

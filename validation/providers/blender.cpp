@@ -15,10 +15,10 @@
 
 #include <fmt/format.h>
 
-#include "renderer/text.hpp"
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/image_io.hpp"
+#include "renderer/text.hpp"
 #include "validation/process.hpp"
 #include "validation/providers/blender_script.hpp"
 #include "validation/providers/providers.hpp"
@@ -29,7 +29,7 @@ namespace {
 namespace fs = std::filesystem;
 
 /// Bumped whenever the export, the script or the settings change.
-constexpr const char* kRevision = "blender-export-7";  // 7: morph targets at their base shape, skins in their bind pose
+constexpr const char* kRevision = "blender-export-7";
 /// Cut-out holes a camera or shadow ray may pass in Cycles (transparent bounces); ours pass any.
 constexpr int kTransparentBounces = 64;
 /// Environment variable naming the Blender executable (a path, or a name looked up on PATH).

@@ -14,9 +14,9 @@
 #include <fmt/ranges.h>
 
 #include "renderer/error.hpp"
-#include "renderer/text.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/image_io.hpp"
+#include "renderer/text.hpp"
 #include "validation/process.hpp"
 #include "validation/providers/povray_export.hpp"
 #include "validation/providers/providers.hpp"
