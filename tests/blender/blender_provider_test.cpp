@@ -481,6 +481,63 @@ TEST(BlenderImport, AMorphTargetRendersAtTheBaseShapeAsTheSceneHasIt) {
   EXPECT_LE(differ, 10u);
 }
 
+TEST(BlenderImport, ASkinnedMeshRendersInItsBindPoseAsTheSceneHasIt) {
+  // The loader leaves skins out (bind pose, with a warning); Blender's importer deformed the mesh
+  // by its joints, here one joint moved 1 m along +x.
+  SB_NEED_BLENDER(provider);
+  const test::ScratchDir dir;
+  scenes::GltfBuilder b("blender-skin-test", 1);
+  const int grey = b.add_material("grey", vec3(0.6f));
+  b.add_node("box", b.add_mesh("box", scenes::make_box(vec3(-0.3f, 0.0f, -0.3f), vec3(0.3f, 0.6f, 0.3f)), grey));
+  b.add_node("wall", b.add_mesh("wall", scenes::make_box(vec3(-3.0f, 0.0f, -2.2f), vec3(3.0f, 2.5f, -2.0f)), grey));
+  b.add_node("floor", b.add_mesh("floor", scenes::make_box(vec3(-3.0f, -0.1f, -2.0f), vec3(3.0f, 0.0f, 2.0f)), grey));
+  b.add_point_light("lamp", vec3(1.0f, 2.0f, 2.0f), vec3(1.0f), 15.0f);
+  const fs::path file = dir / "skin.gltf";
+  b.write(file);
+  nlohmann::json doc = nlohmann::json::parse(test::read_text(file));
+  // An accessor over a buffer of its own (a data URI).
+  const auto add_accessor = [&](const std::vector<unsigned char>& bytes, int component, const char* type,
+                                size_t count) {
+    doc["buffers"].push_back({{"byteLength", bytes.size()},
+                              {"uri", "data:application/octet-stream;base64," + test::MiniGltf::base64(bytes)}});
+    doc["bufferViews"].push_back({{"buffer", doc["buffers"].size() - 1}, {"byteLength", bytes.size()}});
+    doc["accessors"].push_back(
+        {{"bufferView", doc["bufferViews"].size() - 1}, {"componentType", component}, {"count", count}, {"type", type}});
+    return doc["accessors"].size() - 1;
+  };
+  const auto float_bytes = [](const std::vector<float>& v) {
+    std::vector<unsigned char> bytes(v.size() * sizeof(float));
+    std::memcpy(bytes.data(), v.data(), bytes.size());
+    return bytes;
+  };
+  nlohmann::json& prim = doc["meshes"][0]["primitives"][0];
+  const size_t count = doc["accessors"][prim["attributes"]["POSITION"].get<size_t>()]["count"].get<size_t>();
+  std::vector<float> weights;
+  for (size_t i = 0; i < count; ++i) weights.insert(weights.end(), {1.0f, 0.0f, 0.0f, 0.0f});
+  prim["attributes"]["JOINTS_0"] = add_accessor(std::vector<unsigned char>(count * 4, 0), 5121, "VEC4", count);
+  prim["attributes"]["WEIGHTS_0"] = add_accessor(float_bytes(weights), 5126, "VEC4", count);
+  const size_t inverse_bind =
+      add_accessor(float_bytes({1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}), 5126, "MAT4", 1);
+  doc["nodes"].push_back({{"name", "joint"}, {"translation", {1.0, 0.0, 0.0}}});
+  const size_t joint = doc["nodes"].size() - 1;
+  doc["nodes"][0]["skin"] = 0;
+  doc["skins"] = nlohmann::json::array({{{"joints", {joint}}, {"inverseBindMatrices", inverse_bind}}});
+  doc["scenes"][0]["nodes"].push_back(joint);
+  { std::ofstream(file, std::ios::trunc) << doc.dump(1); }
+  const Scene scene = io::load_gltf(file);
+  ASSERT_FALSE(scene.warnings.empty()) << "the loader says it renders the bind pose";
+  const RenderScene prepared(scene);
+  const StereoRig rig = test::rig_at(scene, 96, 54);
+  const TruthRender bl = render_truth(*provider, prepared, file, rig, dir / "blender");
+  const TruthRender f = render_truth(*validation::make_truth_provider("full"), prepared, file, rig, dir / "full");
+  size_t differ = 0;
+  for (int y = 0; y < f.right.height(); ++y)
+    for (int x = 0; x < f.right.width(); ++x) differ += differs(bl.right, f.right, x, y) ? 1 : 0;
+  std::cout << fmt::format("[blender skin] {} of {} pixels differ\n", differ, f.right.width() * f.right.height());
+  // Measured with Blender 3.4.1: 0 differ; with the armature left to deform the mesh, 39.
+  EXPECT_LE(differ, 10u);
+}
+
 TEST(BlenderFailure, APrimitiveWithoutTheUvsOfItsTexturedMaterialBesideOneWithThemIsRefused) {
   // Blender merges the two into one mesh and gives the first texture coordinates (0, 0): its
   // texture (and a cut-out's coverage) would be read there, where ours takes the factor alone.
