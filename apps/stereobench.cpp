@@ -33,6 +33,12 @@ std::string command_line(int argc, char** argv) {
   return out;
 }
 
+/// Calls `check` on `app` and on each of its commands, at every depth.
+void for_each_command(CLI::App& app, void (*check)(CLI::App&)) {
+  check(app);
+  for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) for_each_command(*sub, check);
+}
+
 /// An empty file or folder option (an unset shell variable, say) would read or write the current
 /// folder, or silently drop the output, and an empty value would be taken as not given: refused.
 /// --cache is not among them: '' turns the ground-truth cache off.
@@ -53,7 +59,6 @@ void refuse_empty_values(CLI::App& app) {
           "--mask", "--gate-config", "--config", "--baseline", "--gltf-clip", "--partition"},
          "a name");
   refuse({"--bvh", "--time-limit", "--sbatch-arg"}, "a value");
-  for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) refuse_empty_values(*sub);
 }
 
 /// Options that name a file to write (--json, --junit, sweep collect's merged file): a folder
@@ -71,7 +76,6 @@ void refuse_folder_as_file(CLI::App& app) {
         },
         "", "not a folder"));
   }
-  for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) refuse_folder_as_file(*sub);
 }
 
 /// Folder options: '-' stands for standard output elsewhere (--json -, sweep csv's --out), which
@@ -90,7 +94,6 @@ void refuse_dash_folder(CLI::App& app) {
         },
         "", "a folder"));
   }
-  for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) refuse_dash_folder(*sub);
 }
 
 /// Numeric options take decimal numbers only. The parser would also read C's other forms
@@ -118,7 +121,6 @@ void refuse_non_decimal_numbers(CLI::App& app) {
         },
         "", "decimal"));
   }
-  for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) refuse_non_decimal_numbers(*sub);
 }
 
 /// When parsing stopped for want of a subcommand: the first word after the commands given that
@@ -185,10 +187,9 @@ int main(int argc, char** argv) {
   sb::cli::register_reference_command(app, command_line(argc, argv));
   sb::cli::register_report_command(app);
   sb::cli::register_path_command(app);
-  refuse_empty_values(app);
-  refuse_folder_as_file(app);
-  refuse_dash_folder(app);
-  refuse_non_decimal_numbers(app);
+  for (void (*check)(CLI::App&) : {refuse_empty_values, refuse_folder_as_file, refuse_dash_folder,
+                                    refuse_non_decimal_numbers})
+    for_each_command(app, check);
 
   try {
     app.parse(argc, argv);
