@@ -466,6 +466,12 @@ struct BoxSceneJson {
         {{"bufferView", doc["bufferViews"].size() - 1}, {"componentType", component}, {"count", count}, {"type", type}});
     return doc["accessors"].size() - 1;
   }
+  /// `value` for each of the box's vertices, one after the other.
+  [[nodiscard]] std::vector<float> per_box_vertex(const std::vector<float>& value) {
+    std::vector<float> out;
+    for (size_t i = box_vertices(); i-- > 0;) out.insert(out.end(), value.begin(), value.end());
+    return out;
+  }
   size_t add_floats(const std::vector<float>& values, const char* type, size_t count) {
     std::vector<unsigned char> bytes(values.size() * sizeof(float));
     std::memcpy(bytes.data(), values.data(), bytes.size());
@@ -505,10 +511,7 @@ TEST(BlenderImport, AMorphTargetRendersAtTheBaseShapeAsTheSceneHasIt) {
   const test::ScratchDir dir;
   BoxSceneJson scene(dir.path());
   // The box's target lifts it by 0.6 m, at weight 1.
-  const size_t n = scene.box_vertices();
-  std::vector<float> lift;
-  for (size_t i = 0; i < n; ++i) lift.insert(lift.end(), {0.0f, 0.6f, 0.0f});
-  const size_t target = scene.add_floats(lift, "VEC3", n);
+  const size_t target = scene.add_floats(scene.per_box_vertex({0.0f, 0.6f, 0.0f}), "VEC3", scene.box_vertices());
   scene.doc["accessors"][target]["min"] = {0.0, 0.6, 0.0};
   scene.doc["accessors"][target]["max"] = {0.0, 0.6, 0.0};
   scene.box_primitive()["targets"] = nlohmann::json::array({{{"POSITION", target}}});
@@ -525,11 +528,10 @@ TEST(BlenderImport, ASkinnedMeshRendersInItsBindPoseAsTheSceneHasIt) {
   const test::ScratchDir dir;
   BoxSceneJson scene(dir.path());
   const size_t n = scene.box_vertices();
-  std::vector<float> weights;
-  for (size_t i = 0; i < n; ++i) weights.insert(weights.end(), {1.0f, 0.0f, 0.0f, 0.0f});
   scene.box_primitive()["attributes"]["JOINTS_0"] =
       scene.add_accessor(std::vector<unsigned char>(n * 4, 0), 5121, "VEC4", n);
-  scene.box_primitive()["attributes"]["WEIGHTS_0"] = scene.add_floats(weights, "VEC4", n);
+  scene.box_primitive()["attributes"]["WEIGHTS_0"] =
+      scene.add_floats(scene.per_box_vertex({1.0f, 0.0f, 0.0f, 0.0f}), "VEC4", n);
   const size_t inverse_bind = scene.add_floats({1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}, "MAT4", 1);
   nlohmann::json& doc = scene.doc;
   doc["nodes"].push_back({{"name", "joint"}, {"translation", {1.0, 0.0, 0.0}}});
