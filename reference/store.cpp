@@ -633,6 +633,21 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
         {"versions", io::versions_json()}};
     io::write_text_atomically(staged / kProvenance, io::json_text(provenance, 2) + "\n");
     replace_folder(staged, root_ / id);
+  } catch (const IoError& e) {
+    // The writers name the files in the working folder, which goes now: the message names the
+    // entry they were for.
+    fs::remove_all(staged, ec);
+    std::string message = e.what();
+    const std::string from = staged.string(), to = (root_ / id).string();
+    for (size_t at = message.find(from); at != std::string::npos; at = message.find(from, at + to.size()))
+      message.replace(at, from.size(), to);
+    throw IoError(fmt::format("{} (reference '{}' was not stored; an earlier one of that id is kept)", message, id));
+  } catch (const ToolError& e) {
+    fs::remove_all(staged, ec);
+    throw ToolError(fmt::format("{}\n(the tool's work folder was inside the store's unfinished entry and is removed "
+                                "with it; `stereobench validate --truth {} --out DIR` renders the same truth and keeps "
+                                "its files in DIR/work/)",
+                                e.what(), spec.provider));
   } catch (...) {
     fs::remove_all(staged, ec);
     throw;

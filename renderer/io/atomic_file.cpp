@@ -117,7 +117,7 @@ UniqueFd lock_temporary(const fs::path& tmp, const fs::path& path) {
 /// (the next write of its file removes it as stale).
 struct SignalSlot {
   std::atomic<bool> used{false};     ///< taken by a registration
-  std::atomic<uint32_t> version{0};  ///< odd while `path` is written; changes with every name
+  std::atomic<uint32_t> version{0};  ///< odd while `path` is copied in; changes with every name and release
   char path[PATH_MAX];
 };
 constexpr size_t kSignalSlots = 512;
@@ -159,7 +159,9 @@ class SignalRegistration {
   void release() {
     if (slot_ < 0) return;
     SignalSlot& slot = g_signal_slots[slot_];
-    slot.version.fetch_add(1, std::memory_order_acq_rel);  // odd: no name
+    // Two steps, so the version stays even (a registration makes it odd only while it copies a
+    // name) and still changes: a handler copying the old name meanwhile sees it gone.
+    slot.version.fetch_add(2, std::memory_order_acq_rel);
     slot.used.store(false, std::memory_order_release);
     slot_ = -1;
   }
@@ -285,7 +287,20 @@ void write_through(const fs::path& stream, const std::function<void(const fs::pa
   const Temporary staged = new_temporary(folder / stream.filename());
   const fs::path& tmp = staged.path;
   with_temporary(tmp, stream, [&] {
-    write(tmp);
+    try {
+      write(tmp);
+    } catch (const IoError& e) {
+      // The copy failed, not the stream: the message names the temporary folder (a full /tmp
+      // while the stream's own disk has room).
+      std::string message = e.what();
+      const std::string hidden = tmp.string();
+      const std::string copy = "its copy in " + folder.string();
+      for (size_t at = message.find(hidden); at != std::string::npos; at = message.find(hidden, at + copy.size()))
+        message.replace(at, hidden.size(), copy);
+      throw IoError(fmt::format("cannot write {}: it is written through a copy made first in the temporary folder {}, "
+                                "and that failed: {}; make room there, or set TMPDIR to a folder with room",
+                                stream.string(), folder.string(), message));
+    }
     const UniqueFd in{::open(tmp.c_str(), O_RDONLY | O_CLOEXEC)};
     const UniqueFd out{::open(stream.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC)};
     if (in.get() < 0 || out.get() < 0)

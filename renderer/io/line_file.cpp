@@ -42,11 +42,16 @@ void LineFile::append(const std::string& line) {
   for (size_t done = 0; done < text.size();) {
     const ssize_t n = ::write(fd_.get(), text.data() + done, text.size() - done);
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0)
-      throw IoError(fmt::format("cannot write {}: {}; check free disk space", path_.string(),
-                                n < 0 ? std::strerror(errno) : "nothing written"));
+    if (n <= 0) {
+      const std::string why = n < 0 ? std::strerror(errno) : "nothing written";
+      // The part of the line that did go in is cut off again: the file holds whole lines only.
+      const bool undone = ::ftruncate(fd_.get(), end_) == 0 && ::lseek(fd_.get(), end_, SEEK_SET) == end_;
+      throw IoError(fmt::format("cannot write {}: {}; check free disk space{}", path_.string(), why,
+                                undone ? "" : " (its last line may be cut short)"));
+    }
     done += static_cast<size_t>(n);
   }
+  end_ += static_cast<off_t>(text.size());
   ++lines_;
 }
 

@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <string>
 
+#include <sys/types.h>
+
 #include "renderer/io/unique_fd.hpp"
 
 namespace sb::io {
@@ -21,7 +23,8 @@ class LineFile {
   LineFile(const LineFile&) = delete;
   LineFile& operator=(const LineFile&) = delete;
 
-  /// Writes `line` and a newline, whole, before returning; IoError naming the file (a full disk).
+  /// Writes `line` and a newline, whole, before returning; IoError naming the file (a full disk),
+  /// the part of the line written before the failure cut off again.
   void append(const std::string& line);
   /// Lines appended so far.
   [[nodiscard]] size_t lines() const { return lines_; }
@@ -33,6 +36,7 @@ class LineFile {
   std::filesystem::path path_;
   UniqueFd fd_;
   size_t lines_ = 0;
+  off_t end_ = 0;  ///< the file's size after its last whole line
   bool finished_ = false;
 };
 

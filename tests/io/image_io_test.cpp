@@ -32,6 +32,8 @@
 #include "renderer/io/image_io.hpp"
 #include "renderer/io/line_file.hpp"
 
+#include "support/file_size_limit.hpp"
+#include "support/scoped_env.hpp"
 #include "support/scratch_dir.hpp"
 
 namespace sb {
@@ -497,6 +499,27 @@ TEST_F(ImageIoTest, ALineFileIsWholeUnderItsFinalNameOnlyOnceFinished) {
   EXPECT_EQ(std::string(std::istreambuf_iterator<char>(through), {}), "new\n");
 }
 
+TEST_F(ImageIoTest, ALineThatDoesNotFitLeavesNoPartOfItInTheLineFile) {
+  // A disk that filled mid-line left the part that fit: a line no reader can parse after the whole
+  // ones. The part is cut off again and the file still takes lines once there is room.
+  io::LineFile lines(path("frames.jsonl.partial"));
+  lines.append("{\"frame\": 0}");
+  const std::string whole = "{\"frame\": 0}\n";
+  {
+    const test::FileSizeLimit limit(whole.size() + 5);
+    ASSERT_TRUE(limit.ok());
+    EXPECT_THROW(lines.append("{\"frame\": 1, \"long\": true}"), IoError);
+  }
+  EXPECT_EQ(lines.lines(), 1u);
+  const auto text = [&] {
+    std::ifstream partial(path("frames.jsonl.partial"));
+    return std::string(std::istreambuf_iterator<char>(partial), {});
+  };
+  EXPECT_EQ(text(), whole) << "the part of the line that fit stayed";
+  lines.append("{\"frame\": 1}");
+  EXPECT_EQ(text(), whole + "{\"frame\": 1}\n");
+}
+
 TEST_F(ImageIoTest, AKilledWritesTemporaryGoesWhenTheFileIsWrittenAgain) {
   // Left by a killed write of out.json: no process holds its lock any more. The staging name
   // (a write killed between creating its file and locking it) goes once it is a minute old.
@@ -688,6 +711,34 @@ TEST_F(ImageIoTest, AnOpenFileOfTheProcessIsAppendedToNotReplaced) {
   ::close(pipe_fds[0]);
   write_bytes(path("piped.exr"), received);
   EXPECT_TRUE(io::read_exr(path("piped.exr")) == image);
+}
+
+TEST_F(ImageIoTest, AStreamWhoseCopyCannotBeMadeNamesTheTemporaryFolder) {
+  // A stream is written through a copy in $TMPDIR. When that disk is full the message blamed the
+  // stream ("cannot write /dev/stdout ... check free disk space") while its own disk had room.
+  const fs::path staging = path("staging");
+  fs::create_directories(staging);
+  const test::ScopedEnv tmpdir("TMPDIR", staging.string());
+  int pipe_fds[2];
+  ASSERT_EQ(::pipe(pipe_fds), 0);
+  const std::string stream = "/proc/self/fd/" + std::to_string(pipe_fds[1]);
+  try {
+    const test::FileSizeLimit limit(8);
+    ASSERT_TRUE(limit.ok());
+    io::write_text_atomically(stream, std::string(100, 'x'));
+    ADD_FAILURE() << "the copy was written past the limit";
+  } catch (const IoError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("cannot write " + stream + ": it is written through a copy made first in the temporary "
+                       "folder " + staging.string()),
+              std::string::npos)
+        << msg;
+    EXPECT_NE(msg.find("set TMPDIR to a folder with room"), std::string::npos) << msg;
+    EXPECT_EQ(msg.find(".tmp-"), std::string::npos) << "the hidden copy's name: " << msg;
+  }
+  ::close(pipe_fds[1]);
+  ::close(pipe_fds[0]);
+  EXPECT_TRUE(fs::is_empty(staging)) << "the copy stayed";
 }
 
 TEST_F(ImageIoTest, OverwritingAnExistingExrReplacesItCompletely) {

@@ -83,6 +83,25 @@ TEST(ReferenceStore, GenerateWritesImageAndProvenance) {
   EXPECT_EQ(fs::status(dir / "store" / id).permissions(), fs::status(dir / "plain").permissions());
 }
 
+TEST(ReferenceStore, AFullDiskNamesTheEntryNotItsRemovedWorkingFolder) {
+  // A disk that fills as the image is written (a file-size limit of 8 KiB; the signal sent at the
+  // limit ignored, so the write fails as on a full disk). The message named the hidden working
+  // folder, removed by the time it was read.
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene box-wall --resolution 32x18 --threads 1").code, 0);
+  const test::CliRun r = test::run_shell("trap '' XFSZ; ulimit -f 8; " + std::string(SB_CLI_PATH) + " " +
+                                         ref(dir, "generate") + " --scene box-wall --resolution 64x36 --threads 1");
+  EXPECT_EQ(r.code, 4) << r.out;
+  EXPECT_NE(r.out.find((dir / "store" / "box-wall_full_64x36_e64.0mm_c4.08m" / "right.exr").string()),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("was not stored"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find(".new-"), std::string::npos) << r.out;
+  std::vector<std::string> entries;
+  for (const auto& e : fs::directory_iterator(dir / "store")) entries.push_back(e.path().filename().string());
+  EXPECT_EQ(entries, std::vector<std::string>{"box-wall_full_32x18_e64.0mm_c4.08m"});
+}
+
 TEST(ReferenceStore, VerifyUpdateOnlyFailingAndCorruption) {
   test::ScratchDir dir;
   ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene box-wall --resolution 64x36").code, 0);
