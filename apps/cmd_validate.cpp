@@ -53,6 +53,40 @@ std::vector<PipelineEntry> chosen_pipelines(const std::vector<std::string>& name
 /// non-zero MSE (its PSNR finite) never reads 0.000.
 std::string mse_text(double v) { return v > 0.0 && v < 0.001 ? fmt::format("{:.1e}", v) : table_number(v, 3); }
 
+/// The records of `scene_stem` (scene and truth) that the earlier summary in `out` lists and this
+/// run does not write, retired from `set` with the images of their own: this run replaces the
+/// truth and disocclusion images they point to, so they would describe another truth (another rig,
+/// another scene file of that name). The names of their pipelines; none when there is no earlier
+/// summary or it cannot be read.
+std::vector<std::string> retire_earlier_records(io::StagedFiles& set, const fs::path& out, const fs::path& summary,
+                                                const std::string& scene_stem, const std::vector<std::string>& names) {
+  std::vector<std::string> retired;
+  json earlier;
+  try {
+    if (!fs::is_regular_file(summary)) return retired;
+    earlier = json::parse(io::read_file(summary));
+  } catch (const std::exception&) {
+    return retired;  // a damaged summary is replaced; its records stay as they are
+  }
+  if (!earlier.is_object() || !earlier.contains("records") || !earlier["records"].is_array()) return retired;
+  for (const json& r : earlier["records"]) {
+    if (!r.is_object() || !r.contains("pipeline") || !r["pipeline"].is_string()) continue;
+    const std::string pipeline = r["pipeline"].get<std::string>();
+    if (std::find(names.begin(), names.end(), pipeline) != names.end()) continue;
+    const std::string own = fmt::format("{}_{}", scene_stem, entry_file_stem(pipeline));
+    set.retire(out / (own + ".json"));
+    if (r.contains("images") && r["images"].is_object())
+      for (const auto& [key, file] : r["images"].items())
+        if (file.is_string()) {
+          // Its own images only (the shared truth images are this run's): named after the record.
+          const std::string name = fs::path(file.get<std::string>()).filename().string();
+          if (name.rfind(own + "_", 0) == 0) set.retire(out / name);
+        }
+    retired.push_back(pipeline);
+  }
+  return retired;
+}
+
 void run_validate(const ValidateArgs& a) {
   const RigOverrides overrides = a.rig.overrides();
   const std::vector<PipelineEntry> chosen = chosen_pipelines(a.pipelines);
@@ -90,8 +124,15 @@ void run_validate(const ValidateArgs& a) {
                                     : std::optional<validation::TruthCache>(validation::TruthCache(a.cache));
   // A work folder per scene and provider: the command a record gives to render its truth again
   // runs there, and another scene validated into the same --out would replace its files.
-  const validation::ValidationTarget target = validation::prepare_target(
+  validation::ValidationTarget target = validation::prepare_target(
       prepared, loaded.file, rig, *provider, cache ? &*cache : nullptr, out / "work" / scene_stem, executor);
+  // A truth from the cache was rendered in another run's work folder, which may be gone or hold
+  // another render by now: the export and script are made ready in this one's, and the record gives
+  // the command that renders the truth again there.
+  if (target.truth.cached)
+    if (auto command =
+            provider->prepare({prepared, loaded.file, rig, out / "work" / scene_stem, executor.threads()}))
+      target.truth.render.command = *command;
   fmt::print("truth: {} ({}), {}{:.2f} s; true disocclusions {:.3f} % of the image\n", provider->name(),
              target.truth.render.tool_version, target.truth.cached ? "from the cache, rendered in " : "",
              target.truth.render.seconds,
@@ -103,6 +144,7 @@ void run_validate(const ValidateArgs& a) {
   // the summary last: a run that stops on the way (an image it cannot write, a full disk) leaves an
   // earlier run's summary, records and images as they were.
   io::StagedFiles set;
+  std::vector<std::string> retired;  // pipelines of earlier records this run removes
   validation::ImageFileOptions image_options;
   image_options.staged = &set;
   {
@@ -144,12 +186,17 @@ void run_validate(const ValidateArgs& a) {
                  "pipeline", name_w, "PSNR dB", "SSIM", "MSE", "err %");
       for (const std::string& line : left_lines) fmt::print("{}\n", line);
     }
+    retired = retire_earlier_records(set, out, summary, scene_stem, names);
     const std::string summary_text =
         io::json_text(json{{"kind", "stereobench.validation_summary"}, {"records", records}}, 2) + "\n";
     set.add(summary, [&](const fs::path& tmp) { io::write_text_atomically(tmp, summary_text); });
   }
   set.commit();  // the summary, added last, is the set's marker
   fmt::print("\nwrote {} (one record per pipeline beside it, images under {})\n", summary.string(), out.string());
+  if (!retired.empty())
+    fmt::print("removed the earlier records of {} with their images: not validated in this run, they described the "
+               "truth this run replaced (validate them together, or into another --out, to keep both)\n",
+               fmt::join(retired, ", "));
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <signal.h>
 #include <spawn.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -443,6 +444,29 @@ std::string format_limit(std::chrono::milliseconds limit) {
   if (ms % 60'000 == 0 && ms >= 60'000) return fmt::format("{} min", ms / 60'000);
   if (ms % 1000 == 0) return fmt::format("{} s", ms / 1000);
   return fmt::format("{:g} s", static_cast<double>(ms) / 1000.0);
+}
+
+std::string keep_tool_output(const std::filesystem::path& log, const std::string& output, bool render_failed) {
+  if (!render_failed) {
+    io::write_text_atomically(log, output);
+    return "";
+  }
+  try {
+    io::write_text_atomically(log, output);
+    return "";
+  } catch (const Error& e) {
+    return fmt::format(" (its output could not be kept: {})", e.what());
+  }
+}
+
+std::string low_disk_note(const std::filesystem::path& folder, std::uintmax_t needed) {
+  struct statvfs fs_info {};
+  if (::statvfs(folder.c_str(), &fs_info) != 0) return "";
+  const std::uintmax_t free_bytes = static_cast<std::uintmax_t>(fs_info.f_bavail) * fs_info.f_frsize;
+  if (free_bytes >= needed) return "";
+  return fmt::format("; the disk of {} has {} bytes free where the render needs about {}: make room there, or give an "
+                     "--out on another disk",
+                     folder.string(), free_bytes, needed);
 }
 
 std::string quoted_output(const std::string& text, std::size_t count) {

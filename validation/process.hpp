@@ -4,6 +4,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -77,6 +78,18 @@ struct ProcessResult {
 /// The last `count` non-empty lines of a tool's output, each on a line of its own as "  | LINE",
 /// for quoting at the end of a message ("  | (no output)" when it printed nothing).
 [[nodiscard]] std::string quoted_output(const std::string& text, std::size_t count);
+
+/// Writes an external render's output to `log` (atomically). When the render failed, its own
+/// failure is the error to report: a log that cannot be written (a full disk, which may be why it
+/// failed) is then no error, and what is returned says so ("" when it was written). When it
+/// succeeded, an unwritable log is an IoError as any output is.
+[[nodiscard]] std::string keep_tool_output(const std::filesystem::path& log, const std::string& output,
+                                           bool render_failed);
+
+/// For the message about a failed external render: a note that the disk of `folder` has fewer than
+/// `needed` bytes free (the render's images may not have fit), naming the free bytes and what to do;
+/// "" when it has room or cannot be asked.
+[[nodiscard]] std::string low_disk_note(const std::filesystem::path& folder, std::uintmax_t needed);
 
 /// The environment variable that sets the time limit of one external ground-truth render.
 inline constexpr const char* kToolTimeoutVariable = "STEREOBENCH_TOOL_TIMEOUT";

@@ -33,6 +33,8 @@ Image rgb_plane_only(const Image& image) {
 
 void TruthProvider::check_scene(const Scene& /*scene*/, const std::filesystem::path& /*scene_file*/) const {}
 
+std::optional<std::string> TruthProvider::prepare(const TruthRequest& /*request*/) const { return std::nullopt; }
+
 std::vector<std::string> truth_provider_names() { return {"full", "blender", "povray"}; }
 
 std::unique_ptr<TruthProvider> make_truth_provider(std::string_view name) {

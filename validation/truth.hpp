@@ -70,6 +70,12 @@ class TruthProvider {
   /// Renders the right eye (check_scene first). ToolError when the tool is missing or fails (its
   /// output quoted), InputError for a scene feature the provider cannot export (named).
   [[nodiscard]] virtual TruthRender render(const TruthRequest& request) const = 0;
+  /// Makes ready in request.work_dir what render() would run there (the export, scripts,
+  /// configuration), without rendering, and returns the command that renders it there, as
+  /// TruthRender::command gives it: for a truth served from the cache, whose recorded command
+  /// names the work folder of the run that rendered it. Nothing for a provider without a command
+  /// (the built-in one, the default).
+  [[nodiscard]] virtual std::optional<std::string> prepare(const TruthRequest& request) const;
 };
 
 /// The image with its "rgb" plane only (what caches and references keep of a render);

@@ -204,7 +204,13 @@ void TruthCache::store(const std::string& key, const TruthRender& render) const 
                   {"settings", render.settings},  {"command", render.command},
                   {"seconds", render.seconds},    {"image_sha256", hash_image(rgb)},
                   {"key", key}};
-  io::write_text_atomically(meta, io::json_text(j, 2) + "\n");
+  try {
+    io::write_text_atomically(meta, io::json_text(j, 2) + "\n");
+  } catch (const Error&) {
+    std::error_code ec;
+    std::filesystem::remove(exr, ec);  // an image without its record is no entry, only used space
+    throw;
+  }
 }
 
 ResolvedTruth resolve_truth(const TruthProvider& provider, const TruthRequest& request, const TruthCache* cache) {
@@ -236,7 +242,18 @@ ResolvedTruth resolve_truth(const TruthProvider& provider, const TruthRequest& r
   out.render = provider.render(request);
   // A radiance no renderer gives is never stored for later runs.
   check_truth_samples(out.render, request.work_dir, use_cache);
-  if (use_cache) cache->store(out.key, out.render);
+  if (use_cache) {
+    // The cache only saves later renders: this run has its truth, so one that cannot be kept (a
+    // full disk) is said and the run goes on.
+    try {
+      cache->store(out.key, out.render);
+    } catch (const Error& e) {
+      fmt::print(stderr,
+                 "stereobench: warning: the {} render is not kept in the ground-truth cache: {}; this run goes on "
+                 "without storing it (make room there, or give --cache '' to render without the cache)\n",
+                 provider.name(), e.what());
+    }
+  }
   return out;
 }
 

@@ -59,6 +59,7 @@ struct ResolvedTruth {
 /// follow every change to it. An external render runs under an exclusive lock on the request's
 /// work folder (runs that share one take turns). ToolError when the provider is unavailable;
 /// check_truth_samples' errors for an image with NaN, infinite or negative samples (not stored).
+/// A render that cannot be stored (a full disk) is returned all the same, with a warning.
 [[nodiscard]] ResolvedTruth resolve_truth(const TruthProvider& provider, const TruthRequest& request,
                                           const TruthCache* cache);
 

@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <map>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -90,6 +92,31 @@ TEST(Validate, ExternalTruthIsRenderedOnceThenCached) {
   // Our ray tracer against POV-Ray on an untextured scene: the providers agree (three-way test).
   EXPECT_NE(record["metrics"]["psnr"], "inf");
   EXPECT_GE(record["metrics"]["psnr"].get<double>(), 45.0);
+
+  // Served from the cache into another --out, the record's command renders the truth again in
+  // that --out's work folder, made ready there; it named the first run's folder, whose files a
+  // later run may replace.
+  const fs::path other = dir / "other";
+  const test::CliRun third = test::run_cli(
+      "validate --scene box-wall --resolution 160x90 --threads 2 --scenes-dir " +
+      test::quoted(fs::path(SB_BINARY_DIR) / "Testing" / "scenes-cache") + " --out " + test::quoted(other) +
+      " --cache " + test::quoted(dir / "cache") + " --truth povray --pipelines plain-rt");
+  ASSERT_EQ(third.code, 0) << third.out;
+  EXPECT_NE(third.out.find("from the cache"), std::string::npos) << third.out;
+  const json served = json::parse(test::read_text(other / "box-wall_povray_plain-rt.json"));
+  const fs::path work = other / "work" / "box-wall_povray";
+  const std::string command = served["truth"]["command"].get<std::string>();
+  EXPECT_NE(command.find(work.string()), std::string::npos) << command;
+  EXPECT_EQ(command.find((dir / "out").string()), std::string::npos) << command;
+  EXPECT_TRUE(fs::is_regular_file(work / "scene.pov"));
+  EXPECT_FALSE(fs::exists(work / "right.exr")) << "made ready, not rendered";
+  // Run as recorded, it renders the cached image again.
+  ASSERT_EQ(test::run_shell(command).code, 0) << command;
+  const Image again = io::read_exr(work / "right.exr");
+  const Image cached = io::read_exr(other / "box-wall_truth-povray.exr");
+  ASSERT_TRUE(again.has_plane(planes::rgb) && cached.has_plane(planes::rgb));
+  const auto a = again.plane(planes::rgb).f32(), b = cached.plane(planes::rgb).f32();
+  EXPECT_TRUE(std::equal(a.begin(), a.end(), b.begin(), b.end())) << "the command renders another image";
 }
 
 TEST(Validate, EmptyCacheFolderTurnsTheCacheOff) {
@@ -227,6 +254,29 @@ TEST(Validate, VariantsAreMeasuredBesideTheirPipelineUnderTheirOwnName) {
     EXPECT_EQ(e.code, 3) << entry << ":\n" << e.out;
     EXPECT_NE(e.out.find(message), std::string::npos) << entry << ":\n" << e.out;
   }
+}
+
+TEST(Validate, ARunIntoAnEarlierOnesFolderRemovesTheRecordsItLeavesBehind) {
+  // fw-warp's record stayed beside a later run of repro-rt alone at another interaxial, pointing at
+  // truth and disocclusion images that now showed the later rig.
+  test::ScratchDir dir;
+  const fs::path out = dir / "out";
+  ASSERT_EQ(test::run_cli(base_args(dir) + " --pipelines repro-rt,fw-warp").code, 0);
+  ASSERT_TRUE(fs::exists(out / "box-wall_full_fw-warp.json"));
+  ASSERT_TRUE(fs::exists(out / "box-wall_full_fw-warp_right.png"));
+  const test::CliRun r = test::run_cli(base_args(dir) + " --interaxial 0.12 --pipelines repro-rt");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("removed the earlier records of fw-warp with their images"), std::string::npos) << r.out;
+  std::vector<std::string> left;
+  for (const fs::directory_entry& e : fs::directory_iterator(out))
+    if (e.path().filename().string().find("fw-warp") != std::string::npos) left.push_back(e.path().filename());
+  EXPECT_TRUE(left.empty()) << left.front();
+  // The shared images and the run's own record stay, and the summary lists what is there.
+  for (const char* kept : {"box-wall_truth-full.png", "box-wall_disocclusions.png", "box-wall_full_repro-rt.json"})
+    EXPECT_TRUE(fs::exists(out / kept)) << kept;
+  const json summary = json::parse(test::read_text(out / "box-wall_full_summary.json"));
+  ASSERT_EQ(summary["records"].size(), 1u);
+  EXPECT_EQ(summary["records"][0]["rig"]["interaxial_m"], 0.12);
 }
 
 TEST(Validate, WhatARigForbidsIsRefusedBeforeAnythingRendersAndAStopLeavesNoSummary) {

@@ -569,6 +569,34 @@ TEST(PovrayFailure, FailedRenderThrowsToolErrorQuotingOutputAndKeepsTheScene) {
   EXPECT_FALSE(std::filesystem::exists(dir / "work" / "right.exr"));
 }
 
+TEST(PovrayFailure, AFailedRenderIsReportedWhenItsOutputCannotBeKeptAndItsLeftoversGo) {
+  // On a full disk POV-Ray fails writing its image, and the log of its output cannot be written
+  // either: that write's error hid POV-Ray's own, and the cut image and the state file it left
+  // kept the disk full. (The log is blocked here by a folder at its name.)
+  const test::ScratchDir dir;
+  const auto exe = fake_povray(dir,
+                               "if [ \"$1\" = --version ]; then echo 'POV-Ray 3.7.0.10'; exit 0; fi\n"
+                               "echo 'half' > right.exr; echo 'state' > right.pov-state\n"
+                               "echo 'Cannot access data in file right.exr' >&2\nexit 1\n");
+  const ScopedEnv env("STEREOBENCH_POVRAY", exe.string());
+  const auto povray = validation::make_truth_provider("povray");
+  const Scene scene = load_builtin_with("lit-plane", {});
+  const RenderScene rs(scene);
+  std::filesystem::create_directories(dir / "work" / "povray.log" / "inside");
+  try {
+    (void)render_truth(*povray, rs, test::rig_at(scene, 32, 18), dir / "work");
+    ADD_FAILURE() << "a failing POV-Ray run did not throw";
+  } catch (const ToolError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("POV-Ray failed (exit status 1)"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("Cannot access data in file right.exr"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("its output could not be kept"), std::string::npos) << msg;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "work" / "right.exr"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "work" / "right.pov-state"));
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir / "work" / "scene.pov"));
+}
+
 TEST(PovrayUnsupported, SpotLightIsRefusedByName) {
   SB_REQUIRE_POVRAY(povray);
   const test::ScratchDir dir;

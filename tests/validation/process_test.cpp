@@ -327,3 +327,27 @@ TEST(ToolTimeout, AMalformedValueIsAnInputErrorNamingIt) {
 
 }  // namespace
 }  // namespace sb::validation
+
+namespace sb::validation {
+namespace {
+
+TEST(ToolOutput, ALowDiskIsNamedOnlyWhenTheRenderNeedsMoreThanIsFree) {
+  const test::ScratchDir dir("low-disk");
+  EXPECT_EQ(low_disk_note(dir.path(), 0), "");
+  const std::string note = low_disk_note(dir.path(), UINTMAX_MAX);
+  EXPECT_NE(note.find("the disk of " + dir.path().string() + " has "), std::string::npos) << note;
+  EXPECT_NE(note.find("make room there"), std::string::npos) << note;
+}
+
+TEST(ToolOutput, AnUnwritableLogIsANoteAfterAFailedRenderAndAnErrorAfterAGoodOne) {
+  const test::ScratchDir dir("tool-log");
+  EXPECT_EQ(keep_tool_output(dir / "ok.log", "fine\n", true), "");
+  EXPECT_EQ(test::read_text(dir / "ok.log"), "fine\n");
+  std::filesystem::create_directories(dir / "blocked.log" / "inside");
+  const std::string note = keep_tool_output(dir / "blocked.log", "Render failed\n", true);
+  EXPECT_NE(note.find("its output could not be kept"), std::string::npos) << note;
+  EXPECT_THROW((void)keep_tool_output(dir / "blocked.log", "fine\n", false), Error);
+}
+
+}  // namespace
+}  // namespace sb::validation

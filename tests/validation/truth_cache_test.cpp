@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <thread>
@@ -39,6 +40,7 @@ class CountingProvider final : public TruthProvider {
   TruthRender render(const TruthRequest& request) const override {
     check_scene(request.scene.scene(), request.scene_file);
     ++renders;
+    if (during_render) during_render();
     TruthRender r;
     r.provider = name_;
     r.tool_version = tool_version();
@@ -55,6 +57,7 @@ class CountingProvider final : public TruthProvider {
   std::string revision_ = "r1";
   std::optional<float> bad_sample;  ///< a value the render puts in one sample (NaN, inf, negative)
   std::optional<std::string> refusal;  ///< check_scene's InputError message, when set
+  std::function<void()> during_render;  ///< called as the render runs, when set
 
  private:
   std::string name_;
@@ -274,6 +277,25 @@ TEST_F(TruthCacheTest, AFolderInPlaceOfTheEntryFailsBeforeTheProviderRenders) {
     EXPECT_NE(std::string(e.what()).find("is a folder; remove it"), std::string::npos) << e.what();
   }
   EXPECT_EQ(provider.renders, 0);
+}
+
+TEST_F(TruthCacheTest, ARenderTheCacheCannotKeepIsUsedAllTheSame) {
+  // The cache's disk filled while the external tool rendered (here: a folder took the record's
+  // name). The render was lost and the validation ended with exit 4; the cache is only a saving.
+  CountingProvider provider;
+  const TruthRequest request = request_at(64, 36);
+  std::filesystem::path meta = cache.image_path("counting", truth_key(provider, request));
+  meta.replace_extension(".json");
+  provider.during_render = [&] { std::filesystem::create_directories(meta / "inside"); };
+  testing::internal::CaptureStderr();
+  const ResolvedTruth r = resolve_truth(provider, request, &cache);
+  const std::string said = testing::internal::GetCapturedStderr();
+  EXPECT_FALSE(r.cached);
+  EXPECT_EQ(r.render.right.width(), 64);
+  EXPECT_NE(said.find("warning: the counting render is not kept in the ground-truth cache"), std::string::npos)
+      << said;
+  EXPECT_NE(said.find(meta.string()), std::string::npos) << said;
+  EXPECT_FALSE(std::filesystem::exists(cache.image_path("counting", r.key))) << "an image without its record stayed";
 }
 
 TEST_F(TruthCacheTest, AnUnusableCacheFailsBeforeTheProviderRenders) {

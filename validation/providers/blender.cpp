@@ -362,8 +362,123 @@ class BlenderProvider final : public TruthProvider {
                                    scene_file.string(), scene.nodes_not_loaded));
   }
 
+  std::optional<std::string> prepare(const TruthRequest& request) const override { return set_up(request).command; }
+
   TruthRender render(const TruthRequest& request) const override {
     const auto start = std::chrono::steady_clock::now();
+    const Setup setup = set_up(request);
+    const nlohmann::json& params = setup.params;
+    const std::chrono::milliseconds limit = setup.limit;
+    const std::string& version = setup.version;
+    const EyeCamera& eye = setup.eye;
+    const fs::path& work_dir = setup.work_dir;
+    const std::vector<fs::path>& passes = setup.passes;
+    const fs::path& script = setup.script;
+    const std::string& command = setup.command;
+    const double shift_x = setup.shift_x, shift_y = setup.shift_y;
+    std::error_code ec;
+
+    const ProcessResult run = run_process(setup.argv, blender_options(limit));
+    const fs::path log = work_dir / "blender_output.txt";
+    const bool failed = run.timed_out || !run.ok();
+    const std::string log_note = keep_tool_output(log, run.out, failed);
+    if (failed)  // a cut pass is no use to a rerun and may fill the disk the render failed on
+      for (const fs::path& pass : passes) fs::remove(pass, ec);
+    if (run.timed_out)
+      throw ToolError(fmt::format("{} did not finish rendering {} within {} and was stopped; {}; the script is kept "
+                                  "in {} and the output so far in {}{}; last lines of the output:{}",
+                                  version, request.scene_file.string(), format_limit(limit), tool_timeout_hint(),
+                                  script.string(), log.string(), log_note, quoted_output(run.out, kQuotedLines)));
+    if (failed) {
+      // Each pass is a float RGBA image, with room to spare.
+      const std::uintmax_t needed =
+          passes.size() * std::uintmax_t{16} * eye.width * eye.height + (std::uintmax_t{1} << 20);
+      throw ToolError(fmt::format("{} {} rendering {}{}; the script is kept in {} and the full output in {}{}; "
+                                  "last lines of the output:{}",
+                                  version, run.describe(), request.scene_file.string(), low_disk_note(work_dir, needed),
+                                  script.string(), log.string(), log_note, quoted_output(run.out, kQuotedLines)));
+    }
+
+    // Sum the passes in light order (the order in which our shading adds the lights).
+    TruthRender out;
+    out.provider = name();
+    out.tool_version = version;
+    out.right = Image(eye.width, eye.height);
+    float* sum = out.right.add_plane(planes::rgb).data_f32();
+    const size_t n = out.right.pixel_count() * 3;
+    for (size_t k = 0; k < passes.size(); ++k) {
+      if (!fs::is_regular_file(passes[k]))
+        throw ToolError(fmt::format("{} exited normally but wrote no image {}; the script is kept in {}, its "
+                                    "output in {}{}",
+                                    version, passes[k].string(), script.string(), log.string(),
+                                    quoted_output(run.out, kQuotedLines)));
+      const Image pass = [&] {
+        try {
+          return io::read_exr(passes[k]);
+        } catch (const Error& e) {
+          throw ToolError(fmt::format("{} wrote {} but it cannot be read ({}); the script is kept in {}, its output in "
+                                      "{}{}",
+                                      version, passes[k].string(), e.what(), script.string(), log.string(),
+                                      quoted_output(run.out, kQuotedLines)));
+        }
+      }();
+      if (pass.width() != eye.width || pass.height() != eye.height || !pass.has_plane(planes::rgb))
+        throw ToolError(fmt::format("{} wrote {} as {}x{} with planes [{}]; expected {}x{} with rgb", version,
+                                    passes[k].string(), pass.width(), pass.height(), pass.plane_list(), eye.width,
+                                    eye.height));
+      const float* p = pass.data_f32(planes::rgb);
+      if (k == 0) {
+        std::copy(p, p + n, sum);
+      } else {
+        for (size_t i = 0; i < n; ++i) sum[i] += p[i];
+      }
+    }
+
+    out.command = command;
+    nlohmann::json mixed = nlohmann::json::array();
+    for (size_t t = 0; t < params["textures"].size(); ++t)
+      if (!params["textures"][t].is_null() && params["textures"][t]["mixed_wrap"].get<bool>())
+        mixed.push_back(t);
+    out.settings = cycles_settings(request.threads);
+    out.settings["revision"] = kRevision;
+    out.settings["script"] = script.string();
+    out.settings["passes"] = params["passes"];
+    out.settings["camera"] = {{"type", "PERSP"},
+                              {"sensor_fit", "VERTICAL"},
+                              {"sensor_height_mm", kSensorHeightMm},
+                              {"lens_mm", params["camera"]["lens_mm"]},
+                              {"shift_x", shift_x},
+                              {"shift_y", shift_y},
+                              {"shift_units", "image height (sensor_fit VERTICAL)"},
+                              {"clip_start", kClipStart},
+                              {"clip_end", kClipEnd},
+                              {"axes", "Blender (x, y, z) = glTF (x, -z, y)"}};
+    out.settings["calibration"] = {
+        {"point_power_w_per_intensity_w_sr", kPointPowerPerIntensity},
+        {"sun_strength_per_irradiance", kSunStrengthPerIrradiance},
+        {"sample_offset_px", "about +0.0005 right and up (box filter 0.01 px; measured on lit-plane)"},
+        {"ambient", "Emission of the albedo with strength = ambient (radiance = strength x colour)"}};
+    if (!mixed.empty()) out.settings["textures_wrapped_on_both_axes"] = mixed;
+    out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return out;
+  }
+
+ private:
+  /// What a render runs, made ready in the request's work folder: the textures exported, the
+  /// script written (its parameters above its fixed body), stale passes removed, and the command.
+  struct Setup {
+    nlohmann::json params;
+    std::chrono::milliseconds limit{0};
+    std::string version;
+    EyeCamera eye;
+    fs::path work_dir;
+    std::vector<fs::path> passes;
+    fs::path script;
+    std::vector<std::string> argv;
+    std::string command;
+    double shift_x = 0.0, shift_y = 0.0;
+  };
+  Setup set_up(const TruthRequest& request) const {
     const std::chrono::milliseconds limit = tool_timeout();  // InputError for a malformed value
     const Scene& scene = request.scene.scene();
     check_scene(scene, request.scene_file);
@@ -445,86 +560,10 @@ class BlenderProvider final : public TruthProvider {
     text += "import json\n\nPARAMS = json.loads(r\"\"\"" + params.dump(2) + "\"\"\")\n";
     text += blender_script_body();
     io::write_text_atomically(script, text);
-
-    const ProcessResult run = run_process(argv, blender_options(limit));
-    const fs::path log = work_dir / "blender_output.txt";
-    io::write_text_atomically(log, run.out);
-    if (run.timed_out)
-      throw ToolError(fmt::format("{} did not finish rendering {} within {} and was stopped; {}; the script is kept "
-                                  "in {} and the output so far in {}; last lines of the output:{}",
-                                  version, request.scene_file.string(), format_limit(limit), tool_timeout_hint(),
-                                  script.string(), log.string(), quoted_output(run.out, kQuotedLines)));
-    if (!run.ok())
-      throw ToolError(fmt::format("{} {} rendering {}; the script is kept in {} and the full output in {}; "
-                                  "last lines of the output:{}",
-                                  version, run.describe(), request.scene_file.string(), script.string(), log.string(),
-                                  quoted_output(run.out, kQuotedLines)));
-
-    // Sum the passes in light order (the order in which our shading adds the lights).
-    TruthRender out;
-    out.provider = name();
-    out.tool_version = version;
-    out.right = Image(eye.width, eye.height);
-    float* sum = out.right.add_plane(planes::rgb).data_f32();
-    const size_t n = out.right.pixel_count() * 3;
-    for (size_t k = 0; k < passes.size(); ++k) {
-      if (!fs::is_regular_file(passes[k]))
-        throw ToolError(fmt::format("{} exited normally but wrote no image {}; the script is kept in {}, its "
-                                    "output in {}{}",
-                                    version, passes[k].string(), script.string(), log.string(),
-                                    quoted_output(run.out, kQuotedLines)));
-      const Image pass = [&] {
-        try {
-          return io::read_exr(passes[k]);
-        } catch (const Error& e) {
-          throw ToolError(fmt::format("{} wrote {} but it cannot be read ({}); the script is kept in {}, its output in "
-                                      "{}{}",
-                                      version, passes[k].string(), e.what(), script.string(), log.string(),
-                                      quoted_output(run.out, kQuotedLines)));
-        }
-      }();
-      if (pass.width() != eye.width || pass.height() != eye.height || !pass.has_plane(planes::rgb))
-        throw ToolError(fmt::format("{} wrote {} as {}x{} with planes [{}]; expected {}x{} with rgb", version,
-                                    passes[k].string(), pass.width(), pass.height(), pass.plane_list(), eye.width,
-                                    eye.height));
-      const float* p = pass.data_f32(planes::rgb);
-      if (k == 0) {
-        std::copy(p, p + n, sum);
-      } else {
-        for (size_t i = 0; i < n; ++i) sum[i] += p[i];
-      }
-    }
-
-    out.command = command;
-    nlohmann::json mixed = nlohmann::json::array();
-    for (size_t t = 0; t < params["textures"].size(); ++t)
-      if (!params["textures"][t].is_null() && params["textures"][t]["mixed_wrap"].get<bool>())
-        mixed.push_back(t);
-    out.settings = cycles_settings(request.threads);
-    out.settings["revision"] = kRevision;
-    out.settings["script"] = script.string();
-    out.settings["passes"] = params["passes"];
-    out.settings["camera"] = {{"type", "PERSP"},
-                              {"sensor_fit", "VERTICAL"},
-                              {"sensor_height_mm", kSensorHeightMm},
-                              {"lens_mm", params["camera"]["lens_mm"]},
-                              {"shift_x", shift_x},
-                              {"shift_y", shift_y},
-                              {"shift_units", "image height (sensor_fit VERTICAL)"},
-                              {"clip_start", kClipStart},
-                              {"clip_end", kClipEnd},
-                              {"axes", "Blender (x, y, z) = glTF (x, -z, y)"}};
-    out.settings["calibration"] = {
-        {"point_power_w_per_intensity_w_sr", kPointPowerPerIntensity},
-        {"sun_strength_per_irradiance", kSunStrengthPerIrradiance},
-        {"sample_offset_px", "about +0.0005 right and up (box filter 0.01 px; measured on lit-plane)"},
-        {"ambient", "Emission of the albedo with strength = ambient (radiance = strength x colour)"}};
-    if (!mixed.empty()) out.settings["textures_wrapped_on_both_axes"] = mixed;
-    out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return out;
+    return Setup{std::move(params), limit, version, eye, work_dir, std::move(passes), script, argv, command,
+                 shift_x, shift_y};
   }
 
- private:
   static fs::path executable() {
     Located found = locate_blender();
     if (!found.problem.empty()) throw ToolError("blender provider unavailable: " + found.problem);

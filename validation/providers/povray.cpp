@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <mutex>
+#include <optional>
 #include <regex>
 #include <sstream>
 #include <thread>
@@ -109,8 +110,105 @@ class PovrayProvider final : public TruthProvider {
     povray::check_exportable(scene);
   }
 
+  std::optional<std::string> prepare(const TruthRequest& request) const override {
+    return quoted(set_up(request, std::chrono::steady_clock::now()).cmd);
+  }
+
   TruthRender render(const TruthRequest& request) const override {
     const auto start = std::chrono::steady_clock::now();
+    const Setup setup = set_up(request, start);
+    const EyeCamera& eye = setup.eye;
+    const std::filesystem::path& dir = setup.dir;
+    const std::filesystem::path& image_file = setup.image_file;
+    const std::filesystem::path& log_file = setup.log_file;
+    const povray::ExportResult& exported = setup.exported;
+    const Command& cmd = setup.cmd;
+    const std::chrono::milliseconds limit = setup.limit;
+    const double export_seconds = setup.export_seconds;
+    std::error_code ec;
+
+    const ProcessResult run = cmd.run();
+    const double render_seconds = seconds_since(start) - export_seconds;
+    const std::string& log = run.out;
+    const bool have_image = std::filesystem::is_regular_file(image_file, ec);
+    const bool failed = run.timed_out || !run.ok() || !have_image;
+    const std::string log_note = keep_tool_output(log_file, log, failed);
+    if (failed) {
+      // What a stopped or failed render leaves (a cut image, the state file of its progress) is
+      // no use to a rerun and may fill the disk it failed on.
+      for (const char* left : {"right.exr", "right.pov-state"}) std::filesystem::remove(dir / left, ec);
+    }
+    // The half-float image and the state file beside it, with room to spare.
+    const std::string disk_note =
+        failed ? low_disk_note(dir, std::uintmax_t{16} * eye.width * eye.height + (std::uintmax_t{1} << 20)) : "";
+    if (run.timed_out)
+      throw ToolError(fmt::format(
+          "POV-Ray did not finish rendering '{}' within {} and was stopped; {}; the scene file is kept there, rerun "
+          "it with: {}\nlast lines of its output ({}{}):{}",
+          exported.sdl_file.string(), format_limit(limit), tool_timeout_hint(), quoted(cmd), log_file.string(),
+          log_note, quoted_output(log, kQuotedLines)));
+    if (failed) {
+      std::string failure = "no image written";
+      if (run.signal != 0)
+        failure = fmt::format("killed by signal {}", run.signal);
+      else if (run.exit_code != 0)
+        failure = fmt::format("exit status {}", run.exit_code);
+      throw ToolError(fmt::format(
+          "POV-Ray failed ({}) rendering '{}'{}; the scene file is kept there, rerun it with: {}\nlast lines of its "
+          "output ({}{}):{}",
+          failure, exported.sdl_file.string(), disk_note, quoted(cmd), log_file.string(), log_note,
+          quoted_output(log, kQuotedLines)));
+    }
+
+    Image raw;
+    try {
+      raw = io::read_exr(image_file);
+    } catch (const Error& e) {
+      throw ToolError(fmt::format("POV-Ray wrote '{}' but it cannot be read: {}", image_file.string(), e.what()));
+    }
+    if (raw.width() != eye.width || raw.height() != eye.height || !raw.has_plane(planes::rgb))
+      throw ToolError(fmt::format("POV-Ray wrote '{}' as {}x{} with planes [{}]; expected {}x{} with rgb",
+                                  image_file.string(), raw.width(), raw.height(), raw.plane_list(), eye.width,
+                                  eye.height));
+    TruthRender out;
+    out.provider = name();
+    out.tool_version = info_.version;
+    out.right = Image(eye.width, eye.height);
+    const std::span<const float> src = raw.plane(planes::rgb).f32();
+    std::copy(src.begin(), src.end(), out.right.add_plane(planes::rgb).f32().begin());
+    out.command = quoted(cmd);
+    out.settings = exported.settings;
+    out.settings["provider_revision"] = kProviderRevision;
+    out.settings["executable"] = info_.executable.string();
+    out.settings["executable_from"] = from_variable_ ? kExecutableVariable : "PATH";
+    out.settings["tool_banner"] = info_.banner;
+    out.settings["options"] = cmd.args;
+    out.settings["antialias"] = false;
+    out.settings["radiosity"] = false;
+    out.settings["output"] = "OpenEXR half float (11-bit significand: relative rounding error <= 2^-11 = 4.9e-4)";
+    out.settings["threads"] = setup.threads;
+    out.settings["work_dir"] = dir.string();
+    out.settings["export_seconds"] = export_seconds;
+    out.settings["render_seconds"] = render_seconds;
+    out.settings["export_warnings"] = exported.warnings;
+    out.settings["povray_warnings"] = warning_lines(log, 20);
+    out.seconds = seconds_since(start);
+    return out;
+  }
+
+ private:
+  /// What a render runs, made ready in the request's work folder: the scene exported, POV-Ray's
+  /// private configuration written, a stale image removed, and the command.
+  struct Setup {
+    EyeCamera eye;
+    std::filesystem::path dir, image_file, log_file;
+    povray::ExportResult exported;
+    Command cmd;
+    std::chrono::milliseconds limit{0};
+    int threads = 1;
+    double export_seconds = 0.0;
+  };
+  Setup set_up(const TruthRequest& request, std::chrono::steady_clock::time_point start) const {
     probe();
     if (reason_) throw ToolError(*reason_);
     const std::chrono::milliseconds limit = tool_timeout();  // InputError for a malformed value
@@ -165,67 +263,9 @@ class PovrayProvider final : public TruthProvider {
                 "-C",   // no continued trace
                 "+Q9",
                 fmt::format("+WT{}", threads)};
-
-    const ProcessResult run = cmd.run();
-    const double render_seconds = seconds_since(start) - export_seconds;
-    const std::string& log = run.out;
-    io::write_text_atomically(log_file, log);
-    if (run.timed_out)
-      throw ToolError(fmt::format(
-          "POV-Ray did not finish rendering '{}' within {} and was stopped; {}; the scene file is kept there, rerun "
-          "it with: {}\nlast lines of its output ({}):{}",
-          exported.sdl_file.string(), format_limit(limit), tool_timeout_hint(), quoted(cmd), log_file.string(),
-          quoted_output(log, kQuotedLines)));
-    const bool have_image = std::filesystem::is_regular_file(image_file, ec);
-    if (!run.ok() || !have_image) {
-      std::string failure = "no image written";
-      if (run.signal != 0)
-        failure = fmt::format("killed by signal {}", run.signal);
-      else if (run.exit_code != 0)
-        failure = fmt::format("exit status {}", run.exit_code);
-      throw ToolError(fmt::format(
-          "POV-Ray failed ({}) rendering '{}'; the scene file is kept there, rerun it with: {}\nlast lines of its "
-          "output ({}):{}",
-          failure, exported.sdl_file.string(), quoted(cmd), log_file.string(), quoted_output(log, kQuotedLines)));
-    }
-
-    Image raw;
-    try {
-      raw = io::read_exr(image_file);
-    } catch (const Error& e) {
-      throw ToolError(fmt::format("POV-Ray wrote '{}' but it cannot be read: {}", image_file.string(), e.what()));
-    }
-    if (raw.width() != eye.width || raw.height() != eye.height || !raw.has_plane(planes::rgb))
-      throw ToolError(fmt::format("POV-Ray wrote '{}' as {}x{} with planes [{}]; expected {}x{} with rgb",
-                                  image_file.string(), raw.width(), raw.height(), raw.plane_list(), eye.width,
-                                  eye.height));
-    TruthRender out;
-    out.provider = name();
-    out.tool_version = info_.version;
-    out.right = Image(eye.width, eye.height);
-    const std::span<const float> src = raw.plane(planes::rgb).f32();
-    std::copy(src.begin(), src.end(), out.right.add_plane(planes::rgb).f32().begin());
-    out.command = quoted(cmd);
-    out.settings = exported.settings;
-    out.settings["provider_revision"] = kProviderRevision;
-    out.settings["executable"] = info_.executable.string();
-    out.settings["executable_from"] = from_variable_ ? kExecutableVariable : "PATH";
-    out.settings["tool_banner"] = info_.banner;
-    out.settings["options"] = cmd.args;
-    out.settings["antialias"] = false;
-    out.settings["radiosity"] = false;
-    out.settings["output"] = "OpenEXR half float (11-bit significand: relative rounding error <= 2^-11 = 4.9e-4)";
-    out.settings["threads"] = threads;
-    out.settings["work_dir"] = dir.string();
-    out.settings["export_seconds"] = export_seconds;
-    out.settings["render_seconds"] = render_seconds;
-    out.settings["export_warnings"] = exported.warnings;
-    out.settings["povray_warnings"] = warning_lines(log, 20);
-    out.seconds = seconds_since(start);
-    return out;
+    return Setup{eye, dir, image_file, log_file, exported, cmd, limit, threads, export_seconds};
   }
 
- private:
   static double seconds_since(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
   }
