@@ -192,4 +192,24 @@ void register_gate_command(CLI::App& root) {
   g->callback([a] { run_gate(*a); });
 }
 
+void discard_gate_reports_after_usage_error(CLI::App& root) noexcept {
+  try {
+    const CLI::App* g = root.get_subcommand("gate");
+    if (g->parsed() == 0) return;
+    // The values as typed: a usage error may come before they reach GateArgs (CLI11 converts
+    // and checks values after reading the whole line).
+    const auto typed = [&](const char* name, std::string fallback) {
+      const CLI::Option* o = g->get_option_no_throw(name);
+      return o != nullptr && !o->results().empty() ? o->results().back() : fallback;
+    };
+    const std::string results = typed("--results", ""), config = typed("--config", GateArgs{}.config),
+                      baseline = typed("--baseline", validation::kDefaultBaselineFile),
+                      junit = typed("--junit", ""), json_out = typed("--json", "");
+    remove_earlier_outputs_sparing({{"--results", &results}, {"--config", &config}, {"the baseline", &baseline}},
+                                   {{"--junit", &junit}, {"--json", &json_out}});
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "stereobench: warning: an earlier gate report may remain: {}\n", e.what());
+  }
+}
+
 }  // namespace sb::cli

@@ -28,6 +28,10 @@ void register_validate_command(CLI::App& root);
 void register_sweep_command(CLI::App& root);
 /// `stereobench gate`.
 void register_gate_command(CLI::App& root);
+/// After a usage error on the command line (CLI11's, before any command ran): when it was the
+/// gate's, removes the --junit and --json files an earlier run left, as the gate does on every
+/// other exit 3, so that a green report never stands for a run that was refused. Best effort.
+void discard_gate_reports_after_usage_error(CLI::App& root) noexcept;
 /// `stereobench nightly`.
 void register_nightly_command(CLI::App& root);
 

@@ -165,6 +165,9 @@ int after_flushing_stdout(int code) {
 
 int main(int argc, char** argv) {
   sb::keep_freed_memory();
+  // Line by line, also into a file or pipe: progress and warnings on standard error then fall
+  // between the lines of standard output in the order they were printed (a log of `2>&1`).
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
   // Ctrl-C, `kill`, a job's end: running tools are stopped and temporary files removed.
   sb::validation::install_stop_handler();
   CLI::App app{"stereobench: offline validation and benchmarking of accelerated stereo rendering.\n"
@@ -202,6 +205,7 @@ int main(int argc, char** argv) {
     const std::string unknown = unknown_command_message(app, argc, argv);
     std::fprintf(stderr, "stereobench: error: %s\n", unknown.empty() ? e.what() : unknown.c_str());
     std::fprintf(stderr, "Run `stereobench --help` (or `stereobench SUBCOMMAND --help`) for usage.\n");
+    sb::cli::discard_gate_reports_after_usage_error(app);
     return static_cast<int>(sb::ExitCode::bad_input);
   } catch (const sb::Error& e) {
     std::fprintf(stderr, "stereobench: error: %s\n", e.what());

@@ -38,7 +38,8 @@ struct PathPlace {
 };
 
 PathPlace place_of(size_t keys, int frames, int frame) {
-  const double u = static_cast<double>(frame) / static_cast<double>(frames - 1) * static_cast<double>(keys - 1);
+  // frame (keys - 1) is exact, so a frame whose place is a key stands exactly there.
+  const double u = static_cast<double>(frame) * static_cast<double>(keys - 1) / static_cast<double>(frames - 1);
   const size_t i = std::min(static_cast<size_t>(u), keys - 2);
   return {i, u - static_cast<double>(i)};
 }
@@ -326,6 +327,11 @@ std::vector<CameraKey> parse_camera_keys(const std::string& text) {
       throw InputError(fmt::format("camera key {} '{}': {}", keys.size(), item, *why));
   }
   if (keys.empty()) throw InputError("no camera key given; give POSITION>TARGET;POSITION>TARGET...");
+  // getline drops an empty last item: a trailing ';' (a key left out at the end) is said too.
+  if (text.back() == ';')
+    throw InputError(fmt::format("camera key {} is empty (a ';' ends the list); give POSITION>TARGET;POSITION>TARGET... "
+                                 "with no ';' after the last key",
+                                 keys.size() + 1));
   return keys;
 }
 

@@ -62,6 +62,10 @@ void RigParams::validate() const {
   if (!std::isfinite(vfov) || vfov <= 0.0 || vfov >= kPi)
     throw InputError(fmt::format("vertical field of view {} degrees is out of range (0, 180)",
                                  radians_to_degrees(vfov)));
+  if (const double f = focal_px(vfov, height); !(f <= kMaxFocalPx))
+    throw InputError(fmt::format("vertical field of view {:g} degrees at {} px height gives a focal length of {:g} px, "
+                                 "beyond the {:g} px a rig may have; widen the field of view",
+                                 radians_to_degrees(vfov), height, f, kMaxFocalPx));
   check_disparity(*this);
   require_positive(znear, "znear", "the near plane must lie in front of the camera");
   if (!std::isfinite(zfar) || zfar <= znear)

@@ -67,6 +67,14 @@ std::string toml_text(const toml::node& node) {
 }
 
 /// A threshold value: a non-negative finite number, or `false` to turn the check off.
+/// A TOML number as a double: an integer too large to be one exactly is rounded to the nearest
+/// (toml++'s own conversion gives none for it); nullopt for any other kind of value.
+std::optional<double> number_of(const toml::node& node) {
+  if (node.is_integer()) return static_cast<double>(node.as_integer()->get());
+  if (node.is_floating_point()) return node.as_floating_point()->get();
+  return std::nullopt;
+}
+
 std::optional<double> threshold_value(const toml::node& node, const std::string& key, const std::string& source) {
   if (node.is_boolean()) {
     if (*node.value<bool>())
@@ -77,9 +85,10 @@ std::optional<double> threshold_value(const toml::node& node, const std::string&
   if (!node.is_number())
     config_error(source, node.source(),
                  fmt::format("{} = {} must be a number (or false to turn the check off)", key, toml_text(node)));
-  const double v = *node.value<double>();
+  const double v = *number_of(node);
   if (!std::isfinite(v) || v < 0.0)
-    config_error(source, node.source(), fmt::format("{} = {} is not a non-negative finite number", key, v));
+    config_error(source, node.source(),
+                 fmt::format("{} = {} is not a non-negative finite number", key, toml_text(node)));
   return v;
 }
 
@@ -120,7 +129,7 @@ RegressionSettings read_regression(const toml::table& table, const std::string& 
   for (auto&& [key, node] : table) {
     const std::string k(key.str());
     if (k == "tolerance" || k == "alpha") {
-      const std::optional<double> v = node.value<double>();
+      const std::optional<double> v = number_of(node);
       if (!v || !std::isfinite(*v) || *v < 0.0)
         config_error(source, node.source(),
                      fmt::format("[regression] {} = {} must be a non-negative number", k, toml_text(node)));
@@ -230,14 +239,43 @@ std::string decimals(double v, int places, bool sign = false) {
   return plus + fmt::format("{:.{}f}", v, places);
 }
 
+/// How a check's values are shown: scaled, with decimals (or significant digits, where `places` is
+/// 0), a sign, and a unit.
+struct Shown {
+  double scale = 1.0;
+  int places = 0;
+  bool sign = false;
+  const char* unit = "";
+};
+Shown shown_of(const std::string& check) {
+  if (check == "psnr" || check == "left_psnr") return {1.0, 2, false, " dB"};
+  if (check == "speedup") return {1.0, 2, false, "x"};
+  if (check == "right_share") return {100.0, 1, false, " %"};
+  if (check == kRegressionCheck) return {100.0, 1, true, " %"};
+  return {};
+}
+
 std::string value_text(const std::string& check, double v) {
   if (std::isnan(v)) return "-";
   if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  if (check == "psnr" || check == "left_psnr") return decimals(v, 2) + " dB";
-  if (check == "speedup") return decimals(v, 2) + "x";
-  if (check == "right_share") return decimals(100.0 * v, 1) + " %";
-  if (check == kRegressionCheck) return decimals(100.0 * v, 1, true) + " %";
-  return fmt::format("{:.4g}", v);
+  const Shown s = shown_of(check);
+  if (s.places == 0) return fmt::format("{:.4g}", v);
+  return decimals(s.scale * v, s.places, s.sign) + s.unit;
+}
+
+/// A measured value and a limit as the messages show them: at the check's own precision, or, where
+/// they differ but would read alike ("PSNR 51.16 dB is below the minimum 51.16 dB"), with as many
+/// significant digits as tell them apart.
+std::pair<std::string, std::string> values_apart(const std::string& check, double v, double limit) {
+  std::string a = value_text(check, v), b = value_text(check, limit);
+  if (a != b || v == limit || !std::isfinite(v) || !std::isfinite(limit)) return {a, b};
+  const Shown s = shown_of(check);
+  for (int digits = 6; digits <= 17; ++digits) {
+    a = fmt::format("{}{:.{}g}{}", s.sign && !std::signbit(v) ? "+" : "", s.scale * v, digits, s.unit);
+    b = fmt::format("{}{:.{}g}{}", s.sign && !std::signbit(limit) ? "+" : "", s.scale * limit, digits, s.unit);
+    if (a != b) break;
+  }
+  return {a, b};
 }
 
 json json_number(double v) {
@@ -867,18 +905,20 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
         const bool at_least = mc.direction == Direction::at_least;
         auto beyond = [&](double lim) { return at_least ? v < lim : v > lim; };
         const char* side = at_least ? "below the minimum" : "above the maximum";
-        const std::string shown = value_text(mc.name, v);
         if (check.fail_limit && beyond(*check.fail_limit)) {
           check.verdict = Verdict::fail;
-          check.message = fmt::format("{} {} is {} {}", mc.label, shown, side, value_text(mc.name, *check.fail_limit));
+          const auto [shown, bound] = values_apart(mc.name, v, *check.fail_limit);
+          check.message = fmt::format("{} {} is {} {}", mc.label, shown, side, bound);
         } else if (check.warn_limit && beyond(*check.warn_limit)) {
           check.verdict = Verdict::warn;
+          const auto [shown, bound] = values_apart(mc.name, v, *check.warn_limit);
           check.message = fmt::format("{} {} is {} warning level {}", mc.label, shown,
-                                      at_least ? "below the" : "above the", value_text(mc.name, *check.warn_limit));
+                                      at_least ? "below the" : "above the", bound);
         } else {
           check.verdict = Verdict::pass;
-          check.message = fmt::format("{} {} within {} {}", mc.label, shown, at_least ? ">=" : "<=",
-                                      value_text(mc.name, check.fail_limit ? *check.fail_limit : *check.warn_limit));
+          const auto [shown, bound] =
+              values_apart(mc.name, v, check.fail_limit ? *check.fail_limit : *check.warn_limit);
+          check.message = fmt::format("{} {} within {} {}", mc.label, shown, at_least ? ">=" : "<=", bound);
         }
         add(std::move(check));
       }
@@ -969,9 +1009,11 @@ std::string format_gate_table(const GateReport& report) {
                             std::any_of(std::begin(kMetricChecks), std::end(kMetricChecks), [&](const MetricCheck& m) {
                               return c.check == m.name && m.direction == Direction::at_least;
                             });
+      const auto [measured, limit] = lim ? values_apart(c.check, c.measured, *lim)
+                                         : std::pair{value_text(c.check, c.measured), std::string()};
       out << fmt::format("{:<7} {:<{}} {:<{}} {:<{}} {:>12}  {}\n", c.verdict == Verdict::fail ? "FAIL" : "WARN",
-                         c.cell_id, cell_w, c.pipeline, pipe_w, c.check, check_w, value_text(c.check, c.measured),
-                         lim ? fmt::format("{} {}", at_least ? ">=" : "<=", value_text(c.check, *lim)) : "-");
+                         c.cell_id, cell_w, c.pipeline, pipe_w, c.check, check_w, measured,
+                         lim ? fmt::format("{} {}", at_least ? ">=" : "<=", limit) : "-");
       out << "        " << c.message << "\n";
       if (!c.reproduce.empty()) out << "        reproduce: " << c.reproduce << "\n";
     }

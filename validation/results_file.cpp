@@ -24,6 +24,7 @@
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/json_text.hpp"
 #include "renderer/io/unique_fd.hpp"
+#include "validation/metrics.hpp"
 #include "validation/sweep.hpp"
 
 namespace sb::validation {
@@ -210,6 +211,31 @@ void require_times(const json& root, const std::string& where, const std::string
                                    where, prefix, dotted, stage, t.dump().substr(0, 80)));
 }
 
+/// PSNR is a function of MSE on 8-bit codes (10 log10(255^2 / MSE), inf where MSE is 0, null where
+/// it is null): a line whose two disagree (a PSNR of "inf" beside an MSE of 0.5) is damaged or
+/// edited by hand, and the gate would judge the PSNR. Checked where both are present.
+void require_psnr_of_mse(const json& root, const std::string& where, const std::string& prefix,
+                         const std::string& metrics) {
+  const json* psnr = find(root, metrics + ".psnr");
+  const json* mse = find(root, metrics + ".mse");
+  if (psnr == nullptr || mse == nullptr) return;
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const double expected = mse->is_number() ? psnr_from_mse(mse->get<double>()) : kNaN;
+  const double given = psnr->is_number() ? psnr->get<double>() : *psnr == "inf" ? kInf : *psnr == "-inf" ? -kInf : kNaN;
+  const bool agree = std::isnan(expected) ? std::isnan(given)
+                     : std::isinf(expected)
+                         ? given == expected
+                         : std::isfinite(given) && std::abs(given - expected) <= 1e-6 * std::max(1.0, expected);
+  if (!agree)
+    throw InputError(fmt::format("{}: field '{}{}.psnr' is {}, but its mse {} gives {}; the line is damaged or edited "
+                                 "by hand",
+                                 where, prefix, metrics, psnr->dump(), mse->dump(),
+                                 std::isnan(expected) ? std::string("null")
+                                 : std::isinf(expected) ? std::string("\"inf\"")
+                                                        : fmt::format("{:.6f}", expected)));
+}
+
 /// A field of a results line: its dotted path, what it may hold, whether it may be absent.
 struct Field {
   const char* path;
@@ -248,7 +274,7 @@ constexpr Field kPipelineFields[] = {
     {"validation.metrics.ssim", Kind::metric},
     {"validation.metrics.mse", Kind::metric},
     {"validation.metrics.error_fraction", Kind::metric},
-    {"validation.holes.hole_fraction", Kind::number_or_null, true},
+    {"validation.holes.hole_fraction", Kind::number_or_null},
     {"validation.holes.not_reprojected.recall", Kind::number_or_null, true},
     {"validation.holes.not_reprojected.precision", Kind::number_or_null, true},
     {"validation.total_s", Kind::number_or_null, true},
@@ -431,6 +457,7 @@ void check_cell_record(const json& line, const std::string& where) {
     require_within(p, where, prefix, "validation.metrics.psnr", 0.0, std::numeric_limits<double>::infinity());
     require_within(p, where, prefix, "validation.metrics.ssim", -1.0, 1.0);
     require_within(p, where, prefix, "validation.metrics.mse", 0.0, 255.0 * 255.0);
+    require_psnr_of_mse(p, where, prefix, "validation.metrics");
     for (const char* f : {"validation.metrics.error_fraction", "validation.holes.hole_fraction",
                           "validation.holes.not_reprojected.recall", "validation.holes.not_reprojected.precision"})
       require_within(p, where, prefix, f, 0.0, 1.0);
@@ -444,6 +471,7 @@ void check_cell_record(const json& line, const std::string& where) {
       require_within(p, where, prefix, "validation.left_eye.metrics.psnr", 0.0, std::numeric_limits<double>::infinity());
       require_within(p, where, prefix, "validation.left_eye.metrics.ssim", -1.0, 1.0);
       require_within(p, where, prefix, "validation.left_eye.metrics.mse", 0.0, 255.0 * 255.0);
+      require_psnr_of_mse(p, where, prefix, "validation.left_eye.metrics");
     }
     if (p.contains("timing")) {
       for (const char* t : {"median_s", "min_s", "max_s", "speedup_median", "right_over_left_median"}) {

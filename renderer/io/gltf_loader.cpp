@@ -813,6 +813,17 @@ class Converter {
         if (values.size() != times.size() * per_key * static_cast<size_t>(width))
           fail(spath + "/output", fmt::format("{} values for {} key times ({} per key expected)", values.size() / width,
                                               times.size(), per_key));
+        // A key rotation is a quaternion with a direction, as a node's rotation is (a spline's
+        // tangents may be zero; its value may not).
+        if (ch.property == NodeAnimation::Property::rotation)
+          for (size_t k = 0; k < times.size(); ++k) {
+            const float* q = values.data() + (k * per_key + (per_key == 3 ? 1 : 0)) * 4;
+            if (!(std::max({std::abs(q[0]), std::abs(q[1]), std::abs(q[2]), std::abs(q[3])}) > 0.0f))
+              fail(spath + "/output", fmt::format("the rotation of key {} (at {} s) is a quaternion of length zero; a "
+                                                  "rotation is a unit quaternion [x, y, z, w], e.g. [0, 0, 0, 1] for "
+                                                  "none",
+                                                  k, times[k]));
+          }
         ch.times.assign(times.begin(), times.end());
         ch.values.assign(values.begin(), values.end());
         const auto [it, first] = keyed.emplace(std::pair(ch.node, static_cast<int>(ch.property)), cpath);

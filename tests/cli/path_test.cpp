@@ -52,6 +52,9 @@ TEST(PathCommand, TheScenesGltfAnimationMovesItsMeshAndCamera) {
                            (dir / "out").string() + "' --frames 3";
   const test::CliRun r = test::run_cli(base + " --gltf-animation --pipelines plain-rt,repro-rt");
   ASSERT_EQ(r.code, 0) << r.out;
+  // Standard output and error go to one pipe here: the heading comes before the frames' lines (it
+  // came after all of them, held in standard output's buffer).
+  EXPECT_LT(r.out.find("path on "), r.out.find("frame    0")) << r.out;
   EXPECT_NE(r.out.find("the scene's glTF animation ('animation') from 0 s to 2 s, 1 mesh(es) and 0 light(s) moving "
                        "(BVH refit)"),
             std::string::npos)
@@ -167,12 +170,22 @@ TEST(PathCommand, BadInput) {
   EXPECT_NE(one.out.find("warning: with 1 frame the camera stands at the first of the 2 camera keys"),
             std::string::npos)
       << one.out;
-  // Fewer frames than keys pass some keys by; said as well.
-  const test::CliRun two = test::run_cli(args(dir) + " --frames 2 --pipelines plain-rt --camera-keys "
-                                         "'0,1,6>0,0.5,0;1,1,6>0,0.5,0;2,1,6>0,0.5,0'");
-  EXPECT_EQ(two.code, 0) << two.out;
-  EXPECT_NE(two.out.find("warning: 2 frames pass through fewer points than the 3 camera keys"), std::string::npos)
-      << two.out;
+  // Frames spread over the keys pass some keys by, also when there are more frames than keys (4
+  // frames over 3 keys stand at 0, 2/3, 4/3 and 2: the middle key is never shown); said, with a
+  // count of frames that stands at every key.
+  const std::string three_keys = " --pipelines plain-rt --camera-keys '0,1,6>0,0.5,0;1,1,6>0,0.5,0;2,1,6>0,0.5,0'";
+  for (const auto& [frames, fix] : {std::pair{2, 3}, std::pair{4, 5}}) {
+    const test::CliRun r = test::run_cli(args(dir) + " --frames " + std::to_string(frames) + three_keys);
+    EXPECT_EQ(r.code, 0) << r.out;
+    EXPECT_NE(r.out.find("warning: the " + std::to_string(frames) +
+                         " frames are spread evenly over the path, so camera key 2 falls between frames and is never "
+                         "shown; give --frames " + std::to_string(fix)),
+              std::string::npos)
+        << r.out;
+  }
+  const test::CliRun five = test::run_cli(args(dir) + " --frames 5" + three_keys);
+  EXPECT_EQ(five.code, 0) << five.out;
+  EXPECT_EQ(five.out.find("warning:"), std::string::npos) << "frames 0, 2 and 4 stand at the keys: " << five.out;
   // Camera keys that swap position and target: the camera would stand on its target at frame 1.
   const test::CliRun cross = test::run_cli(args(dir) + " --frames 3 --camera-keys '0,1,4>0,1,3;0,1,3>0,1,4'");
   EXPECT_EQ(cross.code, 3) << cross.out;

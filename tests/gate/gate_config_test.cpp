@@ -102,6 +102,12 @@ TEST(GateConfig, BadValuesAreRejected) {
         << none;
   // A rule's regression_tolerance asks for the time regressions of its cells: a check.
   EXPECT_EQ(config_error("[defaults]\nmin_psnr = false\n[[rule]]\nregression_tolerance = 0.1\n"), "");
+  // An integer beyond 2^53 is a number too: it was read through a conversion that gives none for
+  // it, and the message said "min_psnr = -nan".
+  EXPECT_EQ(config_error("[defaults]\nmin_psnr = 9007199254740993\n"), "");
+  EXPECT_EQ(config_error("[regression]\ntolerance = 9007199254740993\n"), "");
+  const std::string huge = config_error("[defaults]\nmax_error_fraction = 1000000000000000000\n");
+  EXPECT_NE(huge.find("max_error_fraction = 1e+18 is above 1"), std::string::npos) << huge;
 }
 
 TEST(GateConfig, RulesOverrideDefaultsInFileOrder) {

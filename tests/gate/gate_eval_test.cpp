@@ -93,10 +93,26 @@ TEST(GateEval, PassingCellsPass) {
   EXPECT_EQ(find_check(r, "plain-rt", "speedup"), nullptr);
 }
 
+TEST(GateEval, AValueJustBeyondItsLimitIsShownApartFromIt) {
+  // Both used to be rounded alike: "PSNR 40.00 dB is below the minimum 40.00 dB".
+  std::vector<json> cells = passing_cells();
+  test::set_psnr(cells[0]["pipelines"]["repro-rt"]["validation"]["metrics"], 39.999999);
+  const validation::GateReport near = evaluate(cells);
+  const validation::GateCheck* psnr = find_check(near, "repro-rt", "psnr", 0);
+  ASSERT_NE(psnr, nullptr);
+  EXPECT_EQ(psnr->verdict, Verdict::fail);
+  EXPECT_NE(psnr->message.find("39.999999 dB is below the minimum 40 dB"), std::string::npos) << psnr->message;
+  test::set_psnr(cells[0]["pipelines"]["repro-rt"]["validation"]["metrics"], 39.5);
+  const validation::GateReport beyond = evaluate(cells);
+  const validation::GateCheck* far = find_check(beyond, "repro-rt", "psnr", 0);
+  ASSERT_NE(far, nullptr);
+  EXPECT_NE(far->message.find("39.50 dB is below the minimum 40.00 dB"), std::string::npos) << far->message;
+}
+
 TEST(GateEval, AQualityMetricTheRecordLacksFailsAndAnUndefinedRecallIsSkipped) {
   // A null PSNR (a damaged record) used to be skipped, so the gate passed with no PSNR read.
   std::vector<json> cells = passing_cells();
-  cells[0]["pipelines"]["repro-rt"]["validation"]["metrics"]["psnr"] = nullptr;
+  test::set_psnr(cells[0]["pipelines"]["repro-rt"]["validation"]["metrics"], nullptr);
   cells[1]["pipelines"]["repro-rt"]["validation"]["metrics"]["ssim"] = nullptr;
   cells[0]["pipelines"]["repro-rt"]["validation"]["holes"]["not_reprojected"]["recall"] = nullptr;
   const validation::GateReport r = evaluate(cells);
@@ -231,7 +247,7 @@ TEST(GateEval, ALeftEyeSynthesizedInPartIsCheckedWhereItWasMeasured) {
 TEST(GateEval, WarnLevelsAndEveryMetric) {
   std::vector<json> cells = passing_cells();
   // PSNR 33 dB: above the 30 dB failure level, below the 35 dB warning level.
-  cells[0]["pipelines"]["plain-rt"]["validation"]["metrics"]["psnr"] = 33.0;
+  test::set_psnr(cells[0]["pipelines"]["plain-rt"]["validation"]["metrics"], 33.0);
   validation::GateReport r = evaluate(cells);
   EXPECT_EQ(find_check(r, "plain-rt", "psnr")->verdict, Verdict::warn);
   EXPECT_EQ(r.worst, Verdict::warn);
@@ -251,7 +267,7 @@ TEST(GateEval, WarnLevelsAndEveryMetric) {
 
   // PSNR "inf" (identical images) passes any minimum; a null value is reported as a skip.
   cells = passing_cells();
-  cells[0]["pipelines"]["plain-rt"]["validation"]["metrics"]["psnr"] = "inf";
+  test::set_psnr(cells[0]["pipelines"]["plain-rt"]["validation"]["metrics"], "inf");
   cells[0]["pipelines"]["repro-rt"]["validation"]["holes"]["not_reprojected"]["recall"] = nullptr;
   r = evaluate(cells);
   EXPECT_EQ(find_check(r, "plain-rt", "psnr")->verdict, Verdict::pass);
@@ -541,14 +557,14 @@ TEST(GateCli, ExitCodesAndOutputs) {
 
   // A warning only: 1.
   std::vector<json> cells = passing_cells();
-  cells[1]["pipelines"]["plain-rt"]["validation"]["metrics"]["psnr"] = 33.0;
+  test::set_psnr(cells[1]["pipelines"]["plain-rt"]["validation"]["metrics"], 33.0);
   write_results(dir / "warn.jsonl", cells);
   run = run_cli("gate" + config + baseline + " --results " + (dir / "warn.jsonl").string());
   EXPECT_EQ(run.code, 1) << run.out;
   EXPECT_NE(run.out.find("WARN"), std::string::npos) << run.out;
 
   // A failure: 2, with the reproduce command in the table, the JSON and the JUnit XML.
-  cells[0]["pipelines"]["repro-rt"]["validation"]["metrics"]["psnr"] = 39.0;  // min 40
+  test::set_psnr(cells[0]["pipelines"]["repro-rt"]["validation"]["metrics"], 39.0);  // min 40
   write_results(dir / "fail.jsonl", cells);
   run = run_cli("gate" + config + baseline + " --results " + (dir / "fail.jsonl").string() + " --junit " +
                 (dir / "junit.xml").string() + " --json " + (dir / "gate.json").string());
@@ -684,10 +700,13 @@ TEST(GateCli, BadInputIsExitThree) {
   EXPECT_FALSE(std::filesystem::exists(dir / "junit.xml"));
   EXPECT_FALSE(std::filesystem::exists(dir / "gate.json"));
   // So does a run refused for its options before any input is read (--only without
-  // --update-baseline; one file named by both outputs): these used to leave the earlier files.
+  // --update-baseline; one file named by both outputs; a mistyped option and an empty value,
+  // refused by the command-line parser before the gate starts): these used to leave the earlier
+  // files.
   for (const std::string& refused :
-       {outputs + " --only repro-rt", " --junit " + (dir / "junit.xml").string() + " --json " +
-                                          (dir / "junit.xml").string()}) {
+       {outputs + " --only repro-rt",
+        " --junit " + (dir / "junit.xml").string() + " --json " + (dir / "junit.xml").string(),
+        outputs + " --confg " + (dir / "empty.toml").string(), outputs + " --baseline ''"}) {
     run = run_cli("gate" + config + " --results " + (dir / "pass.jsonl").string() + outputs);
     ASSERT_EQ(run.code, 0) << run.out;
     run = run_cli("gate" + config + " --results " + (dir / "pass.jsonl").string() + refused);
@@ -756,6 +775,26 @@ TEST(GateEval, AnUnfinishedSweepFails) {
   EXPECT_NE(xml.find("classname=\"gate.sweep\""), std::string::npos) << xml;
   EXPECT_EQ(xml.find("gate.."), std::string::npos) << xml;
   EXPECT_EQ(xml.find("value=\"\""), std::string::npos) << xml;
+}
+
+TEST(GateJunit, AClassNameHasOneSegmentPerSceneAndPipeline) {
+  // A scene file's path and a variant's decimal point opened packages in CI viewers, which split
+  // class names at dots: "gate.sc/light.gltf.repro-rt:threshold_arcmin=2.5".
+  validation::GateReport report;
+  validation::GateCheck check;
+  check.cell_id = "sc/light.gltf|e=0.064m|c=default|160x90|lights=all|full";
+  check.scene = "sc/light.gltf";
+  check.pipeline = "repro-rt:threshold_arcmin=2.5";
+  check.check = "psnr";
+  report.checks.push_back(check);
+  check.scene = "box-wall";
+  check.pipeline = "repro-rt";
+  check.cell_id = "box-wall|e=0.064m|c=default|160x90|lights=all|full";
+  report.checks.push_back(check);
+  const std::string xml = validation::junit_xml(report, "gate");
+  EXPECT_NE(xml.find("classname=\"gate.light.repro-rt:threshold_arcmin=2_5\""), std::string::npos) << xml;
+  EXPECT_NE(xml.find("classname=\"gate.box-wall.repro-rt\""), std::string::npos) << xml;
+  EXPECT_NE(xml.find("<property name=\"scene\" value=\"sc/light.gltf\"/>"), std::string::npos) << xml;
 }
 
 TEST(GateEval, ReproduceGivesTheLightCountTheCellUsed) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -25,6 +26,20 @@ struct FakePipeline {
   std::vector<double> samples_s{0.010, 0.011, 0.012};
 };
 
+/// The MSE a PSNR comes from (on 8-bit codes), so that a record's two agree as a measured one's do:
+/// 0 for an infinite PSNR.
+inline nlohmann::json mse_of_psnr(double psnr) {
+  return std::isinf(psnr) ? 0.0 : 255.0 * 255.0 / std::pow(10.0, psnr / 10.0);
+}
+
+/// Sets the PSNR of a record's metrics (a number, "inf" or null) and the MSE it comes from.
+inline void set_psnr(nlohmann::json& metrics, const nlohmann::json& psnr) {
+  metrics["psnr"] = psnr;
+  metrics["mse"] = psnr.is_number() ? mse_of_psnr(psnr.get<double>())
+                   : psnr == "inf"  ? nlohmann::json(0.0)
+                                    : nlohmann::json(nullptr);
+}
+
 /// A pipeline entry: a validation record holding the fields the gate reads, and timing.
 inline nlohmann::json fake_entry(const FakePipeline& p) {
   nlohmann::json v = {
@@ -33,7 +48,7 @@ inline nlohmann::json fake_entry(const FakePipeline& p) {
       {"pipeline", p.name},
       {"options", nlohmann::json::object()},
       {"metrics",
-       {{"psnr", p.psnr}, {"ssim", p.ssim}, {"mse", 1.0}, {"error_fraction", p.error_fraction}, {"error_threshold", 2}}},
+       {{"psnr", p.psnr}, {"ssim", p.ssim}, {"mse", mse_of_psnr(p.psnr)}, {"error_fraction", p.error_fraction}, {"error_threshold", 2}}},
       {"holes", {{"hole_fraction", p.hole_fraction}, {"not_reprojected", {{"recall", p.recall}}}}}};
   std::vector<double> sorted = p.samples_s;
   std::sort(sorted.begin(), sorted.end());

@@ -87,13 +87,14 @@ TEST(Lemma1Bound, IsFOverZTimesEAndSaturatesWhereItDoesNotFit) {
   const StereoRig rig = resolve_rig(scene, o);
   const double f_e = rig.focal_px() * rig.params().interaxial;
   EXPECT_EQ(lemma1_bound(rig, 2.0), static_cast<uint64_t>(std::ceil(f_e / 2.0)) + 1);
-  // A field of view of 1e-17 degrees and a 1 m interaxial converged 1e15 m away: f e / z is about
-  // 1e20 px, beyond 64 bits (it once wrapped to 1).
-  o.vfov = 1e-17 * 3.14159265358979 / 180.0;
-  o.interaxial = 1.0;
+  // A field of view of 1e-8 degrees (f some 5e11 px, near the largest a rig may have) and a 1e9 m
+  // interaxial converged 1e15 m away: f e / z is about 9e19 px at 6 m, beyond 64 bits (it once
+  // wrapped to 1).
+  o.vfov = 1e-8 * 3.14159265358979 / 180.0;
+  o.interaxial = 1e9;
   o.convergence = 1e15;
   const StereoRig narrow = resolve_rig(scene, o);
-  ASSERT_GT(narrow.focal_px() / 6.0, 1e19);
+  ASSERT_GT(narrow.focal_px() * narrow.params().interaxial / 6.0, 2e19);
   EXPECT_EQ(lemma1_bound(narrow, 6.0), uint64_t{9'000'000'000'000'000'000u});
 }
 

@@ -68,6 +68,15 @@ TEST(Animation, CameraFollowsKeysAndBadPathsAreRejected) {
   EXPECT_NEAR(glm::length(animator.camera_at(2, base).back - dvec3(0, 0, 1)), 0.0, 1e-12);
   EXPECT_THROW((void)parse_camera_keys("0,1,4"), InputError);
   EXPECT_THROW((void)parse_camera_keys("0,1>0,1,0"), InputError);
+  // A ';' after the last key leaves a key out, as two in a row do (it was accepted silently).
+  for (const char* empty : {"0,1,4>0,1,0;", "0,1,4>0,1,0;;4,1,4>4,1,0"}) {
+    try {
+      (void)parse_camera_keys(empty);
+      ADD_FAILURE() << empty;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("camera key 2 is empty"), std::string::npos) << e.what();
+    }
+  }
   PathSpec bad;
   bad.frames = 0;
   EXPECT_THROW(bad.validate(), InputError);

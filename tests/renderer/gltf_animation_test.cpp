@@ -439,6 +439,23 @@ TEST(GltfAnimation, BadAnimationsAndScenesWithoutOneAreRefused) {
     }
   }
   {
+    // A key rotation of length zero: refused as a node's rotation is (it was played as none).
+    AnimatedScene a;
+    const std::vector<float> times = {0.0f, 1.0f};
+    const std::vector<float> turns = {0, 0, 0, 1, 0, 0, 0, 0};
+    a.builder.add_animation_channel(a.mover, "rotation", times, turns);
+    a.builder.write(dir / "zero-rotation.gltf");
+    try {
+      (void)io::load_gltf(dir / "zero-rotation.gltf");
+      FAIL() << "a zero quaternion key was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("/animations/0/samplers/0/output: the rotation of key 1 (at 1 s) is a "
+                                           "quaternion of length zero"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  {
     AnimatedScene a;  // no animation at all
     Scene scene = a.load(dir, "still.gltf");
     try {

@@ -149,6 +149,23 @@ TEST(Rig, BadParametersAreInputErrors) {
   EXPECT_THROW((void)resolve_rig(empty, wide), InputError);
   wide.max_disparity_px = kMaxDisparityPx;
   EXPECT_NO_THROW((void)resolve_rig(empty, wide));
+  // A field of view so narrow that the focal length overflows the rasterizer's floats: plain-raster
+  // drew an empty image where plain-rt saw the scene. Refused; a narrow one that renders is kept.
+  RigOverrides narrow;
+  narrow.vfov = degrees_to_radians(1e-100);
+  narrow.interaxial = 1e-98;
+  try {
+    (void)resolve_rig(empty, narrow);
+    ADD_FAILURE() << "a field of view of 1e-100 degrees was accepted";
+  } catch (const InputError& err) {
+    EXPECT_NE(std::string(err.what()).find("vertical field of view 1e-100 degrees at 1080 px height gives a focal "
+                                           "length of"),
+              std::string::npos)
+        << err.what();
+  }
+  narrow.vfov = degrees_to_radians(1e-3);
+  narrow.interaxial = 1e-6;
+  EXPECT_NO_THROW((void)resolve_rig(empty, narrow));
 }
 
 TEST(Rig, ACameraAspectRatioBeyondAnyImageIsRefusedUnlessTheWidthIsGiven) {

@@ -6,6 +6,8 @@
 // output folder.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <sys/wait.h>
 
 #include <array>
@@ -199,7 +201,8 @@ TEST(Report, SmokeSweepReportsPassTheBrowserCheck) {
 
 /// A minimal valid results line (no images: the report shows them as unavailable).
 json minimal_line(const std::string& id, int index) {
-  const json metrics{{"psnr", 40.5}, {"ssim", 0.99}, {"mse", 5.8}, {"error_fraction", 0.01}};
+  const json metrics{{"psnr", 40.5}, {"ssim", 0.99}, {"mse", 255.0 * 255.0 / std::pow(10.0, 4.05)}, {"error_fraction", 0.01}};
+  const json holes{{"hole_fraction", 0.02}};
   return json{{"kind", "stereobench.sweep_cell"},
               {"schema_version", 1},
               {"sweep", "tiny"},
@@ -209,10 +212,13 @@ json minimal_line(const std::string& id, int index) {
               {"rig", {{"width", 16}, {"height", 9}, {"interaxial_m", 0.064}, {"convergence_m", 2.0}, {"max_disparity_px", 0.5}}},
               {"baseline", "plain-rt"},
               {"pipelines",
-               {{"plain-rt", {{"validation", {{"metrics", metrics}, {"total_s", 0.01}}}}},
+               {{"plain-rt",
+                 {{"validation",
+                   {{"metrics", metrics}, {"holes", {{"hole_fraction", nullptr}}}, {"total_s", 0.01}}}}},
                 {"repro-rt",
                  {{"validation",
                    {{"metrics", metrics},
+                    {"holes", holes},
                     {"total_s", 0.004},
                     {"timings_s", {{"left_gbuffer", 0.002}, {"hole_fill", 0.001}}},
                     {"stage_eyes", {{"left_gbuffer", "left"}, {"hole_fill", "right"}}}}}}}}}};
@@ -312,7 +318,7 @@ TEST(Report, WarnsOnTornTailAndMissingImagesAndGuardsForeignFolders) {
   // Its right eye's share of the left from the stages' eyes: 0.001 s / 0.002 s; none without them.
   EXPECT_DOUBLE_EQ(repro["right_over_left"].get<double>(), 0.5);
   EXPECT_TRUE(data["cells"][1]["pipelines"]["repro-rt"]["right_over_left"].is_null());
-  EXPECT_TRUE(data["cells"][0]["pipelines"]["plain-rt"]["hole_fraction"].is_null()) << "absent in the line: null, shown as —";
+  EXPECT_TRUE(data["cells"][0]["pipelines"]["plain-rt"]["hole_fraction"].is_null()) << "null in the line: null, shown as —";
   // The page lists what the terminal said: the torn line, both missing images, the missing cell.
   EXPECT_EQ(data["warnings"].size(), 4u) << data["warnings"].dump();
   for (const char* asset : {"report.js", "report.css", "chart.umd.min.js"})

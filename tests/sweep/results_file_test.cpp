@@ -1,9 +1,7 @@
 // The results file: atomic appends, a torn last line tolerated and cut before the next append,
 // duplicates rejected, shards merged, CSV export.
 #include <gtest/gtest.h>
-#include <sys/resource.h>
 
-#include <csignal>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -13,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "renderer/error.hpp"
+#include "support/file_size_limit.hpp"
 #include "support/scratch_dir.hpp"
 #include "validation/results_file.hpp"
 
@@ -21,6 +20,9 @@ namespace {
 
 using nlohmann::json;
 using namespace validation;
+
+/// The MSE (8-bit codes) that gives `psnr`, as a measured record holds it.
+double mse_of(double psnr) { return std::isinf(psnr) ? 0.0 : 255.0 * 255.0 / std::pow(10.0, psnr / 10.0); }
 
 json cell(size_t index, const std::string& id, double psnr = 40.0) {
   return {{"kind", kSweepCellKind},
@@ -39,7 +41,7 @@ json cell(size_t index, const std::string& id, double psnr = 40.0) {
            {{"plain-rt",
              {{"validation",
                {{"scene", {{"lights", 1}}},
-                {"metrics", {{"psnr", psnr}, {"ssim", 0.99}, {"mse", 1.5}, {"error_fraction", 0.01}}},
+                {"metrics", {{"psnr", psnr}, {"ssim", 0.99}, {"mse", mse_of(psnr)}, {"error_fraction", 0.01}}},
                 {"holes", {{"hole_fraction", 0.0}, {"not_reprojected", {{"recall", 1.0}, {"precision", 0.02}}}}}}},
               {"timing", {{"median_s", 0.01}, {"speedup_median", 1.0}, {"right_over_left_median", 0.98}}}}}}}};
 }
@@ -97,23 +99,18 @@ TEST(ResultsFile, AnAppendThatFailsLeavesNoPartOfItsLine) {
   const auto file = dir / "results.jsonl";
   append_result(file, cell(0, "a"));
   const std::string before = test::read_text(file);
-  // A disk that fills mid-line, made by a file-size limit just past the current end (the signal
-  // the kernel sends at the limit is ignored, so the write fails with EFBIG instead).
-  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
-  rlimit old_limit{};
-  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old_limit), 0);
-  rlimit tight = old_limit;
-  tight.rlim_cur = static_cast<rlim_t>(before.size() + 100);
-  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &tight), 0);
   bool failed = false;
-  try {
-    append_result(file, cell(1, "b"));
-  } catch (const IoError& e) {
-    failed = true;
-    EXPECT_NE(std::string(e.what()).find("cannot append to the results file"), std::string::npos) << e.what();
+  {
+    // A disk that fills mid-line, 100 bytes past the current end.
+    const test::FileSizeLimit limit(before.size() + 100);
+    ASSERT_TRUE(limit.ok());
+    try {
+      append_result(file, cell(1, "b"));
+    } catch (const IoError& e) {
+      failed = true;
+      EXPECT_NE(std::string(e.what()).find("cannot append to the results file"), std::string::npos) << e.what();
+    }
   }
-  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &old_limit), 0);
-  std::signal(SIGXFSZ, old_handler);
   EXPECT_TRUE(failed);
   EXPECT_EQ(test::read_text(file), before) << "the first 100 bytes of the line were written, then taken back";
 }
@@ -200,6 +197,13 @@ TEST(ResultsFile, BadLinesAndDuplicatesRejected) {
     broken["pipelines"]["plain-rt"]["validation"]["metrics"]["psnr"] = psnr;
     expect_refused(broken, "checked.jsonl:2: field 'pipelines.plain-rt.validation.metrics.psnr' is " + psnr.dump() +
                             ", outside [0, inf]");
+  }
+  // A PSNR its MSE does not give (edited to pass a minimum): the gate judged the PSNR alone.
+  for (const json& psnr : {json("inf"), json(1e308), json(45.0), json(nullptr)}) {
+    json broken = cell(1, "b");
+    broken["pipelines"]["plain-rt"]["validation"]["metrics"]["psnr"] = psnr;
+    expect_refused(broken, "checked.jsonl:2: field 'pipelines.plain-rt.validation.metrics.psnr' is " + psnr.dump() +
+                               ", but its mse 6.5025 gives 40.000000");
   }
   json ssim_inf = cell(1, "b");
   ssim_inf["pipelines"]["plain-rt"]["validation"]["metrics"]["ssim"] = "inf";
@@ -359,7 +363,7 @@ TEST(ResultsFile, CsvRowsAndQuoting) {
   const std::string row = csv.substr(eol + 2);
   EXPECT_EQ(row,
             "0,\"box-wall|e=0.064m,\"\"x\"\"\",t,box-wall,size=0.5,96,54,0.064,3.5,2,1,,,full,plain-rt,plain-rt,40,0.99,"
-            "1.5,0.01,0,1,0.02,0.01,1,0.98\r\n");
+            "6.5025,0.01,0,1,0.02,0.01,1,0.98\r\n");
   // A frame of a camera path: its frame number and BVH update time.
   json f = cell(3, "spheres|frame=2");
   f["animation"] = {{"frame", 2}, {"bvh_update_s", 0.038}};
