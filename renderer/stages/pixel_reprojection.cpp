@@ -206,7 +206,7 @@ std::vector<OptionSpec> validation_option_specs() {
            "(0 retraced about half of the pixels on spheres); smaller values retrace more and are more exact"},
           {"confirm", "false",
            "also require the reprojected surface within the margin beyond (a second short ray); not in the thesis: "
-           "it catches reprojections that land past a silhouette"}};
+           "it catches reprojections that land past a silhouette; needs margin > 0"}};
 }
 
 ValidationSettings ValidationSettings::from(const std::string& pipeline, const PipelineOptions& options) {
@@ -217,6 +217,13 @@ ValidationSettings ValidationSettings::from(const std::string& pipeline, const P
                                  "short of the reprojected surface",
                                  pipeline, s.margin));
   s.confirm_surface = options.get_bool("confirm");
+  // The confirming segment runs from the hit to (1 + m) / (1 - m) of its distance: empty at m = 0,
+  // where it found no surface and every reprojected pixel was traced again.
+  if (s.confirm_surface && s.margin == 0.0)
+    throw InputError(fmt::format("{}: option confirm=true needs margin > 0: the confirming ray looks for the surface "
+                                 "within margin beyond the reprojected point, and finds none in an empty segment; "
+                                 "give a margin (e.g. the default) or confirm=false",
+                                 pipeline));
   return s;
 }
 

@@ -248,6 +248,16 @@ TEST(PixelReprojection, BadOptionsAreRejected) {
   const StereoRig rig = test::rig_at(scene, 64, 36);
   EXPECT_THROW((void)test::render_with("rt-atomic", prepared, rig, 1, {{"margin", "1"}}), InputError);
   EXPECT_THROW((void)test::render_with("rt-buffer", prepared, rig, 1, {{"margin", "-0.1"}}), InputError);
+  // A confirming ray in an empty segment finds no surface: every reprojected pixel was traced again.
+  for (const char* pipeline : {"rt-atomic", "rt-buffer"}) {
+    try {
+      (void)test::render_with(pipeline, prepared, rig, 1, {{"margin", "0"}, {"confirm", "true"}});
+      ADD_FAILURE() << pipeline << ": confirm=true with margin=0 was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("confirm=true needs margin > 0"), std::string::npos) << e.what();
+    }
+    EXPECT_NO_THROW((void)test::render_with(pipeline, prepared, rig, 1, {{"margin", "0"}}));
+  }
   EXPECT_THROW((void)test::render_with("rt-buffer", prepared, rig, 1, {{"depth", "-1"}}), InputError);
   EXPECT_THROW((void)test::render_with("rt-buffer", prepared, rig, 1, {{"depth", "5000"}}), InputError);
   // The default depth 2e for a disparity the rig accepts (up to 1e6 px) but the buffer cannot
