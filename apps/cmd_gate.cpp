@@ -3,6 +3,7 @@
 // writes JUnit XML and JSON, and exits 0 (pass), 1 (warnings only) or 2 (any failure); bad input is 3.
 // `--update-baseline` instead stores the timing samples of the named pipelines and cells.
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <limits>
 #include <memory>
@@ -198,9 +199,11 @@ void discard_gate_reports_after_usage_error(CLI::App& root) noexcept {
     if (g->parsed() == 0) return;
     // The values as typed: a usage error may come before they reach GateArgs (CLI11 converts
     // and checks values after reading the whole line).
+    // An empty value (itself a usage error) stands for the default, as run_gate reads it: the
+    // default baseline is an input to spare.
     const auto typed = [&](const char* name, std::string fallback) {
       const CLI::Option* o = g->get_option_no_throw(name);
-      return o != nullptr && !o->results().empty() ? o->results().back() : fallback;
+      return o != nullptr && !o->results().empty() && !o->results().back().empty() ? o->results().back() : fallback;
     };
     const std::string results = typed("--results", ""), config = typed("--config", GateArgs{}.config),
                       baseline = typed("--baseline", validation::kDefaultBaselineFile),
@@ -208,7 +211,7 @@ void discard_gate_reports_after_usage_error(CLI::App& root) noexcept {
     remove_earlier_outputs_sparing({{"--results", &results}, {"--config", &config}, {"the baseline", &baseline}},
                                    {{"--junit", &junit}, {"--json", &json_out}});
   } catch (const std::exception& e) {
-    fmt::print(stderr, "stereobench: warning: an earlier gate report may remain: {}\n", e.what());
+    std::fprintf(stderr, "stereobench: warning: an earlier gate report may remain: %s\n", e.what());
   }
 }
 

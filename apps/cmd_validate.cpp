@@ -124,15 +124,12 @@ void run_validate(const ValidateArgs& a) {
                                     : std::optional<validation::TruthCache>(validation::TruthCache(a.cache));
   // A work folder per scene and provider: the command a record gives to render its truth again
   // runs there, and another scene validated into the same --out would replace its files.
-  validation::ValidationTarget target = validation::prepare_target(
-      prepared, loaded.file, rig, *provider, cache ? &*cache : nullptr, out / "work" / scene_stem, executor);
   // A truth from the cache was rendered in another run's work folder, which may be gone or hold
   // another render by now: the export and script are made ready in this one's, and the record gives
   // the command that renders the truth again there.
-  if (target.truth.cached)
-    if (auto command =
-            provider->prepare({prepared, loaded.file, rig, out / "work" / scene_stem, executor.threads()}))
-      target.truth.render.command = *command;
+  const validation::ValidationTarget target =
+      validation::prepare_target(prepared, loaded.file, rig, *provider, cache ? &*cache : nullptr,
+                                 out / "work" / scene_stem, executor, /*prepare_on_cache_hit=*/true);
   fmt::print("truth: {} ({}), {}{:.2f} s; true disocclusions {:.3f} % of the image\n", provider->name(),
              target.truth.render.tool_version, target.truth.cached ? "from the cache, rendered in " : "",
              target.truth.render.seconds,

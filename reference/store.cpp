@@ -637,11 +637,9 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
     // The writers name the files in the working folder, which goes now: the message names the
     // entry they were for.
     fs::remove_all(staged, ec);
-    std::string message = e.what();
-    const std::string from = staged.string(), to = (root_ / id).string();
-    for (size_t at = message.find(from); at != std::string::npos; at = message.find(from, at + to.size()))
-      message.replace(at, from.size(), to);
-    throw IoError(fmt::format("{} (reference '{}' was not stored; an earlier one of that id is kept)", message, id));
+    const std::string message = replace_all(e.what(), staged.string(), (root_ / id).string());
+    throw IoError(fmt::format("{} (reference '{}' was not stored{})", message, id,
+                              fs::exists(root_ / id, ec) ? "; the earlier one of that id is kept" : ""));
   } catch (const ToolError& e) {
     fs::remove_all(staged, ec);
     throw ToolError(fmt::format("{}\n(the tool's work folder was inside the store's unfinished entry and is removed "

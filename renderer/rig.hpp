@@ -22,7 +22,7 @@ constexpr int kMaxImageSide = 16384;
 /// light years) the eyes' frusta hold no common point and the ray setup loses its precision.
 constexpr double kMaxDisparityPx = 1e6;
 
-/// Largest focal length (pixels) a rig may have: a field of view of some 1e-7 degrees at 16384 px.
+/// Largest focal length (pixels) a rig may have: a field of view of about 1e-6 degrees at 16384 px.
 /// The rasterizer projects in single precision, which a vanishing field of view (1e-100 degrees,
 /// 1e102 px) overflows: it drew nothing where the ray tracer saw the scene.
 constexpr double kMaxFocalPx = 1e12;

@@ -29,6 +29,14 @@ namespace sb {
   return v;
 }
 
+/// `text` with every occurrence of `from` (not empty) replaced by `to`, left to right (a replacement
+/// is not searched again).
+[[nodiscard]] inline std::string replace_all(std::string text, std::string_view from, std::string_view to) {
+  for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
+    text.replace(at, from.size(), to);
+  return text;
+}
+
 /// `s` with ASCII letters in lower case (names, extensions, tokens compared without case).
 [[nodiscard]] inline std::string lowercase(std::string_view s) {
   std::string out(s);

@@ -66,7 +66,6 @@ std::string toml_text(const toml::node& node) {
   return out.str();
 }
 
-/// A threshold value: a non-negative finite number, or `false` to turn the check off.
 /// A TOML number as a double: an integer too large to be one exactly is rounded to the nearest
 /// (toml++'s own conversion gives none for it); nullopt for any other kind of value.
 std::optional<double> number_of(const toml::node& node) {
@@ -75,6 +74,7 @@ std::optional<double> number_of(const toml::node& node) {
   return std::nullopt;
 }
 
+/// A threshold value: a non-negative finite number, or `false` to turn the check off.
 std::optional<double> threshold_value(const toml::node& node, const std::string& key, const std::string& source) {
   if (node.is_boolean()) {
     if (*node.value<bool>())

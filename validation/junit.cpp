@@ -2,7 +2,6 @@
 #include "validation/junit.hpp"
 
 #include <cstdint>
-#include <filesystem>
 #include <map>
 #include <vector>
 
@@ -107,14 +106,6 @@ std::string text(std::string_view s) {
   return xml_escape(s, false);
 }
 
-/// A scene as a class name shows it: a built-in's name, a file's name without its folder and
-/// extension ("scenes/lobby.glb" -> "lobby").
-std::string scene_label(const std::string& scene) {
-  const std::filesystem::path p(scene);
-  const std::string ext = p.extension().string();
-  return scene.find('/') != std::string::npos || ext == ".gltf" || ext == ".glb" ? p.stem().string() : scene;
-}
-
 /// One segment of a dotted class name: CI viewers split class names at '.' into a package tree
 /// (and some at '/'), so a variant's "threshold_arcmin=2.5" would open a package "5".
 std::string class_segment(std::string segment) {
@@ -159,7 +150,7 @@ std::string junit_xml(const GateReport& report, const std::string& name) {
     for (const GateCheck* c : checks) {
       out += fmt::format("    <testcase name=\"{}\" classname=\"{}\"", attr(c->pipeline + " " + c->check),
                          attr(c->scene.empty() ? std::string("gate.sweep")
-                                               : "gate." + class_segment(scene_label(c->scene)) + "." +
+                                               : "gate." + class_segment(c->scene) + "." +
                                                      class_segment(c->pipeline)));
       if (c->verdict == Verdict::pass) {
         out += "/>\n";

@@ -464,8 +464,8 @@ std::string low_disk_note(const std::filesystem::path& folder, std::uintmax_t ne
   if (::statvfs(folder.c_str(), &fs_info) != 0) return "";
   const std::uintmax_t free_bytes = static_cast<std::uintmax_t>(fs_info.f_bavail) * fs_info.f_frsize;
   if (free_bytes >= needed) return "";
-  return fmt::format("; the disk of {} has {} bytes free where the render needs about {}: make room there, or give an "
-                     "--out on another disk",
+  return fmt::format("; the disk of {} has {} bytes free where the render needs about {}: make room there, or work on "
+                     "another disk",
                      folder.string(), free_bytes, needed);
 }
 

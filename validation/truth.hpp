@@ -30,6 +30,10 @@ struct TruthRequest {
   /// that a surprising render can be inspected and re-run by hand).
   std::filesystem::path work_dir;
   int threads = 0;  ///< 0 = all cores
+  /// For a truth served from the cache: make the provider's export and script ready in work_dir
+  /// (TruthProvider::prepare) and give the command that renders it there, rather than the command
+  /// of the run that rendered it (validate; a sweep's cells keep that command and write nothing).
+  bool prepare_on_cache_hit = false;
 };
 
 /// A rendered right eye and how it was made.

@@ -221,24 +221,29 @@ ResolvedTruth resolve_truth(const TruthProvider& provider, const TruthRequest& r
   note_single_sided(request.scene.scene(), provider.name());
   ResolvedTruth out;
   const bool use_cache = cache != nullptr && provider.name() != "full";
+  // A hit's command names the work folder of the run that rendered it; where asked, the export is
+  // made ready in this request's folder (under its lock: another run may be rendering there) and
+  // the command is that folder's.
+  const auto served = [&](TruthRender hit, bool locked) {
+    out.render = std::move(hit);
+    out.cached = true;
+    if (request.prepare_on_cache_hit) {
+      std::optional<WorkFolderLock> lock;
+      if (!locked) lock.emplace(request.work_dir, provider.name());
+      if (auto command = provider.prepare(request)) out.render.command = *command;
+    }
+    return std::move(out);
+  };
   if (use_cache) {
     out.key = truth_key(provider, request);
-    if (auto hit = cache->load(provider.name(), out.key)) {
-      out.render = std::move(*hit);
-      out.cached = true;
-      return out;
-    }
+    if (auto hit = cache->load(provider.name(), out.key)) return served(std::move(*hit), false);
   }
   if (use_cache) cache->prepare(provider.name(), out.key);
   // Two runs may share a work folder (two validations into one --out): the second waits for the
   // first's render there, and may then find it in the cache.
   const WorkFolderLock lock(request.work_dir, provider.name());
   if (use_cache && lock.waited())
-    if (auto hit = cache->load(provider.name(), out.key)) {
-      out.render = std::move(*hit);
-      out.cached = true;
-      return out;
-    }
+    if (auto hit = cache->load(provider.name(), out.key)) return served(std::move(*hit), true);
   out.render = provider.render(request);
   // A radiance no renderer gives is never stored for later runs.
   check_truth_samples(out.render, request.work_dir, use_cache);

@@ -32,9 +32,10 @@ RegionMask mask_of(int width, int height, std::vector<uint8_t> inside) {
 
 ValidationTarget prepare_target(const RenderScene& scene, const std::filesystem::path& scene_file,
                                 const StereoRig& rig, const TruthProvider& provider, const TruthCache* cache,
-                                const std::filesystem::path& work_dir, const Executor& executor) {
+                                const std::filesystem::path& work_dir, const Executor& executor,
+                                bool prepare_on_cache_hit) {
   require_frame_memory(rig.params().width, rig.params().height, "validation");
-  const TruthRequest request{scene, scene_file, rig, work_dir, executor.threads()};
+  const TruthRequest request{scene, scene_file, rig, work_dir, executor.threads(), prepare_on_cache_hit};
   ValidationTarget t{scene, rig, resolve_truth(provider, request, cache), {}, {}, 0.0};
   const RigParams& p = rig.params();
   if (t.truth.render.right.width() != p.width || t.truth.render.right.height() != p.height)

@@ -47,7 +47,7 @@ struct ValidationTarget {
 [[nodiscard]] ValidationTarget prepare_target(const RenderScene& scene, const std::filesystem::path& scene_file,
                                               const StereoRig& rig, const TruthProvider& provider,
                                               const TruthCache* cache, const std::filesystem::path& work_dir,
-                                              const Executor& executor);
+                                              const Executor& executor, bool prepare_on_cache_hit = false);
 
 /// The regions every metric is also computed over (DESIGN §6.2), in this order.
 inline constexpr const char* kRegionNames[] = {"reprojected", "filled", "true_disocclusions"};

@@ -24,6 +24,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/io/unique_fd.hpp"
+#include "renderer/text.hpp"
 
 namespace sb::io {
 
@@ -261,11 +262,7 @@ void with_temporary(const fs::path& tmp, const fs::path& path, const std::functi
   } catch (const IoError& e) {
     // The writer names the file it was given, the hidden temporary one: the message names `path`.
     fs::remove(tmp, ec);
-    std::string message = e.what();
-    const std::string hidden = tmp.string();
-    for (size_t at = message.find(hidden); at != std::string::npos; at = message.find(hidden, at + path.string().size()))
-      message.replace(at, hidden.size(), path.string());
-    throw IoError(message);
+    throw IoError(replace_all(e.what(), tmp.string(), path.string()));
   } catch (const Error&) {
     fs::remove(tmp, ec);
     throw;
@@ -292,11 +289,7 @@ void write_through(const fs::path& stream, const std::function<void(const fs::pa
     } catch (const IoError& e) {
       // The copy failed, not the stream: the message names the temporary folder (a full /tmp
       // while the stream's own disk has room).
-      std::string message = e.what();
-      const std::string hidden = tmp.string();
-      const std::string copy = "its copy in " + folder.string();
-      for (size_t at = message.find(hidden); at != std::string::npos; at = message.find(hidden, at + copy.size()))
-        message.replace(at, hidden.size(), copy);
+      const std::string message = replace_all(e.what(), tmp.string(), "its copy in " + folder.string());
       throw IoError(fmt::format("cannot write {}: it is written through a copy made first in the temporary folder {}, "
                                 "and that failed: {}; make room there, or set TMPDIR to a folder with room",
                                 stream.string(), folder.string(), message));

@@ -38,6 +38,8 @@ LineFile::~LineFile() {
 }
 
 void LineFile::append(const std::string& line) {
+  if (torn_)
+    throw IoError(fmt::format("cannot write {}: its last line was cut short by an earlier failed write", path_.string()));
   const std::string text = line + "\n";
   for (size_t done = 0; done < text.size();) {
     const ssize_t n = ::write(fd_.get(), text.data() + done, text.size() - done);
@@ -46,6 +48,7 @@ void LineFile::append(const std::string& line) {
       const std::string why = n < 0 ? std::strerror(errno) : "nothing written";
       // The part of the line that did go in is cut off again: the file holds whole lines only.
       const bool undone = ::ftruncate(fd_.get(), end_) == 0 && ::lseek(fd_.get(), end_, SEEK_SET) == end_;
+      torn_ = !undone;
       throw IoError(fmt::format("cannot write {}: {}; check free disk space{}", path_.string(), why,
                                 undone ? "" : " (its last line may be cut short)"));
     }

@@ -37,6 +37,7 @@ class LineFile {
   UniqueFd fd_;
   size_t lines_ = 0;
   off_t end_ = 0;  ///< the file's size after its last whole line
+  bool torn_ = false;  ///< a failed line could not be cut off again: no line may follow it
   bool finished_ = false;
 };
 

@@ -54,6 +54,8 @@ TEST(PathCommand, TheScenesGltfAnimationMovesItsMeshAndCamera) {
   ASSERT_EQ(r.code, 0) << r.out;
   // Standard output and error go to one pipe here: the heading comes before the frames' lines (it
   // came after all of them, held in standard output's buffer).
+  ASSERT_NE(r.out.find("path on "), std::string::npos) << r.out;
+  ASSERT_NE(r.out.find("frame    0"), std::string::npos) << r.out;
   EXPECT_LT(r.out.find("path on "), r.out.find("frame    0")) << r.out;
   EXPECT_NE(r.out.find("the scene's glTF animation ('animation') from 0 s to 2 s, 1 mesh(es) and 0 light(s) moving "
                        "(BVH refit)"),

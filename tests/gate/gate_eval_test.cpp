@@ -712,7 +712,7 @@ TEST(GateCli, BadInputIsExitThree) {
     run = run_cli("gate" + config + " --results " + (dir / "pass.jsonl").string() + refused);
     EXPECT_EQ(run.code, 3) << refused << "\n" << run.out;
     EXPECT_FALSE(std::filesystem::exists(dir / "junit.xml")) << refused;
-    // gate.json is this refused run's output only in the first case.
+    // gate.json is this refused run's output in every case but the one naming junit.xml twice.
     EXPECT_EQ(std::filesystem::exists(dir / "gate.json"), refused.find("gate.json") == std::string::npos) << refused;
   }
   // An output naming an input is refused and the input kept.
@@ -792,7 +792,7 @@ TEST(GateJunit, AClassNameHasOneSegmentPerSceneAndPipeline) {
   check.cell_id = "box-wall|e=0.064m|c=default|160x90|lights=all|full";
   report.checks.push_back(check);
   const std::string xml = validation::junit_xml(report, "gate");
-  EXPECT_NE(xml.find("classname=\"gate.light.repro-rt:threshold_arcmin=2_5\""), std::string::npos) << xml;
+  EXPECT_NE(xml.find("classname=\"gate.sc_light_gltf.repro-rt:threshold_arcmin=2_5\""), std::string::npos) << xml;
   EXPECT_NE(xml.find("classname=\"gate.box-wall.repro-rt\""), std::string::npos) << xml;
   EXPECT_NE(xml.find("<property name=\"scene\" value=\"sc/light.gltf\"/>"), std::string::npos) << xml;
 }
