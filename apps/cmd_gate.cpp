@@ -92,14 +92,22 @@ void run_update(const GateArgs& a, const fs::path& file) {
                fewest, short_entries == 1 ? "it" : "them", min_repetitions);
 }
 
-void run_gate(const GateArgs& a) {
-  // The default baseline counts as an input too: a report written over ci/baseline.json would lose
-  // the stored timings.
-  const std::string baseline_path = a.baseline.empty() ? validation::kDefaultBaselineFile : a.baseline;
-  // Exit 3 or 4 leaves no --junit or --json file, whatever refuses the run: an earlier green
-  // report must not stand for this one.
+/// The baseline file a run reads: --baseline, or the default one.
+std::string baseline_of(const GateArgs& a) { return a.baseline.empty() ? validation::kDefaultBaselineFile : a.baseline; }
+
+/// Removes the --junit and --json files an earlier run left: exit 3 or 4 leaves none, whatever
+/// refuses the run, so that an earlier green report never stands for this one. The inputs are
+/// spared, the default baseline among them (a report written over ci/baseline.json would lose
+/// the stored timings).
+void discard_earlier_reports(const GateArgs& a) {
+  const std::string baseline_path = baseline_of(a);
   remove_earlier_outputs_sparing({{"--results", &a.results}, {"--config", &a.config}, {"the baseline", &baseline_path}},
                                  {{"--junit", &a.junit}, {"--json", &a.json_out}});
+}
+
+void run_gate(const GateArgs& a) {
+  const std::string baseline_path = baseline_of(a);
+  discard_earlier_reports(a);
   if (a.update_baseline) {
     if (!a.junit.empty() || !a.json_out.empty())
       throw InputError(
@@ -198,18 +206,19 @@ void discard_gate_reports_after_usage_error(CLI::App& root) noexcept {
     const CLI::App* g = root.get_subcommand("gate");
     if (g->parsed() == 0) return;
     // The values as typed: a usage error may come before they reach GateArgs (CLI11 converts
-    // and checks values after reading the whole line).
-    // An empty value (itself a usage error) stands for the default, as run_gate reads it: the
-    // default baseline is an input to spare.
-    const auto typed = [&](const char* name, std::string fallback) {
+    // and checks values after reading the whole line). An empty one (itself a usage error) stands
+    // for the default, as run_gate reads it.
+    const auto typed = [&](const char* name, std::string& into) {
       const CLI::Option* o = g->get_option_no_throw(name);
-      return o != nullptr && !o->results().empty() && !o->results().back().empty() ? o->results().back() : fallback;
+      if (o != nullptr && !o->results().empty() && !o->results().back().empty()) into = o->results().back();
     };
-    const std::string results = typed("--results", ""), config = typed("--config", GateArgs{}.config),
-                      baseline = typed("--baseline", validation::kDefaultBaselineFile),
-                      junit = typed("--junit", ""), json_out = typed("--json", "");
-    remove_earlier_outputs_sparing({{"--results", &results}, {"--config", &config}, {"the baseline", &baseline}},
-                                   {{"--junit", &junit}, {"--json", &json_out}});
+    GateArgs a;
+    typed("--results", a.results);
+    typed("--config", a.config);
+    typed("--baseline", a.baseline);
+    typed("--junit", a.junit);
+    typed("--json", a.json_out);
+    discard_earlier_reports(a);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "stereobench: warning: an earlier gate report may remain: %s\n", e.what());
   }

@@ -447,14 +447,11 @@ std::string format_limit(std::chrono::milliseconds limit) {
 }
 
 std::string keep_tool_output(const std::filesystem::path& log, const std::string& output, bool render_failed) {
-  if (!render_failed) {
-    io::write_text_atomically(log, output);
-    return "";
-  }
   try {
     io::write_text_atomically(log, output);
     return "";
   } catch (const Error& e) {
+    if (!render_failed) throw;
     return fmt::format(" (its output could not be kept: {})", e.what());
   }
 }

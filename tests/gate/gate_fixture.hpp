@@ -3,13 +3,14 @@
 #pragma once
 
 #include <algorithm>
-#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
+
+#include "support/image_metrics.hpp"
 
 namespace sb::test {
 
@@ -26,16 +27,10 @@ struct FakePipeline {
   std::vector<double> samples_s{0.010, 0.011, 0.012};
 };
 
-/// The MSE a PSNR comes from (on 8-bit codes), so that a record's two agree as a measured one's do:
-/// 0 for an infinite PSNR.
-inline nlohmann::json mse_of_psnr(double psnr) {
-  return std::isinf(psnr) ? 0.0 : 255.0 * 255.0 / std::pow(10.0, psnr / 10.0);
-}
-
 /// Sets the PSNR of a record's metrics (a number, "inf" or null) and the MSE it comes from.
 inline void set_psnr(nlohmann::json& metrics, const nlohmann::json& psnr) {
   metrics["psnr"] = psnr;
-  metrics["mse"] = psnr.is_number() ? mse_of_psnr(psnr.get<double>())
+  metrics["mse"] = psnr.is_number() ? nlohmann::json(mse_of_psnr(psnr.get<double>()))
                    : psnr == "inf"  ? nlohmann::json(0.0)
                                     : nlohmann::json(nullptr);
 }

@@ -6,8 +6,6 @@
 // output folder.
 #include <gtest/gtest.h>
 
-#include <cmath>
-
 #include <sys/wait.h>
 
 #include <array>
@@ -20,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "renderer/io/file_lock.hpp"
+#include "support/image_metrics.hpp"
 #include "support/report_support.hpp"
 #include "support/run_cli.hpp"
 #include "support/scratch_dir.hpp"
@@ -201,7 +200,7 @@ TEST(Report, SmokeSweepReportsPassTheBrowserCheck) {
 
 /// A minimal valid results line (no images: the report shows them as unavailable).
 json minimal_line(const std::string& id, int index) {
-  const json metrics{{"psnr", 40.5}, {"ssim", 0.99}, {"mse", 255.0 * 255.0 / std::pow(10.0, 4.05)}, {"error_fraction", 0.01}};
+  const json metrics{{"psnr", 40.5}, {"ssim", 0.99}, {"mse", test::mse_of_psnr(40.5)}, {"error_fraction", 0.01}};
   const json holes{{"hole_fraction", 0.02}};
   return json{{"kind", "stereobench.sweep_cell"},
               {"schema_version", 1},

@@ -2,6 +2,8 @@
 // planes, the way psnr_srgb8 in render_support.hpp compares images.
 #pragma once
 
+#include <cmath>
+
 #include "renderer/image.hpp"
 #include "validation/metrics.hpp"
 
@@ -13,5 +15,9 @@ namespace sb::test {
 inline double ssim_srgb8(const Image& a, const Image& b) {
   return validation::ssim_map(validation::encode_srgb8(a, "image A"), validation::encode_srgb8(b, "image B")).mean;
 }
+
+/// The MSE (8-bit codes) that validation::psnr_from_mse turns into `psnr` (0 for an infinite one):
+/// for records whose PSNR and MSE must agree, as a measured one's do.
+inline double mse_of_psnr(double psnr) { return std::isinf(psnr) ? 0.0 : 255.0 * 255.0 / std::pow(10.0, psnr / 10.0); }
 
 }  // namespace sb::test

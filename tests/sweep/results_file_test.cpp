@@ -12,6 +12,7 @@
 
 #include "renderer/error.hpp"
 #include "support/file_size_limit.hpp"
+#include "support/image_metrics.hpp"
 #include "support/scratch_dir.hpp"
 #include "validation/results_file.hpp"
 
@@ -20,9 +21,6 @@ namespace {
 
 using nlohmann::json;
 using namespace validation;
-
-/// The MSE (8-bit codes) that gives `psnr`, as a measured record holds it.
-double mse_of(double psnr) { return std::isinf(psnr) ? 0.0 : 255.0 * 255.0 / std::pow(10.0, psnr / 10.0); }
 
 json cell(size_t index, const std::string& id, double psnr = 40.0) {
   return {{"kind", kSweepCellKind},
@@ -41,7 +39,7 @@ json cell(size_t index, const std::string& id, double psnr = 40.0) {
            {{"plain-rt",
              {{"validation",
                {{"scene", {{"lights", 1}}},
-                {"metrics", {{"psnr", psnr}, {"ssim", 0.99}, {"mse", mse_of(psnr)}, {"error_fraction", 0.01}}},
+                {"metrics", {{"psnr", psnr}, {"ssim", 0.99}, {"mse", test::mse_of_psnr(psnr)}, {"error_fraction", 0.01}}},
                 {"holes", {{"hole_fraction", 0.0}, {"not_reprojected", {{"recall", 1.0}, {"precision", 0.02}}}}}}},
               {"timing", {{"median_s", 0.01}, {"speedup_median", 1.0}, {"right_over_left_median", 0.98}}}}}}}};
 }
