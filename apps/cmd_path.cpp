@@ -93,20 +93,14 @@ void run_path_command(const PathArgs& a) {
                "warning: with 1 frame the camera stands at the first of the {} camera keys; give --frames {} or more "
                "to move through them\n",
                run.path.camera_keys.size(), run.path.camera_keys.size());
-  else if (a.frames > 1 && run.path.camera_keys.size() > 1) {
-    // The frames are spread evenly over the keys: key j (of K) is a frame's place only where
-    // j (F - 1) is a multiple of K - 1.
+  else if (const std::vector<size_t> passed = run.path.keys_between_frames(); !passed.empty()) {
     const size_t gaps = run.path.camera_keys.size() - 1, steps = static_cast<size_t>(a.frames) - 1;
-    std::vector<size_t> passed;
-    for (size_t j = 1; j < gaps; ++j)
-      if (j * steps % gaps != 0) passed.push_back(j + 1);
-    if (!passed.empty())
-      fmt::print(stderr,
-                 "warning: the {} frames are spread evenly over the path, so camera key{} {} fall{} between frames and "
-                 "{} never shown; give --frames {} (or any number one more than a multiple of {}) to stand at every "
-                 "key\n",
-                 a.frames, passed.size() == 1 ? "" : "s", fmt::join(passed, ", "), passed.size() == 1 ? "s" : "",
-                 passed.size() == 1 ? "is" : "are", (steps + gaps - 1) / gaps * gaps + 1, gaps);
+    fmt::print(stderr,
+               "warning: the {} frames are spread evenly over the path, so camera key{} {} fall{} between frames and "
+               "{} never shown; give --frames {} (or any number one more than a multiple of {}) to stand at every "
+               "key\n",
+               a.frames, passed.size() == 1 ? "" : "s", fmt::join(passed, ", "), passed.size() == 1 ? "s" : "",
+               passed.size() == 1 ? "is" : "are", (steps + gaps - 1) / gaps * gaps + 1, gaps);
   }
   const RigOverrides overrides = a.rig.overrides();
   run.pipelines =

@@ -38,6 +38,7 @@ struct PathPlace {
 };
 
 PathPlace place_of(size_t keys, int frames, int frame) {
+  // keys_between_frames() follows from this spreading.
   // frame (keys - 1) is exact, so a frame whose place is a key stands exactly there.
   const double u = static_cast<double>(frame) * static_cast<double>(keys - 1) / static_cast<double>(frames - 1);
   const size_t i = std::min(static_cast<size_t>(u), keys - 2);
@@ -300,6 +301,15 @@ std::optional<std::string> camera_key_problem(const CameraKey& key) {
                          kMaxSceneCoordinate);
   if (key.position == key.target) return "its target equals its position: it has no viewing direction";
   return std::nullopt;
+}
+
+std::vector<size_t> PathSpec::keys_between_frames() const {
+  std::vector<size_t> passed;
+  if (frames < 2 || camera_keys.size() < 2) return passed;
+  const size_t gaps = camera_keys.size() - 1, steps = static_cast<size_t>(frames) - 1;
+  for (size_t j = 1; j < gaps; ++j)
+    if (j * steps % gaps != 0) passed.push_back(j + 1);
+  return passed;
 }
 
 std::vector<CameraKey> parse_camera_keys(const std::string& text) {

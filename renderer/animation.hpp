@@ -49,6 +49,10 @@ struct PathSpec {
   /// position, a zero spin axis, a non-finite angle, gltf_animation with camera keys or a spin, a
   /// gltf_clip without gltf_animation.
   void validate() const;
+  /// The camera keys (numbered from 1) that no frame stands at: the frames are spread evenly over
+  /// the keys, so with F frames and K keys key j is a frame's place only where (j - 1)(F - 1) is
+  /// a multiple of K - 1. None with fewer than two frames or keys.
+  [[nodiscard]] std::vector<size_t> keys_between_frames() const;
 };
 
 /// Applies the frames of a path to a scene. Frame k is always computed from the scene as loaded (a

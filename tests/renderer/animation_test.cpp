@@ -68,6 +68,18 @@ TEST(Animation, CameraFollowsKeysAndBadPathsAreRejected) {
   EXPECT_NEAR(glm::length(animator.camera_at(2, base).back - dvec3(0, 0, 1)), 0.0, 1e-12);
   EXPECT_THROW((void)parse_camera_keys("0,1,4"), InputError);
   EXPECT_THROW((void)parse_camera_keys("0,1>0,1,0"), InputError);
+  // Frames spread evenly over the keys stand at key j only where (j - 1)(F - 1) is a multiple of
+  // K - 1: 4 frames over 3 keys stand at 0, 2/3, 4/3 and 2, never at key 2.
+  PathSpec spread;
+  spread.camera_keys = parse_camera_keys("0,1,4>0,1,0;4,1,4>4,1,0;4,1,8>4,1,0;0,1,8>0,1,0");
+  spread.frames = 4;
+  EXPECT_EQ(spread.keys_between_frames(), std::vector<size_t>{}) << "3 steps over 3 gaps: every key";
+  spread.frames = 5;
+  EXPECT_EQ(spread.keys_between_frames(), (std::vector<size_t>{2, 3}));
+  spread.frames = 7;
+  EXPECT_EQ(spread.keys_between_frames(), std::vector<size_t>{});
+  spread.frames = 1;
+  EXPECT_EQ(spread.keys_between_frames(), std::vector<size_t>{}) << "one frame: said otherwise";
   // A ';' after the last key leaves a key out, as two in a row do (it was accepted silently).
   for (const char* empty : {"0,1,4>0,1,0;", "0,1,4>0,1,0;;4,1,4>4,1,0"}) {
     try {
