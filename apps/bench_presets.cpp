@@ -85,7 +85,7 @@ class RowScene {
       used_.reset();
       file_.reset();
       file_ = std::make_unique<Scene>(io::load_gltf(path));
-      for (const std::string& w : file_->warnings) fmt::print(stderr, "warning: {}\n", w);
+      print_warnings(file_->warnings);
       path_ = path;
     }
     const size_t keep = std::min(static_cast<size_t>(std::max(lights, 0)), file_->lights.size());

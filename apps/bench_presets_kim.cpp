@@ -281,7 +281,7 @@ void run_kim_focal(const PresetRun& run, const Executor& executor) {
       if (!scene || path != loaded_path) {
         prepared.reset();
         scene = std::make_unique<Scene>(io::load_gltf(path));
-        for (const std::string& w : scene->warnings) fmt::print(stderr, "warning: {}\n", w);
+        print_warnings(scene->warnings);
         prepared = std::make_unique<RenderScene>(*scene);
         loaded_path = path;
       }
@@ -426,7 +426,7 @@ void run_kim_complexity(const PresetRun& run, const Executor& executor) {
         const double resolve_s = seconds_since(resolve_start);
         const auto load_start = std::chrono::steady_clock::now();
         const Scene scene = io::load_gltf(path);
-        for (const std::string& w : scene.warnings) fmt::print(stderr, "warning: {}\n", w);
+        print_warnings(scene.warnings);
         const double load_s = seconds_since(load_start);
         const RenderScene prepared(scene);
         fmt::print(stderr, "{}: scene ready in {:.1f} s (generated or cached), loaded in {:.1f} s, bvh {:.1f} s, {:.0f} MiB\n",

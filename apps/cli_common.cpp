@@ -245,6 +245,10 @@ void print_to_stdout(const std::string& text) {
     throw IoError(fmt::format("cannot write to standard output: {}", errno != 0 ? std::strerror(errno) : "write error"));
 }
 
+void print_warnings(const std::vector<std::string>& warnings) {
+  for (const std::string& w : warnings) fmt::print(stderr, "warning: {}\n", w);
+}
+
 void prepare_output_file_folder(const std::string& file, const char* option) {
   if (file.empty() || file == "-" || io::written_in_place(file)) return;
   const std::filesystem::path target = io::follow_links(file);

@@ -45,7 +45,7 @@ void run_update(const GateArgs& a, const fs::path& file) {
   const int min_repetitions = has_config ? validation::load_gate_config(a.config).regression.min_repetitions
                                          : validation::RegressionSettings{}.min_repetitions;
   const validation::GateResults results = validation::load_gate_results(a.results);
-  for (const std::string& w : results.warnings) fmt::print(stderr, "warning: {}\n", w);
+  print_warnings(results.warnings);
   // Updates of one baseline take turns: each reads the entries the one before it wrote (two at
   // once lost one's entries). The lock file goes with the lock.
   std::error_code ec;

@@ -132,7 +132,10 @@ ChosenRun choose_run_dir(const fs::path& out, const SweepDefinition& d, const fs
     const fs::path newest = out / ids.back();
     if (!fs::exists(newest / kRunDoneFile, ec)) {
       const ResultsFile r = read_results(newest / "results.jsonl");
-      const bool same = r.cells.empty() || r.cells.front().value("definition_sha256", "") == d.sha256;
+      // A run stopped before its first cell was recorded holds no line to tell: its folder's
+      // sweep marker (written before the first cell) does, when it has one.
+      const bool same = r.cells.empty() ? validation::out_folder_is_for(d, newest)
+                                        : r.cells.front().value("definition_sha256", "") == d.sha256;
       if (same) {
         std::optional<io::FileLock> claim = claim_run_id(history_file, ids.back());
         if (!claim)
@@ -145,7 +148,8 @@ ChosenRun choose_run_dir(const fs::path& out, const SweepDefinition& d, const fs
         chosen.claim = std::move(*claim);
         return chosen;
       }
-      fmt::print(stderr, "note: the unfinished run {} holds results of another version of {}; starting a new run\n",
+      fmt::print(stderr, "note: the unfinished run {} was started from another definition than {} as it is now; "
+                 "starting a new run, and leaving that folder as it is\n",
                  newest.string(), d.file.string());
     }
   }
@@ -180,9 +184,13 @@ void refuse_foreign_run(const HistoryFile& history, const fs::path& history_file
 /// Makes sure the history line can be appended at the end of the run, before the sweep costs
 /// anything: the history file's folder exists or is made, and the file, where it exists, is a
 /// writable regular file. `given`: the path came from --history.
+/// The history file as messages name it: as the option that gave it, or as the default file.
+std::string history_named(const fs::path& file, bool given) {
+  return given ? fmt::format("--history {}", file.string()) : fmt::format("history file {}", file.string());
+}
+
 void check_history_writable(const fs::path& file, bool given) {
-  const std::string named =
-      given ? fmt::format("--history {}", file.string()) : fmt::format("history file {}", file.string());
+  const std::string named = history_named(file, given);
   const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
   std::error_code ec;
   fs::create_directories(folder, ec);
@@ -199,7 +207,9 @@ void check_history_writable(const fs::path& file, bool given) {
 
 void run_nightly(const NightlyArgs& a) {
   if (a.jobs < 1 || a.jobs > 256) throw InputError(fmt::format("--jobs {} is outside 1..256", a.jobs));
+  const int threads = checked_threads(a.threads);
   const SweepDefinition d = load_sweep(a.definition);
+  print_warnings(d.warnings);
   const std::string gate_file = !a.gate_config.empty() ? a.gate_config
                                 : d.gate_config        ? d.gate_config->string()
                                                        : std::string(kDefaultGateConfig);
@@ -212,14 +222,12 @@ void run_nightly(const NightlyArgs& a) {
   const fs::path history_file = a.history.empty() ? out / "history.jsonl" : fs::path(a.history);
   // Read before any cell runs: a malformed history stops the run before it costs anything, and so
   // does a missing report asset (the report is written last).
+  if (std::error_code ec; fs::is_directory(history_file, ec))
+    throw InputError(fmt::format("{} is a folder; give the JSON Lines file the runs are appended to",
+                                 history_named(history_file, !a.history.empty())));
   const HistoryFile history_before = read_history(history_file);
   reports::check_report_assets(reports::report_assets_dir());  // before the history's folder is made
-  // The run folders go under --out: a folder that cannot be made is named as that option (the
-  // default history file lies there too, and was blamed).
-  if (const std::optional<std::string> why = io::unwritable_folder(out))
-    throw IoError(fmt::format("--out {}: {}; give a folder you can write", out.string(), *why));
-  check_history_writable(history_file, !a.history.empty());
-  for (const std::string& w : history_before.warnings) fmt::print(stderr, "warning: {}\n", w);
+  print_warnings(history_before.warnings);
 
   Baseline baseline;
   std::string baseline_note;
@@ -246,7 +254,12 @@ void run_nightly(const NightlyArgs& a) {
                                    gate_file, baseline_file.string(), d.name));
   }
 
-  const int threads = checked_threads(a.threads);  // before a run folder is made
+  // The folders are made once every argument is known to be good: a usage error leaves none.
+  // The run folders go under --out: a folder that cannot be made is named as that option (the
+  // default history file lies there too, and was blamed).
+  if (const std::optional<std::string> why = io::unwritable_folder(out))
+    throw IoError(fmt::format("--out {}: {}; give a folder you can write", out.string(), *why));
+  check_history_writable(history_file, !a.history.empty());
 
   // 1. The sweep, into the run folder.
   ChosenRun chosen = choose_run_dir(out, d, history_file);
@@ -276,7 +289,7 @@ void run_nightly(const NightlyArgs& a) {
   // Every cell, held through the gate, history and report.
   const ResultsWriterLock lock(o.results, shard_cells(expand_cells(d).size(), Shard{}));
   const SweepPlan plan = plan_sweep(d, o.results);
-  for (const std::string& w : plan.warnings) fmt::print(stderr, "warning: {}\n", w);
+  print_warnings(plan.warnings);
   fmt::print("nightly {} run {} ({}): {} cells × {} pipelines, {} finished already, {} to run\n", d.name, run_id,
              resumed ? "resumed" : "new", plan.cells.size(), d.pipelines.size(), plan.finished, plan.todo.size());
   std::fflush(stdout);
@@ -357,7 +370,7 @@ void run_nightly(const NightlyArgs& a) {
   }
   options.history = std::move(trends.runs);
   const reports::ReportSummary s = reports::write_report(report_results, options);
-  for (const std::string& w : s.warnings) fmt::print(stderr, "warning: {}\n", w);
+  print_warnings(s.warnings);
 
   // The verdict files and the done file stand together: a write that fails removes those written.
   const int code = exit_code(gate.worst);

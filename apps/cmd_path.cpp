@@ -88,20 +88,7 @@ void run_path_command(const PathArgs& a) {
   if (a.spin_deg) run.path.spin = Spin{parse_axis(a.spin_axis), std::nullopt, *a.spin_deg, a.spin_prefix};
   run.path.validate();
   // Keys the path cannot reach are said, not passed over.
-  if (run.path.camera_keys.size() > 1 && a.frames == 1)
-    fmt::print(stderr,
-               "warning: with 1 frame the camera stands at the first of the {} camera keys; give --frames {} or more "
-               "to move through them\n",
-               run.path.camera_keys.size(), run.path.camera_keys.size());
-  else if (const std::vector<size_t> passed = run.path.keys_between_frames(); !passed.empty()) {
-    const size_t gaps = run.path.camera_keys.size() - 1, steps = static_cast<size_t>(a.frames) - 1;
-    fmt::print(stderr,
-               "warning: the {} frames are spread evenly over the path, so camera key{} {} fall{} between frames and "
-               "{} never shown; give --frames {} (or any number one more than a multiple of {}) to stand at every "
-               "key\n",
-               a.frames, passed.size() == 1 ? "" : "s", fmt::join(passed, ", "), passed.size() == 1 ? "s" : "",
-               passed.size() == 1 ? "is" : "are", (steps + gaps - 1) / gaps * gaps + 1, gaps);
-  }
+  if (const auto unshown = run.path.unshown_keys_warning("--frames")) fmt::print(stderr, "warning: {}\n", *unshown);
   const RigOverrides overrides = a.rig.overrides();
   run.pipelines =
       parse_pipeline_entries(expand_all_pipelines(split_list(a.pipelines, "--pipelines"), "--pipelines"), "--pipelines");

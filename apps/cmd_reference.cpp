@@ -91,6 +91,9 @@ int verdict(const std::vector<reference::VerifyResult>& results) {
 }
 
 int run_verify(const ReferenceArgs& a) {
+  if (a.json_out == "-")
+    throw InputError("--json -: reference verify writes its verdicts to a file (standard output shows one line per "
+                     "reference); give a file name");
   const reference::ReferenceStore store(a.store);
   if (!a.json_out.empty()) {
     // Inside the store the verdicts could replace a reference's own files.
@@ -146,8 +149,8 @@ int run_verify(const ReferenceArgs& a) {
                         "reference generate`, see above)",
                         specless);
   if (unchecked > 0)
-    tail += fmt::format("; {} could not be checked here (their tool is missing: install it, see above, and verify "
-                        "again)",
+    tail += fmt::format("; {} could not be checked here (their tool is missing or failed, see above: install or "
+                        "mend it, and verify again)",
                         unchecked);
   fmt::print("{} of {} reference(s) verified{}\n", results.size() - failures - unchecked, results.size(), tail);
   return code;
@@ -165,8 +168,9 @@ int run_update(const ReferenceArgs& a) {
   const reference::ReferenceStore store(a.store);
   const Executor executor(checked_threads(a.threads));
   std::vector<std::string> targets;
-  // Entries whose check needs a missing tool: the others are still rewritten, then the run exits 4.
-  std::vector<std::string> unchecked;
+  // Entries whose check or render needs a tool that is missing or fails: the others are still
+  // rewritten, then the run exits 4.
+  std::vector<std::string> unchecked, tool_failed;
   if (a.only_failing) {
     for (const reference::VerifyResult& r : verify_all(a, store)) {
       if (r.status == reference::Status::unavailable)
@@ -197,6 +201,9 @@ int run_update(const ReferenceArgs& a) {
     } catch (const InputError& e) {
       unrenderable.push_back(fmt::format("{} ({})", id, e.what()));
       continue;
+    } catch (const ToolError& e) {
+      tool_failed.push_back(fmt::format("{} ({})", id, e.what()));
+      continue;
     }
     fmt::print("updated {}\n", (store.root() / written).string());
     ++written_count;
@@ -219,14 +226,18 @@ int run_update(const ReferenceArgs& a) {
                                    "rewritten reference lies under its own id and the folder is unchanged; remove "
                                    "each folder:\n  {}",
                                    misnamed.size(), fmt::join(misnamed, "\n  ")));
-  // Every kind is named in one message; a missing tool makes it exit 4, the others 3.
+  // Every kind is named in one message; a missing or failing tool makes it exit 4, the others 3.
   if (!unchecked.empty())
     problems.push_back(fmt::format("{} reference(s) could not be checked, so not updated, because their tool is "
-                                   "missing; install it and run the update again:\n  {}",
+                                   "missing or failed; install or mend it and run the update again:\n  {}",
                                    unchecked.size(), fmt::join(unchecked, "\n  ")));
+  if (!tool_failed.empty())
+    problems.push_back(fmt::format("{} reference(s) could not be rewritten because their tool is missing or failed; "
+                                   "install or mend it and run the update again:\n  {}",
+                                   tool_failed.size(), fmt::join(tool_failed, "\n  ")));
   if (problems.empty()) return 0;
   const std::string message = fmt::format("{}", fmt::join(problems, "\n"));
-  if (!unchecked.empty()) throw ToolError(message);
+  if (!unchecked.empty() || !tool_failed.empty()) throw ToolError(message);
   throw InputError(message);
 }
 

@@ -111,6 +111,7 @@ void run_sweep(const SweepRunArgs& a) {
   a.slurm.check_unused(a.executor);
   if (a.jobs < 1 || a.jobs > 256) throw InputError(fmt::format("--jobs {} is outside 1..256", a.jobs));
   const SweepDefinition d = load_sweep(a.definition);
+  print_warnings(d.warnings);
   const Shard shard = parse_shard(a.shard);
 
   SweepRunOptions o;
@@ -125,7 +126,7 @@ void run_sweep(const SweepRunArgs& a) {
   // Held until the last cell is recorded: no other run may plan this shard's cells meanwhile.
   const ResultsWriterLock lock(o.results, shard_cells(expand_cells(d).size(), shard));
   const SweepPlan plan = plan_sweep(d, o.results, shard);
-  for (const std::string& w : plan.warnings) fmt::print(stderr, "warning: {}\n", w);
+  print_warnings(plan.warnings);
   fmt::print("sweep {} ({}): {} cells × {} pipelines (baseline {}), {} warm-up + {} repetitions\n", d.name,
              a.definition, plan.cells.size(), d.pipelines.size(), d.baseline, d.warmup, d.repetitions);
   fmt::print("{}{} finished already, {} to run; {} job{} × {} threads; results {}\n",
@@ -192,6 +193,7 @@ void register_cells(CLI::App& sweep) {
   cells->add_option("--shard", a->shard, "Only the cells of shard I/N")->capture_default_str();
   cells->callback([a] {
     const SweepDefinition d = load_sweep(a->definition);
+    print_warnings(d.warnings);
     const Shard shard = parse_shard(a->shard);
     const std::vector<SweepCell> list = expand_cells(d);
     size_t shown = 0;
@@ -218,7 +220,7 @@ void register_csv(CLI::App& sweep) {
     if (!fs::exists(a->results)) throw InputError(fmt::format("{}: results file does not exist", a->results));
     refuse_overwriting({{"results", &a->results}}, {{"--out", &a->out}});
     const ResultsFile r = read_results(a->results);
-    for (const std::string& w : r.warnings) fmt::print(stderr, "warning: {}\n", w);
+    print_warnings(r.warnings);
     if (r.cells.empty())
       throw InputError(fmt::format("{}: holds no finished cell; run the sweep (stereobench sweep run) first, or give "
                                    "the results file it wrote",
@@ -248,7 +250,7 @@ void register_collect(CLI::App& sweep) {
     for (const std::string& in : a->inputs) refuse_overwriting({{"the input", &in}}, {{"the output", &a->out}});
     std::vector<std::string> warnings;
     const std::vector<nlohmann::json> cells = collect_results(inputs, a->out, &warnings);
-    for (const std::string& w : warnings) fmt::print(stderr, "warning: {}\n", w);
+    print_warnings(warnings);
     if (cells.empty())
       throw InputError(fmt::format("the {} input file(s) hold no finished cell; {} not written (check that the shards "
                                    "ran, and their results paths)",

@@ -53,6 +53,7 @@ void run_sweep_slurm(const SweepSlurmCli& s, const SweepSlurmRequest& r) {
   if (r.jobs < 1 || r.jobs > 256) throw InputError(fmt::format("--jobs {} is outside 1..256", r.jobs));
   if (r.threads != 0) (void)checked_threads(r.threads);
   const SweepDefinition d = load_sweep(r.definition);
+  print_warnings(d.warnings);
   const fs::path out = fs::absolute(r.out.empty() ? fs::path("out") / "sweeps" / d.name : fs::path(r.out));
   const fs::path results = fs::absolute(r.results.empty() ? out / "results.jsonl" : fs::path(r.results));
   const SlurmLayout layout = slurm_layout(out);
@@ -124,7 +125,7 @@ void run_sweep_slurm(const SweepSlurmCli& s, const SweepSlurmRequest& r) {
   }
   std::vector<std::string> warnings;
   const size_t merged = collect_slurm_results(d, sub, results, &warnings);
-  for (const std::string& w : warnings) fmt::print(stderr, "warning: {}\n", w);
+  print_warnings(warnings);
   fmt::print("every task of job {} finished; wrote {}: {} cells from {} shard files\n", sub.job_id, results.string(),
              merged, sub.shards);
 }

@@ -134,7 +134,7 @@ void run_validate(const ValidateArgs& a) {
              target.truth.render.tool_version, target.truth.cached ? "from the cache, rendered in " : "",
              target.truth.render.seconds,
              100.0 * double(target.disocclusions.count()) / double(target.truth_srgb8.pixel_count()));
-  for (const std::string& w : validation::truth_warnings(target.truth.render)) fmt::print(stderr, "warning: {}\n", w);
+  print_warnings(validation::truth_warnings(target.truth.render));
   warn_geometry_before_near_plane(prepared, rig, executor);
 
   // Every file is made whole under a temporary name, and all are renamed into place at the end,

@@ -70,9 +70,12 @@ void refuse_folder_as_file(CLI::App& app) {
     file->check(CLI::Validator(
         [](const std::string& value) {
           std::error_code ec;
-          return value != "-" && std::filesystem::is_directory(value, ec)
-                     ? value + " is a folder; give the name of the file to write"
-                     : std::string();
+          if (value != "-" && std::filesystem::is_directory(value, ec))
+            return value + " is a folder; give the name of the file to write";
+          // A folder not made yet: its parent folders would be made before the write found it.
+          if (!value.empty() && value.back() == '/')
+            return value + " names a folder (it ends in '/'); give the name of the file to write";
+          return std::string();
         },
         "", "not a folder"));
   }

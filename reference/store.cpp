@@ -468,6 +468,12 @@ void check_entry_name(const std::string& id) {
 
 fs::path default_store_dir() { return fs::path(SB_SOURCE_DIR) / "reference" / "store"; }
 
+std::string ReferenceStore::update_command(const std::string& id) const {
+  std::string command = "stereobench reference update " + shell_quote(id);
+  if (root_.lexically_normal() != default_store_dir().lexically_normal()) command += " --store " + shell_quote(root_.string());
+  return command;
+}
+
 const char* to_string(Status s) {
   switch (s) {
     case Status::ok: return "ok";
@@ -745,9 +751,8 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
     // before they named a field of view other than the scene camera's.
     r.detail = fmt::format("{}: its spec makes the reference '{}' (the id names the scene file, the rig, and a field "
                            "of view or light count other than the scene's), but the entry lies in folder '{}'; "
-                           "`stereobench reference update` writes it under that id, or rename the folder to '{}' "
-                           "(and its provenance's \"id\")",
-                           prov_file.string(), expected, id, expected);
+                           "`{}` writes it under that id, or rename the folder to '{}' (and its provenance's \"id\")",
+                           prov_file.string(), expected, id, update_command(id), expected);
     return r;
   }
   // The hash matched, but the file may still be no image of this rig (both replaced together).
@@ -772,7 +777,7 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
   // The preview is what people look at: it must show the stored image (its bytes are not
   // recorded, so its pixels are compared with the image's sRGB encoding).
   const fs::path preview_file = root_ / id / kPreview;
-  const std::string preview_fix = fmt::format("`stereobench reference update {}` writes it again", id);
+  const std::string preview_fix = fmt::format("`{}` writes it again", update_command(id));
   try {
     const validation::Srgb8Image preview = validation::read_srgb8_file(preview_file).image;
     const validation::Srgb8Image expected = validation::encode_srgb8(stored, "the stored reference");
@@ -805,20 +810,36 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
   // may be read-only (a checkout, another user's store).
   const ScratchFolder work(fmt::format("stereobench-verify-{}", id));
   const validation::TruthRequest request{prepared, p.loaded.file, *p.rig, work.path(), executor.threads()};
-  const validation::TruthRender render = provider->render(request);
-  validation::check_truth_samples(render, request.work_dir, false);
-  const Image fresh = validation::rgb_plane_only(render.right);
+  Image fresh;
+  try {
+    const validation::TruthRender render = provider->render(request);
+    validation::check_truth_samples(render, request.work_dir, false);
+    fresh = validation::rgb_plane_only(render.right);
+  } catch (const ToolError& e) {
+    // The tool is there but failed (or wrote nothing readable): this entry is not checked, the
+    // next ones still are.
+    r.status = Status::unavailable;
+    r.detail = fmt::format("{} could not render it again here: {}", spec.provider, e.what());
+    return r;
+  }
   r.bit_identical = fresh == stored;
   r.metrics = validation::compare_images(validation::encode_srgb8(fresh, "the new render"),
                                          validation::encode_srgb8(stored, "the stored reference"));
   const double psnr = r.metrics->psnr;
-  const bool within = r.bit_identical || psnr >= options.min_psnr;
+  // Without --min-psnr (infinite) only a bit-identical image passes: the stored image is linear
+  // float, so a difference may vanish in the 8-bit sRGB encoding the PSNR is measured on.
+  const bool within = r.bit_identical || (std::isfinite(options.min_psnr) && psnr >= options.min_psnr);
   r.status = within ? Status::ok : Status::drift;
-  r.detail = r.bit_identical ? "a new render is bit-identical"
-                             : fmt::format("a new render differs: PSNR {:.2f} dB, max error {} at ({}, {}), {:.4f} % error pixels{}",
-                                           psnr, r.metrics->max_error, r.metrics->max_x, r.metrics->max_y,
-                                           100.0 * r.metrics->error_fraction,
-                                           within ? fmt::format(" (within --min-psnr {})", options.min_psnr) : "");
+  if (r.bit_identical)
+    r.detail = "a new render is bit-identical";
+  else if (r.metrics->max_error == 0)
+    r.detail = "a new render differs from the stored float image, though not in its 8-bit sRGB encoding (PSNR inf "
+               "dB); give --min-psnr to accept differences that small";
+  else
+    r.detail = fmt::format("a new render differs: PSNR {:.2f} dB, max error {} at ({}, {}), {:.4f} % error pixels{}",
+                           psnr, r.metrics->max_error, r.metrics->max_x, r.metrics->max_y,
+                           100.0 * r.metrics->error_fraction,
+                           within ? fmt::format(" (within --min-psnr {})", options.min_psnr) : "");
   return r;
 }
 

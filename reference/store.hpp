@@ -36,7 +36,7 @@ enum class Status {
   drift,          ///< a new render differs from the stored image beyond the tolerance
   corrupt,        ///< the stored image does not match the hash in its provenance (or is unreadable)
   scene_changed,  ///< the scene's content is no longer what the reference was rendered from
-  unavailable,    ///< the provider's tool is missing here: not checked (never a pass)
+  unavailable,    ///< the provider's tool is missing here, or failed to render: not checked (never a pass)
 };
 [[nodiscard]] const char* to_string(Status status);
 /// Whether a status fails a verification (everything but ok).
@@ -62,6 +62,9 @@ class ReferenceStore {
  public:
   explicit ReferenceStore(std::filesystem::path root) : root_(std::move(root)) {}
   [[nodiscard]] const std::filesystem::path& root() const { return root_; }
+  /// The command that writes the entry `id` of this store again (`--store` unless it is the
+  /// default store), for messages.
+  [[nodiscard]] std::string update_command(const std::string& id) const;
 
   /// The ids of complete entries, sorted. InputError when the store does not exist or is not a
   /// folder.

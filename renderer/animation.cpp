@@ -11,6 +11,7 @@
 #include <tuple>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "renderer/error.hpp"
 
@@ -310,6 +311,21 @@ std::vector<size_t> PathSpec::keys_between_frames() const {
   for (size_t j = 1; j < gaps; ++j)
     if (j * steps % gaps != 0) passed.push_back(j + 1);
   return passed;
+}
+
+std::optional<std::string> PathSpec::unshown_keys_warning(const std::string& frames_setting) const {
+  const size_t keys = camera_keys.size();
+  if (keys > 1 && frames == 1)
+    return fmt::format("with 1 frame the camera stands at the first of the {} camera keys; give {} {} or more to "
+                       "move through them",
+                       keys, frames_setting, keys);
+  const std::vector<size_t> passed = keys_between_frames();
+  if (passed.empty()) return std::nullopt;
+  const size_t gaps = keys - 1, steps = static_cast<size_t>(frames) - 1;
+  return fmt::format("the {} frames are spread evenly over the path, so camera key{} {} fall{} between frames and {} "
+                     "never shown; give {} {} (or any number one more than a multiple of {}) to stand at every key",
+                     frames, passed.size() == 1 ? "" : "s", fmt::join(passed, ", "), passed.size() == 1 ? "s" : "",
+                     passed.size() == 1 ? "is" : "are", frames_setting, (steps + gaps - 1) / gaps * gaps + 1, gaps);
 }
 
 std::vector<CameraKey> parse_camera_keys(const std::string& text) {

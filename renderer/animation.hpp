@@ -53,6 +53,10 @@ struct PathSpec {
   /// the keys, so with F frames and K keys key j is a frame's place only where (j - 1)(F - 1) is
   /// a multiple of K - 1. None with fewer than two frames or keys.
   [[nodiscard]] std::vector<size_t> keys_between_frames() const;
+  /// What to tell the user when a camera key is never shown: one frame stands at the first of
+  /// several keys, or keys_between_frames() is not empty; with a frame count that stands at every
+  /// key, given as `frames_setting` ("--frames", "path.frames ="). None when every key is shown.
+  [[nodiscard]] std::optional<std::string> unshown_keys_warning(const std::string& frames_setting) const;
 };
 
 /// Applies the frames of a path to a scene. Frame k is always computed from the scene as loaded (a

@@ -231,11 +231,19 @@ bool holds_report(const fs::path& out) {
           io::read_file(index).find(fmt::format("content=\"{}", kGenerator)) != std::string::npos);
 }
 
+/// Where a report is written before it takes the place of the folder's earlier one: inside the
+/// folder (one file system, so that taking its place is a few renames), so that a report that
+/// cannot be written whole (a full disk, a kill) leaves the earlier one as it was.
+constexpr const char* kStaging = ".stereobench-next";
+/// The parts of a report, the index first: it goes first and comes last, so that the folder never
+/// holds an index.html whose assets or images are gone.
+constexpr const char* kReportParts[] = {"index.html", "assets", "images"};
+
 /// Prepares the output folder: new, empty, or an earlier report (finished, or stopped before its
-/// index was written) whose index, assets and images go. A folder holding anything else is refused
-/// (check_report_folder, naming it as `named`). Returns the lock on the folder, held until the
-/// report is written: a second report into the folder meanwhile is refused (InputError), since the
-/// two would remove each other's images and assets.
+/// index was written), which stays in place until the new one is written whole (replace_report).
+/// A folder holding anything else is refused (check_report_folder, naming it as `named`). Returns
+/// the lock on the folder, held until the report is written: a second report into the folder
+/// meanwhile is refused (InputError), since the two would replace each other's images and assets.
 io::FileLock prepare_out_dir(const fs::path& out, const std::string& named) {
   check_report_folder(out, named);
   std::error_code ec;
@@ -247,17 +255,56 @@ io::FileLock prepare_out_dir(const fs::path& out, const std::string& named) {
                                  "folder",
                                  named));
   check_report_folder(out, named);  // again, under the lock
-  if (!fs::is_empty(out, ec)) {
-    // The index first: a folder never holds an index.html whose assets or images are gone.
-    for (const char* sub : {"index.html", "assets", "images"}) {
-      fs::remove_all(out / sub, ec);
-      if (ec) throw IoError(fmt::format("cannot remove the earlier report's {}: {}", (out / sub).string(), ec.message()));
-    }
-    // An index being written when a run was killed is removed when the new index is written.
-  }
+  // What a report stopped while it was being written left.
+  fs::remove_all(out / kStaging, ec);
+  if (ec) throw IoError(fmt::format("cannot remove {}, left by a report that was stopped: {}",
+                                    (out / kStaging).string(), ec.message()));
   io::write_text_atomically(out / kReportMarker, fmt::format("{} {}\n", kGenerator, SB_VERSION_STRING));
   return std::move(*lock);
 }
+
+/// Whether `out` holds a part of an earlier report.
+bool holds_earlier_report(const fs::path& out) {
+  std::error_code ec;
+  return std::any_of(std::begin(kReportParts), std::end(kReportParts),
+                     [&](const char* part) { return fs::exists(out / part, ec); });
+}
+
+/// Puts the report written whole into `stage` in the place of the folder's earlier one: the
+/// earlier index first, its assets and images after it, then the new images, assets and index.
+/// Removals and renames only, which a full disk does not stop.
+void replace_report(const fs::path& out, const fs::path& stage) {
+  std::error_code ec;
+  for (const char* part : kReportParts) {
+    fs::remove_all(out / part, ec);
+    if (ec) throw IoError(fmt::format("cannot remove the earlier report's {}: {}", (out / part).string(), ec.message()));
+  }
+  for (auto part = std::rbegin(kReportParts); part != std::rend(kReportParts); ++part) {
+    if (!fs::exists(stage / *part, ec)) continue;  // no images copied (linked, or none named)
+    fs::rename(stage / *part, out / *part, ec);
+    if (ec) throw IoError(fmt::format("cannot move the new report's {} into place: {}", (out / *part).string(),
+                                      ec.message()));
+  }
+  io::sync_folder(out);
+  fs::remove_all(stage, ec);  // empty by now
+}
+
+/// Removes the staging folder of a report that was not written whole, unless dismissed.
+class StagingGuard {
+ public:
+  explicit StagingGuard(fs::path stage) : stage_(std::move(stage)) {}
+  StagingGuard(const StagingGuard&) = delete;
+  StagingGuard& operator=(const StagingGuard&) = delete;
+  ~StagingGuard() {
+    if (stage_.empty()) return;
+    std::error_code ec;
+    fs::remove_all(stage_, ec);
+  }
+  void dismiss() { stage_.clear(); }
+
+ private:
+  fs::path stage_;
+};
 
 /// Copies a file atomically (the destination's folders are created).
 void copy_atomically(const fs::path& from, const fs::path& to) {
@@ -418,19 +465,12 @@ void check_report_assets(const fs::path& assets) {
                                   (assets / f).string()));
 }
 
-ReportSummary write_report(const ResultsFile& results, const ReportOptions& options) {
-  const fs::path assets = options.assets_dir.empty() ? report_assets_dir() : options.assets_dir;
-  check_report_assets(assets);
-  json papers;
-  try {
-    papers = io::parse_json(io::read_file(assets / kPapers));
-  } catch (const io::JsonTextError& e) {
-    throw ToolError(fmt::format("report asset {} is not valid JSON: {}", (assets / kPapers).string(), e.what()));
-  }
+namespace {
 
-  const fs::path out = options.out_dir;
-  const io::FileLock lock =
-      prepare_out_dir(out, options.out_name.empty() ? fmt::format("--out {}", out.string()) : options.out_name);
+/// Writes the report of `results` into `stage` as it will stand in `out` (write_report moves it
+/// there): the copied images, the assets and the page.
+ReportSummary write_report_into(const ResultsFile& results, const ReportOptions& options, const fs::path& assets,
+                                const json& papers, const fs::path& out, const fs::path& stage) {
   ReportSummary summary;
   summary.warnings = results.warnings;
 
@@ -478,7 +518,7 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
         throw IoError(fmt::format("cannot express {} relative to {}", source.string(), out.string()));
       return relative.generic_string();
     }
-    copy_atomically(source, out / "images" / name);
+    copy_atomically(source, stage / "images" / name);
     return "images/" + name;
   };
 
@@ -526,15 +566,46 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
   summary.pipeline_names = data["pipelines"];
   summary.cells = data["cells"];
 
-  for (const char* f : kCopiedAssets) copy_atomically(assets / f, out / "assets" / f);
+  for (const char* f : kCopiedAssets) copy_atomically(assets / f, stage / "assets" / f);
 
   const std::string page = fill_template(io::read_file(assets / kTemplate),
                                          {{"GENERATOR", html_escape(fmt::format("{} {}", kGenerator, SB_VERSION_STRING))},
                                           {"TITLE", html_escape(title)},
                                           {"DATA", script_json(data)}},
                                          assets / kTemplate);
+  io::write_text_atomically(stage / "index.html", page);
+  return summary;
+}
+
+}  // namespace
+
+ReportSummary write_report(const ResultsFile& results, const ReportOptions& options) {
+  const fs::path assets = options.assets_dir.empty() ? report_assets_dir() : options.assets_dir;
+  check_report_assets(assets);
+  json papers;
+  try {
+    papers = io::parse_json(io::read_file(assets / kPapers));
+  } catch (const io::JsonTextError& e) {
+    throw ToolError(fmt::format("report asset {} is not valid JSON: {}", (assets / kPapers).string(), e.what()));
+  }
+
+  const fs::path out = options.out_dir;
+  const io::FileLock lock =
+      prepare_out_dir(out, options.out_name.empty() ? fmt::format("--out {}", out.string()) : options.out_name);
+  const bool earlier = holds_earlier_report(out);
+  // Everything is written into `stage` first and takes the earlier report's place at the end.
+  const fs::path stage = out / kStaging;
+  StagingGuard staging(stage);
+  ReportSummary summary;
+  try {
+    summary = write_report_into(results, options, assets, papers, out, stage);
+  } catch (const IoError& e) {
+    if (!earlier) throw;
+    throw IoError(fmt::format("{}; the earlier report in {} is kept as it was", e.what(), out.string()));
+  }
+  replace_report(out, stage);
+  staging.dismiss();
   summary.index_html = out / "index.html";
-  io::write_text_atomically(summary.index_html, page);
   return summary;
 }
 

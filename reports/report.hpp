@@ -83,8 +83,10 @@ void check_report_folder(const std::filesystem::path& out, const std::string& na
 /// earlier stereobench report (then its index.html, assets/ and images/ are replaced): InputError
 /// otherwise.
 /// ToolError (exit 4) when the assets folder lacks a file (Chart.js comes from `npm ci` in ci/,
-/// run by ci/install-deps.sh chromium); IoError when writing fails. index.html is written last
-/// and atomically, so a folder with an index.html holds a complete report.
+/// run by ci/install-deps.sh chromium); IoError when writing fails. The report is written whole
+/// into a hidden folder inside out_dir first and then moved into place, index.html last, so a
+/// folder with an index.html holds a complete report, and a report that cannot be written (a
+/// full disk) leaves the earlier one as it was.
 ReportSummary write_report(const ResultsFile& results, const ReportOptions& options);
 
 }  // namespace sb::reports

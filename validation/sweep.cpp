@@ -119,6 +119,10 @@ class Where {
   [[noreturn]] void fail(const toml::node& at, const std::string& key_path, const std::string& what) const {
     fail(at.source(), key_path, what);
   }
+  /// A warning at a place, in the same form.
+  [[nodiscard]] std::string note(const toml::node& at, const std::string& key_path, const std::string& what) const {
+    return fmt::format("{}:{}: {}: {}", file_.string(), at.source().begin.line, key_path, what);
+  }
   [[nodiscard]] const fs::path& file() const { return file_; }
   /// A path written in the definition: absolute as given, otherwise relative to its folder; made
   /// absolute, so that results name the file wherever they are read (the gate's reproduce commands).
@@ -382,6 +386,8 @@ void parse_path(const Where& where, const toml::node& node, SweepDefinition& d) 
   } catch (const InputError& e) {
     where.fail(node, "path", e.what());
   }
+  if (const auto unshown = path.unshown_keys_warning("path.frames ="))
+    d.warnings.push_back(where.note(*frames, "path.frames", *unshown));
   d.path = path;
 }
 

@@ -75,6 +75,10 @@ struct SweepDefinition {
   /// `[gate] config`: the gate thresholds written for this sweep's cells (a path relative to the
   /// definition file), which `stereobench nightly` applies when no --gate-config is given.
   std::optional<std::filesystem::path> gate_config;
+
+  /// What the definition asks that will not happen as it reads ("FILE:LINE: key: what"): camera
+  /// keys of the path that no frame stands at. The sweep runs; its commands print these first.
+  std::vector<std::string> warnings;
 };
 
 /// One cell: a combination of the axes. Every pipeline of the definition runs in it.

@@ -418,6 +418,29 @@ void check_out_folders(const SweepRunOptions& options, bool cells_to_run) {
                               options.results.string(), std::strerror(errno)));
 }
 
+/// The sweep marker of `out_dir`: none when there is none, null when it is damaged (not an object
+/// with the strings "sweep", "definition_sha256" and "definition"), else its record.
+std::optional<json> read_out_marker(const fs::path& out_dir) {
+  const fs::path marker = out_dir / kOutMarker;
+  std::error_code ec;
+  if (!fs::exists(marker, ec)) return std::nullopt;
+  json theirs;
+  try {
+    theirs = io::parse_json(io::read_file(marker));
+  } catch (const io::JsonTextError&) {
+    return json();
+  }
+  if (!theirs.is_object() || !theirs.value("sweep", json()).is_string() ||
+      !theirs.value("definition_sha256", json()).is_string() || !theirs.value("definition", json()).is_string())
+    return json();
+  return theirs;
+}
+
+/// Whether a marker record names this definition.
+bool marks_definition(const json& theirs, const SweepDefinition& d) {
+  return theirs.is_object() && theirs.value("sweep", "") == d.name && theirs.value("definition_sha256", "") == d.sha256;
+}
+
 /// Claims the output folder for this definition before any cell runs: a folder made for another
 /// definition (its marker names it) is refused, since the cells' images, whose folders are named by
 /// cell index, would overwrite that sweep's; the shards of one sweep share it. Called once every
@@ -429,19 +452,14 @@ void claim_out_folder(const SweepDefinition& d, const SweepRunOptions& options) 
   // Checked and written under a lock on the folder: two sweeps started together into one new folder
   // would otherwise both find no marker and both claim it.
   const io::FileLock lock = io::FileLock::acquire(options.out_dir);
-  if (fs::exists(marker)) {
-    json theirs;
-    try {
-      theirs = io::parse_json(io::read_file(marker));
-    } catch (const io::JsonTextError&) {
-    }
-    if (!theirs.is_object() || !theirs.value("sweep", json()).is_string() ||
-        !theirs.value("definition_sha256", json()).is_string() || !theirs.value("definition", json()).is_string())
+  if (const std::optional<json> found = read_out_marker(options.out_dir)) {
+    const json& theirs = *found;
+    if (theirs.is_null())
       throw InputError(fmt::format("{} holds a damaged sweep marker {} (not the record a sweep writes), so which "
                                    "sweep's cells are there is unknown; its images could be overwritten: give another "
                                    "--out, or delete the folder to start over",
                                    options.out_dir.string(), marker.string()));
-    if (theirs.value("sweep", "") == d.name && theirs.value("definition_sha256", "") == d.sha256) return;
+    if (marks_definition(theirs, d)) return;
     throw InputError(fmt::format(
         "{} holds the cells of sweep '{}' ({}, sha256 {}), not of this definition '{}' ({}, sha256 {}); its images "
         "would be overwritten: give another --out, or delete the folder to start over",
@@ -533,6 +551,11 @@ void check_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, 
 }
 
 }  // namespace
+
+bool out_folder_is_for(const SweepDefinition& definition, const fs::path& out_dir) {
+  const std::optional<json> marker = read_out_marker(out_dir);
+  return !marker || marks_definition(*marker, definition);
+}
 
 void prepare_sweep(const SweepDefinition& d, const std::vector<SweepCell>& cells, const std::vector<size_t>& todo,
                    const SweepRunOptions& options) {

@@ -65,6 +65,11 @@ struct SweepPlan {
 void prepare_sweep(const SweepDefinition& definition, const std::vector<SweepCell>& cells,
                    const std::vector<size_t>& todo, const SweepRunOptions& options);
 
+/// Whether `out_dir` may take the cells of `definition`: it has no sweep marker, or its marker
+/// names this definition (name and content). prepare_sweep refuses a folder for which this is
+/// false; a caller choosing among folders asks first.
+[[nodiscard]] bool out_folder_is_for(const SweepDefinition& definition, const std::filesystem::path& out_dir);
+
 /// Reported after each finished cell (serialised: one call at a time).
 struct CellProgress {
   const SweepCell& cell;

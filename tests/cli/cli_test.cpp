@@ -107,6 +107,9 @@ TEST(Cli, BadArgumentsExitWith3AndSayWhy) {
        "out: " + dir.path().string() + " is a folder; give the name of the file to write"},
       {"gate --results a.jsonl --junit '" + dir.path().string() + "'",
        "--junit: " + dir.path().string() + " is a folder"},
+      // A folder not made yet (a trailing '/'): refused before its folders are made.
+      {"compare a.png b.png --json '" + (dir / "new" / "folder").string() + "/'",
+       "--json: " + (dir / "new" / "folder").string() + "/ names a folder (it ends in '/'); give the name of the file"},
       {"sweep run x.toml --executor slurm --shards -1", "--shards: Value -1 not in range 1 to 1001"},
       {"sweep run x.toml --executor slurm --shards 0", "--shards: Value 0 not in range 1 to 1001"},
   };
@@ -115,6 +118,7 @@ TEST(Cli, BadArgumentsExitWith3AndSayWhy) {
     EXPECT_EQ(r.code, 3) << c.args << "\n" << r.out;
     EXPECT_NE(r.out.find(c.expect), std::string::npos) << c.args << "\nexpected: " << c.expect << "\ngot: " << r.out;
   }
+  EXPECT_FALSE(std::filesystem::exists(dir / "new")) << "a refused run makes no folder";
 }
 
 TEST(Cli, ListOptionsRefuseEmptyEntries) {
@@ -661,6 +665,7 @@ TEST(Cli, RenderAndBenchRejectBadArguments) {
     EXPECT_EQ(r.code, 3) << c.args << "\n" << r.out;
     EXPECT_NE(r.out.find(c.expect), std::string::npos) << c.args << "\nexpected: " << c.expect << "\ngot: " << r.out;
   }
+  EXPECT_FALSE(std::filesystem::exists(dir / "new")) << "a refused run makes no folder";
 }
 
 }  // namespace

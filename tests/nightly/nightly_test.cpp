@@ -218,6 +218,48 @@ TEST(NightlyTest, ResumesAnUnfinishedRunAndRecordsItOnce) {
   EXPECT_EQ(folders, 1u);
 }
 
+TEST(NightlyTest, ARunStoppedBeforeItsFirstCellDoesNotHoldBackAnEditedDefinition) {
+  // A nightly stopped before its first cell was recorded leaves a run folder whose sweep marker
+  // names the definition but no results line. With the definition edited, the next nightly took
+  // that folder for its own (no line to tell otherwise) and the sweep then refused it, on every
+  // run until the folder was removed by hand.
+  test::ScratchDir dir;
+  write_inputs(dir);
+  const test::CliRun first = test::run_cli(nightly_args(dir));
+  ASSERT_EQ(first.code, 0) << first.out;
+  fs::path run;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs"))
+    if (e.is_directory()) run = e.path();
+  ASSERT_FALSE(run.empty());
+  fs::remove(run / "nightly.json");
+  fs::remove(run / "results.jsonl");
+  ASSERT_TRUE(fs::exists(run / ".stereobench-sweep.json"));
+  std::string edited = kDefinition;
+  edited.replace(edited.find("repetitions = 1"), 15, "repetitions = 2");
+  write_text(dir / "tiny.toml", edited);
+  const test::CliRun again = test::run_cli(nightly_args(dir));
+  ASSERT_EQ(again.code, 0) << again.out;
+  EXPECT_NE(again.out.find("note: the unfinished run " + run.string() + " was started from another definition"),
+            std::string::npos)
+      << again.out;
+  size_t folders = 0;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs")) folders += e.is_directory() ? 1 : 0;
+  EXPECT_EQ(folders, 2u) << "a new run, the stopped one left as it was";
+  EXPECT_FALSE(fs::exists(run / "results.jsonl"));
+  // Unedited, such a run is resumed.
+  const fs::path resumed_run = [&] {
+    fs::path newest;
+    for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs"))
+      if (e.is_directory() && e.path().filename() > newest.filename()) newest = e.path();
+    return newest;
+  }();
+  fs::remove(resumed_run / "nightly.json");
+  fs::remove(resumed_run / "results.jsonl");
+  const test::CliRun third = test::run_cli(nightly_args(dir));
+  ASSERT_EQ(third.code, 0) << third.out;
+  EXPECT_NE(third.out.find("run " + resumed_run.filename().string() + " (resumed)"), std::string::npos) << third.out;
+}
+
 TEST(NightlyTest, FailingGateExitsTwoAndIsRecorded) {
   test::ScratchDir dir;
   // 45 dB is above both reprojections' PSNR (39.88 and 32.67 dB measured); plain-rt is inf.
@@ -278,10 +320,18 @@ TEST(NightlyTest, MalformedHistoryIsBadInputNamingFileAndLine) {
   // A folder given as the history is bad input, also found before the sweep.
   const test::CliRun folder = test::run_cli(nightly_args(dir) + " --history " + quoted(dir / "runs"));
   EXPECT_EQ(folder.code, 3) << folder.out;
-  EXPECT_NE(folder.out.find("is a folder, not a file"), std::string::npos) << folder.out;
+  EXPECT_NE(folder.out.find("--history " + (dir / "runs").string() + " is a folder; give the JSON Lines file"),
+            std::string::npos)
+      << "names the option: " << folder.out;
   run_folders = 0;
   for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs")) run_folders += e.is_directory() ? 1 : 0;
   EXPECT_EQ(run_folders, 0u);
+
+  // A usage error makes no folder.
+  const test::CliRun bad_threads = test::run_cli("nightly " + quoted(dir / "tiny.toml") + " --out " +
+                                                 quoted(dir / "never") + " --threads -3");
+  EXPECT_EQ(bad_threads.code, 3) << bad_threads.out;
+  EXPECT_FALSE(fs::exists(dir / "never")) << bad_threads.out;
 
   // A history that cannot be appended to (its folder is a file) is found before the sweep too,
   // named by the flag: it used to fail after the sweep, leaving a passing gate-junit.xml behind.

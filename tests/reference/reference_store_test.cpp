@@ -412,7 +412,8 @@ TEST(ReferenceStore, AnEntryThatContradictsItsFolderIsCorrupt) {
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("its spec makes the reference '" + pole + "' (the id names the scene file"), std::string::npos)
       << r.out;
-  EXPECT_NE(r.out.find("but the entry lies in folder '" + renamed + "'; `stereobench reference update` writes it"),
+  EXPECT_NE(r.out.find("but the entry lies in folder '" + renamed + "'; `stereobench reference update " + renamed +
+                       " --store " + shell_quote(store.string()) + "` writes it"),
             std::string::npos)
       << r.out;
   // update writes that reference under its own id and says that the folder stays as it was,
@@ -625,6 +626,80 @@ TEST(ReferenceStore, MissingToolIsUnavailableNotAPass) {
   EXPECT_EQ(test::run_cli(ref(dir, "verify") + " " + full).code, 0) << "the damaged full entry was rewritten";
 }
 
+
+TEST(ReferenceStore, AFailingOrMissingToolIsNamedAndTheOtherEntriesAreStillHandled) {
+  // A tool that is there but fails stopped verify at its entry, and a missing one stopped a plain
+  // update: the entries after it were never checked or rewritten.
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene box-wall --truth povray --resolution 32x18").code, 0)
+      << "(POV-Ray is installed by ci/install-deps.sh povray)";
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene box-wall --resolution 32x18").code, 0);
+  const std::string full = "box-wall_full_32x18_e64.0mm_c4.08m";
+  const fs::path fake = dir / "fake-povray";
+  std::ofstream(fake) << "#!/bin/sh\nif [ \"$1\" = --version ]; then echo 'POV-Ray 3.7.0.10'; exit 0; fi\n"
+                         "echo 'Parse Error: the fake fails' >&2\nexit 1\n";
+  fs::permissions(fake, fs::perms::owner_all);
+  ::setenv("STEREOBENCH_POVRAY", fake.c_str(), 1);
+  const test::CliRun verify = test::run_cli(ref(dir, "verify") + " --json " + quoted(dir / "verdicts.json"));
+  ::unsetenv("STEREOBENCH_POVRAY");
+  EXPECT_EQ(verify.code, 4) << verify.out;
+  EXPECT_NE(verify.out.find("povray could not render it again here"), std::string::npos) << verify.out;
+  EXPECT_NE(verify.out.find("Parse Error: the fake fails"), std::string::npos) << verify.out;
+  EXPECT_NE(verify.out.find(full + ": a new render is bit-identical"), std::string::npos)
+      << "the entry after it is still verified: " << verify.out;
+  EXPECT_NE(verify.out.find("1 of 2 reference(s) verified; 1 could not be checked here"), std::string::npos)
+      << verify.out;
+  EXPECT_TRUE(fs::exists(dir / "verdicts.json")) << "the verdicts are written";
+
+  const std::string full_provenance = test::read_text(dir / "store" / full / "provenance.json");
+  ::setenv("STEREOBENCH_POVRAY", "/nonexistent/povray", 1);
+  const test::CliRun update = test::run_cli(ref(dir, "update"));
+  ::unsetenv("STEREOBENCH_POVRAY");
+  EXPECT_EQ(update.code, 4) << update.out;
+  EXPECT_NE(update.out.find("1 reference(s) rewritten"), std::string::npos) << update.out;
+  EXPECT_NE(update.out.find("1 reference(s) could not be rewritten because their tool is missing or failed"),
+            std::string::npos)
+      << update.out;
+  EXPECT_NE(test::read_text(dir / "store" / full / "provenance.json"), full_provenance)
+      << "the full entry was rewritten (its provenance has the update's command line)";
+}
+
+TEST(ReferenceStore, WithoutMinPsnrAChangeBelowTheEightBitLevelFails) {
+  // The stored image is linear float; a change that the 8-bit sRGB encoding does not show gave
+  // PSNR inf and passed the default check, which demands identical images.
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene box-wall --resolution 32x18").code, 0);
+  const std::string id = "box-wall_full_32x18_e64.0mm_c4.08m";
+  const fs::path exr = dir / "store" / id / "right.exr";
+  Image image = io::read_exr(exr);
+  for (float& v : image.plane("rgb").f32()) v = std::nextafter(v, 2.0f * v + 1.0f);
+  io::write_exr(exr, image);
+  const test::CliRun sum = test::run_shell("sha256sum " + quoted(exr));
+  ASSERT_EQ(sum.code, 0) << sum.out;
+  json p = json::parse(test::read_text(dir / "store" / id / "provenance.json"));
+  p["image"]["sha256"] = sum.out.substr(0, 64);
+  std::ofstream(dir / "store" / id / "provenance.json", std::ios::trunc) << p.dump(2);
+  const test::CliRun r = test::run_cli(ref(dir, "verify"));
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("a new render differs from the stored float image, though not in its 8-bit sRGB encoding"),
+            std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.find("(-1, -1)"), std::string::npos) << "no position of a largest error that is none: " << r.out;
+  EXPECT_EQ(test::run_cli(ref(dir, "verify") + " --min-psnr 60").code, 0) << "a tolerance accepts it";
+  // The advice to rewrite a damaged preview names this store, not the default one.
+  io::write_png_rgb8(dir / "store" / id / "right.png", std::vector<uint8_t>(32 * 18 * 3, 0), 32, 18);
+  const test::CliRun preview = test::run_cli(ref(dir, "verify") + " --no-render");
+  EXPECT_EQ(preview.code, 2) << preview.out;
+  EXPECT_NE(preview.out.find("`stereobench reference update " + id + " --store " + shell_quote((dir / "store").string()) +
+                             "` writes it again"),
+            std::string::npos)
+      << preview.out;
+  // Verdicts go to a file; '-' is not one.
+  const test::CliRun dash = test::run_cli(ref(dir, "verify") + " --json -");
+  EXPECT_EQ(dash.code, 3) << dash.out;
+  EXPECT_NE(dash.out.find("--json -: reference verify writes its verdicts to a file"), std::string::npos) << dash.out;
+  EXPECT_FALSE(fs::exists("-"));
+}
 
 TEST(ReferenceStore, AnotherRigGeneratedMeanwhileDoesNotReplaceAnEntry) {
   // Two generates of one id with different rigs at once: the check and the replacement are made

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "renderer/io/file_lock.hpp"
+#include "support/file_size_limit.hpp"
 #include "support/image_metrics.hpp"
 #include "support/report_support.hpp"
 #include "support/run_cli.hpp"
@@ -323,14 +324,16 @@ TEST(Report, WarnsOnTornTailAndMissingImagesAndGuardsForeignFolders) {
   for (const char* asset : {"report.js", "report.css", "chart.umd.min.js"})
     EXPECT_TRUE(fs::exists(dir / "out" / "assets" / asset)) << asset;
 
-  // A report stopped before its index (a full disk, a kill) is replaced by the next run.
+  // A report stopped before its index (a full disk, a kill) is replaced by the next run, and what
+  // its writes left in the folder it was being written into goes.
   fs::remove(dir / "out" / "index.html");
-  write_text(dir / "out" / ".index.html.tmp-123-0", "<html");
+  write_text(dir / "out" / ".stereobench-next" / ".index.html.tmp-123-0", "<html");
+  write_text(dir / "out" / ".stereobench-next" / "assets" / "report.js", "// cut");
   ASSERT_TRUE(fs::exists(dir / "out" / ".stereobench-report"));
   const test::CliRun again = test::run_cli("report " + quoted(dir / "results.jsonl") + " --out " + quoted(dir / "out"));
   EXPECT_EQ(again.code, 0) << again.out;
   EXPECT_TRUE(fs::exists(dir / "out" / "index.html"));
-  EXPECT_FALSE(fs::exists(dir / "out" / ".index.html.tmp-123-0")) << "the killed write's leftover goes";
+  EXPECT_FALSE(fs::exists(dir / "out" / ".stereobench-next")) << "the killed write's leftovers go";
 
   // A folder that holds something else is not overwritten.
   write_text(dir / "mine" / "notes.txt", "keep");
@@ -436,6 +439,48 @@ TEST(Report, ASecondReportIntoAFolderBeingWrittenIsRefused) {
   }
   const test::CliRun after = test::run_cli(args + " --title other");
   EXPECT_EQ(after.code, 0) << after.out;
+}
+
+TEST(Report, AReportThatCannotBeWrittenLeavesTheEarlierOneAsItWas) {
+  // A full disk while the new report is written: the earlier report in the folder was removed
+  // before the new one was written, and lost. It now stays as it was until the new one is whole.
+  test::ScratchDir dir;
+  json line = minimal_line("a", 0);
+  line["images"] = {{"left_png", "cells/0000/left.png"}};
+  write_text(dir / "results.jsonl", line.dump() + "\n");
+  fs::create_directories(dir / "cells" / "0000");
+  fs::copy_file(kSource / "reference" / "store" / "box-wall_full_160x90_e64.0mm_c4.08m" / "right.png",
+                dir / "cells" / "0000" / "left.png");
+  const std::string args = "report " + quoted(dir / "results.jsonl") + " --out " + quoted(dir / "out");
+  const test::CliRun first = test::run_cli(args + " --title first");
+  ASSERT_EQ(first.code, 0) << first.out;
+  const std::string index = test::read_text(dir / "out" / "index.html");
+  const std::string chart = test::read_text(dir / "out" / "assets" / "chart.umd.min.js");
+  ASSERT_GT(chart.size(), 100000u) << "the limit below must stop the copy of Chart.js";
+  {
+    const test::FileSizeLimit limit(100000);
+    ASSERT_TRUE(limit.ok());
+    const test::CliRun full = test::run_cli(args + " --title second");
+    EXPECT_EQ(full.code, 4) << full.out;
+    EXPECT_NE(full.out.find("chart.umd.min.js"), std::string::npos) << "names the file it could not write: " << full.out;
+    EXPECT_NE(full.out.find("the earlier report in " + (dir / "out").string() + " is kept as it was"),
+              std::string::npos)
+        << full.out;
+  }
+  EXPECT_EQ(test::read_text(dir / "out" / "index.html"), index);
+  EXPECT_EQ(test::read_text(dir / "out" / "assets" / "chart.umd.min.js"), chart);
+  EXPECT_TRUE(fs::exists(dir / "out" / "assets" / "report.js"));
+  const std::string left = embedded_data(dir / "out" / "index.html")["cells"][0]["images"]["left"].get<std::string>();
+  ASSERT_EQ(left.rfind("images/", 0), 0u) << left;
+  EXPECT_TRUE(fs::exists(dir / "out" / left)) << "the earlier report's images stay: " << left;
+  EXPECT_FALSE(fs::exists(dir / "out" / ".stereobench-next")) << "nothing of the new report is left";
+
+  // With room, the new report takes the earlier one's place.
+  const test::CliRun again = test::run_cli(args + " --title second");
+  ASSERT_EQ(again.code, 0) << again.out;
+  EXPECT_NE(test::read_text(dir / "out" / "index.html").find("<title>second</title>"), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir / "out" / left));
+  EXPECT_FALSE(fs::exists(dir / "out" / ".stereobench-next"));
 }
 
 }  // namespace

@@ -387,6 +387,26 @@ mesh_prefix = "box"
   EXPECT_FALSE(parse_sweep("[sweep]\n", "def.toml").path.has_value());
 }
 
+TEST(SweepDefinition, CameraKeysNoFrameStandsAtAreAWarning) {
+  // Frames spread evenly over 4 keys: 5 frames stand at keys 1 and 4 only; the definition loads
+  // and says so, naming a frame count that stands at every key.
+  const std::string keys = "camera_keys = [[0, 1, 3, 0, 1, 0], [1, 1, 3, 0, 1, 0], [2, 1, 3, 0, 1, 0], [3, 1, 3, 0, 1, 0]]\n";
+  const SweepDefinition five = parse_sweep("[sweep]\n[path]\nframes = 5\n" + keys, "def.toml");
+  ASSERT_EQ(five.warnings.size(), 1u);
+  EXPECT_EQ(five.warnings[0],
+            "def.toml:3: path.frames: the 5 frames are spread evenly over the path, so camera keys 2, 3 fall between "
+            "frames and are never shown; give path.frames = 7 (or any number one more than a multiple of 3) to stand "
+            "at every key");
+  EXPECT_TRUE(parse_sweep("[sweep]\n[path]\nframes = 7\n" + keys, "def.toml").warnings.empty());
+  EXPECT_TRUE(parse_sweep("[sweep]\n[path]\nframes = 4\n" + keys, "def.toml").warnings.empty());
+  const SweepDefinition one = parse_sweep("[sweep]\n[path]\nframes = 1\n" + keys, "def.toml");
+  ASSERT_EQ(one.warnings.size(), 1u);
+  EXPECT_NE(one.warnings[0].find("with 1 frame the camera stands at the first of the 4 camera keys; give path.frames "
+                                 "= 4 or more"),
+            std::string::npos)
+      << one.warnings[0];
+}
+
 TEST(SweepDefinition, RejectsBadPaths) {
   const struct {
     const char* toml;
@@ -485,7 +505,7 @@ TEST(SweepDefinition, ShippedDefinitionsLoad) {
       {"presets/al-hagri-interaxial.toml", 10, 6},      // 10..100 px
       {"presets/al-hagri-lights.toml", 10, 6},          // 1..10 lights
       {"presets/animated-spheres.toml", 30, 6},         // 30 frames of the turning spheres
-      {"presets/wissmann-path.toml", 60, 4},            // 60 frames along the bistro path
+      {"presets/wissmann-path.toml", 61, 4},            // 61 frames along the bistro path
   };
   size_t checked = 0;
   for (const auto& s : shipped) {
@@ -493,6 +513,8 @@ TEST(SweepDefinition, ShippedDefinitionsLoad) {
     const std::vector<validation::SweepCell> cells = validation::expand_cells(d);
     EXPECT_EQ(cells.size(), s.cells) << s.file;
     EXPECT_EQ(d.pipelines.size(), s.pipelines ? s.pipelines : n_pipelines) << s.file;
+    // Nothing it asks goes unseen (a camera key between frames).
+    for (const std::string& w : d.warnings) ADD_FAILURE() << w;
     // A results line's cell fields give back the cell's id (check_cell_record compares them).
     for (const validation::SweepCell& cell : cells)
       EXPECT_EQ(validation::cell_id_from_json(validation::cell_to_json(cell)), std::optional<std::string>(cell.id))
