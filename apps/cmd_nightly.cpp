@@ -148,8 +148,9 @@ ChosenRun choose_run_dir(const fs::path& out, const SweepDefinition& d, const fs
         chosen.claim = std::move(*claim);
         return chosen;
       }
-      fmt::print(stderr, "note: the unfinished run {} was started from another definition than {} as it is now; "
-                 "starting a new run, and leaving that folder as it is\n",
+      fmt::print(stderr, "note: the unfinished run {} is not a run of {} as it is now (its results or its sweep "
+                 "marker name another definition, or the marker is damaged); starting a new run, and leaving that "
+                 "folder as it is\n",
                  newest.string(), d.file.string());
     }
   }
@@ -181,14 +182,14 @@ void refuse_foreign_run(const HistoryFile& history, const fs::path& history_file
           run_dir.string()));
 }
 
-/// Makes sure the history line can be appended at the end of the run, before the sweep costs
-/// anything: the history file's folder exists or is made, and the file, where it exists, is a
-/// writable regular file. `given`: the path came from --history.
 /// The history file as messages name it: as the option that gave it, or as the default file.
 std::string history_named(const fs::path& file, bool given) {
   return given ? fmt::format("--history {}", file.string()) : fmt::format("history file {}", file.string());
 }
 
+/// Makes sure the history line can be appended at the end of the run, before the sweep costs
+/// anything: the history file's folder exists or is made, and the file, where it exists, is a
+/// writable regular file. `given`: the path came from --history.
 void check_history_writable(const fs::path& file, bool given) {
   const std::string named = history_named(file, given);
   const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");

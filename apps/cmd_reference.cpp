@@ -78,7 +78,7 @@ std::vector<reference::VerifyResult> verify_all(const ReferenceArgs& a, const re
 }
 
 /// Exit status of a verification: 2 when a reference failed, 4 when some could not be checked
-/// because a tool is missing, else 0.
+/// because a tool is missing or failed, else 0.
 int verdict(const std::vector<reference::VerifyResult>& results) {
   bool failed = false, unavailable = false;
   for (const auto& r : results) {
@@ -308,7 +308,7 @@ void register_reference_command(CLI::App& root, const std::string& command_line)
   CLI::App* ver = ref->add_subcommand(
       "verify",
       "Re-hash each reference and its scene, render it again and report drift. Exit 0 when all hold,\n"
-      "2 when any drifted, is corrupt or its scene changed, 4 when a provider's tool is missing");
+      "2 when any drifted, is corrupt or its scene changed, 4 when a provider's tool is missing or failed");
   add_selection(ver);
   ver->add_option("--json", a->json_out, "Also write the verdicts as JSON to this file");
   ver->callback([a] { throw VerdictExit{run_verify(*a)}; });

@@ -3,7 +3,8 @@
 # loader and renderer tests (scene loading, rig, animation) and the libraries they use with
 # AddressSanitizer + UndefinedBehaviorSanitizer and runs them again. Those rooms start no
 # `stereobench` (tests/CMakeLists.txt: SB_LIBRARY_ROOMS), so the sanitizer build leaves out the
-# command-line tool and the validation layer: 3.3 min of two cores instead of 7.9.
+# command-line tool and the validation layer: 3.3 min of two cores instead of 7.9. The command
+# line's own handling of broken scenes (tests/cli/bad_scene_cli_test.cpp) runs unsanitized.
 # Each phase prints its wall time.
 # Usage: ci/test.sh            (from anywhere; builds into build/ and build-sanitize/)
 set -euo pipefail

@@ -470,7 +470,8 @@ fs::path default_store_dir() { return fs::path(SB_SOURCE_DIR) / "reference" / "s
 
 std::string ReferenceStore::update_command(const std::string& id) const {
   std::string command = "stereobench reference update " + shell_quote(id);
-  if (root_.lexically_normal() != default_store_dir().lexically_normal()) command += " --store " + shell_quote(root_.string());
+  if (fs::absolute(root_).lexically_normal() != fs::absolute(default_store_dir()).lexically_normal())
+    command += " --store " + shell_quote(root_.string());
   return command;
 }
 
@@ -833,8 +834,10 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
   if (r.bit_identical)
     r.detail = "a new render is bit-identical";
   else if (r.metrics->max_error == 0)
-    r.detail = "a new render differs from the stored float image, though not in its 8-bit sRGB encoding (PSNR inf "
-               "dB); give --min-psnr to accept differences that small";
+    r.detail = fmt::format("a new render differs from the stored float image, though not in its 8-bit sRGB encoding "
+                           "(PSNR inf dB){}",
+                           within ? fmt::format(" (within --min-psnr {})", options.min_psnr)
+                                  : std::string("; give --min-psnr to accept differences that small"));
   else
     r.detail = fmt::format("a new render differs: PSNR {:.2f} dB, max error {} at ({}, {}), {:.4f} % error pixels{}",
                            psnr, r.metrics->max_error, r.metrics->max_x, r.metrics->max_y,

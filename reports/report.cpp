@@ -8,6 +8,7 @@
 #include <optional>
 #include <set>
 #include <span>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -255,10 +256,15 @@ io::FileLock prepare_out_dir(const fs::path& out, const std::string& named) {
                                  "folder",
                                  named));
   check_report_folder(out, named);  // again, under the lock
-  // What a report stopped while it was being written left.
+  // What a report stopped while it was being written left: its staging folder, or the temporary
+  // index of a version that wrote the index straight into the folder.
   fs::remove_all(out / kStaging, ec);
   if (ec) throw IoError(fmt::format("cannot remove {}, left by a report that was stopped: {}",
                                     (out / kStaging).string(), ec.message()));
+  std::vector<fs::path> stale;
+  for (const fs::directory_entry& e : fs::directory_iterator(out, ec))
+    if (e.path().filename().string().starts_with(".index.html.tmp-")) stale.push_back(e.path());
+  for (const fs::path& f : stale) fs::remove(f, ec);
   io::write_text_atomically(out / kReportMarker, fmt::format("{} {}\n", kGenerator, SB_VERSION_STRING));
   return std::move(*lock);
 }

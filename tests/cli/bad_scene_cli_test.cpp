@@ -16,12 +16,12 @@
 namespace sb {
 namespace {
 
-using test::add_camera;
-using test::bad_scene_corpus;
-using test::BadCase;
+using test::bad_scene::add_camera;
+using test::bad_scene::bad_scene_corpus;
+using test::bad_scene::BadCase;
 using test::MiniGltf;
 using test::ScratchDir;
-using test::write_case;
+using test::bad_scene::write_case;
 
 /// Runs `stereobench scenes info` on a scene file.
 test::CliRun scene_info(const std::filesystem::path& scene) { return test::run_cli("scenes info '" + scene.string() + "'"); }

@@ -15,10 +15,10 @@
 namespace sb {
 namespace {
 
-using test::bad_scene_corpus;
-using test::BadCase;
+using test::bad_scene::bad_scene_corpus;
+using test::bad_scene::BadCase;
 using test::ScratchDir;
-using test::write_case;
+using test::bad_scene::write_case;
 
 TEST(BadScenes, EveryCaseIsAClearInputError) {
   ScratchDir dir("bad");

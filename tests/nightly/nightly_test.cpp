@@ -239,7 +239,7 @@ TEST(NightlyTest, ARunStoppedBeforeItsFirstCellDoesNotHoldBackAnEditedDefinition
   write_text(dir / "tiny.toml", edited);
   const test::CliRun again = test::run_cli(nightly_args(dir));
   ASSERT_EQ(again.code, 0) << again.out;
-  EXPECT_NE(again.out.find("note: the unfinished run " + run.string() + " was started from another definition"),
+  EXPECT_NE(again.out.find("note: the unfinished run " + run.string() + " is not a run of "),
             std::string::npos)
       << again.out;
   size_t folders = 0;

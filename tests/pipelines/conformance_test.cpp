@@ -10,6 +10,7 @@
 #include "renderer/render_scene.hpp"
 #include "scenes/generators.hpp"
 #include "renderer/io/image_io.hpp"
+#include "support/image_metrics.hpp"
 #include "support/render_support.hpp"
 #include "support/scene_lists.hpp"
 #include "support/scratch_dir.hpp"

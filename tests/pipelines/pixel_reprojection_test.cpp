@@ -13,6 +13,7 @@
 #include "renderer/scene.hpp"
 #include "renderer/stages/pixel_reprojection.hpp"
 #include "renderer/stages/primary_rays.hpp"
+#include "support/image_metrics.hpp"
 #include "support/render_support.hpp"
 #include "support/scene_lists.hpp"
 

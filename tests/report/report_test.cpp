@@ -329,11 +329,13 @@ TEST(Report, WarnsOnTornTailAndMissingImagesAndGuardsForeignFolders) {
   fs::remove(dir / "out" / "index.html");
   write_text(dir / "out" / ".stereobench-next" / ".index.html.tmp-123-0", "<html");
   write_text(dir / "out" / ".stereobench-next" / "assets" / "report.js", "// cut");
+  write_text(dir / "out" / ".index.html.tmp-123-0", "<html");  // as an earlier version wrote it
   ASSERT_TRUE(fs::exists(dir / "out" / ".stereobench-report"));
   const test::CliRun again = test::run_cli("report " + quoted(dir / "results.jsonl") + " --out " + quoted(dir / "out"));
   EXPECT_EQ(again.code, 0) << again.out;
   EXPECT_TRUE(fs::exists(dir / "out" / "index.html"));
   EXPECT_FALSE(fs::exists(dir / "out" / ".stereobench-next")) << "the killed write's leftovers go";
+  EXPECT_FALSE(fs::exists(dir / "out" / ".index.html.tmp-123-0"));
 
   // A folder that holds something else is not overwritten.
   write_text(dir / "mine" / "notes.txt", "keep");

@@ -1,6 +1,8 @@
 // The corpus of broken scene files: each must fail with InputError (exit code 3 from the CLI) and a
 // message naming the file and the JSON pointer of the fault, never a crash. The loader's tests
-// load them through the library, the command-line tests through `stereobench scenes info`.
+// load them through the library, the command-line tests through `stereobench scenes info`. Its
+// helpers live in a namespace of their own (sb::test::bad_scene), apart from the other support
+// headers' (write_text, for one).
 #pragma once
 
 #include <cstdint>
@@ -14,7 +16,7 @@
 #include "support/mini_gltf.hpp"
 #include "support/scratch_dir.hpp"
 
-namespace sb::test {
+namespace sb::test::bad_scene {
 
 using nlohmann::json;
 
@@ -422,4 +424,4 @@ inline std::filesystem::path write_case(const ScratchDir& dir, const BadCase& bc
   return path;
 }
 
-}  // namespace sb::test
+}  // namespace sb::test::bad_scene

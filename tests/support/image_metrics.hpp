@@ -1,5 +1,6 @@
-// SSIM for tests: the suite's own metric (validation/metrics.hpp) on the sRGB-encoded 8-bit rgb
-// planes, the way psnr_srgb8 in render_support.hpp compares images.
+// PSNR and SSIM for tests: the suite's own metrics (validation/metrics.hpp) on the sRGB-encoded
+// 8-bit rgb planes. They need the validation layer, which the library rooms (tests/CMakeLists.txt:
+// SB_LIBRARY_ROOMS) do not link.
 #pragma once
 
 #include <cmath>
@@ -8,6 +9,13 @@
 #include "validation/metrics.hpp"
 
 namespace sb::test {
+
+/// PSNR of the sRGB-encoded 8-bit rgb planes (validation::encode_srgb8, mse and psnr_from_mse):
+/// infinity for identical images.
+inline double psnr_srgb8(const Image& a, const Image& b) {
+  return validation::psnr_from_mse(
+      validation::mse(validation::encode_srgb8(a, "image A"), validation::encode_srgb8(b, "image B")));
+}
 
 /// SSIM (DESIGN §6.2: Wang et al. 2004, as validation::ssim_map) of the rgb planes encoded with
 /// validation::encode_srgb8: the mean over the pixels at least 5 pixels from the border; NaN for

@@ -13,7 +13,6 @@
 #include "renderer/io/gltf_loader.hpp"
 #include "renderer/pipeline.hpp"
 #include "scenes/catalog.hpp"
-#include "validation/metrics.hpp"
 
 namespace sb::test {
 
@@ -57,13 +56,6 @@ inline std::string stage_eyes_of(const std::string& pipeline, const std::map<std
   std::string out;
   for (const StageTime& s : r.timings.stages()) out += (out.empty() ? "" : " ") + s.name + "=" + stage_eye_name(s.eye);
   return out;
-}
-
-/// PSNR of the sRGB-encoded 8-bit rgb planes (validation::encode_srgb8, mse and psnr_from_mse):
-/// infinity for identical images.
-inline double psnr_srgb8(const Image& a, const Image& b) {
-  return validation::psnr_from_mse(
-      validation::mse(validation::encode_srgb8(a, "image A"), validation::encode_srgb8(b, "image B")));
 }
 
 }  // namespace sb::test
