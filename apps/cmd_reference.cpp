@@ -136,9 +136,7 @@ int run_verify(const ReferenceArgs& a) {
   }
   std::string tail;
   // The command to run as it stands: with the store and scenes folder this run was given.
-  std::string update = "stereobench reference update --only-failing";
-  if (fs::path(a.store).lexically_normal() != reference::default_store_dir().lexically_normal())
-    update += " --store " + shell_quote(a.store);
+  std::string update = "stereobench reference update --only-failing" + store.store_option();
   if (!a.scenes_dir.empty() &&
       fs::path(a.scenes_dir).lexically_normal() != scenes::default_scenes_dir().lexically_normal())
     update += " --scenes-dir " + shell_quote(a.scenes_dir);

@@ -468,11 +468,13 @@ void check_entry_name(const std::string& id) {
 
 fs::path default_store_dir() { return fs::path(SB_SOURCE_DIR) / "reference" / "store"; }
 
+std::string ReferenceStore::store_option() const {
+  if (fs::absolute(root_).lexically_normal() == fs::absolute(default_store_dir()).lexically_normal()) return "";
+  return " --store " + shell_quote(root_.string());
+}
+
 std::string ReferenceStore::update_command(const std::string& id) const {
-  std::string command = "stereobench reference update " + shell_quote(id);
-  if (fs::absolute(root_).lexically_normal() != fs::absolute(default_store_dir()).lexically_normal())
-    command += " --store " + shell_quote(root_.string());
-  return command;
+  return "stereobench reference update " + shell_quote(id) + store_option();
 }
 
 const char* to_string(Status s) {

@@ -62,8 +62,10 @@ class ReferenceStore {
  public:
   explicit ReferenceStore(std::filesystem::path root) : root_(std::move(root)) {}
   [[nodiscard]] const std::filesystem::path& root() const { return root_; }
-  /// The command that writes the entry `id` of this store again (`--store` unless it is the
-  /// default store), for messages.
+  /// " --store ROOT" (shell-quoted) for a command that is to work on this store, empty for the
+  /// default store: for the commands messages give.
+  [[nodiscard]] std::string store_option() const;
+  /// The command that writes the entry `id` of this store again, for messages.
   [[nodiscard]] std::string update_command(const std::string& id) const;
 
   /// The ids of complete entries, sorted. InputError when the store does not exist or is not a

@@ -270,9 +270,12 @@ std::pair<std::string, std::string> values_apart(const std::string& check, doubl
   std::string a = value_text(check, v), b = value_text(check, limit);
   if (a != b || v == limit || !std::isfinite(v) || !std::isfinite(limit)) return {a, b};
   const Shown s = shown_of(check);
+  const auto digits_of = [&s](double x, int digits) {
+    return fmt::format("{}{:.{}g}{}", s.sign && !std::signbit(x) ? "+" : "", s.scale * x, digits, s.unit);
+  };
   for (int digits = 6; digits <= 17; ++digits) {
-    a = fmt::format("{}{:.{}g}{}", s.sign && !std::signbit(v) ? "+" : "", s.scale * v, digits, s.unit);
-    b = fmt::format("{}{:.{}g}{}", s.sign && !std::signbit(limit) ? "+" : "", s.scale * limit, digits, s.unit);
+    a = digits_of(v, digits);
+    b = digits_of(limit, digits);
     if (a != b) break;
   }
   return {a, b};
