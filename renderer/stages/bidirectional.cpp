@@ -124,6 +124,11 @@ std::vector<OptionSpec> bidir_option_specs(bool traced) {
            "triangle for depth, and each shades its share where it is the nearest surface plus the other eye's share "
            "where the other eye does not show that triangle at the point's place (the z-test Kim's §5 proposes "
            "against occlusion artifacts)"},
+          {"clipped", "one",
+           "a triangle both eyes' frusta clip: one (Kim's eq. (1) as published: the eye that clips it less rasterizes "
+           "it; the other eye shows what lies behind it where only that eye sees it, as beside a wall wider than both "
+           "images, and a sliver near a border can go to the eye that sees none of it) or both (each eye whose image "
+           "it reaches rasterizes it)"},
           {"partials", "false",
            "also output each eye's partial image (<stem>_left_partial.png, <stem>_right_partial.png; render, validate and "
            "sweep cells write them)"}};
@@ -143,6 +148,11 @@ BidirSettings BidirSettings::from(const std::string& pipeline, const PipelineOpt
   else if (occlusion != "none")
     throw InputError(fmt::format("{}: option occlusion={} is not one of none, ztest", pipeline, occlusion));
   s.warp.keep_native = s.ztest;
+  const std::string& clipped = options.get("clipped");
+  if (clipped == "both")
+    s.clipped = ClippedRule::both;
+  else if (clipped != "one")
+    throw InputError(fmt::format("{}: option clipped={} is not one of one, both", pipeline, clipped));
   s.crack_depth_ratio = options.get_double("crack_depth");
   if (!(s.crack_depth_ratio == 0.0 || (s.crack_depth_ratio >= 1.0 && s.crack_depth_ratio <= 100.0)))
     throw InputError(fmt::format("{}: option crack_depth={} must be 0 (off) or lie in [1, 100]", pipeline,
@@ -160,7 +170,7 @@ void render_bidirectional(const RenderScene& scene, const StereoRig& rig, const 
   std::vector<uint8_t> bits;
   {
     ScopedStage stage(r.timings, "redirect", StageEye::both);
-    bits = redirect_triangles(scene.geometry(), rig, executor, sent);
+    bits = redirect_triangles(scene.geometry(), rig, executor, sent, settings.clipped);
   }
   r.counters.set("triangles_to_left", sent.left);
   r.counters.set("triangles_to_right", sent.right);

@@ -8,6 +8,7 @@
 #include "renderer/pipeline.hpp"
 #include "renderer/raster/rasterizer.hpp"
 #include "renderer/stages/crack_fill.hpp"
+#include "renderer/stages/redirection.hpp"
 #include "renderer/stages/row_warp.hpp"
 
 namespace sb {
@@ -28,6 +29,8 @@ struct BidirSettings {
   /// the other eye's nearest where the point lands there. Each eye keeps its own pixels in the
   /// composition (RowWarpOptions::keep_native): they are the nearest surface by construction.
   bool ztest = false;
+  /// Where a triangle both frusta clip goes (eq. (1) as published: one eye).
+  ClippedRule clipped = ClippedRule::one;
 
   /// From the options of bidir_option_specs(); InputError for values out of range.
   static BidirSettings from(const std::string& pipeline, const PipelineOptions& options);

@@ -52,14 +52,25 @@ bool crosses_eye_plane(const double (&x)[3]) {
   return behind > 0 && behind < 3;
 }
 
+/// Whether a triangle's horizontal extent (its vertices' x_ndc, all in front of the eye) overlaps
+/// the image's, [-1, 1].
+bool reaches_image(const double (&x)[3]) {
+  if (std::isnan(x[0]) || std::isnan(x[1]) || std::isnan(x[2])) return false;
+  return std::min({x[0], x[1], x[2]}) <= 1.0 && std::max({x[0], x[1], x[2]}) >= -1.0;
+}
+
 /// The redirection from the vertices' x_ndc in each eye ({x0, x1, x2}) and their positions.
 uint8_t redirect_from(const EyeCamera& left, const EyeCamera& right, const double (&xl)[3], const double (&xr)[3],
-                      const dvec3& v0, const dvec3& v1, const dvec3& v2, bool single_sided) {
+                      const dvec3& v0, const dvec3& v1, const dvec3& v2, bool single_sided, ClippedRule clipped) {
   // A triangle reaching behind an eye (a floor or wall passing beside and behind the viewer) has
   // no outermost x_ndc: its projection is unbounded, and it reaches the image borders of both eyes,
   // where each sees a part the other does not. Eq. (1) cannot rank it; both eyes rasterize it.
   if (crosses_eye_plane(xl) || crosses_eye_plane(xr)) return kRedirectBoth;
   const double fl = frustum_from_ndc(xl[0], xl[1], xl[2]), fr = frustum_from_ndc(xr[0], xr[1], xr[2]);
+  if (clipped == ClippedRule::both && fl < 1.0 && fr < 1.0) {
+    const auto to = static_cast<uint8_t>((reaches_image(xl) ? kRedirectLeft : 0) | (reaches_image(xr) ? kRedirectRight : 0));
+    if (to != 0) return to;
+  }
   if (fl != fr) return fl > fr ? kRedirectLeft : kRedirectRight;
   const TriangleFacing facing(v0, v1, v2);
   const double bl = facing.visibility(left.origin, single_sided), br = facing.visibility(right.origin, single_sided);
@@ -78,14 +89,14 @@ double facing_visibility(const EyeCamera& eye, const dvec3& v0, const dvec3& v1,
 }
 
 uint8_t redirect(const EyeCamera& left, const EyeCamera& right, const dvec3& v0, const dvec3& v1, const dvec3& v2,
-                 bool single_sided) {
+                 bool single_sided, ClippedRule clipped) {
   const double xl[3] = {x_ndc(left, v0), x_ndc(left, v1), x_ndc(left, v2)};
   const double xr[3] = {x_ndc(right, v0), x_ndc(right, v1), x_ndc(right, v2)};
-  return redirect_from(left, right, xl, xr, v0, v1, v2, single_sided);
+  return redirect_from(left, right, xl, xr, v0, v1, v2, single_sided, clipped);
 }
 
 std::vector<uint8_t> redirect_triangles(const SceneGeometry& geometry, const StereoRig& rig, const Executor& executor,
-                                        RedirectionCounts& counts) {
+                                        RedirectionCounts& counts, ClippedRule clipped) {
   const Scene& scene = *geometry.scene;
   const EyeCamera left = rig.eye(Eye::left), right = rig.eye(Eye::right);
   std::vector<uint8_t> bits(geometry.triangle_count(), 0);
@@ -112,7 +123,7 @@ std::vector<uint8_t> redirect_triangles(const SceneGeometry& geometry, const Ste
         const double xl[3] = {ndc[2 * i0], ndc[2 * i1], ndc[2 * i2]};
         const double xr[3] = {ndc[2 * i0 + 1], ndc[2 * i1 + 1], ndc[2 * i2 + 1]};
         const uint8_t to = redirect_from(left, right, xl, xr, dvec3(mesh.positions[i0]), dvec3(mesh.positions[i1]),
-                                         dvec3(mesh.positions[i2]), single_sided);
+                                         dvec3(mesh.positions[i2]), single_sided, clipped);
         bits[geometry.first_triangle[m] + t] = to;
         (to == kRedirectBoth ? b : to == kRedirectLeft ? l : r)++;
       }

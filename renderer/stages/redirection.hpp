@@ -20,6 +20,19 @@ enum RedirectBits : uint8_t {
   kRedirectBoth = kRedirectLeft | kRedirectRight,
 };
 
+/// Where a triangle that both eyes' frusta clip goes. Each eye may then see a part of it the other
+/// does not (a wall wider than both images: the left eye sees more of its left end, the right eye
+/// more of its right end); a part outside the rasterizing eye's frustum reaches the other eye by no
+/// warp, so that eye shows what lies behind it there.
+enum class ClippedRule : uint8_t {
+  one,   ///< Kim's eq. (1) as published: the eye that clips it less (the larger frustum visibility)
+  /// each eye whose image it reaches horizontally rasterizes it (eq. (1) when it reaches neither):
+  /// both where each may see a part of it, and the eye that sees it where eq. (1) would pick the
+  /// other, which does not (a triangle just past one border of one image that reaches far past the
+  /// same border of the other)
+  both,
+};
+
 /// Kim's eq. (1): 1 while the triangle lies within the eye's frustum horizontally
 /// (|x_ndc| <= 1 for the vertex with the largest |x_ndc|), decreasing as 1 / |x_ndc| beyond; 0 when
 /// a vertex lies at or behind the eye's plane.
@@ -33,9 +46,11 @@ enum RedirectBits : uint8_t {
 
 /// The eye(s) a triangle goes to: the larger frustum visibility wins; on a tie, the larger facing
 /// visibility; on an exact tie, both. A triangle with vertices on both sides of an eye's plane
-/// (reaching behind the viewer) goes to both: eq. (1) is not defined for it.
+/// (reaching behind the viewer) goes to both: eq. (1) is not defined for it. Under ClippedRule::both
+/// a triangle both frusta clip (frustum visibility below 1 in each eye) goes to each eye whose
+/// image it reaches.
 [[nodiscard]] uint8_t redirect(const EyeCamera& left, const EyeCamera& right, const dvec3& v0, const dvec3& v1,
-                               const dvec3& v2, bool single_sided);
+                               const dvec3& v2, bool single_sided, ClippedRule clipped = ClippedRule::one);
 
 /// Triangles sent to each eye.
 struct RedirectionCounts {
@@ -44,8 +59,9 @@ struct RedirectionCounts {
   uint64_t both = 0;
 };
 
-/// The RedirectBits of every triangle of the scene, by global triangle id.
+/// The RedirectBits of every triangle of the scene, by global triangle id: redirect()'s decisions.
 [[nodiscard]] std::vector<uint8_t> redirect_triangles(const SceneGeometry& geometry, const StereoRig& rig,
-                                                      const Executor& executor, RedirectionCounts& counts);
+                                                      const Executor& executor, RedirectionCounts& counts,
+                                                      ClippedRule clipped = ClippedRule::one);
 
 }  // namespace sb

@@ -76,6 +76,38 @@ TEST(Redirection, ATriangleReachingBehindTheEyesGoesToBoth) {
   EXPECT_NE(redirect(l, r, b0, b1, b2, false), kRedirectBoth);
 }
 
+TEST(Redirection, ATriangleBothFrustaClipGoesToOneEyeAsPublishedOrToBoth) {
+  const StereoRig rig = test_rig();
+  const EyeCamera l = rig.eye(Eye::left), r = rig.eye(Eye::right);
+  // A wall 10 m away, wider than both images and reaching further past the right eye's right
+  // border than past the left eye's left border: each eye sees an end of it the other does not.
+  const dvec3 v0(-12.0, -4.0, -10.0), v1(16.0, -4.0, -10.0), v2(2.0, 8.0, -10.0);
+  const double fl = frustum_visibility(l, v0, v1, v2), fr = frustum_visibility(r, v0, v1, v2);
+  ASSERT_LT(fl, 1.0);
+  ASSERT_LT(fr, 1.0);
+  // Eq. (1): the eye that clips it less, here the left one.
+  ASSERT_GT(fl, fr);
+  EXPECT_EQ(redirect(l, r, v0, v1, v2, false), kRedirectLeft);
+  EXPECT_EQ(redirect(l, r, v0, v1, v2, false, ClippedRule::one), redirect(l, r, v0, v1, v2, false));
+  EXPECT_EQ(redirect(l, r, v0, v1, v2, false, ClippedRule::both), kRedirectBoth);
+  EXPECT_EQ(redirect(l, r, v0, v1, v2, true, ClippedRule::both), kRedirectBoth);
+  // A sliver reaching from 0.5 m to 100 m, just past the left image's right border: in front of
+  // the convergence distance the right eye sees it further left, so only the right eye sees it,
+  // and from 0.5 m it reaches less far past the right image's border than past the left's. Eq. (1)
+  // gives it to the left eye, which sees none of it; under clipped=both it goes to the right eye.
+  const dvec3 n0 = l.unproject(330.0, 80.0, 0.5), n1 = l.unproject(340.0, 100.0, 0.5), f0 = l.unproject(335.0, 90.0, 100.0);
+  ASSERT_LT(frustum_visibility(r, n0, n1, f0), frustum_visibility(l, n0, n1, f0));
+  ASSERT_GT(r.project(n0).x, 0.0);
+  ASSERT_LT(r.project(n0).x, 320.0) << "the right eye sees a part of it";
+  for (const dvec3& v : {n0, n1, f0}) ASSERT_GT(l.project(v).x, 320.0) << "the left eye sees none of it";
+  EXPECT_EQ(redirect(l, r, n0, n1, f0, false), kRedirectLeft);
+  EXPECT_EQ(redirect(l, r, n0, n1, f0, false, ClippedRule::both), kRedirectRight);
+  // A triangle only one frustum clips is still ranked by eq. (1).
+  const dvec3 p = l.unproject(317.0, 90.0, 10.0);
+  const dvec3 s0 = p, s1 = p + dvec3(0.01, 0.0, 0.0), s2 = p + dvec3(0.0, 0.01, 0.0);
+  EXPECT_EQ(redirect(l, r, s0, s1, s2, false, ClippedRule::both), kRedirectLeft);
+}
+
 TEST(Redirection, EachEyeRasterizesOnlyItsShare) {
   const Scene scene = test::load_builtin("box-wall");
   const RenderScene prepared(scene);
@@ -111,19 +143,27 @@ TEST(Redirection, EveryTriangleOfAManyMeshSceneAsRedirectDecidesAtAnyThreadCount
   const StereoRig rig = test::rig_at(scene, 160, 90, 3.0);
   const EyeCamera left = rig.eye(Eye::left), right = rig.eye(Eye::right);
   const SceneGeometry& geometry = prepared.geometry();
-  std::vector<uint8_t> expected(geometry.triangle_count());
-  size_t by_frustum = 0;
+  std::vector<uint8_t> expected(geometry.triangle_count()), expected_both(geometry.triangle_count());
+  size_t by_frustum = 0, clipped_by_both = 0;
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     const Mesh& mesh = scene.meshes[m];
     for (size_t t = 0; t < mesh.triangle_count(); ++t) {
       const dvec3 v0(mesh.positions[mesh.indices[3 * t]]), v1(mesh.positions[mesh.indices[3 * t + 1]]),
           v2(mesh.positions[mesh.indices[3 * t + 2]]);
-      expected[geometry.first_triangle[m] + t] = redirect(left, right, v0, v1, v2, geometry.single_sided[m] != 0);
+      const bool single_sided = geometry.single_sided[m] != 0;
+      expected[geometry.first_triangle[m] + t] = redirect(left, right, v0, v1, v2, single_sided);
+      expected_both[geometry.first_triangle[m] + t] = redirect(left, right, v0, v1, v2, single_sided, ClippedRule::both);
       by_frustum += frustum_visibility(left, v0, v1, v2) != frustum_visibility(right, v0, v1, v2) ? 1 : 0;
+      clipped_by_both +=
+          frustum_visibility(left, v0, v1, v2) < 1.0 && frustum_visibility(right, v0, v1, v2) < 1.0 ? 1 : 0;
     }
   }
   EXPECT_GT(by_frustum, 0u) << "some triangles decided by the frustum comparison";
+  EXPECT_GT(clipped_by_both, 0u) << "some triangles clipped by both frusta";
   for (const int threads : {1, 2, 3}) {
+    RedirectionCounts both_counts;
+    EXPECT_TRUE(redirect_triangles(geometry, rig, Executor(threads), both_counts, ClippedRule::both) == expected_both)
+        << threads << " threads, clipped=both";
     RedirectionCounts counts;
     const std::vector<uint8_t> bits = redirect_triangles(geometry, rig, Executor(threads), counts);
     ASSERT_EQ(bits.size(), expected.size());
