@@ -270,7 +270,8 @@ Thresholds (as in OpenImageIO's idiff): the comparison fails when PSNR < --fail-
 Exit codes: 0 pass, 1 warnings only, 2 failure, 3 bad input or usage (a missing, damaged or
 non-image input file, a size or channel mismatch, an empty mask, a stereo EXR without --eye, an
 SSIM limit where SSIM is undefined),
-4 I/O failure (an existing input that cannot be opened, an output that cannot be written).
+4 I/O failure (an existing input that cannot be opened, an output that cannot be written) or too
+little memory (images whose comparison would not fit in what this process may use).
 Exit 3 or 4 leaves no --json, --diff or --ssim-map file (an earlier one at that path is removed),
 unless the command line itself cannot be read, names an input as an output or a picture not
 ending in .png; on 0, 1 and 2 all are written.)";

@@ -1217,6 +1217,12 @@ Scene load_gltf(const fs::path& path, const GltfLoadOptions& options) {
     // A syntax error has a byte; nesting and number range are limits of the reader on valid JSON.
     if (e.byte() == 0)
       throw InputError(fmt::format("{}: its JSON exceeds what the reader accepts: {}", file, e.what()));
+    // Not JSON from its first byte, under another name than .gltf: some other kind of file (an
+    // image or a mesh given as the scene).
+    if (e.byte() == 1 && lowercase(path.extension().string()) != ".gltf")
+      throw InputError(fmt::format("{}: not a glTF scene (neither glTF JSON nor binary .glb); give a .gltf or .glb "
+                                   "file, or a built-in scene name (stereobench scenes list)",
+                                   file));
     throw InputError(fmt::format("{}: not valid JSON at byte {}: {}", file, e.byte(), short_parse_error(e.what())));
   }
   check_gltf_json(doc, file);

@@ -55,6 +55,8 @@ inline void write_text(const std::filesystem::path& p, const std::string& s) { M
 inline std::vector<BadCase> bad_scene_corpus() {
   std::vector<BadCase> c;
   c.push_back({"not_json", "a.gltf", [](auto& p) { write_text(p, "{ \"asset\": { \"version\": \"2.0\" "); }, "not valid JSON"});
+  c.push_back({"image_as_scene", "a.png", [](auto& p) { write_text(p, std::string("\x89PNG\r\n\x1a\n\0\0\0\rIHDR", 16)); },
+               "not a glTF scene (neither glTF JSON nor binary .glb)"});
   c.push_back({"empty_file", "a.gltf", [](auto& p) { write_text(p, ""); }, "empty"});
   c.push_back({"top_level_array", "a.gltf", [](auto& p) { write_text(p, "[1,2,3]"); }, "expected a JSON object"});
   c.push_back({"no_asset", "a.gltf", [](auto& p) { write_text(p, "{}"); }, "/asset: required property is missing"});
