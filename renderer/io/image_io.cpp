@@ -937,8 +937,8 @@ Image read_exr_eye(const fs::path& path, bool right) {
     }
     if (mine.empty() && other) mine = unassigned;  // multi-view: the default view is this eye
     if (mine.empty())
-      throw InputError(fmt::format("{} holds no {} eye (channels: {})", path.string(), right ? "right" : "left",
-                                   channel_list(file)));
+      throw InputError(fmt::format("{} holds no {} eye (channels: {}){}", path.string(), right ? "right" : "left",
+                                   channel_list(file), other ? fmt::format("; it holds the {} eye", right ? "left" : "right") : ""));
     return std::move(build_images(file, {plan_planes(mine)}).front());
   });
 }

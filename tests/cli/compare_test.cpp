@@ -322,6 +322,7 @@ TEST_F(Compare, StereoExrNeedsAnEye) {
     r = compare(q(path("left-only.exr")) + " " + q(path("a.png")) + " --eye right");
     EXPECT_EQ(r.code, 3) << r.out;
     EXPECT_NE(r.out.find("left-only.exr holds no right eye (channels: "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("); it holds the left eye"), std::string::npos) << r.out;
   }
 
   // A damaged pair reports the damage, not that it is a pair.
