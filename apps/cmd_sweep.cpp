@@ -122,6 +122,7 @@ void run_sweep(const SweepRunArgs& a) {
   o.definition_label = a.definition;
   o.jobs = a.jobs;
   o.threads = checked_threads(a.threads);
+  validation::refuse_local_run_of_slurm_folder(o.out_dir, o.results);
 
   // Held until the last cell is recorded: no other run may plan this shard's cells meanwhile.
   const ResultsWriterLock lock(o.results, shard_cells(expand_cells(d).size(), shard));

@@ -192,6 +192,23 @@ SlurmLayout slurm_layout(const fs::path& out_dir) {
   return l;
 }
 
+void refuse_local_run_of_slurm_folder(const fs::path& out_dir, const fs::path& results) {
+  const SlurmLayout l = slurm_layout(out_dir);
+  std::error_code ec;
+  if (!fs::exists(l.submission, ec)) return;
+  if (fs::weakly_canonical(fs::absolute(results).parent_path(), ec) == fs::weakly_canonical(fs::absolute(l.dir), ec))
+    return;
+  std::string job;
+  try {
+    job = io::parse_json(io::read_file(l.submission)).value("job_id", "");
+  } catch (const std::exception&) {
+    // Unreadable: the refusal below still holds, without the job's number.
+  }
+  throw InputError(fmt::format("{} was submitted to Slurm{} ({}); continue it with `sweep run --executor slurm`, which "
+                               "merges its tasks' results, or give another --out",
+                               out_dir.string(), job.empty() ? "" : " as job " + job, l.submission.string()));
+}
+
 fs::path slurm_tool(const std::string& name) {
   if (std::optional<fs::path> found = find_program(name)) return *found;
   throw ToolError(fmt::format(

@@ -29,6 +29,12 @@ struct SlurmLayout {
 };
 [[nodiscard]] SlurmLayout slurm_layout(const std::filesystem::path& out_dir);
 
+/// Refuses a run of the local executor into `out_dir` that writes `results` outside the folder's
+/// Slurm log folder, when the folder was submitted to Slurm: its tasks may still be writing the
+/// same cells, and the next merge refuses a results file it did not write (docs/slurm.md).
+/// InputError naming the job and the way on. A Slurm task (its results in the log folder) passes.
+void refuse_local_run_of_slurm_folder(const std::filesystem::path& out_dir, const std::filesystem::path& results);
+
 /// How a sweep is submitted.
 struct SlurmSweepOptions {
   std::filesystem::path stereobench;  ///< the executable every task runs (made absolute)

@@ -734,5 +734,23 @@ TEST(SweepRun, AnOutFolderThatCannotBeMadeIsNamed) {
   EXPECT_EQ(r.out.find("lock file"), std::string::npos) << r.out;
 }
 
+TEST(SweepRun, TheLocalExecutorRefusesAFolderSubmittedToSlurm) {
+  // Its array may still be running the same cells, and the next merge would refuse a results file
+  // it did not write; the Slurm tasks themselves (results in the log folder) still run.
+  test::ScratchDir dir;
+  fs::create_directories(dir / "out" / "slurm");
+  std::ofstream(dir / "out" / "slurm" / "submission.json") << R"({"job_id": "4711", "shards": 2})";
+  const std::string smoke = quoted(fs::path(SB_SOURCE_DIR) / "ci" / "smoke.toml");
+  const test::CliRun r = test::run_cli("sweep run " + smoke + " --out " + quoted(dir / "out"));
+  EXPECT_EQ(r.code, 3) << r.out;
+  EXPECT_NE(r.out.find((dir / "out").string() + " was submitted to Slurm as job 4711"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("continue it with `sweep run --executor slurm`"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "out" / "results.jsonl"));
+  // A task's run: shard 39 of 40 (no cell of the smoke sweep), its results beside the submission.
+  const test::CliRun task = test::run_cli("sweep run " + smoke + " --out " + quoted(dir / "out") +
+                                          " --shard 39/40 --results " + quoted(dir / "out" / "slurm" / "results-39.jsonl"));
+  EXPECT_EQ(task.code, 0) << task.out;
+}
+
 }  // namespace
 }  // namespace sb
