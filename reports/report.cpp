@@ -162,6 +162,27 @@ std::vector<std::string> distinct(const ResultsFile& results, const char* key) {
   return out;
 }
 
+/// A warning when the cells were measured under different `key` values (threads, jobs, versions:
+/// a sweep resumed with other options or another build), each value with its cell count; their
+/// times and speed-ups are then not comparable. Empty when all agree.
+std::optional<std::string> mixed_conditions(const ResultsFile& results, const char* key) {
+  std::vector<std::pair<std::string, size_t>> seen;
+  for (const CellLine& c : results.cells) {
+    const std::string v = get_or_null(c.json, key).dump();
+    auto it = std::find_if(seen.begin(), seen.end(), [&v](const auto& p) { return p.first == v; });
+    if (it == seen.end())
+      seen.emplace_back(v, 1);
+    else
+      ++it->second;
+  }
+  if (seen.size() < 2) return std::nullopt;
+  std::string values;
+  for (const auto& [v, n] : seen) values += fmt::format("{}{} ({} cell{})", values.empty() ? "" : ", ", v, n, n == 1 ? "" : "s");
+  return fmt::format("the cells were measured under different {}: {}; their times and speed-ups are not comparable "
+                     "(a sweep resumed with other options or another build); the overview shows the first cell's",
+                     key, values);
+}
+
 /// `text` with &, <, >, " escaped for HTML text and attribute values.
 std::string html_escape(const std::string& text) {
   std::string out;
@@ -564,7 +585,13 @@ ReportSummary write_report_into(const ResultsFile& results, const ReportOptions&
     summary.warnings.push_back(fmt::format("{}: {}", results.path.string(), unfinished));
     page_warnings.push_back(fmt::format("{}: {}", results_name, unfinished));
   }
-  // The page lists every warning the terminal shows: skipped lines, missing images, missing cells.
+  for (const char* key : {"threads", "jobs", "versions"})
+    if (const auto mixed = mixed_conditions(results, key)) {
+      summary.warnings.push_back(fmt::format("{}: {}", results.path.string(), *mixed));
+      page_warnings.push_back(fmt::format("{}: {}", results_name, *mixed));
+    }
+  // The page lists every warning the terminal shows: skipped lines, missing images, missing cells,
+  // cells measured under different conditions.
   data["warnings"] = page_warnings;
   if (!options.history.is_null()) data["history"] = options.history;
   if (!options.history_note.empty()) data["history_note"] = options.history_note;

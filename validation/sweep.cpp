@@ -380,6 +380,10 @@ void parse_path(const Where& where, const toml::node& node, SweepDefinition& d) 
     if (bvh != "refit" && bvh != "rebuild")
       where.fail(*v, "path.bvh", fmt::format("'{}' is neither \"refit\" nor \"rebuild\"", bvh));
     d.path_refit = bvh == "refit";
+    // Nothing moves without a spin or an animation: a BVH update asked for would never be done.
+    if (!path.spin && !path.gltf_animation)
+      where.fail(*v, "path.bvh", "needs path.spin or path.gltf_animation (nothing else moves the scene's meshes); "
+                 "drop the key");
   }
   try {
     path.validate();

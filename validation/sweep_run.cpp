@@ -103,7 +103,8 @@ SweepPlan plan_sweep(const SweepDefinition& definition, const fs::path& results,
     if (sweep != definition.name || sha != definition.sha256)
       throw InputError(fmt::format(
           "{} holds cells of sweep '{}' (definition sha256 {}), not of this definition '{}' ({}, sha256 {}); "
-          "the definition changed since those cells ran: give another --out, or delete the file to start over",
+          "the definition changed since those cells ran: give another --out, or delete the sweep's output folder "
+          "(and this file, where --results put it elsewhere) to start over",
           results.string(), sweep, sha.substr(0, 12), definition.name, definition.file.string(),
           definition.sha256.substr(0, 12)));
   }

@@ -381,6 +381,31 @@ TEST(Report, WarnsOnTornTailAndMissingImagesAndGuardsForeignFolders) {
   EXPECT_EQ(page["warnings"].dump().find(dir.path().string()), std::string::npos) << page["warnings"].dump();
 }
 
+TEST(Report, CellsMeasuredUnderDifferentThreadCountsAreWarnedAbout) {
+  // A sweep resumed with another --threads: its cells' times are not comparable, and the
+  // overview's machine row shows only the first cell's count.
+  test::ScratchDir dir;
+  std::string text;
+  for (int i = 0; i < 3; ++i) {
+    json line = minimal_line(std::string(1, static_cast<char>('a' + i)), i);
+    line["threads"] = i == 0 ? 1 : 2;
+    line["jobs"] = 1;
+    text += line.dump() + "\n";
+  }
+  write_text(dir / "results.jsonl", text);
+  const test::CliRun r = test::run_cli("report " + quoted(dir / "results.jsonl") + " --out " + quoted(dir / "out"));
+  ASSERT_EQ(r.code, 0) << r.out;
+  const std::string expected =
+      "the cells were measured under different threads: 1 (1 cell), 2 (2 cells); their times and speed-ups are not "
+      "comparable";
+  EXPECT_NE(r.out.find(expected), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("different jobs"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("different versions"), std::string::npos) << "absent in every line alike: " << r.out;
+  const json data = embedded_data(dir / "out" / "index.html");
+  ASSERT_EQ(data["warnings"].size(), 1u) << data["warnings"].dump();
+  EXPECT_NE(data["warnings"][0].get<std::string>().find("results.jsonl: " + expected), std::string::npos);
+}
+
 TEST(Report, ImagesOfEveryPipelineKeepTheirOwnFolderAndALinkedResultsFileFindsThem) {
   // Two pipeline names that the image folders once mapped alike ("repro-rt:x=1", "repro-rt_x_1"):
   // each keeps its own right eye. The results file is read through a link in another folder: its

@@ -371,11 +371,16 @@ TEST_F(SlurmCluster, FailedTasksAreReportedAndResubmissionContinues) {
   EXPECT_FALSE(fs::exists(dir / "out" / "results.jsonl"));
   EXPECT_EQ(validation::read_results(sd / "results-0.jsonl").cells.size(), 1u);
 
-  // The sweep finished by the local executor into the same folder: its results file is not the
-  // merge's to replace (it was, once any submission had been made there).
+  // The local executor does not run into a folder submitted to Slurm (it used to run every cell
+  // beside a queued array) ...
   const test::CliRun local = test::run_cli("sweep run " + quoted(dir / "two.toml") + " --out " + quoted(dir / "out") +
                                            " --scenes-dir " + quoted(dir / "scenes") + " --cache ''");
-  ASSERT_EQ(local.code, 0) << local.out;
+  EXPECT_EQ(local.code, 3) << local.out;
+  EXPECT_NE(local.out.find("was submitted to Slurm as job"), std::string::npos) << local.out;
+  EXPECT_FALSE(fs::exists(dir / "out" / "results.jsonl"));
+  // ... and a results file put there otherwise (by hand, or by an older version's local run) is
+  // not the merge's to replace (it was, once any submission had been made there).
+  fs::copy_file(sd / "results-0.jsonl", dir / "out" / "results.jsonl");
   const std::string local_results = test::read_text(dir / "out" / "results.jsonl");
   const test::CliRun over = test::run_cli(run);
   EXPECT_EQ(over.code, 3) << over.out;

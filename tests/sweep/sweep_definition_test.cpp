@@ -428,6 +428,9 @@ TEST(SweepDefinition, RejectsBadPaths) {
        "def.toml:4: path.camera_keys: a key pose: its position (1e+300, 1, 4) m lies beyond"},
       {"[sweep]\n[path]\nframes = 3\ncamera_keys = []\n", "def.toml:4: path.camera_keys: must be a non-empty array"},
       {"[sweep]\n[path]\nframes = 3\nbvh = \"refresh\"\n", "def.toml:4: path.bvh: 'refresh' is neither"},
+      // Nothing moves the meshes: the update it asks for would never be done (as `path --bvh`).
+      {"[sweep]\n[path]\nframes = 3\nbvh = \"rebuild\"\n",
+       "def.toml:4: path.bvh: needs path.spin or path.gltf_animation (nothing else moves the scene's meshes)"},
       {"[sweep]\n[path]\nframes = 3\n[path.spin]\naxis = [0, 0, 0]\n", "def.toml:5: path.spin.axis: is zero"},
       {"[sweep]\n[path]\nframes = 3\n[path.spin]\naxis = [0, 1]\n",
        "def.toml:5: path.spin.axis: must be an array of 3 numbers"},
