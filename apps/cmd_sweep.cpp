@@ -189,7 +189,8 @@ void register_cells(CLI::App& sweep) {
     std::string shard = "0/1";
   };
   auto a = std::make_shared<Args>();
-  CLI::App* cells = sweep.add_subcommand("cells", "List a definition's cells (index and cell_id), checking the definition");
+  CLI::App* cells = sweep.add_subcommand("cells", "List a definition's cells (index and cell_id), checking the definition file; the checks that "
+                                             "need a cell's scene (a pipeline's rig limits, the disparity a rig gives) come when the sweep runs");
   cells->add_option("definition", a->definition, "Sweep definition (TOML)")->required();
   cells->add_option("--shard", a->shard, "Only the cells of shard I/N")->capture_default_str();
   cells->callback([a] {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <initializer_list>
+#include <set>
 #include <string_view>
 #include <vector>
 
@@ -222,13 +223,34 @@ class Checker {
                        quantized || uv ? "" : " (integer types need KHR_mesh_quantization)"));
   }
 
-  void extras(const json& obj, const std::string& path) const {
+  /// Where a stereobench extras object sits: its keys differ.
+  enum class ExtrasOf { scene, node };
+
+  void extras(const json& obj, const std::string& path, ExtrasOf of) const {
     const json* e = member(obj, "extras", path);
     if (!e || !e->is_object()) return;  // extras may be anything; only ours is checked
     const json* sb = find(*e, "stereobench");
     if (!sb) return;
     const std::string p = path + "/extras/stereobench";
     require_object(*sb, p);
+    // The namespace is this suite's: a misspelt key would otherwise leave its default in place
+    // without a word. The scene's keys (the generators write generator, seed and params) and the
+    // camera node's are told apart.
+    static const std::set<std::string> scene_keys{"background", "ambient", "generator", "seed", "params"};
+    static const std::set<std::string> node_keys{"interaxial", "convergence", "width", "height"};
+    const std::set<std::string>& known = of == ExtrasOf::scene ? scene_keys : node_keys;
+    const std::set<std::string>& other = of == ExtrasOf::scene ? node_keys : scene_keys;
+    for (const auto& [key, value] : sb->items()) {
+      if (known.count(key)) continue;
+      if (other.count(key))
+        fail(p + "/" + key, fmt::format("'{}' belongs in the {}'s extras.stereobench, not the {}'s; move it there",
+                                        key, of == ExtrasOf::scene ? "camera node" : "scene",
+                                        of == ExtrasOf::scene ? "scene" : "node"));
+      std::string names;
+      for (const std::string& k : known) names += (names.empty() ? "" : ", ") + k;
+      fail(p + "/" + key, fmt::format("unknown key '{}'; a {}'s extras.stereobench holds {}", key,
+                                      of == ExtrasOf::scene ? "scene" : "camera node", names));
+    }
     if (const json* v = member(*sb, "interaxial", p))
       if (positive(*v, p + "/interaxial", "the eye separation in metres") > kMaxSceneCoordinate)
         fail(p + "/interaxial", fmt::format("value {:g} m is beyond the {:g} m a scene may span; give the eye "
@@ -271,7 +293,7 @@ class Checker {
         require_array(*nodes, p + "/nodes");
         for (size_t i = 0; i < nodes->size(); ++i) index((*nodes)[i], fmt::format("{}/nodes/{}", p, i), "nodes");
       }
-      extras(s, p);
+      extras(s, p, ExtrasOf::scene);
     });
 
     each(doc_, "nodes", "", [&](const json& n, const std::string& p) {
@@ -325,7 +347,7 @@ class Checker {
           opt_index(*l, "light", lp, "lights", true);
         }
       }
-      extras(n, p);
+      extras(n, p, ExtrasOf::node);
     });
 
     // glTF 2.0 §3.5.3: the nodes form disjoint strict trees; no node is the child of two.

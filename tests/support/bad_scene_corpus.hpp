@@ -250,6 +250,13 @@ inline std::vector<BadCase> bad_scene_corpus() {
   }), "the count is wrong or the buffer is truncated (used by /animations/0/samplers/0/input)"});
   c.push_back({"zero_quaternion", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["rotation"] = {0, 0, 0, 0}; }), "/nodes/0/rotation: the quaternion has length zero"});
   c.push_back({"base_color_above_one", "a.gltf", edited([](MiniGltf& g) { g.doc["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorFactor", {2, 0.5, 0.5, 1}}}}}}); }), "/materials/0/pbrMetallicRoughness/baseColorFactor/0: value 2 is out of range [0, 1]"});
+  // Misspelt keys of the suite's own extras used to leave their defaults in place silently.
+  c.push_back({"rig_extras_misspelt", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["extras"]["stereobench"]["interaxal"] = 0.2; }),
+               "/nodes/0/extras/stereobench/interaxal: unknown key 'interaxal'; a camera node's extras.stereobench holds convergence, height, interaxial, width"});
+  c.push_back({"scene_extras_misspelt", "a.gltf", edited([](MiniGltf& g) { g.doc["scenes"][0]["extras"]["stereobench"]["backgrund"] = {1, 0, 0}; }),
+               "/scenes/0/extras/stereobench/backgrund: unknown key 'backgrund'; a scene's extras.stereobench holds ambient, background, generator, params, seed"});
+  c.push_back({"rig_extras_on_the_scene", "a.gltf", edited([](MiniGltf& g) { g.doc["scenes"][0]["extras"]["stereobench"]["convergence"] = 5; }),
+               "/scenes/0/extras/stereobench/convergence: 'convergence' belongs in the camera node's extras.stereobench, not the scene's"});
   c.push_back({"negative_ambient", "a.gltf", edited([](MiniGltf& g) { g.doc["scenes"][0]["extras"]["stereobench"]["ambient"] = -0.5; }), "/scenes/0/extras/stereobench/ambient: value -0.5 is out of range"});
   c.push_back({"glb_bad_magic", "a.glb", [](auto& p) { write_text(p, std::string("XglT\x02\0\0\0", 8) + std::string(40, ' ')); }, "not a binary glTF file: it starts with 'XglT'"});
   c.push_back({"syntax_error_in_data_uri", "a.gltf", [](auto& p) { write_text(p, "{\"asset\": {\"version\": \"2.0\"}, \"buffers\": [{\"uri\": \"data:" + std::string(3000, 'A') + "}"); }, "'\"data:AAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAA...' (3007 characters)"});
