@@ -233,6 +233,11 @@ void write_all_or_none(std::initializer_list<NamedPath> outputs, const std::func
   }
 }
 
+void check_output_folder(const std::string& folder, const char* option) {
+  if (const auto why = io::folder_cannot_be_made(folder))
+    throw IoError(fmt::format("{} {}: {}; give a folder you can write", option, folder, *why));
+}
+
 void prepare_output_folder(const std::string& folder, const char* option) {
   if (const auto why = io::unwritable_folder(folder))
     throw IoError(fmt::format("{} {}: {}; give a folder you can write", option, folder, *why));

@@ -97,10 +97,12 @@ void run_path_command(const PathArgs& a) {
   if (auto why = provider->unavailable_reason())
     throw ToolError(fmt::format("--truth {}: the provider is unavailable: {}", a.truth, *why));
   const Executor executor(checked_threads(a.threads));
-  prepare_output_folder(a.out, "--out");
+  check_output_folder(a.out, "--out");
   scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
   const StereoRig rig = resolve_rig(loaded.scene, overrides);
   for (const PipelineEntry& e : run.pipelines) e.check_rig(e.options(), rig);
+  // Made once the input is known to be good: a refused run leaves no empty folder behind.
+  prepare_output_folder(a.out, "--out");
   run.scene_file = loaded.file;
   run.rig = rig.params();
   run.pose = rig.pose();

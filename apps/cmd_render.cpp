@@ -81,12 +81,14 @@ void run_render(const RenderArgs& a) {
   const PipelineOptions options = entry.options(given);
   const io::StereoViews views = io::StereoViews::from_names(split_list(a.stereo, "--stereo"), "--stereo");
   const Executor executor(checked_threads(a.threads));
-  prepare_output_folder(a.out, "--out");
+  check_output_folder(a.out, "--out");
   const scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
   const Scene& scene = loaded.scene;
   const size_t lights_in_file = loaded.lights_in_file;
   const StereoRig rig = resolve_rig(scene, overrides);
   entry.check_rig(options, rig);
+  // Made once the input is known to be good: a refused run leaves no empty folder behind.
+  prepare_output_folder(a.out, "--out");
   // A scene file that is one of the outputs (<stem>.exr, <stem>_left.png, ..., <stem>_stats.json,
   // or a diagnostic <stem>_NAME.png already there), by name or through a link either way, would be
   // replaced by it.

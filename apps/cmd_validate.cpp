@@ -101,13 +101,15 @@ void run_validate(const ValidateArgs& a) {
   if (auto why = provider->unavailable_reason())
     throw ToolError(fmt::format("--truth {}: the provider is unavailable: {}", a.truth, *why));
   const Executor executor(checked_threads(a.threads));
-  prepare_output_folder(a.out, "--out");
+  check_output_folder(a.out, "--out");
   const scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
   const Scene& scene = loaded.scene;
   const size_t lights_in_file = loaded.lights_in_file;
   const StereoRig rig = resolve_rig(scene, overrides);
   // What a pipeline cannot do with this rig stops the run before any pipeline renders.
   for (size_t i = 0; i < chosen.size(); ++i) chosen[i].check_rig(options[i], rig);
+  // Made once the input is known to be good: a refused run leaves no empty folder behind.
+  prepare_output_folder(a.out, "--out");
   const RenderScene prepared(scene);
   fmt::print("validating {} pipeline(s) on {} ({} triangles, {}), {}, {} threads, truth: {}\n", chosen.size(),
              scene.name, scene.triangle_count(), describe_lights(scene.lights.size(), lights_in_file),

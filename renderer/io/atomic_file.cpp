@@ -539,6 +539,19 @@ std::optional<std::string> unwritable_folder(const fs::path& folder) {
   return std::nullopt;
 }
 
+std::optional<std::string> folder_cannot_be_made(const fs::path& folder) {
+  std::error_code ec;
+  fs::path existing = folder;
+  while (!existing.empty() && !fs::exists(fs::symlink_status(existing, ec))) existing = existing.parent_path();
+  if (existing.empty()) existing = ".";
+  const bool whole = existing == folder;
+  if (!fs::is_directory(existing, ec)) return fmt::format("cannot create the folder ({})", std::strerror(ENOTDIR));
+  if (::access(existing.c_str(), W_OK | X_OK) != 0)
+    return whole ? fmt::format("cannot create a file in it ({})", std::strerror(errno))
+                 : fmt::format("cannot create the folder ({})", std::strerror(errno));
+  return std::nullopt;
+}
+
 std::string read_file(const fs::path& path) {
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);

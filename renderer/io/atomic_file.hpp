@@ -105,6 +105,12 @@ void write_text_atomically(const std::filesystem::path& path, const std::string&
 /// not when the first is written. Why the folder cannot be written, or nothing.
 [[nodiscard]] std::optional<std::string> unwritable_folder(const std::filesystem::path& folder);
 
+/// Why `folder` could not be made or written, as far as it shows without making anything: its
+/// nearest existing ancestor is not a folder or may not be written. The text matches
+/// unwritable_folder's. Nothing when it looks possible (unwritable_folder, once the input is known
+/// to be good, has the last word).
+[[nodiscard]] std::optional<std::string> folder_cannot_be_made(const std::filesystem::path& folder);
+
 /// Reads a whole file, or a pipe to its end; InputError for a folder or a device (which may never
 /// end), IoError naming the path if it cannot be read.
 [[nodiscard]] std::string read_file(const std::filesystem::path& path);

@@ -609,6 +609,25 @@ TEST(Cli, AnOutputFolderThatCannotBeMadeFailsBeforeAnyWork) {
   }
 }
 
+TEST(Cli, ARefusedInputLeavesNoEmptyOutputFolder) {
+  // The folder is made once the scene has loaded and every pipeline accepted the rig.
+  test::ScratchDir dir("outlate");
+  const std::string scenes = " --scenes-dir '" + (dir / "scenes").string() + "'";
+  const std::pair<std::string, std::string> cases[] = {
+      {"render --scene '" + (dir / "none.gltf").string() + "'", "does not exist"},
+      {"render --scene box-wall --pipeline rt-buffer --resolution 64x36 --max-disparity 5000" + scenes,
+       "rt-buffer"},
+      {"validate --scene '" + (dir / "none.gltf").string() + "' --pipelines plain-rt", "does not exist"},
+      {"path --scene '" + (dir / "none.gltf").string() + "' --pipelines plain-rt", "does not exist"},
+  };
+  for (const auto& [args, error] : cases) {
+    const CliRun r = run(args + " --out '" + (dir / "out" / "a" / "b").string() + "'");
+    EXPECT_EQ(r.code, 3) << args << "\n" << r.out;
+    EXPECT_NE(r.out.find(error), std::string::npos) << args << "\n" << r.out;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out")) << args;
+  }
+}
+
 TEST(Cli, RenderAndBenchRejectBadArguments) {
   test::ScratchDir dir("renderbad");
   const std::string bench_common = " --scenes-dir '" + (dir / "scenes").string() + "' --resolution 32x18";
