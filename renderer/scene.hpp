@@ -45,6 +45,9 @@ struct Mesh {
   int material = -1;   ///< index into Scene::materials; -1 = default white material
   std::vector<vec3> positions;
   std::vector<vec3> normals;  ///< empty, or one per position (shading normals, world space)
+  /// The file gives vertex normals that were dropped (some have length zero): the mesh is shaded
+  /// with its geometric normals, where a tool importing the file itself would use them.
+  bool file_normals_dropped = false;
   std::vector<vec2> uvs;      ///< empty, or one per position (the material's TEXCOORD set)
   std::vector<uint32_t> indices;  ///< three per triangle
   /// For a mesh on an animated node (Scene::animation moves its node): its vertices and normals in

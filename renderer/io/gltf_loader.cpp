@@ -1027,6 +1027,7 @@ class Converter {
                           "primitive is shaded with its geometric normals",
                           ppath, zero, nv, it->second));
           nrm.clear();
+          mesh.file_normals_dropped = true;
         }
       }
       if (!nrm.empty()) {

@@ -575,6 +575,31 @@ TEST(BlenderFailure, APrimitiveWithoutTheUvsOfItsTexturedMaterialBesideOneWithTh
   }
 }
 
+TEST(BlenderFailure, APrimitiveWhoseFileNormalsWereDroppedIsRefused) {
+  // One vertex normal of length zero: the loader shades the primitive with its geometric normals,
+  // while Blender's importer smooths it with the file's (a sphere measured 43.66 dB against the
+  // full truth), and the truth cache, keyed by the loaded scene, could not tell two such files apart.
+  const test::ScratchDir dir;
+  test::MiniGltf g;
+  const int pos = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  std::vector<float> normals = {0, 0, 1, 0, 0, 0, 0, 0, 1};
+  const int nrm = g.add_accessor(g.add_view(normals), 5126, 3, "VEC3");
+  g.add_node({{"mesh", g.add_mesh(nlohmann::json::array({{{"attributes", {{"POSITION", pos}, {"NORMAL", nrm}}}}}))}});
+  g.write_gltf(dir / "z.gltf");
+  const Scene scene = io::load_gltf(dir / "z.gltf");
+  try {
+    validation::make_truth_provider("blender")->check_scene(scene, dir / "z.gltf");
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("has vertex normals of length zero, so this suite shades it with its "
+                                         "geometric normals"),
+              std::string::npos)
+        << e.what();
+  }
+  // POV-Ray renders the loaded scene, not the file: it takes it.
+  EXPECT_NO_THROW(validation::make_truth_provider("povray")->check_scene(scene, dir / "z.gltf"));
+}
+
 // ---------------------------------------------------------------------------------------------
 // Determinism and failure modes.
 

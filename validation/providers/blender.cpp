@@ -352,6 +352,16 @@ class BlenderProvider final : public TruthProvider {
               "takes the factor alone: add texture coordinates to that primitive, or use the full or povray provider",
               scene.name, without.name, without.node, set));
     }
+    // A primitive whose file normals the loader dropped (some of length zero) is shaded with its
+    // geometric normals here; Blender's importer smooths over such normals instead (measured on a
+    // sphere with one zero normal: 43.66 dB against the full truth, 73.09 dB against POV-Ray's).
+    for (const Mesh& m : scene.meshes)
+      if (m.file_normals_dropped)
+        throw InputError(fmt::format(
+            "scene '{}': mesh '{}' (node {}) has vertex normals of length zero, so this suite shades it with its "
+            "geometric normals, while Blender's importer would smooth it with the file's normals: give the "
+            "primitive unit normals (or none), or use the full or povray provider",
+            scene.name, m.name, m.node));
     // Blender's importer brings in every node of the file; the loaded scene is glTF scene 0 (or
     // `scene`) alone.
     if (scene.nodes_not_loaded > 0)
