@@ -69,7 +69,8 @@ json write_target_images(const std::filesystem::path& dir, const std::string& st
   const std::string provider = target.truth.render.provider;
   const std::filesystem::path exr = dir / fmt::format("{}_truth-{}.exr", stem, provider);
   const std::filesystem::path png = dir / fmt::format("{}_truth-{}.png", stem, provider);
-  const std::filesystem::path dis = dir / fmt::format("{}_disocclusions.png", stem);
+  // Per provider, as the truth it is drawn over: another provider's run into the folder leaves it.
+  const std::filesystem::path dis = dir / fmt::format("{}_disocclusions-{}.png", stem, provider);
   json files = json::object();
   std::vector<FileWriter> writers = {
       {png, [&](const std::filesystem::path& to) { write_png(to, target.truth_srgb8); }},

@@ -272,7 +272,7 @@ TEST(Validate, ARunIntoAnEarlierOnesFolderRemovesTheRecordsItLeavesBehind) {
     if (e.path().filename().string().find("fw-warp") != std::string::npos) left.push_back(e.path().filename());
   EXPECT_TRUE(left.empty()) << left.front();
   // The shared images and the run's own record stay, and the summary lists what is there.
-  for (const char* kept : {"box-wall_truth-full.png", "box-wall_disocclusions.png", "box-wall_full_repro-rt.json"})
+  for (const char* kept : {"box-wall_truth-full.png", "box-wall_disocclusions-full.png", "box-wall_full_repro-rt.json"})
     EXPECT_TRUE(fs::exists(out / kept)) << kept;
   const json summary = json::parse(test::read_text(out / "box-wall_full_summary.json"));
   ASSERT_EQ(summary["records"].size(), 1u);
