@@ -56,6 +56,15 @@ class WorkFolderLock {
   bool waited_ = false;
 };
 
+/// Prints a warning on standard error once per scene file and provider.
+void warn_once(const Scene& scene, const std::string& provider, const char* topic, const std::string& text) {
+  static std::mutex mutex;
+  static std::set<std::string> said;
+  const std::lock_guard lock(mutex);
+  if (!said.insert(scene.path + "\n" + provider + "\n" + topic).second) return;
+  fmt::print(stderr, "stereobench: warning: {}\n", text);
+}
+
 /// Says once per scene file and provider, on standard error, that an external tool shows what
 /// this suite's renderer culls: glTF's single-sided materials (doubleSided false, the default)
 /// hide their back faces from camera rays here, while Cycles and POV-Ray draw both sides.
@@ -66,15 +75,30 @@ void note_single_sided(const Scene& scene, const std::string& provider) {
     if (m.material >= 0 && !scene.materials[static_cast<size_t>(m.material)].double_sided && m.triangle_count() > 0)
       ++meshes;
   if (meshes == 0) return;
-  static std::mutex mutex;
-  static std::set<std::string> said;
-  const std::lock_guard lock(mutex);
-  if (!said.insert(scene.path + "\n" + provider).second) return;
-  fmt::print(stderr,
-             "stereobench: warning: {} mesh(es) of {} use single-sided materials: this suite's renderer hides their "
-             "back faces from the eye, as glTF asks, while the {} ground truth shows them; where an eye sees one, "
-             "the images differ for that reason (mark the materials doubleSided to compare like with like)\n",
-             meshes, scene.path, provider);
+  warn_once(scene, provider, "single-sided",
+            fmt::format("{} mesh(es) of {} use single-sided materials: this suite's renderer hides their back faces "
+                        "from the eye, as glTF asks, while the {} ground truth shows them; where an eye sees one, the "
+                        "images differ for that reason (mark the materials doubleSided to compare like with like)",
+                        meshes, scene.path, provider));
+}
+
+/// Says once per scene file and provider that an external tool samples textures without
+/// mip-mapping: on a textured scene the per-pixel metrics against it measure mostly that
+/// (docs/ground_truth.md, "the textured gap").
+void note_textured(const Scene& scene, const std::string& provider) {
+  if (provider == "full") return;
+  size_t meshes = 0;
+  for (const Mesh& m : scene.meshes)
+    if (m.material >= 0 && scene.materials[static_cast<size_t>(m.material)].base_color_texture >= 0 &&
+        m.triangle_count() > 0)
+      ++meshes;
+  if (meshes == 0) return;
+  warn_once(scene, provider, "textured",
+            fmt::format("{} mesh(es) of {} are textured: the {} ground truth takes one bilinear texture sample per "
+                        "pixel, without the mip-mapping this suite's renderers use, so minified textures alias there "
+                        "and the per-pixel metrics measure mostly that (docs/ground_truth.md, the textured gap); "
+                        "compare textured scenes against --truth full",
+                        meshes, scene.path, provider));
 }
 
 }  // namespace
@@ -219,6 +243,7 @@ ResolvedTruth resolve_truth(const TruthProvider& provider, const TruthRequest& r
   // Before the cache: an entry an older provider rendered of a scene it now refuses is not served.
   provider.check_scene(request.scene.scene(), request.scene_file);
   note_single_sided(request.scene.scene(), provider.name());
+  note_textured(request.scene.scene(), provider.name());
   ResolvedTruth out;
   const bool use_cache = cache != nullptr && provider.name() != "full";
   // A hit's command names the work folder of the run that rendered it; where asked, the export is

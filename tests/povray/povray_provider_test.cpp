@@ -649,5 +649,22 @@ TEST(PovrayUnsupported, ASweepCellWithASpotLightIsRefusedBeforeAnyCellRuns) {
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "results.jsonl"));
 }
 
+TEST(PovrayNotes, ATexturedSceneIsWarnedAboutOnceAnUntexturedOneNot) {
+  SB_REQUIRE_POVRAY(povray);
+  // One bilinear sample per pixel, without mip-mapping: against it the per-pixel metrics of a
+  // textured scene measure mostly the aliasing (docs/ground_truth.md, the textured gap).
+  const test::ScratchDir dir;
+  const std::string common = " --pipelines plain-rt --resolution 32x18 --truth povray --no-cache --scenes-dir '" +
+                             (dir / "scenes").string() + "' --out '" + (dir / "out").string() + "'";
+  const test::CliRun textured = test::run_cli("validate --scene textured-plane" + common);
+  ASSERT_EQ(textured.code, 0) << textured.out;
+  const std::string note = "are textured: the povray ground truth takes one bilinear texture sample per pixel";
+  EXPECT_NE(textured.out.find(note), std::string::npos) << textured.out;
+  EXPECT_EQ(textured.out.find(note), textured.out.rfind(note)) << "said once: " << textured.out;
+  const test::CliRun plain = test::run_cli("validate --scene lit-plane" + common);
+  ASSERT_EQ(plain.code, 0) << plain.out;
+  EXPECT_EQ(plain.out.find("are textured"), std::string::npos) << plain.out;
+}
+
 }  // namespace
 }  // namespace sb
