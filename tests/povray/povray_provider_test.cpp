@@ -618,8 +618,20 @@ TEST(PovrayUnsupported, SpotLightIsRefusedByName) {
     EXPECT_NE(msg.find("'stage-spot'"), std::string::npos) << msg;
     EXPECT_NE(msg.find("spot light"), std::string::npos) << msg;
     EXPECT_NE(msg.find("`full`"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("keep only the lights before it with --lights 1"), std::string::npos) << msg;
   }
   EXPECT_FALSE(std::filesystem::exists(dir / "work" / "scene.pov"));
+  // The spot first: no --lights leaves it out.
+  scene.lights = {spot};
+  const RenderScene first(scene);
+  try {
+    (void)render_truth(*povray, first, test::rig_at(scene, 32, 18), dir / "work");
+    ADD_FAILURE() << "a spot light was rendered";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("remove the light from the scene, or move it after the lights you keep"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(PovrayUnsupported, ASweepCellWithASpotLightIsRefusedBeforeAnyCellRuns) {
@@ -644,6 +656,7 @@ TEST(PovrayUnsupported, ASweepCellWithASpotLightIsRefusedBeforeAnyCellRuns) {
   EXPECT_EQ(r.code, 3) << r.out;
   EXPECT_NE(r.out.find((dir / "spot.toml").string() + ": cell 1 "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("'stage-spot') is a spot light"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("keep only the lights before it with --lights 1"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("no cell has run"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("[1/2]"), std::string::npos) << "no cell may run: " << r.out;
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "results.jsonl"));

@@ -226,8 +226,10 @@ void check_exportable(const Scene& scene) {
           "scene '{}': light {} ('{}') is a spot light, which the povray provider cannot render exactly: "
           "POV-Ray 3.7 fades a spotlight between its cones with a cubic smoothstep in cos(angle), the shading "
           "of DESIGN §3 with KHR_lights_punctual's quadratic ramp; use the `full` or `blender` provider for this "
-          "scene, or leave the light out with --lights",
-          scene.name, i, light.name));
+          "scene, or {}",
+          scene.name, i, light.name,
+          i == 0 ? "remove the light from the scene, or move it after the lights you keep (--lights keeps the first N)"
+                 : fmt::format("keep only the lights before it with --lights {}", i)));
   }
 }
 
