@@ -205,8 +205,17 @@ int main(int argc, char** argv) {
     return after_flushing_stdout(app.exit(e));  // --help, --version: 4 when they could not be written
   } catch (const CLI::ParseError& e) {
     // Usage errors read like every other error: one "stereobench: error:" line, then where to look.
-    const std::string unknown = unknown_command_message(app, argc, argv);
-    std::fprintf(stderr, "stereobench: error: %s\n", unknown.empty() ? e.what() : unknown.c_str());
+    std::string message = unknown_command_message(app, argc, argv);
+    if (message.empty()) message = e.what();
+    // Only decimal numbers reach the conversion (refuse_non_decimal_numbers): one that fails to
+    // convert does not fit the option's integer type.
+    if (dynamic_cast<const CLI::ConversionError*>(&e) != nullptr && message.starts_with("Could not convert: ")) {
+      std::string option_value = message.substr(19);  // "--lights = 99999999999"
+      if (const size_t eq = option_value.find(" = "); eq != std::string::npos) option_value.replace(eq, 3, " ");
+      message = option_value + " lies outside what the option can hold; give a value in its range (see the "
+                               "command's --help)";
+    }
+    std::fprintf(stderr, "stereobench: error: %s\n", message.c_str());
     std::fprintf(stderr, "Run `stereobench --help` (or `stereobench SUBCOMMAND --help`) for usage.\n");
     sb::cli::discard_gate_reports_after_usage_error(app);
     return static_cast<int>(sb::ExitCode::bad_input);

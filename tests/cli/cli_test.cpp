@@ -100,6 +100,8 @@ TEST(Cli, BadArgumentsExitWith3AndSayWhy) {
       {"scenes generate spheres --seed 18446744073709551616 --out '" + dir.path().string() + "'",
        "not 18446744073709551616"},  // 2^64: saturated to 2^64 - 1 before
       {"scenes generate spheres --seed 1e3 --out '" + dir.path().string() + "'", "--seed: '1e3' is not a decimal integer"},
+      // Decimal, but more than the option's integer holds: said so, with where to find its range.
+      {"render --lights 99999999999", "--lights 99999999999 lies outside what the option can hold; give a value in its range"},
       // A folder where a file is to be written: refused before the work, not when writing it.
       {"bench --scene " + scene + " --resolution 16x9 --pipelines plain-rt --json '" + dir.path().string() + "'",
        "--json: " + dir.path().string() + " is a folder; give the name of the file to write"},
