@@ -15,6 +15,7 @@
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
 #include "renderer/io/gltf_loader.hpp"
+#include "renderer/io/render_output.hpp"
 #include "renderer/render_scene.hpp"
 #include "renderer/rig.hpp"
 #include "renderer/stages/primary_rays.hpp"
@@ -71,17 +72,26 @@ void generate_scenes(const GenerateArgs& args) {
     throw InputError("--param applies to one scene; generate the scenes one at a time");
   // Names and parameters are checked before anything is written (the folder included).
   for (const std::string& n : names) (void)scenes::resolve_params(scenes::find_generator(n), opt.params);
+  // So are the files: a folder where one is to go stops the run before the first scene is written.
+  const bool builtin = opt.seed == 1 && opt.params.empty();
+  const auto file_of = [&](const std::string& n) {
+    const scenes::GeneratorInfo& g = scenes::find_generator(n);
+    return fs::path(args.out_dir) / (builtin ? g.file_name : scenes::variant_file_name(g, opt.seed, opt.params));
+  };
+  std::vector<fs::path> files;
+  for (const std::string& n : names) {
+    files.push_back(file_of(n));
+    files.push_back(scenes::stamp_path(files.back()));
+  }
+  io::check_no_folder_at(files, "give another --out");
   prepare_output_folder(args.out_dir, "--out");
   fmt::print("{:<15} {:>12} {:>10} {:>7} {:>12} {:>9}  {}\n", "scene", "triangles", "vertices", "lights", "bytes",
              "seconds", "file");
   for (const std::string& n : names) {
-    const scenes::GeneratorInfo& g = scenes::find_generator(n);
     // Default scenes are stamped so that commands naming them reuse the file; another seed or
     // parameters get a file name of their own, so that they never stand in for the default.
-    const bool builtin = opt.seed == 1 && opt.params.empty();
     const scenes::GenerateResult r =
-        builtin ? scenes::generate_builtin(n, args.out_dir)
-                : scenes::generate(n, opt, fs::path(args.out_dir) / scenes::variant_file_name(g, opt.seed, opt.params));
+        builtin ? scenes::generate_builtin(n, args.out_dir) : scenes::generate(n, opt, file_of(n));
     fmt::print("{:<15} {:>12} {:>10} {:>7} {:>12} {:>9.2f}  {}\n", n, r.triangles, r.vertices, r.lights, r.bytes,
                r.seconds, r.path.string());
   }

@@ -630,6 +630,21 @@ TEST(Cli, ARefusedInputLeavesNoEmptyOutputFolder) {
   }
 }
 
+TEST(Cli, ScenesGenerateRefusesAFolderInTheWayOfAnyFileBeforeWritingOne) {
+  // The stamp of the second scene is blocked: the first is not written either, and the message is
+  // render's (the generator picks the names, so "give the name of the file" was no help).
+  test::ScratchDir dir("genblocked");
+  std::filesystem::create_directories(dir / "box-wall.gltf.stamp");
+  const CliRun r = run("scenes generate lit-plane box-wall --out '" + dir.path().string() + "'");
+  EXPECT_EQ(r.code, 4) << r.out;
+  EXPECT_NE(r.out.find("cannot write " + (dir / "box-wall.gltf.stamp").string() +
+                       ": a folder of that name is in the way; remove it or give another --out"),
+            std::string::npos)
+      << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "lit-plane.gltf"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "box-wall.gltf"));
+}
+
 TEST(Cli, RenderAndBenchRejectBadArguments) {
   test::ScratchDir dir("renderbad");
   const std::string bench_common = " --scenes-dir '" + (dir / "scenes").string() + "' --resolution 32x18";
