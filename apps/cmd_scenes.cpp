@@ -1,4 +1,5 @@
 // `stereobench scenes`: list the built-in scene generators, generate scenes, describe scene files.
+#include <algorithm>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -108,6 +109,7 @@ struct InfoArgs {
 struct DepthRange {
   double nearest = 0.0, farthest = 0.0;
   size_t hits = 0, rays = 0;
+  size_t before_near = 0;  ///< hits nearer than the near plane, which every pipeline clips
   int step = 1;
 };
 
@@ -126,6 +128,10 @@ DepthRange visible_depth_range(const Scene& scene, const StereoRig& rig) {
       ++r.rays;
       if (hits[i].prim == kNoPrimitiveId) continue;
       const double z = static_cast<double>(hits[i].t) * cos_to_axis(centre, queries[i].dir);
+      if (z < rig.params().znear) {
+        ++r.before_near;
+        continue;
+      }
       r.nearest = std::min(r.nearest, z);
       r.farthest = std::max(r.farthest, z);
       ++r.hits;
@@ -139,6 +145,17 @@ DepthRange visible_depth_range(const Scene& scene, const StereoRig& rig) {
     }
   if (!queries.empty()) flush();
   return r;
+}
+
+/// A disparity in pixels to the rig's scale: two decimals, more where the rig's largest disparity
+/// `scale` is below 10 px (a tiny interaxial: three significant digits of it), and no minus sign on
+/// a value that rounds to zero (a surface at the convergence distance, up to float noise).
+std::string disparity_text(double px, double scale) {
+  const int decimals =
+      std::clamp(2 - static_cast<int>(std::floor(std::log10(std::max(scale, 1e-12)))), 2, 12);
+  std::string text = fmt::format("{:.{}f}", px, decimals);
+  if (text.find_first_not_of("-0.") == std::string::npos && text[0] == '-') text.erase(0, 1);
+  return text;
 }
 
 void print_info(const InfoArgs& args) {
@@ -169,11 +186,24 @@ void print_info(const InfoArgs& args) {
     const StereoRig rig = resolve_rig(scene, overrides);
     fmt::print("rig        {}\n", describe(rig));
     const DepthRange range = visible_depth_range(scene, rig);
+    const std::string before_near =
+        range.before_near == 0
+            ? std::string()
+            : fmt::format("; {} hit a surface nearer than the near plane ({:g} m), which every pipeline clips",
+                          range.before_near, rig.params().znear);
+    const double scale = std::max({std::abs(rig.disparity_px(range.nearest)),
+                                   std::abs(rig.disparity_px(range.farthest)), rig.max_disparity_px()});
     if (range.hits > 0)
-      fmt::print("disparity  {:.2f} px at the nearest visible surface ({:.3f} m) .. {:.2f} px at the farthest "
-                 "({:.3f} m), over {} of {} rays (every {} px){}\n",
-                 rig.disparity_px(range.nearest), range.nearest, rig.disparity_px(range.farthest), range.farthest,
-                 range.hits, range.rays, range.step, range.hits < range.rays ? "; the rest see the sky" : "");
+      fmt::print("disparity  {} px at the nearest visible surface ({:.3f} m) .. {} px at the farthest "
+                 "({:.3f} m), over {} of {} rays (every {} px){}{}\n",
+                 disparity_text(rig.disparity_px(range.nearest), scale), range.nearest,
+                 disparity_text(rig.disparity_px(range.farthest), scale), range.farthest, range.hits, range.rays, range.step,
+                 range.hits + range.before_near < range.rays ? "; the rest see the sky" : "", before_near);
+    else if (range.before_near > 0)
+      fmt::print("disparity  none: {} of {} rays hit a surface nearer than the near plane ({:g} m), which every "
+                 "pipeline clips{}\n",
+                 range.before_near, range.rays, rig.params().znear,
+                 range.before_near < range.rays ? "; the rest see the sky" : "");
     else
       fmt::print("disparity  none: the centre camera sees no surface (no ray through every {} px hits one)\n",
                  range.step);

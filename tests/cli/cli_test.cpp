@@ -575,6 +575,12 @@ TEST(Cli, GeometryBeforeTheNearPlaneIsWarnedAbout) {
   const CliRun cmp = run("compare " + test::quoted(dir / "out" / "near_plain-raster_right.png") + " " +
                          test::quoted(dir / "out" / "near_plain-rt_right.png"));
   EXPECT_NE(cmp.out.find("(3172 pixels with a channel difference"), std::string::npos) << cmp.out;
+  // scenes info counts those rays apart: their disparity is no surface's a pipeline shows.
+  const CliRun info = run("scenes info " + test::quoted(dir / "near.gltf") + " --resolution 160x90");
+  ASSERT_EQ(info.code, 0) << info.out;
+  EXPECT_NE(info.out.find("hit a surface nearer than the near plane (2 m), which every pipeline clips"),
+            std::string::npos)
+      << info.out;
 
   write_scene(0.5);
   const CliRun near = run("render --pipeline plain-raster" + args);
