@@ -480,8 +480,11 @@ class Converter {
   }
 
   /// Records an unsupported feature once, counting repeats.
-  void warn(const std::string& key, const std::string& text) {
-    if (warning_counts_[key]++ == 0) warning_text_[key] = "unsupported: " + text;
+  void warn(const std::string& key, const std::string& text) { note(key, "unsupported: " + text); }
+
+  /// A warning said once per key, with its count.
+  void note(const std::string& key, const std::string& text) {
+    if (warning_counts_[key]++ == 0) warning_text_[key] = text;
   }
 
   void check_extensions() {
@@ -1060,6 +1063,11 @@ class Converter {
         for (size_t v = 0; v < nv; ++v) idx[v] = static_cast<uint32_t>(v);
       }
       mesh.indices = triangulate(idx, prim.mode, ppath);
+      if (mesh.indices.empty() && prim.mode != TINYGLTF_MODE_TRIANGLES)
+        // Said (and listed by an otherwise empty scene's error), not dropped in silence.
+        note("short-" + ppath, fmt::format("{}: a {} of {} {} has no triangle; it is skipped", ppath,
+                                           prim.mode == TINYGLTF_MODE_TRIANGLE_STRIP ? "TRIANGLE_STRIP" : "TRIANGLE_FAN",
+                                           idx.size(), idx.size() == 1 ? "vertex" : "vertices"));
       if (flip)
         for (size_t t = 0; t < mesh.indices.size(); t += 3) std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
       if (!mesh.indices.empty()) scene.meshes.push_back(std::move(mesh));

@@ -57,6 +57,13 @@ inline std::vector<BadCase> bad_scene_corpus() {
   c.push_back({"not_json", "a.gltf", [](auto& p) { write_text(p, "{ \"asset\": { \"version\": \"2.0\" "); }, "not valid JSON"});
   c.push_back({"image_as_scene", "a.png", [](auto& p) { write_text(p, std::string("\x89PNG\r\n\x1a\n\0\0\0\rIHDR", 16)); },
                "not a glTF scene (neither glTF JSON nor binary .glb)"});
+  c.push_back({"strip_of_two_vertices", "a.gltf", [](auto& p) {
+                 MiniGltf g;
+                 const int pos = g.add_positions({0, 0, 0, 1, 0, 0});
+                 g.add_node({{"mesh", g.add_mesh(json::array({{{"attributes", {{"POSITION", pos}}}, {"mode", 5}}}))}});
+                 g.write_gltf(p);
+               },
+               "/meshes/0/primitives/0: a TRIANGLE_STRIP of 2 vertices has no triangle; it is skipped"});
   c.push_back({"empty_file", "a.gltf", [](auto& p) { write_text(p, ""); }, "empty"});
   c.push_back({"top_level_array", "a.gltf", [](auto& p) { write_text(p, "[1,2,3]"); }, "expected a JSON object"});
   c.push_back({"no_asset", "a.gltf", [](auto& p) { write_text(p, "{}"); }, "/asset: required property is missing"});
