@@ -81,7 +81,7 @@ void run_update(const GateArgs& a, const fs::path& file) {
     }
   if (short_entries > 0)
     fmt::print(stderr,
-               "warning: {} of the {} stored entr{} hold{} fewer than the {} timing samples the rank test needs "
+               "stereobench: warning: {} of the {} stored entr{} hold{} fewer than the {} timing samples the rank test needs "
                "({}; the fewest: {}): every time check against {} will warn \"not enough repetitions\" and never "
                "pass or fail; set repetitions = {} or more in the [timing] table of the sweep's definition, "
                "run the sweep again and update\n",

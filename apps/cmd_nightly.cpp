@@ -345,7 +345,7 @@ void run_nightly(const NightlyArgs& a) {
           const json recorded = r.value("gate", json::object());
           if (recorded.value("verdict", "") != gate_verdict(gate))
             fmt::print(stderr,
-                       "warning: run {} is recorded in {} with the gate verdict '{}' (exit {}); this evaluation "
+                       "stereobench: warning: run {} is recorded in {} with the gate verdict '{}' (exit {}); this evaluation "
                        "gives '{}' (exit {}), which the run's gate files and nightly.json hold. A history line "
                        "is never rewritten: the trends keep the recorded verdict\n",
                        run_id, history_file.string(), recorded.value("verdict", "?"),
