@@ -15,7 +15,10 @@ cmake --build build -j"$jobs" --target stereobench
 sb=./build/apps/stereobench
 out=out/main
 # The smoke sweep (ci/smoke.toml): every registered pipeline on a built-in scene, validated against
-# the built-in ground truth (full ray tracing) and timed side by side. A second run resumes it.
+# the built-in ground truth (full ray tracing) and timed side by side. It starts afresh each time
+# (it takes seconds): resumed, a finished sweep would run nothing, and the gate would judge the
+# cells an earlier build measured.
+rm -rf "$out"
 $sb sweep run ci/smoke.toml --out "$out"
 # The HTML report of the sweep (tables, charts, an image viewer per cell), readable offline.
 $sb report "$out/results.jsonl" --out "$out/report"

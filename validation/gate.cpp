@@ -385,7 +385,7 @@ GateConfig load_gate_config(const std::filesystem::path& file) {
 
 ThresholdValues thresholds_for(const GateConfig& config, const std::string& pipeline, const std::string& scene,
                                const std::string& cell_id, std::vector<bool>* rule_used,
-                               std::map<std::string, std::string>* origins) {
+                               std::map<std::string, std::string>* origins, std::map<std::string, size_t>* set_by_out) {
   ThresholdValues values = config.defaults;
   // The [regression] tolerance applies everywhere only when the table is there.
   if (config.regression_table) values[kToleranceKey] = config.regression.tolerance;
@@ -407,6 +407,7 @@ ThresholdValues thresholds_for(const GateConfig& config, const std::string& pipe
       (*origins)[entry.first] = it == set_by.end() ? std::string("[defaults]")
                                                    : fmt::format("the [[rule]] at line {}", config.rules[it->second].line);
     }
+  if (set_by_out != nullptr) *set_by_out = std::move(set_by);
   return values;
 }
 
@@ -728,9 +729,10 @@ std::string reproduce_command(const GateCell& cell, const std::string& pipeline,
 namespace {
 
 /// Whether the results hold every cell of their sweep: a results file left by a sweep that stopped
-/// early (killed, a full disk) must not pass. Nothing when the records do not say how many cells
-/// the sweep has.
+/// early (killed, a full disk) must not pass, nor one whose records do not say how many cells the
+/// sweep has (a line without cell_count: edited, or of an older version). Nothing for no cells.
 std::optional<GateCheck> completeness_check(const GateResults& results) {
+  if (results.cells.empty()) return std::nullopt;
   std::vector<const json*> records;
   std::string definition;
   for (const GateCell& cell : results.cells) {
@@ -739,18 +741,25 @@ std::optional<GateCheck> completeness_check(const GateResults& results) {
       definition = cell.record["definition"].get<std::string>();
   }
   const std::optional<CellCoverage> coverage = cell_coverage(records);
-  if (!coverage) return std::nullopt;
-  const uint64_t expected = coverage->expected;
   GateCheck check;
   check.check = kCompleteCheck;
   check.cell_id = "(all cells)";
   check.pipeline = "(all)";
-  check.measured = static_cast<double>(coverage->present);
-  check.fail_limit = static_cast<double>(expected);
   check.reproduce = fmt::format("stereobench sweep run {} --out {}", definition.empty() ? "DEFINITION" : shell_quote(definition),
                                 shell_quote(results.file.parent_path().empty() ? "." : results.file.parent_path().string()));
   // sweep run resumes <out>/results.jsonl unless told otherwise.
   if (results.file.filename() != "results.jsonl") check.reproduce += " --results " + shell_quote(results.file.string());
+  if (!coverage) {
+    check.measured = kNaN;
+    check.verdict = Verdict::fail;
+    check.message = fmt::format("{}: a line without cell_count does not say how many cells the sweep has, so the gate "
+                                "cannot tell whether the sweep finished; run the sweep again (its lines record it)",
+                                results.file.string());
+    return check;
+  }
+  const uint64_t expected = coverage->expected;
+  check.measured = static_cast<double>(coverage->present);
+  check.fail_limit = static_cast<double>(expected);
   if (coverage->present >= expected) {
     check.message = fmt::format("all {} cells of the sweep have results", expected);
     return check;
@@ -818,6 +827,37 @@ std::optional<std::string> unused_rules_note(const GateConfig& config, const Gat
       count == 1 ? "its" : "their", fmt::join(parts, "; "));
 }
 
+/// Limits of rules that match some cell but never make a check: overridden by a later rule
+/// wherever they match, or on a measure no record they match carries (a left eye's for a pipeline
+/// that renders its left eye, a speed-up of the baseline pipeline). `won` holds the keys each rule
+/// gave the limit of some (cell, pipeline), `applied` those that then made a check. One note
+/// names them with their rule's line; a key set to false (a check turned off) is none.
+std::optional<std::string> unapplied_limits_note(const GateConfig& config, const std::vector<bool>& rule_used,
+                                                 const std::vector<std::set<std::string>>& won,
+                                                 const std::vector<std::set<std::string>>& applied) {
+  std::vector<std::string> overridden, unmeasured;
+  for (size_t i = 0; i < config.rules.size(); ++i) {
+    if (!rule_used[i]) continue;  // unused_rules_note names it
+    for (const auto& [key, value] : config.rules[i].values) {
+      if (!value || applied[i].count(key)) continue;
+      const std::string item = fmt::format("{} (line {})", key, config.rules[i].line);
+      (won[i].count(key) ? unmeasured : overridden).push_back(item);
+    }
+  }
+  if (overridden.empty() && unmeasured.empty()) return std::nullopt;
+  std::vector<std::string> parts;
+  if (!overridden.empty())
+    parts.push_back(fmt::format("a later [[rule]] sets {} wherever {} rule matches: {}",
+                                overridden.size() == 1 ? "it" : "them", overridden.size() == 1 ? "its" : "their",
+                                fmt::join(overridden, ", ")));
+  if (!unmeasured.empty())
+    parts.push_back(fmt::format("no record {} rule matches has that measure (a left eye's for a pipeline that "
+                                "renders its own, a speed-up of the baseline pipeline): {}",
+                                unmeasured.size() == 1 ? "its" : "their", fmt::join(unmeasured, ", ")));
+  return fmt::format("{}: [[rule]] limits that check nothing, so are not in force: {}", config.source,
+                     fmt::join(parts, "; "));
+}
+
 /// The skipped checks, counted by (check, reason): every cell without a baseline entry is one line.
 std::map<std::pair<std::string, std::string>, int> skip_reasons(const std::vector<GateCheck>& checks) {
   std::map<std::pair<std::string, std::string>, int> reasons;
@@ -850,12 +890,21 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
   report.notes = results.warnings;
   const RegressionSettings& reg = config.regression;
   std::vector<bool> rule_used(config.rules.size(), false);
+  // Per rule, the keys whose limit it gave somewhere, and those that then made a check.
+  std::vector<std::set<std::string>> won(config.rules.size()), applied(config.rules.size());
   std::set<std::string> level_notes;
   for (const GateCell& cell : results.cells) {
     const std::string where = fmt::format("{}: cell '{}'", results.file.string(), cell.cell_id);
     for (const auto& [pipeline, entry] : cell.record["pipelines"].items()) {
       std::map<std::string, std::string> origins;
-      const ThresholdValues limits = thresholds_for(config, pipeline, cell.scene, cell.cell_id, &rule_used, &origins);
+      std::map<std::string, size_t> set_by;
+      const ThresholdValues limits =
+          thresholds_for(config, pipeline, cell.scene, cell.cell_id, &rule_used, &origins, &set_by);
+      for (const auto& [key, rule] : set_by) won[rule].insert(key);
+      const auto mark_applied = [&](const char* key) {
+        if (key == nullptr) return;
+        if (const auto it = set_by.find(key); it != set_by.end()) applied[it->second].insert(key);
+      };
       for (const std::string& note : unreachable_warning_levels(limits, origins, pipeline, cell.scene))
         if (level_notes.insert(note).second) report.notes.push_back(fmt::format("{}: {}", config.source, note));
       const std::string quality_command = reproduce_command(cell, pipeline, reproduce, Remeasure::quality);
@@ -886,6 +935,8 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
           const json::json_pointer scope(mc.applies_unless_null);
           if (entry.contains(scope) && entry.at(scope).is_null()) continue;
         }
+        mark_applied(mc.fail_key);
+        mark_applied(mc.warn_key);
         const std::optional<double> value = record_number(entry, mc.pointer, where + ": pipelines." + pipeline);
         check.measured = value ? *value : kNaN;
         if (!value || std::isnan(*value)) {
@@ -929,6 +980,7 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
       // Time regression against the baseline.
       const std::optional<double> tolerance = limit(kToleranceKey);
       if (!tolerance) continue;
+      mark_applied(kToleranceKey);
       GateCheck check;
       check.check = kRegressionCheck;
       check.fail_limit = tolerance;
@@ -981,6 +1033,8 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
     throw InputError(nothing_checked_message(config, results, report.checks));
   if (complete) report.checks.push_back(*complete);
   if (std::optional<std::string> note = unused_rules_note(config, results, rule_used)) report.notes.push_back(*note);
+  if (std::optional<std::string> note = unapplied_limits_note(config, rule_used, won, applied))
+    report.notes.push_back(*note);
   for (const GateCheck& c : report.checks) {
     ++report.counts[c.verdict];
     report.worst = std::max(report.worst, c.verdict);

@@ -129,11 +129,13 @@ struct GateConfig {
 /// The thresholds in force for one (pipeline, scene, cell): the defaults with every matching rule
 /// applied in file order; the regression tolerance under the key "regression_tolerance". With
 /// `rule_used` (one flag per rule), the matching rules' flags are set; with `origins`, each key
-/// gets the table that set it: "[defaults]" or "the [[rule]] at line N".
+/// gets the table that set it: "[defaults]" or "the [[rule]] at line N"; with `set_by`, each key a
+/// rule set gets that rule's index (a key [defaults] set has none).
 [[nodiscard]] ThresholdValues thresholds_for(const GateConfig& config, const std::string& pipeline,
                                              const std::string& scene, const std::string& cell_id,
                                              std::vector<bool>* rule_used = nullptr,
-                                             std::map<std::string, std::string>* origins = nullptr);
+                                             std::map<std::string, std::string>* origins = nullptr,
+                                             std::map<std::string, size_t>* set_by = nullptr);
 
 /// Where the merged thresholds of one (pipeline, scene) put a warning level beyond its failure
 /// level — e.g. warn_psnr = 35 from [defaults] under min_psnr = 40 from a rule — so that the

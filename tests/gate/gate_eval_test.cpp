@@ -775,6 +775,16 @@ TEST(GateEval, AnUnfinishedSweepFails) {
   EXPECT_NE(xml.find("classname=\"gate.sweep\""), std::string::npos) << xml;
   EXPECT_EQ(xml.find("gate.."), std::string::npos) << xml;
   EXPECT_EQ(xml.find("value=\"\""), std::string::npos) << xml;
+  // Lines that do not say how many cells the sweep has cannot vouch for it: the check fails (it
+  // used to vanish, and a cut file passed).
+  std::vector<json> uncounted = passing_cells();
+  uncounted[1].erase("cell_count");
+  const validation::GateReport unknown = evaluate(uncounted);
+  ASSERT_NE(complete(unknown), nullptr);
+  EXPECT_EQ(complete(unknown)->verdict, Verdict::fail);
+  EXPECT_NE(complete(unknown)->message.find("a line without cell_count does not say how many cells the sweep has"),
+            std::string::npos)
+      << complete(unknown)->message;
 }
 
 TEST(GateJunit, AClassNameHasOneSegmentPerSceneAndPipeline) {
@@ -970,6 +980,32 @@ TEST(GateEval, ARuleThatMatchesNothingIsNoted) {
       << grouped[0];
   EXPECT_EQ(typo.worst, evaluate(passing_cells()).worst) << "a note, not a verdict";
   EXPECT_EQ(typo.checks.size(), evaluate(passing_cells()).checks.size());
+}
+
+TEST(GateEval, RuleLimitsThatCheckNothingAreNoted) {
+  const auto notes_about_limits = [](const validation::GateReport& r) {
+    std::vector<std::string> out;
+    for (const std::string& n : r.notes)
+      if (n.find("limits that check nothing") != std::string::npos) out.push_back(n);
+    return out;
+  };
+  EXPECT_TRUE(notes_about_limits(evaluate(passing_cells())).empty())
+      << fmt::format("{}", fmt::join(evaluate(passing_cells()).notes, "\n"));
+  // A stricter rule before a broader one: the broader one's limit is in force wherever both
+  // match, so repro-rt's 45 dB minimum never checks (its PSNR of 44 passed against 20), nor does
+  // kConfig's 40 dB. A minimum speed-up for the baseline pipeline has nothing to check.
+  const validation::GateReport r =
+      evaluate(passing_cells(), {},
+               kConfig + "[[rule]]\npipeline = \"repro-rt\"\nmin_psnr = 45\n[[rule]]\nscene = \"*\"\nmin_psnr = 20\n"
+                         "[[rule]]\npipeline = \"plain-rt\"\nmin_speedup = 5\n");
+  const std::vector<std::string> notes = notes_about_limits(r);
+  ASSERT_EQ(notes.size(), 1u) << fmt::format("{}", fmt::join(r.notes, "\n"));
+  EXPECT_EQ(notes[0],
+            "test.toml: [[rule]] limits that check nothing, so are not in force: a later [[rule]] sets them wherever "
+            "their rule matches: min_psnr (line 10), min_psnr (line 15); no record its rule matches has that measure "
+            "(a left eye's for a pipeline that renders its own, a speed-up of the baseline pipeline): min_speedup "
+            "(line 21)");
+  EXPECT_EQ(find_check(r, "repro-rt", "psnr")->fail_limit, 20.0) << "the later rule is in force";
 }
 
 TEST(GateEval, AFrameOfAPathIsReproducedByRunningItsCellAgain) {
