@@ -216,9 +216,22 @@ void discard_gate_reports_after_usage_error(CLI::App& root) noexcept {
     typed("--results", a.results);
     typed("--config", a.config);
     typed("--baseline", a.baseline);
-    typed("--junit", a.junit);
-    typed("--json", a.json_out);
-    discard_earlier_reports(a);
+    // Every value of a report option given more than once (itself the usage error): each names a
+    // file an earlier run may have left.
+    const auto every = [&](const char* name) {
+      std::vector<std::string> values;
+      if (const CLI::Option* o = g->get_option_no_throw(name))
+        for (const std::string& v : o->results())
+          if (!v.empty()) values.push_back(v);
+      if (values.empty()) values.emplace_back();
+      return values;
+    };
+    for (const std::string& junit : every("--junit"))
+      for (const std::string& json_out : every("--json")) {
+        a.junit = junit;
+        a.json_out = json_out;
+        discard_earlier_reports(a);
+      }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "stereobench: warning: an earlier gate report may remain: %s\n", e.what());
   }

@@ -578,6 +578,12 @@ std::vector<BaselineChange> update_baseline(Baseline& baseline, const GateResult
       if (e.samples_s.empty())
         throw InputError(fmt::format("{}: cell '{}' pipeline {} has no timing.samples_s to store as its baseline",
                                      where, cell.cell_id, pipeline));
+      // The baseline's reader takes positive times only: a zero stored here would refuse every
+      // later gate run.
+      if (std::any_of(e.samples_s.begin(), e.samples_s.end(), [](double t) { return !(t > 0.0); }))
+        throw InputError(fmt::format("{} pipeline {}: timing.samples_s holds a time of 0 s, which a baseline cannot "
+                                     "hold (a ratio against it is undefined); run the cell again before storing it",
+                                     where, pipeline));
       e.median_s = median(e.samples_s);
       e.recorded = cell.record.value("finished", json("")).is_string() ? cell.record.value("finished", "") : "";
       e.host = cell.record.value("host", json("")).is_string() ? cell.record.value("host", "") : "";
@@ -892,6 +898,7 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
   std::vector<bool> rule_used(config.rules.size(), false);
   // Per rule, the keys whose limit it gave somewhere, and those that then made a check.
   std::vector<std::set<std::string>> won(config.rules.size()), applied(config.rules.size());
+  size_t regression_checks = 0, regression_with_entry = 0;
   std::set<std::string> level_notes;
   for (const GateCell& cell : results.cells) {
     const std::string where = fmt::format("{}: cell '{}'", results.file.string(), cell.cell_id);
@@ -981,13 +988,21 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
       const std::optional<double> tolerance = limit(kToleranceKey);
       if (!tolerance) continue;
       mark_applied(kToleranceKey);
+      ++regression_checks;
       GateCheck check;
       check.check = kRegressionCheck;
       check.fail_limit = tolerance;
       check.measured = kNaN;
       const std::vector<double> samples = record_samples(entry);
       const BaselineEntry* base = baseline.find(cell.cell_id, pipeline);
-      if (samples.empty()) {
+      if (base) ++regression_with_entry;
+      if (samples.empty() && base) {
+        // A sweep writes them for every pipeline: the record is damaged, and a time the gate
+        // cannot read must not pass.
+        check.verdict = Verdict::fail;
+        check.message = "no timing samples in the record (timing.samples_s), though the baseline has an entry for it: "
+                        "the record is damaged or of another version; run the cell again";
+      } else if (samples.empty()) {
         check.verdict = Verdict::skip;
         check.message = "no timing samples in the record";
       } else if (!base) {
@@ -1035,6 +1050,13 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
   if (std::optional<std::string> note = unused_rules_note(config, results, rule_used)) report.notes.push_back(*note);
   if (std::optional<std::string> note = unapplied_limits_note(config, rule_used, won, applied))
     report.notes.push_back(*note);
+  // A baseline of another sweep (or of cells since renamed) skips every time check without a word.
+  if (!baseline.empty() && regression_checks > 0 && regression_with_entry == 0)
+    report.notes.push_back(fmt::format(
+        "the baseline has no entry for any (cell, pipeline) of {} (its {} cell(s) include '{}'; the results', '{}'): "
+        "every time check is skipped; give this sweep's baseline, or store one for these cells (gate "
+        "--update-baseline)",
+        results.file.string(), baseline.cells.size(), baseline.cells.begin()->first, results.cells.front().cell_id));
   for (const GateCheck& c : report.checks) {
     ++report.counts[c.verdict];
     report.worst = std::max(report.worst, c.verdict);

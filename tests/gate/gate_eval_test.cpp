@@ -321,6 +321,41 @@ TEST(GateEval, TimeRegressionAgainstTheBaseline) {
   // The other cell and pipeline have no baseline entry.
   EXPECT_EQ(find_check(r, "repro-rt", "time_regression", 1)->message, "no baseline");
   EXPECT_EQ(find_check(r, "plain-rt", "time_regression")->message, "no baseline");
+  for (const std::string& n : r.notes) EXPECT_EQ(n.find("no entry for any"), std::string::npos) << n;
+
+  // A record without its samples, where the baseline has an entry: damaged, and it fails (it was
+  // skipped, so a damaged file passed).
+  cells[0]["pipelines"]["repro-rt"]["timing"].erase("samples_s");
+  reg = find_check(evaluate(cells, baseline), "repro-rt", "time_regression");
+  EXPECT_EQ(reg->verdict, Verdict::fail);
+  EXPECT_NE(reg->message.find("though the baseline has an entry for it"), std::string::npos) << reg->message;
+
+  // A baseline of another sweep: every time check is skipped, and a note says why.
+  validation::Baseline other;
+  other.cells["elsewhere|320x180"]["repro-rt"] = baseline.cells[id]["repro-rt"];
+  r = evaluate(passing_cells(), other);
+  ASSERT_FALSE(r.notes.empty());
+  EXPECT_NE(r.notes.back().find("the baseline has no entry for any (cell, pipeline) of results.jsonl (its 1 cell(s) "
+                                "include 'elsewhere|320x180'"),
+            std::string::npos)
+      << r.notes.back();
+}
+
+TEST(GateEval, ABaselineUpdateRefusesATimeOfZeroItsReaderWouldRefuse) {
+  std::vector<json> cells = passing_cells();
+  json& timing = cells[0]["pipelines"]["repro-rt"]["timing"];
+  timing["repetitions"] = 3;
+  timing["samples_s"] = {0.0, 0.01, 0.01};
+  validation::Baseline baseline;
+  try {
+    (void)validation::update_baseline(baseline, validation::gate_results(cells, {}, "results.jsonl"),
+                                      validation::BaselineSelection{{"repro-rt"}, ""});
+    ADD_FAILURE() << "a zero time was stored";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("pipeline repro-rt: timing.samples_s holds a time of 0 s"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_TRUE(baseline.empty());
 }
 
 TEST(GateEval, AGateThatChecksNothingIsBadInputNotAPass) {
@@ -706,7 +741,9 @@ TEST(GateCli, BadInputIsExitThree) {
   for (const std::string& refused :
        {outputs + " --only repro-rt",
         " --junit " + (dir / "junit.xml").string() + " --json " + (dir / "junit.xml").string(),
-        outputs + " --confg " + (dir / "empty.toml").string(), outputs + " --baseline ''"}) {
+        outputs + " --confg " + (dir / "empty.toml").string(), outputs + " --baseline ''",
+        // --junit twice: the first file named used to stay.
+        outputs + " --junit " + (dir / "other.xml").string()}) {
     run = run_cli("gate" + config + " --results " + (dir / "pass.jsonl").string() + outputs);
     ASSERT_EQ(run.code, 0) << run.out;
     run = run_cli("gate" + config + " --results " + (dir / "pass.jsonl").string() + refused);
