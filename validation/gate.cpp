@@ -442,6 +442,11 @@ GateResults take_cells(const std::vector<json>& cells, std::vector<std::string> 
   results.warnings = std::move(warnings);
   for (const json& record : cells)
     results.cells.push_back({record["cell_id"].get<std::string>(), record["cell"]["scene"].get<std::string>(), record});
+  // In cell order, not the order parallel jobs finished them: the same cells give the same
+  // JUnit and JSON bytes (cell_index is checked to be unique per file).
+  std::stable_sort(results.cells.begin(), results.cells.end(), [](const GateCell& a, const GateCell& b) {
+    return a.record["cell_index"].get<int64_t>() < b.record["cell_index"].get<int64_t>();
+  });
   if (results.cells.empty())
     throw InputError(fmt::format(
         "{} holds no finished cell; run the sweep first (an empty results file is not a pass)", file.string()));

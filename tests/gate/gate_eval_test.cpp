@@ -341,6 +341,16 @@ TEST(GateEval, TimeRegressionAgainstTheBaseline) {
       << r.notes.back();
 }
 
+TEST(GateEval, CellsAreGatedInCellOrderWhateverOrderTheyFinishedIn) {
+  // Parallel jobs append cells as they finish: the same cells give the same report.
+  std::vector<json> reversed = passing_cells();
+  std::swap(reversed[0], reversed[1]);
+  const validation::GateReport a = evaluate(passing_cells()), b = evaluate(reversed);
+  EXPECT_EQ(validation::junit_xml(a, "gate"), validation::junit_xml(b, "gate"));
+  ASSERT_FALSE(b.checks.empty());
+  EXPECT_EQ(b.checks.front().cell_id, passing_cells()[0]["cell_id"].get<std::string>());
+}
+
 TEST(GateEval, ABaselineUpdateRefusesATimeOfZeroItsReaderWouldRefuse) {
   std::vector<json> cells = passing_cells();
   json& timing = cells[0]["pipelines"]["repro-rt"]["timing"];
