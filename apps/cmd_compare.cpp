@@ -229,7 +229,7 @@ int run_compare(const CompareArgs& a) {
     fmt::print(out, "  {:<14} 0 (identical)\n", "max error");
   else
     fmt::print(out, "  {:<14} {}/255 at ({}, {})\n", "max error", m.max_error, m.max_x, m.max_y);
-  for (const std::string& w : warnings) fmt::print(out, "stereobench: warning: {}\n", w);
+  for (const std::string& w : warnings) fmt::print(out, "warning: {}\n", w);  // a verdict line, beside failure: and verdict:
   for (const std::string& f : failures) fmt::print(out, "failure: {}\n", f);
   fmt::print(out, "verdict: {}\n",
              code == ExitCode::gate_failure   ? "FAIL"

@@ -101,8 +101,6 @@ void run_path_command(const PathArgs& a) {
   scenes::LoadedScene loaded = scenes::load_scene(a.scene, a.scenes_dir, a.lights);
   const StereoRig rig = resolve_rig(loaded.scene, overrides);
   for (const PipelineEntry& e : run.pipelines) e.check_rig(e.options(), rig);
-  // Made once the input is known to be good: a refused run leaves no empty folder behind.
-  prepare_output_folder(a.out, "--out");
   run.scene_file = loaded.file;
   run.rig = rig.params();
   run.pose = rig.pose();
@@ -114,7 +112,10 @@ void run_path_command(const PathArgs& a) {
 
   // The path checked against the scene before the first frame (run_path plays it on its own animator).
   const SceneAnimator animation(loaded.scene, run.path);
+  provider->check_scene(loaded.scene, loaded.file);
   validation::check_path_truth(*provider, loaded.scene, run.path, loaded.file);
+  // Made once the input is known to be good: a refused run leaves no empty folder behind.
+  prepare_output_folder(a.out, "--out");
   fmt::print("path on {} ({} triangles): {} frames, {}{}; {}, truth {}\n", loaded.scene.name,
              loaded.scene.triangle_count(), a.frames,
              run.path.camera_keys.empty() ? "the scene's camera" : fmt::format("{} camera key{}", run.path.camera_keys.size(), run.path.camera_keys.size() == 1 ? "" : "s"),

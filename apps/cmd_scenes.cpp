@@ -82,7 +82,7 @@ void generate_scenes(const GenerateArgs& args) {
   std::vector<fs::path> files;
   for (const std::string& n : names) {
     files.push_back(file_of(n));
-    files.push_back(scenes::stamp_path(files.back()));
+    if (builtin) files.push_back(scenes::stamp_path(files.back()));  // only the defaults are stamped
   }
   io::check_no_folder_at(files, "give another --out");
   prepare_output_folder(args.out_dir, "--out");
@@ -109,7 +109,7 @@ struct InfoArgs {
 struct DepthRange {
   double nearest = 0.0, farthest = 0.0;
   size_t hits = 0, rays = 0;
-  size_t before_near = 0;  ///< hits nearer than the near plane, which every pipeline clips
+  size_t before_near = 0;  ///< hits nearer than the near plane, which rasterizing pipelines clip
   int step = 1;
 };
 
@@ -148,7 +148,7 @@ DepthRange visible_depth_range(const Scene& scene, const StereoRig& rig) {
 }
 
 /// A disparity in pixels to the rig's scale: two decimals, more where the rig's largest disparity
-/// `scale` is below 10 px (a tiny interaxial: three significant digits of it), and no minus sign on
+/// `scale` is below 1 px (a tiny interaxial: three significant digits of it), and no minus sign on
 /// a value that rounds to zero (a surface at the convergence distance, up to float noise).
 std::string disparity_text(double px, double scale) {
   const int decimals =
@@ -189,7 +189,8 @@ void print_info(const InfoArgs& args) {
     const std::string before_near =
         range.before_near == 0
             ? std::string()
-            : fmt::format("; {} hit a surface nearer than the near plane ({:g} m), which every pipeline clips",
+            : fmt::format("; {} hit a surface nearer than the near plane ({:g} m), which rasterizing pipelines clip "
+                          "(ray tracing and the ground truths show it)",
                           range.before_near, rig.params().znear);
     const double scale = std::max({std::abs(rig.disparity_px(range.nearest)),
                                    std::abs(rig.disparity_px(range.farthest)), rig.max_disparity_px()});
@@ -200,8 +201,8 @@ void print_info(const InfoArgs& args) {
                  disparity_text(rig.disparity_px(range.farthest), scale), range.farthest, range.hits, range.rays, range.step,
                  range.hits + range.before_near < range.rays ? "; the rest see the sky" : "", before_near);
     else if (range.before_near > 0)
-      fmt::print("disparity  none: {} of {} rays hit a surface nearer than the near plane ({:g} m), which every "
-                 "pipeline clips{}\n",
+      fmt::print("disparity  none: {} of {} rays hit a surface nearer than the near plane ({:g} m), which "
+                 "rasterizing pipelines clip (ray tracing and the ground truths show it){}\n",
                  range.before_near, range.rays, rig.params().znear,
                  range.before_near < range.rays ? "; the rest see the sky" : "");
     else

@@ -108,6 +108,8 @@ void run_validate(const ValidateArgs& a) {
   const StereoRig rig = resolve_rig(scene, overrides);
   // What a pipeline cannot do with this rig stops the run before any pipeline renders.
   for (size_t i = 0; i < chosen.size(); ++i) chosen[i].check_rig(options[i], rig);
+  // What the ground truth's tool cannot render exactly is refused now too (resolve_truth checks again).
+  provider->check_scene(scene, loaded.file);
   // Made once the input is known to be good: a refused run leaves no empty folder behind.
   prepare_output_folder(a.out, "--out");
   const RenderScene prepared(scene);

@@ -212,8 +212,7 @@ int main(int argc, char** argv) {
     if (dynamic_cast<const CLI::ConversionError*>(&e) != nullptr && message.starts_with("Could not convert: ")) {
       std::string option_value = message.substr(19);  // "--lights = 99999999999"
       if (const size_t eq = option_value.find(" = "); eq != std::string::npos) option_value.replace(eq, 3, " ");
-      message = option_value + " lies outside what the option can hold; give a value in its range (see the "
-                               "command's --help)";
+      message = option_value + " is too large in magnitude for the option to hold; give a smaller number";
     }
     std::fprintf(stderr, "stereobench: error: %s\n", message.c_str());
     std::fprintf(stderr, "Run `stereobench --help` (or `stereobench SUBCOMMAND --help`) for usage.\n");

@@ -581,8 +581,7 @@ std::vector<BaselineChange> update_baseline(Baseline& baseline, const GateResult
       BaselineEntry e;
       e.samples_s = record_samples(entry);
       if (e.samples_s.empty())
-        throw InputError(fmt::format("{}: cell '{}' pipeline {} has no timing.samples_s to store as its baseline",
-                                     where, cell.cell_id, pipeline));
+        throw InputError(fmt::format("{} pipeline {} has no timing.samples_s to store as its baseline", where, pipeline));
       // The baseline's reader takes positive times only: a zero stored here would refuse every
       // later gate run.
       if (std::any_of(e.samples_s.begin(), e.samples_s.end(), [](double t) { return !(t > 0.0); }))
@@ -763,8 +762,9 @@ std::optional<GateCheck> completeness_check(const GateResults& results) {
   if (!coverage) {
     check.measured = kNaN;
     check.verdict = Verdict::fail;
-    check.message = fmt::format("{}: a line without cell_count does not say how many cells the sweep has, so the gate "
-                                "cannot tell whether the sweep finished; run the sweep again (its lines record it)",
+    check.message = fmt::format("{}: its lines do not say how many cells the sweep has (no cell_count: written by an "
+                                "older version, or edited), so the gate cannot tell whether the sweep finished; run the "
+                                "sweep afresh (delete the results file, or give another --out), whose lines record it",
                                 results.file.string());
     return check;
   }

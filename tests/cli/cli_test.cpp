@@ -101,7 +101,7 @@ TEST(Cli, BadArgumentsExitWith3AndSayWhy) {
        "not 18446744073709551616"},  // 2^64: saturated to 2^64 - 1 before
       {"scenes generate spheres --seed 1e3 --out '" + dir.path().string() + "'", "--seed: '1e3' is not a decimal integer"},
       // Decimal, but more than the option's integer holds: said so, with where to find its range.
-      {"render --lights 99999999999", "--lights 99999999999 lies outside what the option can hold; give a value in its range"},
+      {"render --lights 99999999999", "--lights 99999999999 is too large in magnitude for the option to hold; give a smaller number"},
       // A folder where a file is to be written: refused before the work, not when writing it.
       {"bench --scene " + scene + " --resolution 16x9 --pipelines plain-rt --json '" + dir.path().string() + "'",
        "--json: " + dir.path().string() + " is a folder; give the name of the file to write"},
@@ -578,7 +578,7 @@ TEST(Cli, GeometryBeforeTheNearPlaneIsWarnedAbout) {
   // scenes info counts those rays apart: their disparity is no surface's a pipeline shows.
   const CliRun info = run("scenes info " + test::quoted(dir / "near.gltf") + " --resolution 160x90");
   ASSERT_EQ(info.code, 0) << info.out;
-  EXPECT_NE(info.out.find("hit a surface nearer than the near plane (2 m), which every pipeline clips"),
+  EXPECT_NE(info.out.find("hit a surface nearer than the near plane (2 m), which rasterizing pipelines clip"),
             std::string::npos)
       << info.out;
 

@@ -3,6 +3,7 @@
 // as published and with the z-test of Kim's §5; what the z-test guarantees of each eye's own pixels.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <tuple>
@@ -152,8 +153,8 @@ TEST(BidirWarpRt, TracesItsCracksSoAVanishingDisparityReproducesTheTruth) {
 /// box-wall's wall through a 1-degree field of view: its triangles reach past both images, the
 /// left eye seeing more of its left end and the right eye more of its right end. As published
 /// (clipped=one) one eye rasterizes each, and the other eye's border strip shows what lies behind
-/// the wall (measured 19.62 dB at 320x180, a strip about 18 px wide). With clipped=both both eyes
-/// rasterize them and each eye is plain-raster's (measured: identical, at 320x180).
+/// the wall (measured 19.62 dB here and at 320x180, a strip about 18 px wide there). With
+/// clipped=both both eyes rasterize them and each eye is plain-raster's in 8 bits.
 TEST(BidirClipped, AWallWiderThanBothImagesIsWholeInBothEyesUnderClippedBoth) {
   const Scene scene = test::load_builtin("box-wall");
   const RenderScene prepared(scene);
@@ -172,8 +173,8 @@ TEST(BidirClipped, AWallWiderThanBothImagesIsWholeInBothEyesUnderClippedBoth) {
     std::printf("%s: right eye %.2f dB as published, %.2f dB with clipped=both (left %.2f dB)\n", pipeline.c_str(),
                 p_published, p_both, l_both);
     EXPECT_LT(p_published, 30.0) << pipeline;
-    EXPECT_GT(p_both, 50.0) << pipeline;
-    EXPECT_GT(l_both, 50.0) << pipeline;
+    EXPECT_TRUE(std::isinf(p_both)) << pipeline << " " << p_both;
+    EXPECT_TRUE(std::isinf(l_both)) << pipeline << " " << l_both;
     EXPECT_GT(both.counters.get("triangles_to_both"), published.counters.get("triangles_to_both")) << pipeline;
   }
 }

@@ -102,9 +102,14 @@ TEST(Redirection, ATriangleBothFrustaClipGoesToOneEyeAsPublishedOrToBoth) {
   for (const dvec3& v : {n0, n1, f0}) ASSERT_GT(l.project(v).x, 320.0) << "the left eye sees none of it";
   EXPECT_EQ(redirect(l, r, n0, n1, f0, false), kRedirectLeft);
   EXPECT_EQ(redirect(l, r, n0, n1, f0, false, ClippedRule::both), kRedirectRight);
-  // A triangle only one frustum clips is still ranked by eq. (1).
-  const dvec3 p = l.unproject(317.0, 90.0, 10.0);
-  const dvec3 s0 = p, s1 = p + dvec3(0.01, 0.0, 0.0), s2 = p + dvec3(0.0, 0.01, 0.0);
+  // A triangle only one frustum clips is still ranked by eq. (1): inside the left image, 10 m
+  // away, across the right image's right border (about 6 px further right there), where both
+  // eyes see a part of it.
+  const dvec3 s0 = l.unproject(312.0, 90.0, 10.0), s1 = l.unproject(316.0, 90.0, 10.0),
+              s2 = l.unproject(314.0, 95.0, 10.0);
+  ASSERT_EQ(frustum_visibility(l, s0, s1, s2), 1.0);
+  ASSERT_LT(frustum_visibility(r, s0, s1, s2), 1.0);
+  ASSERT_LT(r.project(s0).x, 320.0) << "the right eye sees a part of it";
   EXPECT_EQ(redirect(l, r, s0, s1, s2, false, ClippedRule::both), kRedirectLeft);
 }
 

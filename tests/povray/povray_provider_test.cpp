@@ -660,6 +660,15 @@ TEST(PovrayUnsupported, ASweepCellWithASpotLightIsRefusedBeforeAnyCellRuns) {
   EXPECT_NE(r.out.find("no cell has run"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("[1/2]"), std::string::npos) << "no cell may run: " << r.out;
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "results.jsonl"));
+  // validate and path refuse the same scene before making their --out (they left it, empty).
+  for (const std::string command : {"validate --pipelines plain-rt", "path --pipelines plain-rt --frames 2"}) {
+    const test::CliRun refused = test::run_cli(command + " --scene '" + (dir / "lit.gltf").string() +
+                                               "' --truth povray --resolution 32x18 --out '" +
+                                               (dir / "refused" / "out").string() + "'");
+    EXPECT_EQ(refused.code, 3) << command << "\n" << refused.out;
+    EXPECT_NE(refused.out.find("'stage-spot') is a spot light"), std::string::npos) << refused.out;
+    EXPECT_FALSE(std::filesystem::exists(dir / "refused")) << command;
+  }
 }
 
 TEST(PovrayNotes, ATexturedSceneIsWarnedAboutOnceAnUntexturedOneNot) {

@@ -229,7 +229,7 @@ void check_exportable(const Scene& scene) {
           "scene, or {}",
           scene.name, i, light.name,
           i == 0 ? "remove the light from the scene, or move it after the lights you keep (--lights keeps the first N)"
-                 : fmt::format("keep only the lights before it with --lights {}", i)));
+                 : fmt::format("keep only the lights before it with --lights {} (in a sweep, lights = [{}])", i, i)));
   }
 }
 
