@@ -63,6 +63,8 @@ Baseline parse_baseline(const json& doc, const std::string& source, std::vector<
       entry.median_s = median_of(entry.samples_s);
       if (e.contains("recorded") && e["recorded"].is_string()) entry.recorded = e["recorded"].get<std::string>();
       if (e.contains("host") && e["host"].is_string()) entry.host = e["host"].get<std::string>();
+      for (const auto& [key, value] : e.items())
+        if (key != "samples_s" && key != "median_s" && key != "recorded" && key != "host") entry.other[key] = value;
       b.cells[cell_id][pipeline] = std::move(entry);
     }
   }
@@ -88,9 +90,14 @@ Baseline load_baseline(const std::filesystem::path& file, std::vector<DamagedEnt
 json baseline_json(const Baseline& baseline) {
   json doc = json::object();
   for (const auto& [cell_id, pipes] : baseline.cells)
-    for (const auto& [pipeline, e] : pipes)
-      doc[cell_id][pipeline] = {
-          {"samples_s", e.samples_s}, {"median_s", e.median_s}, {"recorded", e.recorded}, {"host", e.host}};
+    for (const auto& [pipeline, e] : pipes) {
+      json entry = e.other.is_object() ? e.other : json::object();
+      entry["samples_s"] = e.samples_s;
+      entry["median_s"] = e.median_s;
+      entry["recorded"] = e.recorded;
+      entry["host"] = e.host;
+      doc[cell_id][pipeline] = std::move(entry);
+    }
   return doc;
 }
 

@@ -1,6 +1,6 @@
 // Stored timing baselines for the gate's time-regression check: per (cell id, pipeline) the
 // repetition samples of an accepted run, in a JSON file (default ci/baseline.json) of
-// {cell_id: {pipeline: {samples_s, median_s, recorded, host}}}.
+// {cell_id: {pipeline: {samples_s, median_s, recorded, host}}}; other fields of an entry are kept.
 #pragma once
 
 #include <filesystem>
@@ -21,6 +21,9 @@ struct BaselineEntry {
   double median_s = 0.0;
   std::string recorded;  ///< when the samples were measured (the cell's `finished` time)
   std::string host;      ///< where they were measured
+  /// Any other fields the file gives the entry (a note by hand), written back as they were while
+  /// the entry is not rewritten.
+  nlohmann::json other = nlohmann::json::object();
 };
 
 /// cell id -> pipeline -> entry.

@@ -440,6 +440,12 @@ TEST(GateEval, BaselineUpdateTouchesOnlyWhatIsNamed) {
   old.cells[id0]["plain-rt"] = {{0.5, 0.5, 0.5}, 0.5, "earlier", "oldhost"};
   old.cells[id0]["repro-rt"] = {{0.4, 0.4, 0.4}, 0.4, "earlier", "oldhost"};
   validation::save_baseline(dir / "baseline.json", old);
+  // Fields of its own a hand gave an entry stay while the entry is not rewritten (they were
+  // dropped from every entry, "every other entry unchanged" notwithstanding).
+  json with_notes = json::parse(read_text(dir / "baseline.json"));
+  with_notes[id0]["plain-rt"]["note"] = "accepted after the BVH change";
+  with_notes["old-cell|x"]["plain-rt"] = {{"samples_s", {1.0}}, {"note", "kept"}};
+  write_file(dir / "baseline.json", with_notes.dump(2) + "\n");
   write_results(dir / "results.jsonl", cells);
 
   // No selection: an error that says how to name what to update; the file is unchanged.
@@ -458,6 +464,9 @@ TEST(GateEval, BaselineUpdateTouchesOnlyWhatIsNamed) {
   validation::Baseline now = validation::load_baseline(dir / "baseline.json");
   EXPECT_EQ(now.find(id0, "plain-rt")->samples_s, std::vector<double>({0.5, 0.5, 0.5}));
   EXPECT_EQ(now.find(id0, "plain-rt")->host, "oldhost");
+  const json written = json::parse(read_text(dir / "baseline.json"));
+  EXPECT_EQ(written[id0]["plain-rt"].value("note", ""), "accepted after the BVH change");
+  EXPECT_EQ(written["old-cell|x"]["plain-rt"].value("note", ""), "kept");
   EXPECT_EQ(now.find(id0, "repro-rt")->samples_s, std::vector<double>({0.010, 0.011, 0.012}));
   EXPECT_DOUBLE_EQ(now.find(id0, "repro-rt")->median_s, 0.011);
   EXPECT_EQ(now.find(id0, "repro-rt")->host, "testhost");
