@@ -1,5 +1,6 @@
 // `stereobench render` and `stereobench pipelines`: render a stereo pair with one pipeline and
 // write its images and statistics; list and describe the registered pipelines.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -123,7 +124,11 @@ void run_render(const RenderArgs& a) {
   fmt::print("  {:<22} {:>10.2f} ms ({:.1f} MiB)\n", "bvh build (once)", prepared.bvh_build_seconds() * 1e3,
              prepared.rays().memory_bytes() / 1048576.0);
   print_timings(result);
-  for (const auto& [name, value] : result.counters.snapshot()) fmt::print("  {:<22} {:>12}\n", name, value);
+  // Counters in one column, as wide as the longest name needs (hole_pixels_occluding_edge is 26).
+  const auto counters = result.counters.snapshot();
+  size_t width = 22;
+  for (const auto& counter : counters) width = std::max(width, counter.first.size());
+  for (const auto& [name, value] : counters) fmt::print("  {:<{}} {:>12}\n", name, width, value);
   if (holes) print_holes(*holes, result.right.pixel_count());
   const std::vector<fs::path> written = files.all();
   for (size_t i = 0; i < written.size(); ++i) fmt::print("{}{}\n", i == 0 ? "wrote " : "      ", written[i].string());
