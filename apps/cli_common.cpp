@@ -250,10 +250,6 @@ void print_to_stdout(const std::string& text) {
     throw IoError(fmt::format("cannot write to standard output: {}", errno != 0 ? std::strerror(errno) : "write error"));
 }
 
-void print_warnings(const std::vector<std::string>& warnings) {
-  for (const std::string& w : warnings) fmt::print(stderr, "stereobench: warning: {}\n", w);
-}
-
 void prepare_output_file_folder(const std::string& file, const char* option) {
   if (file.empty() || file == "-" || io::written_in_place(file)) return;
   const std::filesystem::path target = io::follow_links(file);
@@ -289,11 +285,11 @@ void warn_geometry_before_near_plane(const RenderScene& scene, const StereoRig& 
   const uint64_t left = pixels_before_near_plane(scene, rig.eye(Eye::left), executor);
   const uint64_t right = pixels_before_near_plane(scene, rig.eye(Eye::right), executor);
   if (left == 0 && right == 0) return;
-  fmt::print(stderr,
-             "stereobench: warning: {} pixels of the left eye and {} of the right see geometry nearer than the camera's near plane "
-             "(znear {:g} m): rasterizing pipelines clip it, ray tracing and the ground truths show it, so their "
-             "images differ there for the camera's sake; lower the camera's znear in the scene\n",
-             left, right, rig.params().znear);
+  print_warning(fmt::format(
+      "{} pixels of the left eye and {} of the right see geometry nearer than the camera's near plane (znear {:g} m): "
+      "rasterizing pipelines clip it, ray tracing and the ground truths show it, so their images differ there for "
+      "the camera's sake; lower the camera's znear in the scene",
+      left, right, rig.params().znear));
 }
 
 }  // namespace sb::cli

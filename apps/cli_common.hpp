@@ -118,9 +118,6 @@ void write_option_file(const std::string& option, const std::string& path, const
 /// success with the JSON lost.
 void print_to_stdout(const std::string& text);
 
-/// Prints each of `warnings` on stderr as "warning: ...".
-void print_warnings(const std::vector<std::string>& warnings);
-
 /// The same for the folder of an output file (a --json written after a long benchmark); nothing
 /// for "" (no file), "-" (standard output) or a bare file name (the current folder).
 void prepare_output_file_folder(const std::string& file, const char* option);

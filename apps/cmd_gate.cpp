@@ -80,16 +80,16 @@ void run_update(const GateArgs& a, const fs::path& file) {
       fewest = std::min(fewest, c.samples);
     }
   if (short_entries > 0)
-    fmt::print(stderr,
-               "stereobench: warning: {} of the {} stored entr{} hold{} fewer than the {} timing samples the rank test needs "
+    print_warning(fmt::format(
+               "{} of the {} stored entr{} hold{} fewer than the {} timing samples the rank test needs "
                "({}; the fewest: {}): every time check against {} will warn \"not enough repetitions\" and never "
                "pass or fail; set repetitions = {} or more in the [timing] table of the sweep's definition, "
-               "run the sweep again and update\n",
+               "run the sweep again and update",
                short_entries, changes.size(), changes.size() == 1 ? "y" : "ies", short_entries == 1 ? "s" : "",
                min_repetitions,
                has_config ? fmt::format("[regression] min_repetitions in {}", a.config)
                           : fmt::format("the default min_repetitions; {} is not here", a.config),
-               fewest, short_entries == 1 ? "it" : "them", min_repetitions);
+               fewest, short_entries == 1 ? "it" : "them", min_repetitions));
 }
 
 /// The baseline file a run reads: --baseline, or the default one.
@@ -233,7 +233,7 @@ void discard_gate_reports_after_usage_error(CLI::App& root) noexcept {
         discard_earlier_reports(a);
       }
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "stereobench: warning: an earlier gate report may remain: %s\n", e.what());
+    print_warning(std::string("an earlier gate report may remain: ") + e.what());
   }
 }
 

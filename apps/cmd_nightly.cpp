@@ -344,12 +344,12 @@ void run_nightly(const NightlyArgs& a) {
         if (r["run_id"] == run_id) {
           const json recorded = r.value("gate", json::object());
           if (recorded.value("verdict", "") != gate_verdict(gate))
-            fmt::print(stderr,
-                       "stereobench: warning: run {} is recorded in {} with the gate verdict '{}' (exit {}); this evaluation "
+            print_warning(fmt::format(
+                       "run {} is recorded in {} with the gate verdict '{}' (exit {}); this evaluation "
                        "gives '{}' (exit {}), which the run's gate files and nightly.json hold. A history line "
-                       "is never rewritten: the trends keep the recorded verdict\n",
+                       "is never rewritten: the trends keep the recorded verdict",
                        run_id, history_file.string(), recorded.value("verdict", "?"),
-                       recorded.value("exit_code", -1), gate_verdict(gate), exit_code(gate.worst));
+                       recorded.value("exit_code", -1), gate_verdict(gate), exit_code(gate.worst)));
         }
     } else {
       append_history(history_file, history_entry(run, cells, gate));

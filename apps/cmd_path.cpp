@@ -88,7 +88,7 @@ void run_path_command(const PathArgs& a) {
   if (a.spin_deg) run.path.spin = Spin{parse_axis(a.spin_axis), std::nullopt, *a.spin_deg, a.spin_prefix};
   run.path.validate();
   // Keys the path cannot reach are said, not passed over.
-  if (const auto unshown = run.path.unshown_keys_warning("--frames")) fmt::print(stderr, "stereobench: warning: {}\n", *unshown);
+  if (const auto unshown = run.path.unshown_keys_warning("--frames")) print_warning(*unshown);
   const RigOverrides overrides = a.rig.overrides();
   run.pipelines =
       parse_pipeline_entries(expand_all_pipelines(split_list(a.pipelines, "--pipelines"), "--pipelines"), "--pipelines");

@@ -82,7 +82,7 @@ void run_report(const ReportArgs& a) {
     if (!std::filesystem::exists(a.history))
       throw InputError(fmt::format("--history {}: file does not exist", a.history));
     h = validation::read_history(a.history);
-    for (const std::string& w : h.warnings) std::fprintf(stderr, "stereobench: warning: %s\n", w.c_str());
+    print_warnings(h.warnings);
   }
   const reports::ResultsFile results = reports::read_results_file(a.results);
   if (!a.history.empty()) {
@@ -96,7 +96,7 @@ void run_report(const ReportArgs& a) {
     options.history = std::move(trends.runs);
   }
   const reports::ReportSummary s = reports::write_report(results, options);
-  for (const std::string& w : s.warnings) std::fprintf(stderr, "stereobench: warning: %s\n", w.c_str());
+  print_warnings(s.warnings);
   print_summary_table(s);
   fmt::print("report of {} cell(s) x {} pipeline(s), {} image(s) {}{}\nwrote {}\n", s.cells.size(), s.pipeline_names.size(), s.images,
              a.link_images ? "linked" : "copied",

@@ -187,11 +187,9 @@ void print_info(const InfoArgs& args) {
     fmt::print("rig        {}\n", describe(rig));
     const DepthRange range = visible_depth_range(scene, rig);
     const std::string before_near =
-        range.before_near == 0
-            ? std::string()
-            : fmt::format("; {} hit a surface nearer than the near plane ({:g} m), which rasterizing pipelines clip "
-                          "(ray tracing and the ground truths show it)",
-                          range.before_near, rig.params().znear);
+        fmt::format("hit a surface nearer than the near plane ({:g} m), which rasterizing pipelines clip (ray tracing "
+                    "and the ground truths show it)",
+                    rig.params().znear);
     const double scale = std::max({std::abs(rig.disparity_px(range.nearest)),
                                    std::abs(rig.disparity_px(range.farthest)), rig.max_disparity_px()});
     if (range.hits > 0)
@@ -199,11 +197,10 @@ void print_info(const InfoArgs& args) {
                  "({:.3f} m), over {} of {} rays (every {} px){}{}\n",
                  disparity_text(rig.disparity_px(range.nearest), scale), range.nearest,
                  disparity_text(rig.disparity_px(range.farthest), scale), range.farthest, range.hits, range.rays, range.step,
-                 range.hits + range.before_near < range.rays ? "; the rest see the sky" : "", before_near);
+                 range.hits + range.before_near < range.rays ? "; the rest see the sky" : "",
+                 range.before_near > 0 ? fmt::format("; {} {}", range.before_near, before_near) : std::string());
     else if (range.before_near > 0)
-      fmt::print("disparity  none: {} of {} rays hit a surface nearer than the near plane ({:g} m), which "
-                 "rasterizing pipelines clip (ray tracing and the ground truths show it){}\n",
-                 range.before_near, range.rays, rig.params().znear,
+      fmt::print("disparity  none: {} of {} rays {}{}\n", range.before_near, range.rays, before_near,
                  range.before_near < range.rays ? "; the rest see the sky" : "");
     else
       fmt::print("disparity  none: the centre camera sees no surface (no ray through every {} px hits one)\n",

@@ -1,8 +1,11 @@
 // Typed errors thrown by library code; the command line maps them to exit codes (DESIGN §2).
 #pragma once
 
+#include <cstdio>
 #include <stdexcept>
 #include <string>
+#include <string_view>
+#include <vector>
 
 namespace sb {
 
@@ -48,5 +51,16 @@ class ResourceError : public Error {
  public:
   explicit ResourceError(const std::string& message) : Error(ExitCode::environment, message) {}
 };
+
+/// Prints a warning on standard error as the command line prints its errors:
+/// "stereobench: warning: TEXT".
+inline void print_warning(std::string_view text) {
+  std::fprintf(stderr, "stereobench: warning: %.*s\n", static_cast<int>(text.size()), text.data());
+}
+
+/// print_warning for each of `warnings`, in order.
+inline void print_warnings(const std::vector<std::string>& warnings) {
+  for (const std::string& w : warnings) print_warning(w);
+}
 
 }  // namespace sb

@@ -169,7 +169,7 @@ LoadedScene load_scene(const std::string& spec, const std::filesystem::path& sce
                                  "it is generated again",
                                  e.what(), spec, out.file.string()));
   }
-  for (const std::string& w : out.scene.warnings) fmt::print(stderr, "stereobench: warning: {}\n", w);
+  print_warnings(out.scene.warnings);
   out.lights_in_file = out.scene.lights.size();
   if (lights) keep_first_lights(out.scene, *lights);
   return out;

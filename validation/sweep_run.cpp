@@ -185,7 +185,7 @@ class SceneCache {
       loaded_ = std::make_unique<Scene>(io::load_gltf(file));
       content_sha256_ = hash_scene(*loaded_);
       if (warned_.insert(file).second)  // once per file, however often the cells switch scenes
-        for (const std::string& w : loaded_->warnings) fmt::print(stderr, "stereobench: warning: {}\n", w);
+        print_warnings(loaded_->warnings);
       file_ = file;
     }
     const size_t keep = kept_lights(lights, loaded_->lights.size());

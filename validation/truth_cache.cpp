@@ -62,7 +62,7 @@ void warn_once(const Scene& scene, const std::string& provider, const char* topi
   static std::set<std::string> said;
   const std::lock_guard lock(mutex);
   if (!said.insert(scene.path + "\n" + provider + "\n" + topic).second) return;
-  fmt::print(stderr, "stereobench: warning: {}\n", text);
+  print_warning(text);
 }
 
 /// Says once per scene file and provider, on standard error, that an external tool shows what
@@ -278,10 +278,10 @@ ResolvedTruth resolve_truth(const TruthProvider& provider, const TruthRequest& r
     try {
       cache->store(out.key, out.render);
     } catch (const Error& e) {
-      fmt::print(stderr,
-                 "stereobench: warning: the {} render is not kept in the ground-truth cache: {}; this run goes on "
-                 "without storing it (make room there, or give --cache '' to render without the cache)\n",
-                 provider.name(), e.what());
+      print_warning(fmt::format(
+                 "the {} render is not kept in the ground-truth cache: {}; this run goes on "
+                 "without storing it (make room there, or give --cache '' to render without the cache)",
+                 provider.name(), e.what()));
     }
   }
   return out;
