@@ -18,6 +18,7 @@
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/json_text.hpp"
 #include "scenes/catalog.hpp"
+#include "validation/truth_cache.hpp"
 #include "validation/validation_images.hpp"
 
 namespace sb::cli {
@@ -87,6 +88,36 @@ std::vector<std::string> retire_earlier_records(io::StagedFiles& set, const fs::
   return retired;
 }
 
+/// Hex digits of the truth key that name a work folder after its scene and provider.
+constexpr size_t work_key_digits = 12;
+
+std::string work_folder_name(const std::string& scene_stem, const std::string& truth_key) {
+  return fmt::format("{}_{}", scene_stem, truth_key.substr(0, work_key_digits));
+}
+
+/// Removes the work folders of `scene_stem` (`<scene_stem>_<key digits>`) other than `kept`: this
+/// run has replaced every record that named them. One that cannot be removed is left with a warning.
+void remove_earlier_work_folders(const fs::path& work, const std::string& scene_stem, const std::string& kept) {
+  std::error_code ec;
+  if (!fs::is_directory(work, ec)) return;
+  const std::string prefix = scene_stem + "_";
+  std::vector<fs::path> earlier;
+  for (const fs::directory_entry& entry : fs::directory_iterator(work, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name == kept || name.size() != prefix.size() + work_key_digits || name.rfind(prefix, 0) != 0) continue;
+    if (!std::all_of(name.begin() + static_cast<std::ptrdiff_t>(prefix.size()), name.end(),
+                     [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'); }))
+      continue;
+    if (entry.is_directory(ec)) earlier.push_back(entry.path());
+  }
+  for (const fs::path& folder : earlier) {
+    fs::remove_all(folder, ec);
+    if (ec)
+      print_warning(fmt::format("could not remove {}, the work folder of a truth this run replaced: {}",
+                                folder.string(), ec.message()));
+  }
+}
+
 void run_validate(const ValidateArgs& a) {
   const RigOverrides overrides = a.rig.overrides();
   const std::vector<PipelineEntry> chosen = chosen_pipelines(a.pipelines);
@@ -126,14 +157,18 @@ void run_validate(const ValidateArgs& a) {
   const std::optional<validation::TruthCache> cache =
       a.no_cache || a.cache.empty() ? std::nullopt
                                     : std::optional<validation::TruthCache>(validation::TruthCache(a.cache));
-  // A work folder per scene and provider: the command a record gives to render its truth again
-  // runs there, and another scene validated into the same --out would replace its files.
+  // A work folder per scene, provider and truth (its cache key: scene contents, rig, provider): the
+  // command a record gives to render its truth again runs there. Another scene or rig validated
+  // into the same --out works in a folder of its own, so a run that fails after its truth rendered
+  // leaves the earlier records' commands rendering what they describe.
   // A truth from the cache was rendered in another run's work folder, which may be gone or hold
   // another render by now: the export and script are made ready in this one's, and the record gives
   // the command that renders the truth again there.
+  const std::string work_name = work_folder_name(
+      scene_stem, validation::truth_key(*provider, {prepared, loaded.file, rig, {}, executor.threads(), true}));
   const validation::ValidationTarget target =
       validation::prepare_target(prepared, loaded.file, rig, *provider, cache ? &*cache : nullptr,
-                                 out / "work" / scene_stem, executor, /*prepare_on_cache_hit=*/true);
+                                 out / "work" / work_name, executor, /*prepare_on_cache_hit=*/true);
   fmt::print("truth: {} ({}), {}{:.2f} s; true disocclusions {:.3f} % of the image\n", provider->name(),
              target.truth.render.tool_version, target.truth.cached ? "from the cache, rendered in " : "",
              target.truth.render.seconds,
@@ -193,6 +228,7 @@ void run_validate(const ValidateArgs& a) {
     set.add(summary, [&](const fs::path& tmp) { io::write_text_atomically(tmp, summary_text); });
   }
   set.commit();  // the summary, added last, is the set's marker
+  remove_earlier_work_folders(out / "work", scene_stem, work_name);
   fmt::print("\nwrote {} (one record per pipeline beside it, images under {})\n", summary.string(), out.string());
   if (!retired.empty())
     fmt::print("removed the earlier records of {} with their images: not validated in this run, they described the "

@@ -28,6 +28,18 @@ std::string base_args(const test::ScratchDir& dir, const std::string& cache = ""
          "' --cache " + (cache.empty() ? test::quoted(dir / "cache") : cache);
 }
 
+/// The work folder of `stem` (scene and provider) in `out`: `work/<stem>_<12 hex digits of the truth
+/// key>`; empty unless there is exactly one.
+fs::path work_folder(const fs::path& out, const std::string& stem) {
+  std::vector<fs::path> found;
+  if (fs::is_directory(out / "work"))
+    for (const auto& entry : fs::directory_iterator(out / "work")) {
+      const std::string name = entry.path().filename().string();
+      if (name.size() == stem.size() + 13 && name.rfind(stem + "_", 0) == 0) found.push_back(entry.path());
+    }
+  return found.size() == 1 ? found.front() : fs::path();
+}
+
 TEST(Validate, WritesRecordsImagesAndTable) {
   test::ScratchDir dir;
   const test::CliRun r = test::run_cli(base_args(dir) + " --pipelines plain-rt,repro-rt --pipelines fw-warp");
@@ -104,7 +116,8 @@ TEST(Validate, ExternalTruthIsRenderedOnceThenCached) {
   ASSERT_EQ(third.code, 0) << third.out;
   EXPECT_NE(third.out.find("from the cache"), std::string::npos) << third.out;
   const json served = json::parse(test::read_text(other / "box-wall_povray_plain-rt.json"));
-  const fs::path work = other / "work" / "box-wall_povray";
+  const fs::path work = work_folder(other, "box-wall_povray");
+  ASSERT_FALSE(work.empty());
   const std::string command = served["truth"]["command"].get<std::string>();
   EXPECT_NE(command.find(work.string()), std::string::npos) << command;
   EXPECT_EQ(command.find((dir / "out").string()), std::string::npos) << command;
@@ -139,9 +152,47 @@ TEST(Validate, EmptyCacheFolderTurnsTheCacheOff) {
   other.replace(other.find("--scene box-wall"), std::string("--scene box-wall").size(), "--scene thin-pole");
   ASSERT_EQ(test::run_shell(other).code, 0);
   const std::string command = record["truth"]["command"].get<std::string>();
-  EXPECT_NE(command.find((dir / "out" / "work" / "box-wall_povray").string()), std::string::npos) << command;
-  EXPECT_TRUE(fs::exists(dir / "out" / "work" / "box-wall_povray"));
-  EXPECT_TRUE(fs::exists(dir / "out" / "work" / "thin-pole_povray"));
+  const fs::path work = work_folder(dir / "out", "box-wall_povray");
+  ASSERT_FALSE(work.empty());
+  EXPECT_NE(command.find(work.string()), std::string::npos) << command;
+  EXPECT_FALSE(work_folder(dir / "out", "thin-pole_povray").empty());
+}
+
+TEST(Validate, EachRigRendersItsTruthInAWorkFolderOfItsOwn) {
+  test::ScratchDir dir;
+  const std::string args = base_args(dir) + " --truth povray --no-cache --pipelines plain-rt";
+  ASSERT_EQ(test::run_cli(args).code, 0) << "(POV-Ray is installed by ci/install-deps.sh povray)";
+  const fs::path out = dir / "out";
+  const json record = json::parse(test::read_text(out / "box-wall_povray_plain-rt.json"));
+  const std::string command = record["truth"]["command"].get<std::string>();
+  const fs::path first = work_folder(out, "box-wall_povray");
+  ASSERT_FALSE(first.empty());
+  fs::remove(first / "right.exr");
+
+  // Another rig whose truth fails to render (POV-Ray stopped at once) leaves the first run's records,
+  // and its work folder, whose command renders the truth those records describe.
+  std::string other = args;
+  other.replace(other.find("160x90"), 6, "200x100");
+  const test::CliRun failed = test::run_shell("STEREOBENCH_TOOL_TIMEOUT=0.001 " + std::string(SB_CLI_PATH) + " " + other);
+  ASSERT_EQ(failed.code, 4) << failed.out;
+  ASSERT_EQ(test::run_shell(command).code, 0) << command;
+  const Image again = io::read_exr(first / "right.exr");
+  EXPECT_EQ(again.width(), 160);
+  const Image truth = io::read_exr(out / "box-wall_truth-povray.exr");
+  ASSERT_TRUE(again.has_plane(planes::rgb) && truth.has_plane(planes::rgb));
+  const auto a = again.plane(planes::rgb).f32(), b = truth.plane(planes::rgb).f32();
+  EXPECT_TRUE(std::equal(a.begin(), a.end(), b.begin(), b.end())) << "the command renders another image";
+
+  // Once a run with another rig replaces the records, the first work folder, which no record names
+  // any more, is removed.
+  const test::CliRun replaced = test::run_cli(other);
+  ASSERT_EQ(replaced.code, 0) << replaced.out;
+  EXPECT_FALSE(fs::exists(first));
+  const fs::path second = work_folder(out, "box-wall_povray");
+  ASSERT_FALSE(second.empty());
+  EXPECT_NE(json::parse(test::read_text(out / "box-wall_povray_plain-rt.json"))["truth"]["command"].get<std::string>().find(
+                second.string()),
+            std::string::npos);
 }
 
 TEST(Validate, PipelineOptionsApplyAndAreChecked) {
