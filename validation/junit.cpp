@@ -114,6 +114,18 @@ std::string class_segment(std::string segment) {
   return segment;
 }
 
+/// A test case's name: pipeline and check, and for a check of one cell that cell's parameters
+/// (its id after the scene, which the class name holds), so that the cells of a sweep over
+/// interaxials or resolutions are distinct test cases in CI viewers, which know a test by class
+/// name and name.
+std::string case_name(const GateCheck& c) {
+  const std::string name = c.pipeline + " " + c.check;
+  if (c.scene.empty()) return name;
+  const std::string prefix = c.scene + "|";
+  const bool scene_first = c.cell_id.rfind(prefix, 0) == 0;
+  return fmt::format("{} [{}]", name, scene_first ? c.cell_id.substr(prefix.size()) : c.cell_id);
+}
+
 }  // namespace
 
 std::string junit_xml(const GateReport& report, const std::string& name) {
@@ -148,7 +160,7 @@ std::string junit_xml(const GateReport& report, const std::string& name) {
       out += fmt::format("    <properties>\n      <property name=\"scene\" value=\"{}\"/>\n    </properties>\n",
                          attr(checks.front()->scene));
     for (const GateCheck* c : checks) {
-      out += fmt::format("    <testcase name=\"{}\" classname=\"{}\"", attr(c->pipeline + " " + c->check),
+      out += fmt::format("    <testcase name=\"{}\" classname=\"{}\"", attr(case_name(*c)),
                          attr(c->scene.empty() ? std::string("gate.sweep")
                                                : "gate." + class_segment(c->scene) + "." +
                                                      class_segment(c->pipeline)));

@@ -863,6 +863,33 @@ TEST(GateJunit, AClassNameHasOneSegmentPerSceneAndPipeline) {
   EXPECT_NE(xml.find("<property name=\"scene\" value=\"sc/light.gltf\"/>"), std::string::npos) << xml;
 }
 
+TEST(GateJunit, CellsOfOneSceneAndPipelineAreDistinctTestCases) {
+  // CI viewers know a test case by class name and name; the cells of an interaxial sweep shared
+  // both and were merged into one test's history.
+  validation::GateReport report;
+  validation::GateCheck check;
+  check.scene = "spheres";
+  check.pipeline = "repro-rt";
+  check.check = "psnr";
+  for (const char* e : {"0.064", "0.12"}) {
+    check.cell_id = fmt::format("spheres|e={}m|c=default|320x180|lights=all|full", e);
+    report.checks.push_back(check);
+  }
+  check.scene.clear();
+  check.pipeline = "(all)";
+  check.cell_id = "(all cells)";
+  check.check = "sweep_complete";
+  report.checks.push_back(check);
+  const std::string xml = validation::junit_xml(report, "gate");
+  for (const char* e : {"0.064", "0.12"})
+    EXPECT_NE(xml.find(fmt::format("<testcase name=\"repro-rt psnr [e={}m|c=default|320x180|lights=all|full]\" "
+                                   "classname=\"gate.spheres.repro-rt\"",
+                                   e)),
+              std::string::npos)
+        << xml;
+  EXPECT_NE(xml.find("<testcase name=\"(all) sweep_complete\" classname=\"gate.sweep\""), std::string::npos) << xml;
+}
+
 TEST(GateEval, ReproduceGivesTheLightCountTheCellUsed) {
   // A cell asking for 7 lights of a 5-light scene keeps the scene's 5; validate refuses --lights 7.
   json cell = fake_cell(1, 0.064, {FakePipeline{}});
