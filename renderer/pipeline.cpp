@@ -247,7 +247,7 @@ int PipelineOptions::get_int(const std::string& name) const {
 bool PipelineOptions::get_bool(const std::string& name) const {
   const std::string& v = get(name);
   if (const std::optional<bool> b = boolean_value(v)) return *b;
-  throw InputError(fmt::format("pipeline '{}': option {}={} is not a boolean (true/false)", pipeline_, name, v));
+  throw InputError(fmt::format("pipeline '{}': option {}={} is not a boolean: give true or false (also 1/0, on/off, yes/no)", pipeline_, name, v));
 }
 
 }  // namespace sb

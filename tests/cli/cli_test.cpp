@@ -322,6 +322,14 @@ TEST(Cli, RenderWritesEveryOutputAndBenchPrintsATable) {
   // A diagnostic image an option asked for goes with the next render of the stem that does not
   // ask for it (it stayed, from another resolution, beside the new set).
   const std::string repro = "render --scene box-wall --pipeline repro-rt --out '" + dir.path().string() + "'" + common;
+  const CliRun maybe = run(repro + " --option grid_overlay=maybe");
+  EXPECT_EQ(maybe.code, 3) << maybe.out;
+  EXPECT_NE(maybe.out.find("option grid_overlay=maybe is not a boolean: give true or false (also 1/0, on/off, yes/no)"),
+            std::string::npos)
+      << maybe.out;
+  ASSERT_EQ(run(repro + " --option grid_overlay=on").code, 0);
+  ASSERT_TRUE(std::filesystem::exists(dir / "box-wall_repro-rt_grid.png"));
+  ASSERT_EQ(run(repro).code, 0);
   ASSERT_EQ(run(repro + " --option grid_overlay=true").code, 0);
   ASSERT_TRUE(std::filesystem::exists(dir / "box-wall_repro-rt_grid.png"));
   ASSERT_EQ(run(repro).code, 0);
