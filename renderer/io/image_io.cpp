@@ -771,8 +771,13 @@ auto guarded_read(const fs::path& path, F&& read) -> decltype(read()) {
   } catch (const Error&) {
     throw;
   } catch (const std::bad_alloc&) {
-    throw InputError(
-        fmt::format("cannot read image {}: out of memory (is its size plausible?); {}", path.string(), kCorruptHint));
+    // The size an image declares is checked against the memory left before it is decoded
+    // (decode_from): running out later is this machine's shortage (exit 4), though a damaged file
+    // whose decoder asks for more than the image needs looks the same.
+    throw ResourceError(fmt::format("cannot read image {}: out of memory; free memory or run on a machine with more "
+                                    "(a damaged file can ask for more too: if it is truncated or not an image, "
+                                    "regenerate or replace it)",
+                                    path.string()));
   } catch (const std::exception& e) {
     throw InputError(fmt::format("cannot read image {}: {}; {}", path.string(), e.what(), kCorruptHint));
   }
