@@ -136,10 +136,8 @@ int run_verify(const ReferenceArgs& a) {
   }
   std::string tail;
   // The command to run as it stands: with the store and scenes folder this run was given.
-  std::string update = "stereobench reference update --only-failing" + store.store_option();
-  if (!a.scenes_dir.empty() &&
-      fs::path(a.scenes_dir).lexically_normal() != scenes::default_scenes_dir().lexically_normal())
-    update += " --scenes-dir " + shell_quote(a.scenes_dir);
+  const std::string update = "stereobench reference update --only-failing" + store.store_option() +
+                             reference::ReferenceStore::scenes_dir_option(a.scenes_dir);
   if (failures > specless)
     tail += fmt::format("; {} did not (rewrite them with `{}`)", failures - specless, update);
   if (specless > 0)

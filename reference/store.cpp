@@ -80,7 +80,7 @@ std::optional<double> optional_quantity(const json& j, const char* key, const ch
   return v.get<double>();
 }
 
-json spec_to_json(const ReferenceSpec& s) {
+json spec_to_json_fields(const ReferenceSpec& s) {
   return {{"scene", s.scene},
           {"lights", optional_json(s.lights)},
           {"provider", s.provider},
@@ -91,6 +91,19 @@ json spec_to_json(const ReferenceSpec& s) {
             {"width", optional_json(s.rig.width)},
             {"height", optional_json(s.rig.height)},
             {"vfov_rad", optional_json(s.rig.vfov)}}}};
+}
+
+/// The spec as a provenance in the store at `root` records it. A scene file is given by its absolute
+/// path and, as "scene_from_store", relative to the store, so that a project moved or checked out
+/// elsewhere with its store and scenes still finds it (spec_in prefers that one).
+json spec_to_json(const ReferenceSpec& s, const fs::path& root) {
+  json out = spec_to_json_fields(s);
+  if (scenes::is_scene_file_spec(s.scene)) {
+    std::error_code ec;
+    const fs::path relative = fs::relative(s.scene, root, ec);
+    if (!ec && !relative.empty()) out["scene_from_store"] = relative.generic_string();
+  }
+  return out;
 }
 
 /// The rig as a provenance records it: its parameters and the camera pose.
@@ -200,6 +213,15 @@ ReferenceSpec spec_in(const json& provenance, const fs::path& file) {
     throw InputError(fmt::format("{}: {}; the provenance is damaged: remove the entry and generate it again",
                                  file.string(), e.what()));
   }
+  // A scene file the store's own relative path still finds is the one meant, wherever the project
+  // (store and scenes) has moved; else the recorded absolute path.
+  const json& recorded = provenance.at("spec");
+  if (recorded.contains("scene_from_store") && recorded.at("scene_from_store").is_string()) {
+    std::error_code ec;
+    const fs::path beside = fs::weakly_canonical(
+        file.parent_path().parent_path() / fs::path(recorded.at("scene_from_store").get<std::string>()), ec);
+    if (!ec && fs::is_regular_file(beside, ec)) spec.scene = beside.string();
+  }
   const std::vector<std::string> providers = validation::truth_provider_names();
   if (std::find(providers.begin(), providers.end(), spec.provider) == providers.end())
     throw InputError(fmt::format("{}: spec.provider '{}' is not a ground-truth provider ({})", file.string(),
@@ -235,13 +257,18 @@ json without_scratch_path(const json& value, const fs::path& scratch) {
 /// The entry's folder name: scene (its file_stem: a name safe in a path, never hidden), provider,
 /// size, interaxial and convergence; the field of view and the light count where they are not the
 /// scene's (`lights_in_file`: the scene's own count).
-std::string reference_id(const Scene& scene, const ReferenceSpec& spec, const StereoRig& rig, size_t lights_in_file) {
+/// With `as_given`, the field of view and light count the spec gives are named even where they are the
+/// scene's: the id the entry had when the scene's own differed (verify accepts both).
+std::string reference_id(const Scene& scene, const ReferenceSpec& spec, const StereoRig& rig, size_t lights_in_file,
+                         bool as_given = false) {
   const RigParams& p = rig.params();
   std::string id = fmt::format("{}_{}_{}x{}_e{:.1f}mm_c{:.3g}m", scene.file_stem(), spec.provider, p.width,
                                p.height, p.interaxial * 1e3, p.convergence);
   // The scene camera's field of view goes without saying; any other is part of the id.
-  if (p.vfov != resolve_rig(scene, {}).params().vfov) id += fmt::format("_v{:.4g}deg", radians_to_degrees(p.vfov));
-  if (spec.lights && static_cast<size_t>(*spec.lights) != lights_in_file) id += fmt::format("_l{}", *spec.lights);
+  if (p.vfov != resolve_rig(scene, {}).params().vfov || (as_given && spec.rig.vfov))
+    id += fmt::format("_v{:.4g}deg", radians_to_degrees(p.vfov));
+  if (spec.lights && (static_cast<size_t>(*spec.lights) != lights_in_file || as_given))
+    id += fmt::format("_l{}", *spec.lights);
   return id;
 }
 
@@ -415,10 +442,19 @@ void replace_folder(const fs::path& staged, const fs::path& dir) {
   fs::remove_all(old, ec);
 }
 
-/// The scene argument as the store records and compares it: a glTF path absolute and normal (so
-/// that `verify` and `update` find it from any working folder), a built-in name as given.
+/// The scene argument as the store records and compares it: a glTF path absolute, with its links
+/// and ".." resolved (so that `verify` and `update` find it from any working folder; "link/../x"
+/// is the x beside the link's target), a built-in name as given. A path that is not UTF-8 cannot
+/// be recorded in the provenance (JSON) as it is, and is refused.
 std::string stored_scene(const std::string& scene) {
-  return scenes::is_scene_file_spec(scene) ? fs::absolute(scene).lexically_normal().string() : scene;
+  if (!scenes::is_scene_file_spec(scene)) return scene;
+  if (!io::is_utf8(scene))
+    throw InputError(fmt::format("--scene {}: the path is not valid UTF-8, and the provenance (JSON) could not record "
+                                 "it as it is; rename the file or its folders",
+                                 printable(scene)));
+  std::error_code ec;
+  const fs::path canonical = fs::weakly_canonical(scene, ec);
+  return ec ? fs::absolute(scene).lexically_normal().string() : canonical.string();
 }
 
 struct Prepared {
@@ -473,8 +509,13 @@ std::string ReferenceStore::store_option() const {
   return " --store " + shell_quote(root_.string());
 }
 
-std::string ReferenceStore::update_command(const std::string& id) const {
-  return "stereobench reference update " + shell_quote(id) + store_option();
+std::string ReferenceStore::scenes_dir_option(const fs::path& scenes_dir) {
+  if (scenes_dir.empty() || scenes_dir.lexically_normal() == scenes::default_scenes_dir().lexically_normal()) return "";
+  return " --scenes-dir " + shell_quote(scenes_dir.string());
+}
+
+std::string ReferenceStore::update_command(const std::string& id, const fs::path& scenes_dir) const {
+  return "stereobench reference update " + shell_quote(id) + store_option() + scenes_dir_option(scenes_dir);
 }
 
 const char* to_string(Status s) {
@@ -581,7 +622,7 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
           id, root_.string(), before->scene, stored.scene, scene.file_stem(), (root_ / id).string()));
     const json rig_now = rig_record(*p.rig);
     if (before && well_formed_rig(before_rig) && !same_record(before_rig, rig_now) &&
-        !same_record(spec_to_json(*before), spec_to_json(stored)))
+        !same_record(spec_to_json_fields(*before), spec_to_json_fields(stored)))
       throw InputError(fmt::format(
           "reference '{}' in {} was made with another rig ({}; the id gives the interaxial to 0.1 mm and the "
           "convergence to 3 digits); give this one another --store, or remove {} to replace it",
@@ -605,7 +646,7 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
         {"kind", kKind},
         {"version", 1},
         {"id", id},
-        {"spec", spec_to_json(stored)},
+        {"spec", spec_to_json(stored, root_)},
         {"provider",
          {{"name", render.provider},
           {"tool_version", render.tool_version},
@@ -748,14 +789,17 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
   }
   // With scene and rig as recorded, the folder's name is the id its spec gives: a renamed folder
   // would be found under a name that `reference generate` never writes, and regenerated beside it.
-  if (const std::string expected = reference_id(p.loaded.scene, spec, *p.rig, p.loaded.lights_in_file); expected != id) {
+  // A field of view (or light count) the spec gives explicitly that the scene's camera (or file) has
+  // since come to share leaves the rig as recorded, and the id as it was made.
+  if (const std::string expected = reference_id(p.loaded.scene, spec, *p.rig, p.loaded.lights_in_file);
+      expected != id && reference_id(p.loaded.scene, spec, *p.rig, p.loaded.lights_in_file, true) != id) {
     r.status = Status::corrupt;
     // Also an entry of a store written when ids named a scene by the name inside its file, or
     // before they named a field of view other than the scene camera's.
     r.detail = fmt::format("{}: its spec makes the reference '{}' (the id names the scene file, the rig, and a field "
                            "of view or light count other than the scene's), but the entry lies in folder '{}'; "
                            "`{}` writes it under that id, or rename the folder to '{}' (and its provenance's \"id\")",
-                           prov_file.string(), expected, id, update_command(id), expected);
+                           prov_file.string(), expected, id, update_command(id, scenes_dir), expected);
     return r;
   }
   // The hash matched, but the file may still be no image of this rig (both replaced together).
@@ -780,7 +824,7 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
   // The preview is what people look at: it must show the stored image (its bytes are not
   // recorded, so its pixels are compared with the image's sRGB encoding).
   const fs::path preview_file = root_ / id / kPreview;
-  const std::string preview_fix = fmt::format("`{}` writes it again", update_command(id));
+  const std::string preview_fix = fmt::format("`{}` writes it again", update_command(id, scenes_dir));
   try {
     const validation::Srgb8Image preview = validation::read_srgb8_file(preview_file).image;
     const validation::Srgb8Image expected = validation::encode_srgb8(stored, "the stored reference");

@@ -65,8 +65,12 @@ class ReferenceStore {
   /// " --store ROOT" (shell-quoted) for a command that is to work on this store, empty for the
   /// default store: for the commands messages give.
   [[nodiscard]] std::string store_option() const;
-  /// The command that writes the entry `id` of this store again, for messages.
-  [[nodiscard]] std::string update_command(const std::string& id) const;
+  /// " --scenes-dir DIR" (shell-quoted) for a command that loads scenes from `scenes_dir`, empty for
+  /// none given or the default folder.
+  [[nodiscard]] static std::string scenes_dir_option(const std::filesystem::path& scenes_dir);
+  /// The command that writes the entry `id` of this store again (its scenes from `scenes_dir`), for
+  /// messages.
+  [[nodiscard]] std::string update_command(const std::string& id, const std::filesystem::path& scenes_dir) const;
 
   /// The ids of complete entries, sorted. InputError when the store does not exist or is not a
   /// folder.

@@ -413,7 +413,8 @@ TEST(ReferenceStore, AnEntryThatContradictsItsFolderIsCorrupt) {
   EXPECT_NE(r.out.find("its spec makes the reference '" + pole + "' (the id names the scene file"), std::string::npos)
       << r.out;
   EXPECT_NE(r.out.find("but the entry lies in folder '" + renamed + "'; `stereobench reference update " + renamed +
-                       " --store " + shell_quote(store.string()) + "` writes it"),
+                       " --store " + shell_quote(store.string()) + " --scenes-dir " + shell_quote(kScenes.string()) +
+                       "` writes it"),
             std::string::npos)
       << r.out;
   // update writes that reference under its own id and says that the folder stays as it was,
@@ -490,6 +491,79 @@ TEST(ReferenceStore, AnotherSceneOfTheSameNameDoesNotReplaceAnEntry) {
   // The same scene again replaces its entry, as `reference update` does.
   EXPECT_EQ(test::run_cli(ref(dir, "generate") + " --scene " + quoted(copy) + args).code, 0);
   EXPECT_EQ(store.ids().size(), 1u);
+}
+
+TEST(ReferenceStore, AProjectMovedWithItsStoreAndScenesStillVerifies) {
+  // A store committed beside its scene files is checked out elsewhere: the entry finds its scene
+  // by the path relative to the store (it knew only the absolute one, which no longer exists, and
+  // neither verify nor update could mend it).
+  test::ScratchDir dir;
+  const fs::path project = dir / "projA";
+  fs::create_directories(project / "scenes");
+  fs::copy_file(scenes::resolve_scene("box-wall", kScenes), project / "scenes" / "mybox.gltf");
+  const std::string generate = "cd " + quoted(project) + " && " + SB_CLI_PATH +
+                               " reference generate --store refs --scene scenes/mybox.gltf --resolution 32x18 "
+                               "--threads 1";
+  ASSERT_EQ(test::run_shell(generate).code, 0);
+  const ReferenceStore before(project / "refs");
+  ASSERT_EQ(before.ids().size(), 1u);
+  const std::string id = before.ids()[0];
+  const json spec = json::parse(test::read_text(project / "refs" / id / "provenance.json"))["spec"];
+  EXPECT_EQ(spec["scene"], (project / "scenes" / "mybox.gltf").string());
+  EXPECT_EQ(spec["scene_from_store"], "../scenes/mybox.gltf");
+  fs::rename(project, dir / "projB");
+  const std::string verify = "cd " + quoted(dir / "projB") + " && " + SB_CLI_PATH + " reference verify --store refs";
+  const test::CliRun moved = test::run_shell(verify);
+  EXPECT_EQ(moved.code, 0) << moved.out;
+  EXPECT_NE(moved.out.find("1 of 1 reference(s) verified"), std::string::npos) << moved.out;
+  EXPECT_EQ(ReferenceStore(dir / "projB" / "refs").spec_of(id).scene, (dir / "projB" / "scenes" / "mybox.gltf").string());
+  // The store moved alone still finds the scene by its absolute path.
+  fs::rename(dir / "projB" / "refs", dir / "refs");
+  fs::rename(dir / "projB", project);
+  const test::CliRun alone = test::run_cli("reference verify --store " + quoted(dir / "refs"));
+  EXPECT_EQ(alone.code, 0) << alone.out;
+}
+
+TEST(ReferenceStore, AScenePathIsRecordedWithItsLinksResolvedAndInUtf8) {
+  test::ScratchDir dir;
+  fs::create_directories(dir / "sc" / "sub");
+  fs::copy_file(scenes::resolve_scene("box-wall", kScenes), dir / "sc" / "mybox.gltf");
+  fs::create_directory_symlink(dir / "sc" / "sub", dir / "deep");
+  const std::string args = " --resolution 32x18 --threads 1";
+  // "deep/../mybox.gltf" is sc/mybox.gltf (deep links to sc/sub); it was taken as the file beside
+  // deep, which does not exist.
+  const test::CliRun linked = test::run_cli(ref(dir, "generate") + " --scene " + quoted(dir / "deep" / ".." / "mybox.gltf") + args);
+  ASSERT_EQ(linked.code, 0) << linked.out;
+  const ReferenceStore store(dir / "store");
+  ASSERT_EQ(store.ids().size(), 1u);
+  EXPECT_EQ(store.spec_of(store.ids()[0]).scene, (dir / "sc" / "mybox.gltf").string());
+  EXPECT_EQ(test::run_cli(ref(dir, "verify")).code, 0);
+  // A path that is not UTF-8 is refused: the provenance recorded it with U+FFFD in place of the
+  // byte, and the entry could then never be verified.
+  const fs::path odd = dir / "b\xffx.gltf";
+  fs::copy_file(dir / "sc" / "mybox.gltf", odd);
+  const test::CliRun refused = test::run_cli(ref(dir, "generate") + " --scene " + quoted(odd) + args);
+  EXPECT_EQ(refused.code, 3) << refused.out;
+  EXPECT_NE(refused.out.find("the path is not valid UTF-8"), std::string::npos) << refused.out;
+  EXPECT_EQ(store.ids().size(), 1u);
+}
+
+TEST(ReferenceStore, AFieldOfViewTheSceneCameraComesToShareKeepsItsEntryValid) {
+  // The id names a field of view other than the scene camera's. Given as 50 degrees and the
+  // camera's changed to 50 since, rig and image are as recorded: the entry was called corrupt.
+  test::ScratchDir dir;
+  const fs::path scene = dir / "fov.gltf";
+  fs::copy_file(scenes::resolve_scene("box-wall", kScenes), scene);
+  ASSERT_EQ(test::run_cli(ref(dir, "generate") + " --scene " + quoted(scene) + " --resolution 32x18 --vfov 50").code, 0);
+  const ReferenceStore store(dir / "store");
+  ASSERT_EQ(store.ids().size(), 1u);
+  EXPECT_NE(store.ids()[0].find("_v50deg"), std::string::npos) << store.ids()[0];
+  json gltf = json::parse(test::read_text(scene));
+  ASSERT_TRUE(gltf["cameras"][0]["perspective"].contains("yfov"));
+  gltf["cameras"][0]["perspective"]["yfov"] = 50.0 * 3.141592653589793 / 180.0;
+  std::ofstream(scene, std::ios::trunc) << gltf.dump(2);
+  const test::CliRun r = test::run_cli(ref(dir, "verify"));
+  EXPECT_EQ(r.code, 0) << r.out;
 }
 
 TEST(ReferenceStore, AnotherRigDoesNotReplaceAnEntry) {
@@ -686,12 +760,13 @@ TEST(ReferenceStore, WithoutMinPsnrAChangeBelowTheEightBitLevelFails) {
       << r.out;
   EXPECT_EQ(r.out.find("(-1, -1)"), std::string::npos) << "no position of a largest error that is none: " << r.out;
   EXPECT_EQ(test::run_cli(ref(dir, "verify") + " --min-psnr 60").code, 0) << "a tolerance accepts it";
-  // The advice to rewrite a damaged preview names this store, not the default one.
+  // The advice to rewrite a damaged preview names this store, not the default one, and the scenes
+  // folder the run was given (it was left out, and the command then missed the scene).
   io::write_png_rgb8(dir / "store" / id / "right.png", std::vector<uint8_t>(32 * 18 * 3, 0), 32, 18);
   const test::CliRun preview = test::run_cli(ref(dir, "verify") + " --no-render");
   EXPECT_EQ(preview.code, 2) << preview.out;
   EXPECT_NE(preview.out.find("`stereobench reference update " + id + " --store " + shell_quote((dir / "store").string()) +
-                             "` writes it again"),
+                             " --scenes-dir " + shell_quote(kScenes.string()) + "` writes it again"),
             std::string::npos)
       << preview.out;
   // Verdicts go to a file; '-' is not one.
