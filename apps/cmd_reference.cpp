@@ -1,4 +1,5 @@
 // `stereobench reference generate|verify|update|list`: the reference store of DESIGN §6.4.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -45,7 +46,11 @@ struct ReferenceArgs {
 /// The entries named on the command line, each checked to be one the store holds, or all of them.
 std::vector<std::string> chosen_ids(const reference::ReferenceStore& store, const std::vector<std::string>& ids) {
   std::vector<std::string> all = store.ids();
-  for (const std::string& id : ids) store.require(id);
+  for (size_t i = 0; i < ids.size(); ++i) {
+    store.require(ids[i]);
+    if (std::find(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(i), ids[i]) != ids.begin() + static_cast<std::ptrdiff_t>(i))
+      throw InputError(fmt::format("reference '{}' is named twice; name each entry once", ids[i]));
+  }
   if (!ids.empty()) return ids;
   if (all.empty()) throw InputError(fmt::format("the reference store {} is empty; run `stereobench reference generate`",
                                                 store.root().string()));

@@ -596,6 +596,10 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
   // when done), so that a generate of the same id running meanwhile is waited for, and then checked
   // against.
   std::error_code made_root;
+  if (fs::exists(root_, made_root) && !fs::is_directory(root_, made_root))
+    throw InputError(fmt::format("the reference store {} is a file, not a folder; give --store a folder (a new one is "
+                                 "made)",
+                                 root_.string()));
   fs::create_directories(root_, made_root);  // a new store
   if (made_root)
     throw IoError(fmt::format("cannot create the reference store {}: {}; give a --store you can write",

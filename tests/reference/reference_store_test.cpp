@@ -133,6 +133,17 @@ TEST(ReferenceStore, VerifyUpdateOnlyFailingAndCorruption) {
   EXPECT_EQ(fs::last_write_time(dir / "store" / box / "provenance.json"), box_time) << "a passing reference was rewritten";
   EXPECT_EQ(store.provenance(box)["date"], box_date);
   EXPECT_EQ(test::run_cli(ref(dir, "verify")).code, 0);
+
+  // An entry named twice is refused (it was checked twice, "2 of 2 verified").
+  const test::CliRun twice = test::run_cli(ref(dir, "verify") + " --no-render " + box + " " + box);
+  EXPECT_EQ(twice.code, 3) << twice.out;
+  EXPECT_NE(twice.out.find("reference '" + box + "' is named twice"), std::string::npos) << twice.out;
+  // A file given as the store is bad input (exit 3), not an I/O failure.
+  std::ofstream(dir / "a-file") << "x";
+  const test::CliRun file = test::run_cli("reference generate --store " + quoted(dir / "a-file") + " --scenes-dir " +
+                                          quoted(kScenes) + " --scene box-wall --resolution 32x18");
+  EXPECT_EQ(file.code, 3) << file.out;
+  EXPECT_NE(file.out.find("is a file, not a folder"), std::string::npos) << file.out;
 }
 
 TEST(ReferenceStore, DamagedProvenanceIsAFindingNotAStop) {
