@@ -1,6 +1,7 @@
 // `stereobench compare A B`: the metrics of DESIGN §6.2 for any two image files, with idiff-style
 // pass / warn / fail thresholds, a JSON record, and difference and SSIM map pictures.
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -55,16 +56,32 @@ void check_limit(const std::optional<double>& v, const char* option, double lo, 
     throw InputError(fmt::format("{} {} is out of range; give {} in [{}, {}]", option, *v, what, lo, hi));
 }
 
+/// `value` with `digits` decimals, or as many more as it takes for the text to fall on the side of
+/// `limit` that `value` lies on (below it, or above): 39.41995 against 39.42 reads 39.41995, not
+/// 39.4200.
+std::string beside_limit(double value, double limit, int digits, bool below) {
+  std::string text;
+  for (int d = digits; d <= 17; ++d) {
+    text = fmt::format("{:.{}f}", value, d);
+    const double shown = std::strtod(text.c_str(), nullptr);
+    if (below ? shown < limit : shown > limit) break;
+  }
+  return text;
+}
+
 /// Reasons the metrics violate the given limits, e.g. "PSNR 23.1000 dB < --fail-psnr 30".
 std::vector<std::string> violations(const ImageMetrics& m, const Limit& psnr, const Limit& ssim, const Limit& percent) {
   std::vector<std::string> out;
   if (psnr.value && m.psnr < *psnr.value)
-    out.push_back(fmt::format("PSNR {} dB < {} {}", format_psnr(m.psnr), psnr.option, *psnr.value));
+    out.push_back(fmt::format("PSNR {} dB < {} {}",
+                              std::isinf(m.psnr) ? format_psnr(m.psnr) : beside_limit(m.psnr, *psnr.value, 4, true),
+                              psnr.option, *psnr.value));
   if (ssim.value && m.ssim < *ssim.value)
-    out.push_back(fmt::format("SSIM {:.6f} < {} {}", m.ssim, ssim.option, *ssim.value));
+    out.push_back(fmt::format("SSIM {} < {} {}", beside_limit(m.ssim, *ssim.value, 6, true), ssim.option, *ssim.value));
   const double percent_value = 100.0 * m.error_fraction;
   if (percent.value && percent_value > *percent.value)
-    out.push_back(fmt::format("error pixels {:.4f} % > {} {}", percent_value, percent.option, *percent.value));
+    out.push_back(fmt::format("error pixels {} % > {} {}", beside_limit(percent_value, *percent.value, 4, false),
+                              percent.option, *percent.value));
   return out;
 }
 
@@ -244,7 +261,9 @@ int run_compare(const CompareArgs& a) {
 constexpr const char* kCompareFooter = R"(
 Metrics (DESIGN 6.2) are computed on 8-bit sRGB images:
   EXR and other linear float files are clamped to [0,1], encoded with the exact sRGB curve and
-  rounded; 8-bit PNG/JPEG files are taken as stored (16-bit samples rounded to 8 bits). Grey
+  rounded; 8-bit PNG/JPEG files are taken as stored (16-bit samples rounded to 8 bits), unless
+  the file says its samples are linear (a PNG with gAMA 1.0, a TIFF tagged linear): those are
+  encoded like EXR. The encoding each image was read with is printed beside its name. Grey
   images count as R=G=B; an alpha channel is ignored. Both images must have the same size and
   both be grey or both colour.
   MSE    sum of squared channel differences / (3 * pixels), on the 0..255 scale

@@ -139,7 +139,9 @@ Srgb8File read_srgb8_file(const fs::path& path, std::string_view eye) {
     for (std::size_t i = 0; i < n; ++i)
       for (std::size_t c = 0; c < 3; ++c) rgb[i * 3 + c] = sample(i, c);
     file.image = encode_srgb8(linear, path.string());
-    file.encoding = fmt::format("{}, linear float encoded to sRGB", d.format);
+    // An integer file read as linear says so itself (a PNG's gAMA of 1.0, a TIFF tagged linear).
+    file.encoding = fmt::format("{}, {} encoded to sRGB", d.format,
+                                d.integer ? "linear as the file says (its colour space tag)" : "linear float");
   }
   return file;
 }

@@ -843,6 +843,7 @@ DecodedImage decode_from(OIIO::ImageInput& in, const std::string& name) {
   image.height = spec.height;
   image.channels = spec.nchannels;
   image.srgb = is_srgb(spec);
+  image.integer = !spec.format.is_floating_point();
   image.format = in.format_name();
   // Decoded a band of rows at a time, the buffer grown with each band: where the reader decodes
   // row by row (scan-line files other than interlaced PNG), a file that declares more rows than it

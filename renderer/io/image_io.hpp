@@ -120,7 +120,8 @@ struct DecodedImage {
   /// Whether the samples are sRGB-encoded (8-bit PNG and JPEG: yes; EXR, HDR: no). Values are
   /// never linearised here: the caller decides (glTF base colour is sRGB, other maps are not).
   bool srgb = false;
-  std::string format;  ///< the reader that decoded it, e.g. "png", "jpeg", "openexr"
+  bool integer = false;  ///< stored as integer samples (8- or 16-bit), not floating point
+  std::string format;    ///< the reader that decoded it, e.g. "png", "jpeg", "openexr"
 };
 
 /// Decodes an image file held in memory (PNG, JPEG, EXR, TIFF, BMP, HDR, ... whatever

@@ -12,9 +12,12 @@
 #include <filesystem>
 #include <limits>
 #include <string>
+#include <tuple>
+#include <cstring>
 #include <utility>
 #include <vector>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "renderer/color.hpp"
@@ -100,6 +103,24 @@ TEST_F(Compare, ThresholdsGiveFailAndWarnExitCodes) {
   r = compare(ab() + " --fail-psnr " + psnr_above + " --warn-psnr " + psnr_above);
   EXPECT_EQ(r.code, 2) << r.out;  // a failure outranks a warning
   EXPECT_NE(r.out.find("failure: PSNR"), std::string::npos) << r.out;
+  // A limit just above the measured value, where the value's usual digits round up to it: the
+  // message shows the digits that tell them apart (it printed "PSNR 39.4200 dB < --fail-psnr
+  // 39.42" for 39.41995). PSNR is printed with 4 decimals, SSIM with 6; the one whose rounding goes
+  // up is tried, both if both do.
+  int tried = 0;
+  for (const auto& [name, option, value, digits] :
+       {std::tuple{"PSNR", "--fail-psnr", m.psnr, 4}, std::tuple{"SSIM", "--fail-ssim", m.ssim, 6}}) {
+    const std::string rounded = fmt::format("{:.{}f}", value, digits);
+    const double limit = value + 1e-12 * std::max(1.0, value);
+    if (std::strtod(rounded.c_str(), nullptr) < limit) continue;  // rounds down: no collision to show
+    ++tried;
+    r = compare(ab() + " " + option + " " + fmt::format("{:.17g}", limit));
+    EXPECT_EQ(r.code, 2) << r.out;
+    const size_t at = r.out.find(fmt::format("failure: {} ", name));
+    ASSERT_NE(at, std::string::npos) << r.out;
+    EXPECT_LT(std::strtod(r.out.c_str() + at + 10 + std::strlen(name), nullptr), limit) << r.out;
+  }
+  EXPECT_GT(tried, 0) << "neither metric rounds up; pick another picture pair";
   r = compare(ab() + " --fail-ssim 1");
   EXPECT_EQ(r.code, 2) << r.out;
   r = compare(ab() + " --warn-ssim 1 --fail-ssim 0.5");
