@@ -251,7 +251,7 @@
     if (groups.length === 0) return null;
     const first = build(groups[0].cells);
     const scales = {
-      x: opts.linear ? axis(opts.xTitle, { type: 'linear' }) : axis(opts.xTitle, { offset: true }),
+      x: opts.linear ? axis(opts.xTitle, Object.assign({ type: 'linear' }, opts.xExtra || {})) : axis(opts.xTitle, { offset: true }),
       y: axis(opts.yTitle, opts.yExtra || {}),
     };
     const config = { type: 'line', data: first.data,
@@ -476,6 +476,8 @@
     if (framed.length === 0) return null;
     return metricVsAxis({ axis: 'frame', cells: framed, pipelines, title: 'Frame time along the path', key: (c) => c.frame, order: (k) => (typeof k === 'number' ? k : -1),
       label: (k) => String(k), linear: true, xTitle: 'frame', yTitle: 'time (ms)',
+      // Frames are whole numbers: no tick between two.
+      xExtra: { ticks: { stepSize: 1, precision: 0 } },
       value: (c, p) => { const t = num(field(c, p, 'time_s')); return t === null ? null : 1000 * t; },
       caption: 'Median time per frame of each pipeline along the camera path.' });
   }
@@ -901,10 +903,22 @@
     const node = el('section', { 'aria-labelledby': 'trends-h' }, el('h2', { id: 'trends-h' }, 'Trends'));
     if (data.history_note) node.append(el('p', { class: 'note' }, data.history_note));
     if (runs.length === 0) {
-      node.append(el('p', { class: 'note' }, 'The history file holds no run yet.'));
+      // The runs of other sweeps are left out (the note above counts them).
+      node.append(el('p', { class: 'note' }, 'The history file holds no run of this sweep yet.'));
       return { id: 'trends', title: 'Trends', node };
     }
     const labels = runs.map((r) => String(r.date).replace('T', ' ').replace('Z', ''));
+    // The axis names each run by its date, or date and time where a day has several runs, unrotated
+    // and thinned to what fits (the tooltips give the full time): full rotated date-times took half
+    // of a chart's height, and the plot shrank to a strip once the history held a few dozen runs.
+    const days = labels.map((l) => l.slice(0, 10));
+    const oneADay = new Set(days).size === days.length;
+    const tickLabel = (i) => (oneADay ? days[i] : labels[i].slice(0, 16));
+    const runAxis = (extra) => axis('run (UTC)', Object.assign({ ticks: { maxRotation: 0, autoSkip: true, autoSkipPadding: 12,
+      callback: (value, i) => tickLabel(i) } }, extra));
+    // Markers on every run merge into bands in a long history: smaller, then none (the line and
+    // the tooltips remain).
+    const radius = runs.length <= 30 ? 5 : runs.length <= 120 ? 2 : 0;
     // This report's pipelines first (their colours as elsewhere), then those only earlier runs had.
     const names = distinct([...pipelines, ...runs.flatMap((r) => Object.keys(r.pipelines || {}))])
       .filter((p) => runs.some((r) => (r.pipelines || {})[p]));
@@ -925,13 +939,13 @@
           return;
         }
         datasets.unshift({ label: p, data: points, borderColor: colour(p), backgroundColor: colour(p),
-          pointStyle: markers[k % markers.length], pointRadius: 5, borderWidth: 2, borderDash: dashes[k % dashes.length],
-          spanGaps: true, clip: 8 });
+          pointStyle: markers[k % markers.length], pointRadius: radius, pointHitRadius: 6, borderWidth: 2,
+          borderDash: dashes[k % dashes.length], spanGaps: true, clip: 8 });
       });
       if (datasets.length === 0) return null;
       const why = omitted.length ? ` Not plotted (no finite value${omittedWhy ? ': ' + omittedWhy : ''}): ${omitted.join(', ')}.` : '';
       const config = { type: 'line', data: { labels, datasets },
-        options: { scales: { x: axis('run (UTC)', { offset: true }), y: axis(yTitle) },
+        options: { scales: { x: runAxis({ offset: true }), y: axis(yTitle) },
           plugins: { legend: { position: 'bottom', reverse: true, labels: { usePointStyle: true } } } } };
       return chartFigure(title, `${caption} ${runText}.${why}`, config, 230 + 24 * Math.ceil(names.length / 5));
     };
@@ -941,7 +955,7 @@
       `Checks of the gate per verdict in each run; a run fails with any failed check, warns with warnings only, else passes (skipped checks do not count). ${runText}.`,
       { type: 'bar', data: { labels, datasets: verdicts.map(([v, c]) => ({ label: v, backgroundColor: c,
         data: runs.map((r) => num(((r.gate || {}).counts || {})[v]) || 0) })) },
-      options: { scales: { x: axis('run (UTC)', { stacked: true }), y: axis('checks', { stacked: true, beginAtZero: true }) },
+      options: { scales: { x: runAxis({ stacked: true }), y: axis('checks', { stacked: true, beginAtZero: true }) },
         plugins: { legend: { position: 'bottom' } } } }, 280);
 
     const grid = el('div', { class: 'charts' });

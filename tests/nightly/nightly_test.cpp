@@ -188,6 +188,26 @@ TEST(NightlyTest, TwoRunsGiveHistoryGateFilesAndTrends) {
                                             quoted(dir / "runs" / "history.jsonl"));
   ASSERT_EQ(report.code, 0) << report.out;
   EXPECT_EQ(embedded_data(dir / "report-again" / "index.html")["history"].size(), 2u);
+
+  // A history of 60 nightly runs keeps the trend charts legible (check_report.mjs: the plot at
+  // least 45 % of a chart's height, the run labels unrotated); rotated date-times left a strip.
+  std::string long_history;
+  for (int day = 0; day < 60; ++day) {
+    json h = history[static_cast<size_t>(day % 2)];
+    const std::string date = fmt::format("2025-{:02}-{:02}", 1 + day / 28, 1 + day % 28);
+    h["date"] = date + "T02:00:00Z";
+    h["run_id"] = fmt::format("2025{:02}{:02}T020000Z", 1 + day / 28, 1 + day % 28);
+    long_history += h.dump() + "\n";
+  }
+  std::ofstream(dir / "long.jsonl") << long_history;
+  const test::CliRun long_report = test::run_cli("report " + quoted(runs[0] / "results.jsonl") + " --out " +
+                                                 quoted(dir / "report-long") + " --history " + quoted(dir / "long.jsonl"));
+  ASSERT_EQ(long_report.code, 0) << long_report.out;
+  const test::CliRun long_browser = run_shell("node " + quoted(kSource / "tests" / "report" / "check_report.mjs") + " " +
+                                              quoted(dir / "report-long" / "index.html") + " " +
+                                              quoted(dir / "report-long.png") + " --quick");
+  EXPECT_EQ(long_browser.code, 0) << long_browser.out;
+  EXPECT_NE(long_browser.out.find("Median time per run: 3 datasets of 60 points"), std::string::npos) << long_browser.out;
 }
 
 TEST(NightlyTest, ResumesAnUnfinishedRunAndRecordsItOnce) {

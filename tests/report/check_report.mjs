@@ -184,7 +184,11 @@ try {
       for (const el of meta.data)
         if (Number.isFinite(el.x) && Number.isFinite(el.y)) positions.add(`${Math.round(el.x)},${Math.round(el.y)}`);
     });
-    return { title: canvas.getAttribute('aria-label').split('.')[0], pixels: saturated, positions: positions.size };
+    // A frame axis counts whole frames: its ticks (0, 0.5, 1, ... once) must be whole numbers.
+    const xScale = chart.scales.x;
+    const fractionalFrames = xScale && xScale.options.title && xScale.options.title.text === 'frame'
+      ? xScale.ticks.filter((t) => !Number.isInteger(t.value)).length : 0;
+    return { title: canvas.getAttribute('aria-label').split('.')[0], pixels: saturated, positions: positions.size, fractionalFrames };
   }));
   // The charts of every report: speed-up vs resolution, PSNR, SSIM, MSE and holes vs interaxial,
   // per-stage time (a chart without a finite value is left out and named in the caption).
@@ -196,6 +200,8 @@ try {
     else if (c.pixels < need)
       problems.push(`chart "${c.title}": ${c.pixels} data pixels (< ${need})${c.missing ? ', no chart object' : ''}`);
   }
+  for (const c of charts)
+    if (c.fractionalFrames) problems.push(`chart "${c.title}": ${c.fractionalFrames} ticks between whole frames`);
   report.charts = charts.map((c) => `${c.title}: ${c.pixels}`);
 
   // Trends (a report written with a history file): the median-time and gate-verdict charts always,
@@ -210,7 +216,10 @@ try {
         charts: [...section.querySelectorAll('figure.chart canvas')].map((canvas) => {
           const chart = window.Chart && Chart.getChart(canvas);
           return { title: canvas.getAttribute('aria-label').split('.')[0], type: chart ? chart.config.type : null,
-            points: chart ? chart.data.datasets.map((d) => d.data.length) : [] };
+            points: chart ? chart.data.datasets.map((d) => d.data.length) : [],
+            // The plot's share of the chart's height, and the run axis labels' rotation.
+            plotShare: chart ? chart.chartArea.height / chart.height : 0,
+            rotation: chart ? chart.scales.x.labelRotation : 0 };
         }),
       };
     });
@@ -221,8 +230,12 @@ try {
       const finitePsnr = data.history.some((r) => Object.values(r.pipelines).some((p) => typeof p.psnr === 'number'));
       const expected = finitePsnr ? 3 : 2;
       if (trends.charts.length !== expected) problems.push(`trends: ${trends.charts.length} charts, expected ${expected}`);
-      for (const c of trends.charts)
+      for (const c of trends.charts) {
         if (c.points.some((n) => n !== runs)) problems.push(`trend chart "${c.title}": datasets of ${c.points.join(', ')} points for ${runs} runs`);
+        // A long history once left a strip of plot under rotated date-times.
+        if (c.plotShare < 0.45) problems.push(`trend chart "${c.title}": the plot is ${(100 * c.plotShare).toFixed(0)} % of the chart's height (< 45 %)`);
+        if (c.rotation !== 0) problems.push(`trend chart "${c.title}": run labels rotated ${c.rotation.toFixed(0)}°`);
+      }
       report.trends = trends.charts.map((c) => `${c.title}: ${c.points.length} datasets of ${runs} points`);
     }
   }

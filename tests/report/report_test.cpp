@@ -199,6 +199,27 @@ TEST(Report, SmokeSweepReportsPassTheBrowserCheck) {
   }
 }
 
+TEST(Report, APathSweepsFrameChartCountsWholeFrames) {
+  require_browser_tools();
+  if (HasFatalFailure()) return;
+  test::ScratchDir dir;
+  // Four frames of spheres spinning: the frame axis had ticks at 0, 0.5, 1, 1.5, ...
+  write_text(dir / "path.toml",
+             "[sweep]\nname = \"spin\"\nscenes = [\"spheres\"]\npipelines = [\"plain-rt\", \"repro-rt\"]\n"
+             "baseline = \"plain-rt\"\nmax_disparity_px = [4, 8]\nresolutions = [\"64x36\"]\n"
+             "[path]\nframes = 4\nbvh = \"refit\"\n[path.spin]\naxis = [0, 1, 0]\ndegrees_per_frame = 5.0\n"
+             "mesh_prefix = \"sphere\"\n[timing]\nrepetitions = 1\nwarmup = 0\n");
+  const test::CliRun run = test::run_cli("sweep run " + quoted(dir / "path.toml") + " --out " + quoted(dir / "sweep") +
+                                         " --threads 2 --scenes-dir " +
+                                         quoted(fs::path(SB_BINARY_DIR) / "Testing" / "scenes-cache"));
+  ASSERT_EQ(run.code, 0) << run.out;
+  const test::CliRun report =
+      test::run_cli("report " + quoted(dir / "sweep" / "results.jsonl") + " --out " + quoted(dir / "report"));
+  ASSERT_EQ(report.code, 0) << report.out;
+  const std::string checked = check_in_browser(dir / "report" / "index.html", dir / "report.png", true);
+  EXPECT_NE(checked.find("Frame time along the path"), std::string::npos) << checked;
+}
+
 /// A minimal valid results line (no images: the report shows them as unavailable).
 json minimal_line(const std::string& id, int index) {
   const json metrics{{"psnr", 40.5}, {"ssim", 0.99}, {"mse", test::mse_of_psnr(40.5)}, {"error_fraction", 0.01}};
