@@ -236,6 +236,17 @@ void require_psnr_of_mse(const json& root, const std::string& where, const std::
                                                         : fmt::format("{:.6f}", expected)));
 }
 
+/// The metrics at `metrics` (psnr, ssim, an optional mse): each a number, "inf" or null, within what a
+/// measurement gives, the PSNR the one its MSE gives.
+void require_metrics(const json& root, const std::string& where, const std::string& prefix, const std::string& metrics) {
+  for (const char* m : {"psnr", "ssim", "mse"})
+    require(root, where, prefix, metrics + "." + m, Kind::metric, m == std::string("mse"));
+  require_within(root, where, prefix, metrics + ".psnr", 0.0, std::numeric_limits<double>::infinity());
+  require_within(root, where, prefix, metrics + ".ssim", -1.0, 1.0);
+  require_within(root, where, prefix, metrics + ".mse", 0.0, 255.0 * 255.0);
+  require_psnr_of_mse(root, where, prefix, metrics);
+}
+
 /// A field of a results line: its dotted path, what it may hold, whether it may be absent.
 struct Field {
   const char* path;
@@ -465,14 +476,21 @@ void check_cell_record(const json& line, const std::string& where) {
     require_times(p, where, prefix, "validation.timings_s");
     // A left eye synthesized in part is measured as the right eye is.
     require(p, where, prefix, "validation.left_eye", Kind::object_or_null, true);
-    if (const json* left = find(p, "validation.left_eye"); left != nullptr && left->is_object()) {
-      for (const char* m : {"psnr", "ssim", "mse"})
-        require(p, where, prefix, std::string("validation.left_eye.metrics.") + m, Kind::metric, m == std::string("mse"));
-      require_within(p, where, prefix, "validation.left_eye.metrics.psnr", 0.0, std::numeric_limits<double>::infinity());
-      require_within(p, where, prefix, "validation.left_eye.metrics.ssim", -1.0, 1.0);
-      require_within(p, where, prefix, "validation.left_eye.metrics.mse", 0.0, 255.0 * 255.0);
-      require_psnr_of_mse(p, where, prefix, "validation.left_eye.metrics");
-    }
+    if (const json* left = find(p, "validation.left_eye"); left != nullptr && left->is_object())
+      require_metrics(p, where, prefix, "validation.left_eye.metrics");
+    // The metrics per region (reprojected, filled, true disocclusions), which the report shows.
+    require(p, where, prefix, "validation.regions", Kind::object, true);
+    if (const json* regions = find(p, "validation.regions"))
+      for (const auto& [region, r] : regions->items()) {
+        const std::string at = "validation.regions." + region;
+        if (region.empty() || region.find('.') != std::string::npos || !r.is_object())
+          throw InputError(fmt::format("{}: field '{}{}' is {}, not a region's metrics (an object); the line is "
+                                       "damaged or edited by hand",
+                                       where, prefix, at, r.dump().substr(0, 80)));
+        require(p, where, prefix, at + ".pixels", Kind::integer);
+        require_within(p, where, prefix, at + ".pixels", 0.0, std::numeric_limits<double>::max());
+        require_metrics(p, where, prefix, at);
+      }
     if (p.contains("timing")) {
       for (const char* t : {"median_s", "min_s", "max_s", "speedup_median", "right_over_left_median"}) {
         require(p, where, prefix, std::string("timing.") + t, Kind::number_or_null, true);

@@ -272,6 +272,12 @@ TEST(Report, MalformedResultsExit3NamingFileAndLine) {
   negative_time["pipelines"]["plain-rt"]["validation"]["total_s"] = -0.5;
   json wrapped_version = minimal_line("b", 1);
   wrapped_version["schema_version"] = 4294967297LL;  // 2^32 + 1, which an int reads as 1
+  // The metrics per region were copied into the page unchecked.
+  json bad_region = minimal_line("b", 1);
+  bad_region["pipelines"]["repro-rt"]["validation"]["regions"] = {{"filled", {{"pixels", -3}, {"psnr", "x"}}}};
+  json bad_region_psnr = minimal_line("b", 1);
+  bad_region_psnr["pipelines"]["repro-rt"]["validation"]["regions"] = {
+      {"reprojected", {{"pixels", 10}, {"psnr", "x"}, {"ssim", 0.9}, {"mse", 1.0}}}};
   const std::vector<Case> cases = {
       {good + "{\"kind\": \"stereobench.sweep_cell\", oops}\n" + minimal_line("c", 2).dump() + "\n",
        "results.jsonl:2: not a JSON line"},
@@ -291,6 +297,10 @@ TEST(Report, MalformedResultsExit3NamingFileAndLine) {
        "results.jsonl:2: field 'pipelines.repro-rt.validation.metrics.ssim' is 5, outside [-1, 1]"},
       {good + negative_time.dump() + "\n", "results.jsonl:2: field 'pipelines.plain-rt.validation.total_s' is -0.5"},
       {good + wrapped_version.dump() + "\n", "results.jsonl:2: schema_version 4294967297 is newer"},
+      {good + bad_region.dump() + "\n",
+       "results.jsonl:2: field 'pipelines.repro-rt.validation.regions.filled.pixels' is -3, outside"},
+      {good + bad_region_psnr.dump() + "\n",
+       "results.jsonl:2: field 'pipelines.repro-rt.validation.regions.reprojected.psnr' is \"x\""},
       {"[1, 2]\n", "results.jsonl:1: a results line must be a JSON object"},
       {"", "holds no finished cell"},
       {"{\"kind\": \"stereobench.sweep_ce", "holds no finished cell"},
