@@ -258,9 +258,14 @@ void run_nightly(const NightlyArgs& a) {
   // The folders are made once every argument is known to be good: a usage error leaves none.
   // The run folders go under --out: a folder that cannot be made is named as that option (the
   // default history file lies there too, and was blamed).
+  // A --history elsewhere is checked before --out is made, so that its refusal leaves no empty
+  // run folder behind; the default one lies in --out.
+  if (const std::optional<std::string> why = io::folder_cannot_be_made(out))
+    throw IoError(fmt::format("--out {}: {}; give a folder you can write", out.string(), *why));
+  if (!a.history.empty()) check_history_writable(history_file, true);
   if (const std::optional<std::string> why = io::unwritable_folder(out))
     throw IoError(fmt::format("--out {}: {}; give a folder you can write", out.string(), *why));
-  check_history_writable(history_file, !a.history.empty());
+  if (a.history.empty()) check_history_writable(history_file, false);
 
   // 1. The sweep, into the run folder.
   ChosenRun chosen = choose_run_dir(out, d, history_file);

@@ -491,6 +491,18 @@ TEST(NightlyTest, AReportFolderThatCannotTakeTheReportIsRefusedBeforeTheSweep) {
   EXPECT_FALSE(fs::exists(dir / "runs" / "history.jsonl")) << "no run was recorded";
 }
 
+TEST(NightlyTest, AHistoryThatCannotBeWrittenLeavesNoRunFolder) {
+  // A --history whose folder cannot be made (a file is in the way) is refused before --out is
+  // made: it left an empty --out behind.
+  test::ScratchDir dir;
+  write_inputs(dir);
+  write_text(dir / "a-file", "x\n");
+  const test::CliRun r = test::run_cli(nightly_args(dir) + " --history " + quoted(dir / "a-file" / "history.jsonl"));
+  EXPECT_EQ(r.code, 4) << r.out;
+  EXPECT_NE(r.out.find("cannot make its folder"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "runs")) << r.out;
+}
+
 TEST(NightlyTest, SweepsSharingAHistoryKeepTheirRunsApart) {
   // Two sweeps, one history: a new run takes an id no line of the history has (it used to take the
   // other sweep's id of the same second and was silently not recorded), its trends show its own
