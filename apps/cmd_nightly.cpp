@@ -371,7 +371,7 @@ void run_nightly(const NightlyArgs& a) {
   // The trends are this sweep's: a history shared with other sweeps keeps their runs out.
   SweepRuns trends = runs_of_sweep(history, d.name, history_file);
   if (!trends.left_out.empty()) {
-    options.history_note = fmt::format("The {}.", trends.left_out);
+    options.history_note = fmt::format("The {}.", trends.left_out_on_page);
     fmt::print(stderr, "note: the {}\n", trends.left_out);
   }
   options.history = std::move(trends.runs);

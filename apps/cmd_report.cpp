@@ -90,7 +90,7 @@ void run_report(const ReportArgs& a) {
     validation::SweepRuns trends =
         validation::runs_of_sweep(h, results.cells.front().json.value("sweep", ""), a.history);
     if (!trends.left_out.empty()) {
-      options.history_note = fmt::format("The {}.", trends.left_out);
+      options.history_note = fmt::format("The {}.", trends.left_out_on_page);
       std::fprintf(stderr, "stereobench: note: the %s\n", trends.left_out.c_str());
     }
     options.history = std::move(trends.runs);

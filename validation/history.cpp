@@ -192,9 +192,13 @@ SweepRuns runs_of_sweep(const HistoryFile& history, const std::string& sweep, co
   SweepRuns out;
   for (const json& r : history.runs)
     if (r.value("sweep", "") == sweep) out.runs.push_back(r);
-  if (out.runs.size() < history.runs.size())
-    out.left_out = fmt::format("trends leave out {} runs of other sweeps in {}", history.runs.size() - out.runs.size(),
-                               file.string());
+  if (out.runs.size() < history.runs.size()) {
+    const size_t others = history.runs.size() - out.runs.size();
+    const char* runs = others == 1 ? "run" : "runs";
+    out.left_out = fmt::format("trends leave out {} {} of other sweeps in {}", others, runs, file.string());
+    out.left_out_on_page =
+        fmt::format("trends leave out {} {} of other sweeps in {}", others, runs, file.filename().string());
+  }
   return out;
 }
 

@@ -60,6 +60,9 @@ struct HistoryFile {
 struct SweepRuns {
   nlohmann::json runs = nlohmann::json::array();
   std::string left_out;
+  /// The same for the report's page, naming the file by its name alone: the page names no folder
+  /// of this machine.
+  std::string left_out_on_page;
 };
 [[nodiscard]] SweepRuns runs_of_sweep(const HistoryFile& history, const std::string& sweep,
                                       const std::filesystem::path& file);

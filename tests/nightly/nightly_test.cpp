@@ -552,6 +552,8 @@ TEST(NightlyTest, SweepsSharingAHistoryKeepTheirRunsApart) {
   EXPECT_NE(page["history_note"].get<std::string>().find(fmt::format("leave out {} runs of other sweeps", other_runs)),
             std::string::npos)
       << "the page says it too";
+  // By the history file's name alone: the page names no folder of this machine.
+  EXPECT_EQ(page["history_note"].get<std::string>().find(dir.path().string()), std::string::npos) << page["history_note"];
   const json trends = page["history"];
   ASSERT_EQ(trends.size(), 2u) << trends.dump();
   for (const json& r : trends) EXPECT_EQ(r["sweep"], "nightly-tiny");
