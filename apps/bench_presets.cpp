@@ -15,6 +15,7 @@
 #include "renderer/io/gltf_loader.hpp"
 #include "renderer/io/json_text.hpp"
 #include "renderer/io/render_output.hpp"
+#include "renderer/text.hpp"
 #include "scenes/catalog.hpp"
 #include "scenes/generators.hpp"
 
@@ -217,7 +218,10 @@ std::string preset_overrides(const PresetRun& run) {
   std::vector<std::string> parts;
   if (o.width && o.height) parts.push_back(fmt::format("image size {}x{}", *o.width, *o.height));
   if (o.convergence) parts.push_back(fmt::format("convergence {:g} m", *o.convergence));
-  if (o.vfov) parts.push_back(fmt::format("vertical field of view {:g} degrees", radians_to_degrees(*o.vfov)));
+  if (o.vfov) {
+    const double degrees = radians_to_degrees(*o.vfov);
+    parts.push_back(fmt::format("vertical field of view {:g} degree{}", degrees, degrees == 1.0 ? "" : "s"));
+  }
   return fmt::format("{}", fmt::join(parts, ", "));
 }
 
@@ -228,7 +232,9 @@ void print_preset_summary(const PresetRun& run) {
 }
 
 nlohmann::json preset_json(const PresetRun& run, const Executor& executor) {
-  return {{"preset", run.preset->name},
+  return {{"kind", "stereobench.bench_preset"},
+          {"schema_version", 1},
+          {"preset", run.preset->name},
           {"summary", run.preset->summary},
           {"overrides", preset_overrides(run)},
           {"pipelines", run.config.pipelines},
@@ -299,9 +305,9 @@ void run_bench_preset(const PresetRun& run, const Executor& executor) {
   std::string pipelines;
   for (const std::string& p : run.config.pipelines) pipelines += (pipelines.empty() ? "" : ", ") + p;
   print_preset_summary(run);
-  fmt::print("{} series, {} rows; {}; baseline {}; {} threads, {} warm-up + {} repetitions per row\n",
-             preset.series.size(), total_rows, pipelines, run.config.baseline, executor.threads(), run.config.warmup,
-             run.config.repetitions);
+  fmt::print("{} series, {}; {}; baseline {}; {}, {} warm-up + {} per row\n", preset.series.size(),
+             counted(static_cast<long long>(total_rows), "row"), pipelines, run.config.baseline,
+             counted(executor.threads(), "thread"), run.config.warmup, counted(run.config.repetitions, "repetition"));
   if (const std::string given = given_options(run.config); !given.empty()) fmt::print("options: {}\n", given);
   fmt::print("speed-up = median over repetitions of {}'s total / the pipeline's total, paired per repetition\n",
              run.config.baseline);
@@ -324,6 +330,8 @@ void run_bench_preset(const PresetRun& run, const Executor& executor) {
       const RenderScene& prepared = current.get(path, row.lights);
       const Scene& scene = prepared.scene();
       const size_t lights = scene.lights.size();
+      // The series' rigs are checked before its header is printed: a refusal follows no empty table.
+      if (i == 0) check_series_rigs(run, series, n, path, scene, speed_row_rig);
       if (!header_printed) {
         fmt::print("\n{}: {} ({} triangles), {}{}\n", series.name, scene.name, scene.triangle_count(), series.fixed,
                    lights_fixed(series) ? fmt::format(", {} light{}", lights, lights == 1 ? "" : "s") : "");
@@ -333,7 +341,6 @@ void run_bench_preset(const PresetRun& run, const Executor& executor) {
         print_table_header(layout, series.swept, run.config.pipelines);
         header_printed = true;
       }
-      if (i == 0) check_series_rigs(run, series, n, path, scene, speed_row_rig);
       const StereoRig rig = speed_row_rig(scene, run, row);
       run.output_starts();
       const BenchResult r = run_bench(prepared, rig, run.config, executor);

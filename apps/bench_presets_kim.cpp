@@ -23,6 +23,7 @@
 #include "renderer/io/json_text.hpp"
 #include "renderer/io/render_output.hpp"
 #include "renderer/memory.hpp"
+#include "renderer/text.hpp"
 #include "scenes/catalog.hpp"
 #include "validation/metrics.hpp"
 
@@ -96,9 +97,9 @@ nlohmann::json scene_json(const Scene& scene, const PresetRow& row) {
 
 void print_run_head(const PresetRun& run, const Executor& executor) {
   print_preset_summary(run);
-  fmt::print("{}; baseline {}; {} threads, {} warm-up + {} repetitions per row\n",
-             fmt::join(run.config.pipelines, ", "), run.config.baseline, executor.threads(), run.config.warmup,
-             run.config.repetitions);
+  fmt::print("{}; baseline {}; {}, {} warm-up + {} per row\n", fmt::join(run.config.pipelines, ", "),
+             run.config.baseline, counted(executor.threads(), "thread"), run.config.warmup,
+             counted(run.config.repetitions, "repetition"));
   if (const std::string given = given_options(run.config); !given.empty()) fmt::print("options: {}\n", given);
   fmt::print("times: median over repetitions of each pipeline's total; speed-up = median over repetitions of {}'s "
              "total / the pipeline's total, paired per repetition\n",

@@ -17,6 +17,7 @@
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/json_text.hpp"
 #include "renderer/io/render_output.hpp"
+#include "renderer/text.hpp"
 #include "scenes/catalog.hpp"
 #include "validation/benchmark.hpp"
 
@@ -129,9 +130,9 @@ void run_bench_command(const BenchArgs& a) {
   // From here the run's own --json, or none: an earlier one is not left to be read as this run's.
   remove_earlier_output(a.json_out, "--json");
   const RenderScene prepared(scene);
-  fmt::print(out, "scene {} ({} triangles, {}), {}, {} threads, {} warm-up + {} repetitions\n", scene.name,
-             scene.triangle_count(), describe_lights(scene.lights.size(), lights_in_file), describe(rig),
-             executor.threads(), a.warmup, a.repetitions);
+  fmt::print(out, "scene {} ({} triangles, {}), {}, {}, {} warm-up + {}\n", scene.name, scene.triangle_count(),
+             describe_lights(scene.lights.size(), lights_in_file), describe(rig), counted(executor.threads(), "thread"),
+             a.warmup, counted(a.repetitions, "repetition"));
   if (const std::string given = given_options(config); !given.empty()) fmt::print(out, "options: {}\n", given);
   fmt::print(out, "bvh build {:.1f} ms, {:.1f} MiB\n", prepared.bvh_build_seconds() * 1e3,
              prepared.rays().memory_bytes() / 1048576.0);

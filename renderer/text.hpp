@@ -13,6 +13,11 @@
 
 namespace sb {
 
+/// "1 thread", "2 threads": `n` and the noun, in the plural unless n is 1 (nouns that take an -s).
+[[nodiscard]] inline std::string counted(long long n, std::string_view noun) {
+  return std::to_string(n) + " " + std::string(noun) + (n == 1 ? "" : "s");
+}
+
 /// The whole of `text` as a finite decimal number, or nothing (partial parses, NaN, infinities,
 /// hexadecimal such as 0x10 and leading blanks, which the C library would accept, fail).
 [[nodiscard]] inline std::optional<double> parse_finite(const std::string& text) {

@@ -128,8 +128,9 @@ Summary paired_speedup(const PipelineBench& base, const PipelineBench& b) {
 }
 
 nlohmann::json bench_to_json(const BenchResult& r) {
-  nlohmann::json out = {
-      {"baseline", r.baseline}, {"warmup", r.warmup}, {"repetitions", r.repetitions}, {"threads", r.threads}};
+  nlohmann::json out = {{"kind", "stereobench.bench"},   {"schema_version", 1},
+                        {"baseline", r.baseline},          {"warmup", r.warmup},
+                        {"repetitions", r.repetitions},    {"threads", r.threads}};
   auto summary = [](const Summary& s) { return nlohmann::json{{"median", s.median}, {"min", s.min}, {"max", s.max}}; };
   for (const PipelineBench& b : r.pipelines) {
     const std::optional<Summary> share = b.right_over_left();

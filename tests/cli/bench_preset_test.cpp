@@ -51,6 +51,8 @@ TEST(BenchPreset, DimensionsRunsTheFirstSizeOfEveryScene) {
 
   const json j = json::parse(test::read_text(dir / "dimensions.json"));
   EXPECT_TRUE(j.at("complete").get<bool>());
+  EXPECT_EQ(j.at("kind"), "stereobench.bench_preset");
+  EXPECT_EQ(j.at("schema_version"), 1);
   EXPECT_EQ(j.at("preset"), "al-hagri-dimensions");
   const json& rows = j.at("rows");
   ASSERT_EQ(rows.size(), 6u);  // spheres, atrium, bistro, temple, dragon, complexity
@@ -332,6 +334,17 @@ TEST(BenchPresetKim, AnSsimBelowItsWindowIsPrintedAsUndefined) {
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("undefined/"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("nan"), std::string::npos) << r.out;
+}
+
+TEST(BenchPreset, ARigARowRefusesIsNamedBeforeTheSeriesTable) {
+  test::ScratchDir dir("refusedrig");
+  // rt-buffer's buffer depth beyond its bound at 600x600: refused before the series' table header
+  // (an empty header was printed above the error).
+  const CliRun r = test::run_cli("bench --preset al-hagri-lights --preset-rows 1 -n 1 -w 0 -p rt-buffer -o "
+                                 "rt-buffer.depth=4096 --scenes-dir '" + (dir / "scenes").string() + "'");
+  EXPECT_EQ(r.code, 3) << r.out;
+  EXPECT_NE(r.out.find("(no row of the series has run)"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("rt-buffer ms"), std::string::npos) << "a table header before the refusal:\n" << r.out;
 }
 
 TEST(BenchPresetKim, ARowARigRefusesStopsTheSeriesBeforeItsFirstRow) {

@@ -355,11 +355,17 @@ TEST(Cli, RenderWritesEveryOutputAndBenchPrintsATable) {
                                            " --json -" + common + " 2>/dev/null)");
   ASSERT_EQ(json_only.code, 0) << json_only.out;
   EXPECT_EQ(nlohmann::json::parse(json_only.out).at("baseline"), "plain-rt") << json_only.out;
+  EXPECT_EQ(nlohmann::json::parse(json_only.out).at("kind"), "stereobench.bench") << json_only.out;
+  EXPECT_EQ(nlohmann::json::parse(json_only.out).at("schema_version"), 1) << json_only.out;
   EXPECT_FALSE(std::filesystem::exists("-"));
   // Numbers are decimal: a leading zero does not make an integer octal (010 is ten, not eight).
   const CliRun zeros = run("bench --scene box-wall --pipelines plain-rt --baseline plain-rt -n 010 -w 00" + common);
   ASSERT_EQ(zeros.code, 0) << zeros.out;
   EXPECT_NE(zeros.out.find("0 warm-up + 10 repetitions"), std::string::npos) << zeros.out;
+  // One of a thing is not "1 threads" or "1 repetitions".
+  const CliRun one = run("bench --scene box-wall --pipelines plain-rt --baseline plain-rt -n 1 -w 0 --threads 1" + common);
+  ASSERT_EQ(one.code, 0) << one.out;
+  EXPECT_NE(one.out.find(", 1 thread, 0 warm-up + 1 repetition\n"), std::string::npos) << one.out;
   // 'all' times every registered pipeline, beside a variant named after it.
   const CliRun every =
       run("bench --scene box-wall --pipelines all,bidir-warp:occlusion=ztest --baseline plain-rt -n 1 -w 0" + common);
