@@ -100,8 +100,10 @@ json spec_to_json(const ReferenceSpec& s, const fs::path& root) {
   json out = spec_to_json_fields(s);
   if (scenes::is_scene_file_spec(s.scene)) {
     std::error_code ec;
-    const fs::path relative = fs::relative(s.scene, root, ec);
-    if (!ec && !relative.empty()) out["scene_from_store"] = relative.generic_string();
+    // The folder relative to the store's, the file's own name kept (a linked scene file is the link).
+    const fs::path scene(s.scene);
+    const fs::path folder = fs::relative(scene.parent_path(), root, ec);
+    if (!ec && !folder.empty()) out["scene_from_store"] = (folder / scene.filename()).generic_string();
   }
   return out;
 }
@@ -218,9 +220,10 @@ ReferenceSpec spec_in(const json& provenance, const fs::path& file) {
   const json& recorded = provenance.at("spec");
   if (recorded.contains("scene_from_store") && recorded.at("scene_from_store").is_string()) {
     std::error_code ec;
-    const fs::path beside = fs::weakly_canonical(
-        file.parent_path().parent_path() / fs::path(recorded.at("scene_from_store").get<std::string>()), ec);
-    if (!ec && fs::is_regular_file(beside, ec)) spec.scene = beside.string();
+    const fs::path relative(recorded.at("scene_from_store").get<std::string>());
+    const fs::path folder = fs::weakly_canonical(file.parent_path().parent_path() / relative.parent_path(), ec);
+    const fs::path beside = folder / relative.filename();
+    if (!ec && !relative.filename().empty() && fs::is_regular_file(beside, ec)) spec.scene = beside.string();
   }
   const std::vector<std::string> providers = validation::truth_provider_names();
   if (std::find(providers.begin(), providers.end(), spec.provider) == providers.end())
@@ -254,22 +257,28 @@ json without_scratch_path(const json& value, const fs::path& scratch) {
   return out;
 }
 
-/// The entry's folder name: scene (its file_stem: a name safe in a path, never hidden), provider,
-/// size, interaxial and convergence; the field of view and the light count where they are not the
-/// scene's (`lights_in_file`: the scene's own count).
-/// With `as_given`, the field of view and light count the spec gives are named even where they are the
-/// scene's: the id the entry had when the scene's own differed (verify accepts both).
-std::string reference_id(const Scene& scene, const ReferenceSpec& spec, const StereoRig& rig, size_t lights_in_file,
-                         bool as_given = false) {
+/// The ids an entry of this spec may lie under. The first is the id an entry is made under: the
+/// scene (its file_stem: a name safe in a path, never hidden), provider, size, interaxial and
+/// convergence; the field of view and the light count where they are not the scene's
+/// (`lights_in_file`: the scene's own count). Then those naming a field of view or light count the
+/// spec gives explicitly although the scene has come to share it: the id was made when the scene's
+/// own differed, and the rig is as recorded.
+std::vector<std::string> reference_ids(const Scene& scene, const ReferenceSpec& spec, const StereoRig& rig,
+                                       size_t lights_in_file) {
   const RigParams& p = rig.params();
-  std::string id = fmt::format("{}_{}_{}x{}_e{:.1f}mm_c{:.3g}m", scene.file_stem(), spec.provider, p.width,
-                               p.height, p.interaxial * 1e3, p.convergence);
-  // The scene camera's field of view goes without saying; any other is part of the id.
-  if (p.vfov != resolve_rig(scene, {}).params().vfov || (as_given && spec.rig.vfov))
-    id += fmt::format("_v{:.4g}deg", radians_to_degrees(p.vfov));
-  if (spec.lights && (static_cast<size_t>(*spec.lights) != lights_in_file || as_given))
-    id += fmt::format("_l{}", *spec.lights);
-  return id;
+  const bool vfov_named = p.vfov != resolve_rig(scene, {}).params().vfov;
+  const bool lights_named = spec.lights && static_cast<size_t>(*spec.lights) != lights_in_file;
+  const std::string base = fmt::format("{}_{}_{}x{}_e{:.1f}mm_c{:.3g}m", scene.file_stem(), spec.provider, p.width,
+                                       p.height, p.interaxial * 1e3, p.convergence);
+  std::vector<std::string> ids;
+  for (const bool vfov : {vfov_named, spec.rig.vfov.has_value()})
+    for (const bool lights : {lights_named, spec.lights.has_value()}) {
+      std::string id = base;
+      if (vfov) id += fmt::format("_v{:.4g}deg", radians_to_degrees(p.vfov));
+      if (lights) id += fmt::format("_l{}", *spec.lights);
+      if (std::find(ids.begin(), ids.end(), id) == ids.end()) ids.push_back(id);
+    }
+  return ids;
 }
 
 /// A folder of its own in the temporary folder (TMPDIR, else /tmp), "PREFIX-XXXXXX", removed with
@@ -442,19 +451,25 @@ void replace_folder(const fs::path& staged, const fs::path& dir) {
   fs::remove_all(old, ec);
 }
 
-/// The scene argument as the store records and compares it: a glTF path absolute, with its links
-/// and ".." resolved (so that `verify` and `update` find it from any working folder; "link/../x"
-/// is the x beside the link's target), a built-in name as given. A path that is not UTF-8 cannot
-/// be recorded in the provenance (JSON) as it is, and is refused.
+/// The scene argument as the store records and compares it: a glTF path absolute, its folders'
+/// links and ".." resolved (so that `verify` and `update` find it from any working folder;
+/// "link/../x" is the x beside the link's target), the file's own name kept (a linked scene file
+/// keeps its name, which the id gives, and its buffers and textures are found beside the link), a
+/// built-in name as given. A path that is not UTF-8 cannot be recorded in the provenance (JSON) as
+/// it is, and is refused.
 std::string stored_scene(const std::string& scene) {
   if (!scenes::is_scene_file_spec(scene)) return scene;
-  if (!io::is_utf8(scene))
-    throw InputError(fmt::format("--scene {}: the path is not valid UTF-8, and the provenance (JSON) could not record "
-                                 "it as it is; rename the file or its folders",
-                                 printable(scene)));
+  // Not normalized as text first: "link/.." is the link target's folder, not the link's.
+  const fs::path absolute = fs::absolute(scene);
   std::error_code ec;
-  const fs::path canonical = fs::weakly_canonical(scene, ec);
-  return ec ? fs::absolute(scene).lexically_normal().string() : canonical.string();
+  const fs::path folder = fs::weakly_canonical(absolute.parent_path(), ec);
+  const std::string stored =
+      ec ? absolute.lexically_normal().string() : (folder / absolute.filename()).string();
+  if (!io::is_utf8(stored))
+    throw InputError(fmt::format("--scene {}: the path {} is not valid UTF-8, and the provenance (JSON) could not "
+                                 "record it as it is; rename the file or its folders",
+                                 printable(scene), printable(stored)));
+  return stored;
 }
 
 struct Prepared {
@@ -587,7 +602,12 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
   stored.scene = stored_scene(spec.scene);
   const Prepared p = prepare(stored, scenes_dir);
   const Scene& scene = p.loaded.scene;
-  const std::string id = reference_id(scene, stored, *p.rig, p.loaded.lights_in_file);
+  // An entry made when the scene's field of view or light count differed from the spec's keeps its
+  // folder (reference_ids); otherwise the id reference_id gives.
+  const std::vector<std::string> candidates = reference_ids(scene, stored, *p.rig, p.loaded.lights_in_file);
+  const auto existing = std::find_if(candidates.begin(), candidates.end(),
+                                     [&](const std::string& c) { return fs::exists(root_ / c / kProvenance); });
+  const std::string id = existing != candidates.end() ? *existing : candidates.front();
   // The id names the scene by its file's name alone and the rig rounded: another file (or a
   // built-in) of that name, or a rig that differs by less than the id shows, would silently take
   // the entry's place. Regenerating from the same scene and spec replaces it (also when the scene's camera has
@@ -662,8 +682,8 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
           {"work_folder",
            fmt::format("{} is the folder the provider exported the scene to and ran its tool in; it is removed once "
                        "the reference is stored. `stereobench reference generate` with this spec makes it again "
-                       "(`stereobench validate --truth {} --out DIR` keeps its own in DIR/work/{}).",
-                       kWorkPlaceholder, render.provider, render.provider)},
+                       "(`stereobench validate --truth {} --out DIR` keeps its own under DIR/work/).",
+                       kWorkPlaceholder, render.provider)},
           {"seconds", render.seconds}}},
         {"scene",
          {{"name", scene.name},
@@ -794,9 +814,10 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
   // With scene and rig as recorded, the folder's name is the id its spec gives: a renamed folder
   // would be found under a name that `reference generate` never writes, and regenerated beside it.
   // A field of view (or light count) the spec gives explicitly that the scene's camera (or file) has
-  // since come to share leaves the rig as recorded, and the id as it was made.
-  if (const std::string expected = reference_id(p.loaded.scene, spec, *p.rig, p.loaded.lights_in_file);
-      expected != id && reference_id(p.loaded.scene, spec, *p.rig, p.loaded.lights_in_file, true) != id) {
+  // since come to share leaves the rig as recorded, and the id as it was made (reference_ids).
+  if (const std::vector<std::string> ids = reference_ids(p.loaded.scene, spec, *p.rig, p.loaded.lights_in_file);
+      std::find(ids.begin(), ids.end(), id) == ids.end()) {
+    const std::string& expected = ids.front();
     r.status = Status::corrupt;
     // Also an entry of a store written when ids named a scene by the name inside its file, or
     // before they named a field of view other than the scene camera's.
@@ -810,6 +831,8 @@ VerifyResult ReferenceStore::verify(const std::string& id, const fs::path& scene
   Image stored;
   try {
     stored = validation::rgb_plane_only(io::read_exr(image_file));
+  } catch (const ResourceError&) {
+    throw;  // this machine's shortage (exit 4), not a damaged entry
   } catch (const std::exception& e) {
     r.status = Status::corrupt;
     r.detail = fmt::format("{} cannot be read ({}); remove {} and make the reference again with `stereobench "

@@ -909,13 +909,14 @@
     }
     const labels = runs.map((r) => String(r.date).replace('T', ' ').replace('Z', ''));
     // The axis names each run by its date, or date and time where a day has several runs, unrotated
-    // and thinned to what fits (the tooltips give the full time): full rotated date-times took half
-    // of a chart's height, and the plot shrank to a strip once the history held a few dozen runs.
+    // and thinned to what fits (the tooltips give the full time; a category tick's value is the
+    // index of its run): full rotated date-times took half of a chart's height, and the plot
+    // shrank to a strip once the history held a few dozen runs.
     const days = labels.map((l) => l.slice(0, 10));
     const oneADay = new Set(days).size === days.length;
     const tickLabel = (i) => (oneADay ? days[i] : labels[i].slice(0, 16));
     const runAxis = (extra) => axis('run (UTC)', Object.assign({ ticks: { maxRotation: 0, autoSkip: true, autoSkipPadding: 12,
-      callback: (value, i) => tickLabel(i) } }, extra));
+      callback: (value) => tickLabel(value) } }, extra));
     // Markers on every run merge into bands in a long history: smaller, then none (the line and
     // the tooltips remain).
     const radius = runs.length <= 30 ? 5 : runs.length <= 120 ? 2 : 0;

@@ -38,6 +38,9 @@ std::string ref(const test::ScratchDir& dir, const std::string& sub) {
   return "reference " + sub + " --store " + quoted(dir / "store") + " --scenes-dir " + quoted(kScenes);
 }
 
+/// A scene file's path as the store records it: its folders' links resolved, its own name kept.
+std::string recorded(const fs::path& file) { return (fs::weakly_canonical(file.parent_path()) / file.filename()).string(); }
+
 void damage(const fs::path& file) {
   std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
   f.seekp(-8, std::ios::end);
@@ -490,12 +493,12 @@ TEST(ReferenceStore, AnotherSceneOfTheSameNameDoesNotReplaceAnEntry) {
   const ReferenceStore store(dir / "store");
   ASSERT_EQ(store.ids().size(), 1u);
   const std::string id = store.ids()[0];
-  EXPECT_EQ(store.spec_of(id).scene, copy.string()) << "a file is recorded by its absolute path";
+  EXPECT_EQ(store.spec_of(id).scene, recorded(copy)) << "a file is recorded by its absolute path";
   const std::string before = test::read_text(dir / "store" / id / "provenance.json");
   const test::CliRun other = test::run_cli(ref(dir, "generate") + " --scene box-wall" + args);
   EXPECT_EQ(other.code, 3) << other.out;
   EXPECT_NE(other.out.find("reference '" + id + "' in " + (dir / "store").string() + " was made from scene " +
-                           copy.string() + ", not box-wall"),
+                           recorded(copy) + ", not box-wall"),
             std::string::npos)
       << other.out;
   EXPECT_EQ(test::read_text(dir / "store" / id / "provenance.json"), before);
@@ -520,14 +523,14 @@ TEST(ReferenceStore, AProjectMovedWithItsStoreAndScenesStillVerifies) {
   ASSERT_EQ(before.ids().size(), 1u);
   const std::string id = before.ids()[0];
   const json spec = json::parse(test::read_text(project / "refs" / id / "provenance.json"))["spec"];
-  EXPECT_EQ(spec["scene"], (project / "scenes" / "mybox.gltf").string());
+  EXPECT_EQ(spec["scene"], recorded(project / "scenes" / "mybox.gltf"));
   EXPECT_EQ(spec["scene_from_store"], "../scenes/mybox.gltf");
   fs::rename(project, dir / "projB");
   const std::string verify = "cd " + quoted(dir / "projB") + " && " + SB_CLI_PATH + " reference verify --store refs";
   const test::CliRun moved = test::run_shell(verify);
   EXPECT_EQ(moved.code, 0) << moved.out;
   EXPECT_NE(moved.out.find("1 of 1 reference(s) verified"), std::string::npos) << moved.out;
-  EXPECT_EQ(ReferenceStore(dir / "projB" / "refs").spec_of(id).scene, (dir / "projB" / "scenes" / "mybox.gltf").string());
+  EXPECT_EQ(ReferenceStore(dir / "projB" / "refs").spec_of(id).scene, recorded(dir / "projB" / "scenes" / "mybox.gltf"));
   // The store moved alone still finds the scene by its absolute path.
   fs::rename(dir / "projB" / "refs", dir / "refs");
   fs::rename(dir / "projB", project);
@@ -547,16 +550,25 @@ TEST(ReferenceStore, AScenePathIsRecordedWithItsLinksResolvedAndInUtf8) {
   ASSERT_EQ(linked.code, 0) << linked.out;
   const ReferenceStore store(dir / "store");
   ASSERT_EQ(store.ids().size(), 1u);
-  EXPECT_EQ(store.spec_of(store.ids()[0]).scene, (dir / "sc" / "mybox.gltf").string());
+  EXPECT_EQ(store.spec_of(store.ids()[0]).scene, recorded(dir / "sc" / "mybox.gltf"));
   EXPECT_EQ(test::run_cli(ref(dir, "verify")).code, 0);
+  // A linked scene file keeps its own name (the id's) and its place (its buffers lie beside it):
+  // only its folders' links are resolved.
+  fs::create_symlink(dir / "sc" / "mybox.gltf", dir / "sc" / "linked.gltf");
+  const test::CliRun link = test::run_cli(ref(dir, "generate") + " --scene " + quoted(dir / "sc" / "linked.gltf") + args);
+  ASSERT_EQ(link.code, 0) << link.out;
+  ASSERT_EQ(store.ids().size(), 2u);
+  EXPECT_EQ(store.ids()[0].rfind("linked_full_", 0), 0u) << store.ids()[0];
+  EXPECT_EQ(store.spec_of(store.ids()[0]).scene, recorded(dir / "sc" / "linked.gltf"));
   // A path that is not UTF-8 is refused: the provenance recorded it with U+FFFD in place of the
   // byte, and the entry could then never be verified.
   const fs::path odd = dir / "b\xffx.gltf";
   fs::copy_file(dir / "sc" / "mybox.gltf", odd);
   const test::CliRun refused = test::run_cli(ref(dir, "generate") + " --scene " + quoted(odd) + args);
   EXPECT_EQ(refused.code, 3) << refused.out;
-  EXPECT_NE(refused.out.find("the path is not valid UTF-8"), std::string::npos) << refused.out;
-  EXPECT_EQ(store.ids().size(), 1u);
+  EXPECT_NE(refused.out.find("is not valid UTF-8, and the provenance (JSON) could not record it"), std::string::npos)
+      << refused.out;
+  EXPECT_EQ(store.ids().size(), 2u);
 }
 
 TEST(ReferenceStore, AFieldOfViewTheSceneCameraComesToShareKeepsItsEntryValid) {
@@ -575,6 +587,12 @@ TEST(ReferenceStore, AFieldOfViewTheSceneCameraComesToShareKeepsItsEntryValid) {
   std::ofstream(scene, std::ios::trunc) << gltf.dump(2);
   const test::CliRun r = test::run_cli(ref(dir, "verify"));
   EXPECT_EQ(r.code, 0) << r.out;
+  // The same spec generated or updated again goes into that entry, not a second one beside it.
+  const std::string id = store.ids()[0];
+  EXPECT_EQ(test::run_cli(ref(dir, "generate") + " --scene " + quoted(scene) + " --resolution 32x18 --vfov 50").code, 0);
+  const test::CliRun updated = test::run_cli(ref(dir, "update") + " " + id);
+  EXPECT_EQ(updated.code, 0) << updated.out;
+  EXPECT_EQ(store.ids(), std::vector<std::string>{id});
 }
 
 TEST(ReferenceStore, AnotherRigDoesNotReplaceAnEntry) {

@@ -219,7 +219,8 @@ try {
             points: chart ? chart.data.datasets.map((d) => d.data.length) : [],
             // The plot's share of the chart's height, and the run axis labels' rotation.
             plotShare: chart ? chart.chartArea.height / chart.height : 0,
-            rotation: chart ? chart.scales.x.labelRotation : 0 };
+            rotation: chart ? chart.scales.x.labelRotation : 0,
+            ticks: chart ? chart.scales.x.ticks.map((t) => ({ value: t.value, label: String(t.label) })) : [] };
         }),
       };
     });
@@ -235,6 +236,12 @@ try {
         // A long history once left a strip of plot under rotated date-times.
         if (c.plotShare < 0.45) problems.push(`trend chart "${c.title}": the plot is ${(100 * c.plotShare).toFixed(0)} % of the chart's height (< 45 %)`);
         if (c.rotation !== 0) problems.push(`trend chart "${c.title}": run labels rotated ${c.rotation.toFixed(0)}°`);
+        // Each tick names its own run: the start of that run's date and time.
+        for (const t of c.ticks) {
+          const run = data.history[t.value];
+          const when = run ? String(run.date).replace('T', ' ') : '';
+          if (!t.label || !when.startsWith(t.label)) problems.push(`trend chart "${c.title}": tick ${t.value} reads "${t.label}", its run is of ${when || 'no run'}`);
+        }
       }
       report.trends = trends.charts.map((c) => `${c.title}: ${c.points.length} datasets of ${runs} points`);
     }
