@@ -95,11 +95,31 @@ std::string work_folder_name(const std::string& scene_stem, const std::string& t
   return fmt::format("{}_{}", scene_stem, truth_key.substr(0, work_key_digits));
 }
 
-/// Removes the work folders of `scene_stem` (`<scene_stem>_<key digits>`) other than `kept`: this
-/// run has replaced every record that named them. One that cannot be removed is left with a warning.
-void remove_earlier_work_folders(const fs::path& work, const std::string& scene_stem, const std::string& kept) {
+/// The truth commands of the records an earlier summary lists (none when there is none or it cannot
+/// be read): each names the work folder it renders in.
+std::vector<std::string> earlier_truth_commands(const fs::path& summary) {
+  std::vector<std::string> commands;
+  try {
+    if (!fs::is_regular_file(summary)) return commands;
+    const json earlier = json::parse(io::read_file(summary));
+    if (!earlier.is_object() || !earlier.contains("records") || !earlier["records"].is_array()) return commands;
+    for (const json& r : earlier["records"])
+      if (r.is_object() && r.contains("truth") && r["truth"].is_object() && r["truth"].contains("command") &&
+          r["truth"]["command"].is_string())
+        commands.push_back(r["truth"]["command"].get<std::string>());
+  } catch (const std::exception&) {
+  }
+  return commands;
+}
+
+/// Removes the work folders of `scene_stem` (`<scene_stem>_<key digits>`) other than `kept` that the
+/// commands of the records this run replaced name: no record names them any more. A folder no such
+/// record names (one another run into this --out is rendering in) is left; one that cannot be
+/// removed is left with a warning.
+void remove_earlier_work_folders(const fs::path& work, const std::string& scene_stem, const std::string& kept,
+                                 const std::vector<std::string>& earlier_commands) {
   std::error_code ec;
-  if (!fs::is_directory(work, ec)) return;
+  if (earlier_commands.empty() || !fs::is_directory(work, ec)) return;
   const std::string prefix = scene_stem + "_";
   std::vector<fs::path> earlier;
   for (const fs::directory_entry& entry : fs::directory_iterator(work, ec)) {
@@ -108,7 +128,10 @@ void remove_earlier_work_folders(const fs::path& work, const std::string& scene_
     if (!std::all_of(name.begin() + static_cast<std::ptrdiff_t>(prefix.size()), name.end(),
                      [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'); }))
       continue;
-    if (entry.is_directory(ec)) earlier.push_back(entry.path());
+    const bool named = std::any_of(earlier_commands.begin(), earlier_commands.end(), [&](const std::string& command) {
+      return command.find("/" + name) != std::string::npos;
+    });
+    if (named && entry.is_directory(ec)) earlier.push_back(entry.path());
   }
   for (const fs::path& folder : earlier) {
     fs::remove_all(folder, ec);
@@ -164,8 +187,12 @@ void run_validate(const ValidateArgs& a) {
   // A truth from the cache was rendered in another run's work folder, which may be gone or hold
   // another render by now: the export and script are made ready in this one's, and the record gives
   // the command that renders the truth again there.
-  const std::string work_name = work_folder_name(
-      scene_stem, validation::truth_key(*provider, {prepared, loaded.file, rig, {}, executor.threads(), true}));
+  // The built-in provider writes no files there: its scene is not hashed for a name it never uses.
+  const std::string work_name =
+      provider->name() == "full"
+          ? scene_stem
+          : work_folder_name(scene_stem,
+                             validation::truth_key(*provider, {prepared, loaded.file, rig, {}, executor.threads(), true}));
   const validation::ValidationTarget target =
       validation::prepare_target(prepared, loaded.file, rig, *provider, cache ? &*cache : nullptr,
                                  out / "work" / work_name, executor, /*prepare_on_cache_hit=*/true);
@@ -227,8 +254,9 @@ void run_validate(const ValidateArgs& a) {
         io::json_text(json{{"kind", "stereobench.validation_summary"}, {"records", records}}, 2) + "\n";
     set.add(summary, [&](const fs::path& tmp) { io::write_text_atomically(tmp, summary_text); });
   }
+  const std::vector<std::string> earlier_commands = earlier_truth_commands(summary);
   set.commit();  // the summary, added last, is the set's marker
-  remove_earlier_work_folders(out / "work", scene_stem, work_name);
+  remove_earlier_work_folders(out / "work", scene_stem, work_name, earlier_commands);
   fmt::print("\nwrote {} (one record per pipeline beside it, images under {})\n", summary.string(), out.string());
   if (!retired.empty())
     fmt::print("removed the earlier records of {} with their images: not validated in this run, they described the "

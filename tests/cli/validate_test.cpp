@@ -184,10 +184,14 @@ TEST(Validate, EachRigRendersItsTruthInAWorkFolderOfItsOwn) {
   EXPECT_TRUE(std::equal(a.begin(), a.end(), b.begin(), b.end())) << "the command renders another image";
 
   // Once a run with another rig replaces the records, the first work folder, which no record names
-  // any more, is removed.
+  // any more, is removed; one no earlier record named (another run's, rendering meanwhile) is left.
+  const fs::path others = out / "work" / "box-wall_povray_0123456789ab";
+  fs::create_directories(others);
   const test::CliRun replaced = test::run_cli(other);
   ASSERT_EQ(replaced.code, 0) << replaced.out;
   EXPECT_FALSE(fs::exists(first));
+  EXPECT_TRUE(fs::exists(others));
+  fs::remove(others);
   const fs::path second = work_folder(out, "box-wall_povray");
   ASSERT_FALSE(second.empty());
   EXPECT_NE(json::parse(test::read_text(out / "box-wall_povray_plain-rt.json"))["truth"]["command"].get<std::string>().find(
