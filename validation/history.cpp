@@ -193,11 +193,12 @@ SweepRuns runs_of_sweep(const HistoryFile& history, const std::string& sweep, co
   for (const json& r : history.runs)
     if (r.value("sweep", "") == sweep) out.runs.push_back(r);
   if (out.runs.size() < history.runs.size()) {
-    const size_t others = history.runs.size() - out.runs.size();
-    const char* runs = others == 1 ? "run" : "runs";
-    out.left_out = fmt::format("trends leave out {} {} of other sweeps in {}", others, runs, file.string());
-    out.left_out_on_page =
-        fmt::format("trends leave out {} {} of other sweeps in {}", others, runs, file.filename().string());
+    const auto left_out = [&](const std::string& named) {
+      return fmt::format("trends leave out {} of other sweeps in {}",
+                         counted(static_cast<long long>(history.runs.size() - out.runs.size()), "run"), named);
+    };
+    out.left_out = left_out(file.string());
+    out.left_out_on_page = left_out(file.filename().string());
   }
   return out;
 }

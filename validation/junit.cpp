@@ -115,15 +115,15 @@ std::string class_segment(std::string segment) {
 }
 
 /// A test case's name: pipeline and check, and for a check of one cell that cell's parameters
-/// (its id after the scene, which the class name holds), so that the cells of a sweep over
-/// interaxials or resolutions are distinct test cases in CI viewers, which know a test by class
-/// name and name.
+/// (its id after the scene name, which the class name holds; a generator's parameters, "scene:k=v|",
+/// stay), so that the cells of a sweep over interaxials or resolutions are distinct test cases in
+/// CI viewers, which know a test by class name and name.
 std::string case_name(const GateCheck& c) {
   const std::string name = c.pipeline + " " + c.check;
   if (c.scene.empty()) return name;
-  const std::string prefix = c.scene + "|";
-  const bool scene_first = c.cell_id.rfind(prefix, 0) == 0;
-  return fmt::format("{} [{}]", name, scene_first ? c.cell_id.substr(prefix.size()) : c.cell_id);
+  std::string cell = c.cell_id;
+  if (cell.rfind(c.scene + "|", 0) == 0 || cell.rfind(c.scene + ":", 0) == 0) cell.erase(0, c.scene.size() + 1);
+  return fmt::format("{} [{}]", name, cell);
 }
 
 }  // namespace

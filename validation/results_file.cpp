@@ -483,7 +483,11 @@ void check_cell_record(const json& line, const std::string& where) {
     if (const json* regions = find(p, "validation.regions"))
       for (const auto& [region, r] : regions->items()) {
         const std::string at = "validation.regions." + region;
-        if (region.empty() || region.find('.') != std::string::npos || !r.is_object())
+        if (region.empty() || region.find('.') != std::string::npos)
+          throw InputError(fmt::format("{}: field '{}validation.regions' names a region '{}', which no measurement "
+                                       "gives; the line is damaged or edited by hand",
+                                       where, prefix, region));
+        if (!r.is_object())
           throw InputError(fmt::format("{}: field '{}{}' is {}, not a region's metrics (an object); the line is "
                                        "damaged or edited by hand",
                                        where, prefix, at, r.dump().substr(0, 80)));

@@ -763,7 +763,8 @@ std::vector<Image> build_images(InputFile& file, const std::vector<std::vector<P
   return images;
 }
 
-/// Runs a read step, turning exceptions from inside OpenImageIO/OpenEXR into InputError.
+/// Runs a read step, turning exceptions from inside OpenImageIO/OpenEXR into InputError (running
+/// out of memory into ResourceError).
 template <typename F>
 auto guarded_read(const fs::path& path, F&& read) -> decltype(read()) {
   try {

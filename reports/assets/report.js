@@ -940,7 +940,9 @@
           return;
         }
         datasets.unshift({ label: p, data: points, borderColor: colour(p), backgroundColor: colour(p),
-          pointStyle: markers[k % markers.length], pointRadius: radius, pointHitRadius: 6, borderWidth: 2,
+          // A pipeline with one finite value has no line to show it: its marker stays.
+          pointStyle: markers[k % markers.length], pointRadius: points.filter((v) => v !== null).length < 2 ? 5 : radius,
+          pointHitRadius: 6, borderWidth: 2,
           borderDash: dashes[k % dashes.length], spanGaps: true, clip: 8 });
       });
       if (datasets.length === 0) return null;

@@ -875,6 +875,8 @@ TEST(GateJunit, CellsOfOneSceneAndPipelineAreDistinctTestCases) {
     check.cell_id = fmt::format("spheres|e={}m|c=default|320x180|lights=all|full", e);
     report.checks.push_back(check);
   }
+  check.cell_id = "spheres:count=500|e=0.064m|c=default|320x180|lights=all|full";  // a generated variant
+  report.checks.push_back(check);
   check.scene.clear();
   check.pipeline = "(all)";
   check.cell_id = "(all cells)";
@@ -887,6 +889,9 @@ TEST(GateJunit, CellsOfOneSceneAndPipelineAreDistinctTestCases) {
                                    e)),
               std::string::npos)
         << xml;
+  EXPECT_NE(xml.find("<testcase name=\"repro-rt psnr [count=500|e=0.064m|c=default|320x180|lights=all|full]\""),
+            std::string::npos)
+      << xml;
   EXPECT_NE(xml.find("<testcase name=\"(all) sweep_complete\" classname=\"gate.sweep\""), std::string::npos) << xml;
 }
 
