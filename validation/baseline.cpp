@@ -63,8 +63,17 @@ Baseline parse_baseline(const json& doc, const std::string& source, std::vector<
       entry.median_s = median_of(entry.samples_s);
       if (e.contains("recorded") && e["recorded"].is_string()) entry.recorded = e["recorded"].get<std::string>();
       if (e.contains("host") && e["host"].is_string()) entry.host = e["host"].get<std::string>();
+      if (e.contains("threads")) {
+        const json& t = e["threads"];
+        if (!t.is_number_integer() || t.get<long long>() < 1 || t.get<long long>() > 1 << 20) {
+          refuse(fmt::format("threads is {}, not a count of worker threads", t.dump()));
+          continue;
+        }
+        entry.threads = t.get<int>();
+      }
       for (const auto& [key, value] : e.items())
-        if (key != "samples_s" && key != "median_s" && key != "recorded" && key != "host") entry.other[key] = value;
+        if (key != "samples_s" && key != "median_s" && key != "recorded" && key != "host" && key != "threads")
+          entry.other[key] = value;
       b.cells[cell_id][pipeline] = std::move(entry);
     }
   }
@@ -96,6 +105,7 @@ json baseline_json(const Baseline& baseline) {
       entry["median_s"] = e.median_s;
       entry["recorded"] = e.recorded;
       entry["host"] = e.host;
+      if (e.threads) entry["threads"] = *e.threads;
       doc[cell_id][pipeline] = std::move(entry);
     }
   return doc;

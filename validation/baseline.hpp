@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,9 @@ struct BaselineEntry {
   double median_s = 0.0;
   std::string recorded;  ///< when the samples were measured (the cell's `finished` time)
   std::string host;      ///< where they were measured
+  /// The worker threads they were measured with (the cell's `threads`); none in an entry stored
+  /// before it was recorded.
+  std::optional<int> threads;
   /// Any other fields the file gives the entry (a note by hand), written back as they were while
   /// the entry is not rewritten.
   nlohmann::json other = nlohmann::json::object();

@@ -591,6 +591,9 @@ std::vector<BaselineChange> update_baseline(Baseline& baseline, const GateResult
       e.median_s = median(e.samples_s);
       e.recorded = cell.record.value("finished", json("")).is_string() ? cell.record.value("finished", "") : "";
       e.host = cell.record.value("host", json("")).is_string() ? cell.record.value("host", "") : "";
+      if (const json threads = cell.record.value("threads", json()); threads.is_number_integer() &&
+                                                                       threads.get<long long>() >= 1)
+        e.threads = threads.get<int>();
       BaselineChange change{cell.cell_id, pipeline, false, 0.0, e.median_s, e.samples_s.size()};
       if (const BaselineEntry* old = baseline.find(cell.cell_id, pipeline)) {
         change.replaced = true;
@@ -1019,7 +1022,16 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
         const std::string change = fmt::format("median {:.4g} s vs baseline {:.4g} s ({:+.3g} %, tolerance {:.3g} %)",
                                                now, before, 100.0 * check.measured, 100.0 * *tolerance);
         const int n_now = static_cast<int>(samples.size()), n_base = static_cast<int>(base->samples_s.size());
-        if (n_now < reg.min_repetitions || n_base < reg.min_repetitions) {
+        const json threads_now = cell.record.value("threads", json());
+        if (base->threads && threads_now.is_number_integer() && threads_now.get<long long>() != *base->threads) {
+          // Times of another thread count are no regression and no gain: a warning to store a
+          // baseline of this machine, not a verdict on the time.
+          check.verdict = Verdict::warn;
+          check.message = fmt::format(
+              "not comparable: the baseline was measured with {} threads, this cell with {}; {}; store a baseline "
+              "measured as the sweep runs now (gate --update-baseline)",
+              *base->threads, threads_now.get<long long>(), change);
+        } else if (n_now < reg.min_repetitions || n_base < reg.min_repetitions) {
           check.verdict = Verdict::warn;
           check.message = fmt::format(
               "not enough repetitions for the rank test: {} now and {} in the baseline, "

@@ -318,6 +318,22 @@ TEST(GateEval, TimeRegressionAgainstTheBaseline) {
   EXPECT_EQ(reg->verdict, Verdict::warn);
   EXPECT_NE(reg->message.find("not enough repetitions"), std::string::npos) << reg->message;
 
+  // A baseline measured with another thread count is not compared: a warning to store one of
+  // this machine (a 4-thread baseline against a 2-thread run read as a regression).
+  baseline.cells[id]["repro-rt"].threads = 4;
+  cells[0]["threads"] = 2;
+  run_samples({0.02, 0.0201, 0.0199, 0.0202, 0.0198});
+  const validation::GateReport other_threads = evaluate(cells, baseline);
+  reg = find_check(other_threads, "repro-rt", "time_regression");
+  EXPECT_EQ(reg->verdict, Verdict::warn) << reg->message;
+  EXPECT_NE(reg->message.find("not comparable: the baseline was measured with 4 threads, this cell with 2"),
+            std::string::npos)
+      << reg->message;
+  cells[0]["threads"] = 4;
+  EXPECT_EQ(find_check(evaluate(cells, baseline), "repro-rt", "time_regression")->verdict, Verdict::fail);
+  baseline.cells[id]["repro-rt"].threads.reset();
+  run_samples({0.010, 0.010});
+
   // The other cell and pipeline have no baseline entry.
   EXPECT_EQ(find_check(r, "repro-rt", "time_regression", 1)->message, "no baseline");
   EXPECT_EQ(find_check(r, "plain-rt", "time_regression")->message, "no baseline");
@@ -326,7 +342,8 @@ TEST(GateEval, TimeRegressionAgainstTheBaseline) {
   // A record without its samples, where the baseline has an entry: damaged, and it fails (it was
   // skipped, so a damaged file passed).
   cells[0]["pipelines"]["repro-rt"]["timing"].erase("samples_s");
-  reg = find_check(evaluate(cells, baseline), "repro-rt", "time_regression");
+  const validation::GateReport damaged = evaluate(cells, baseline);
+  reg = find_check(damaged, "repro-rt", "time_regression");
   EXPECT_EQ(reg->verdict, Verdict::fail);
   EXPECT_NE(reg->message.find("though the baseline has an entry for it"), std::string::npos) << reg->message;
 
@@ -446,6 +463,7 @@ TEST(GateEval, BaselineUpdateTouchesOnlyWhatIsNamed) {
   with_notes[id0]["plain-rt"]["note"] = "accepted after the BVH change";
   with_notes["old-cell|x"]["plain-rt"] = {{"samples_s", {1.0}}, {"note", "kept"}};
   write_file(dir / "baseline.json", with_notes.dump(2) + "\n");
+  cells[0]["threads"] = 2;  // stored with the entry: a baseline of another thread count is not compared
   write_results(dir / "results.jsonl", cells);
 
   // No selection: an error that says how to name what to update; the file is unchanged.
@@ -471,6 +489,9 @@ TEST(GateEval, BaselineUpdateTouchesOnlyWhatIsNamed) {
   EXPECT_DOUBLE_EQ(now.find(id0, "repro-rt")->median_s, 0.011);
   EXPECT_EQ(now.find(id0, "repro-rt")->host, "testhost");
   EXPECT_EQ(now.find(id0, "repro-rt")->recorded, "2026-11-21T19:20:00Z");
+  EXPECT_EQ(now.find(id0, "repro-rt")->threads, 2);
+  EXPECT_EQ(written[id0]["repro-rt"]["threads"], 2);
+  EXPECT_FALSE(written[id0]["repro-rt"]["other"].is_object()) << "threads is a field, not kept as a note";
   ASSERT_NE(now.find(id1, "repro-rt"), nullptr);
   EXPECT_EQ(now.find(id1, "plain-rt"), nullptr);
   // Three samples each: as many as the rank test needs, so no warning.
