@@ -201,8 +201,6 @@ RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::st
   // place, the stats JSON last (it marks a complete set): a failure on the way (a full disk) leaves
   // an earlier render's set as it was. The earlier stats JSON goes before the first rename, so
   // that a run stopped among the renames leaves no mixed set looking complete.
-  ImageMetadata meta;
-  meta["stereobench/record"] = record.dump();
   std::vector<std::pair<fs::path, const Image*>> pngs{{f.left_png, &result.left}, {f.right_png, &result.right}};
   std::vector<Image> views_made;
   views_made.reserve(std::size(kStereoViews));  // the pointers into it stay valid
@@ -217,6 +215,9 @@ RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::st
   for (const fs::path& file : f.all()) names.push_back(file.filename().string());
   stats["files"] = names;
   const std::vector<std::string> earlier = earlier_files(f.stats_json, stem);
+  // The EXR's header holds the stats JSON's content, its file list included.
+  ImageMetadata meta;
+  meta["stereobench/record"] = stats.dump();
 
   StagedFiles set;
   set.add(f.exr, [&](const fs::path& tmp) { write_exr_stereo(tmp, result.left, result.right, meta); });

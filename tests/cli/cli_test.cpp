@@ -286,6 +286,8 @@ TEST(Cli, RenderWritesEveryOutputAndBenchPrintsATable) {
   EXPECT_GT(j.at("timings_s").at("left_gbuffer").get<double>(), 0.0);
   EXPECT_GT(j.at("counters").at("shadow_rays").get<uint64_t>(), 0u);
   EXPECT_EQ(j.at("rig").at("width").get<int>(), 64);
+  // The EXR's header holds the stats JSON's content, its file list included (it was left out).
+  EXPECT_EQ(nlohmann::json::parse(io::read_exr_metadata(dir / "box-wall_plain-raster.exr").at("stereobench/record")), j);
 
   // A render that stops while writing (here: the side-by-side image's path is a link into a folder
   // that does not exist) places none of its files: every file is made whole before any takes its
