@@ -15,6 +15,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/scene_geometry.hpp"
 #include "renderer/stages/near_plane.hpp"
 #include "scenes/catalog.hpp"
 
@@ -279,6 +280,39 @@ void refuse_overwriting(std::initializer_list<NamedPath> inputs, std::initialize
         throw InputError(
             fmt::format("{} and {} both name {}; give each output its own file", earlier->name, out->name, *out->path));
   }
+}
+
+void warn_scene_far_from_origin(const RenderScene& scene) {
+  const Bounds3 b = scene.scene().bounds();
+  if (b.empty()) return;
+  const double size = glm::length(dvec3(b.extent()));
+  const double reach = std::max({std::fabs(double(b.lo.x)), std::fabs(double(b.lo.y)), std::fabs(double(b.lo.z)),
+                                 std::fabs(double(b.hi.x)), std::fabs(double(b.hi.y)), std::fabs(double(b.hi.z))});
+  // The shadow-ray offset follows the float resolution of the largest coordinate: beyond a
+  // thousandth of the scene's size, shadows of small objects and thin detail are lost.
+  const double offset = scene.ray_epsilon();
+  if (!(offset > 1e-3 * size)) return;
+  print_warning(fmt::format(
+      "scene '{}' reaches {:g} m from the origin and is {:g} m across: positions are floats, so shadow rays start "
+      "{:.3g} m off the surfaces there and small objects lose their shadows and detail; move the scene near the "
+      "origin (subtract its centre, ({:g}, {:g}, {:g}) m, in the file)",
+      scene.scene().name, reach, size, offset, 0.5 * (double(b.lo.x) + b.hi.x), 0.5 * (double(b.lo.y) + b.hi.y),
+      0.5 * (double(b.lo.z) + b.hi.z)));
+}
+
+void warn_if_no_surface_seen(const Image& left, const Image& right, const StereoRig& rig) {
+  const auto background = [](const Image& eye) {
+    if (!eye.has_plane(planes::primid)) return false;
+    const uint32_t* prim = eye.data_u32(planes::primid);
+    return std::all_of(prim, prim + eye.pixel_count(), [](uint32_t p) { return p == kNoPrimitiveId; });
+  };
+  if (!background(left) || !background(right)) return;
+  const RigParams& p = rig.params();
+  print_warning(fmt::format(
+      "neither eye sees a surface: every pixel is background. The eyes stand {:g} m either side of the centre camera "
+      "(interaxial {:g} m, convergence {:g} m); for a scene of another scale give --interaxial and --convergence in "
+      "its units, and check that the camera looks at the scene (`stereobench scenes info`)",
+      0.5 * p.interaxial, p.interaxial, p.convergence));
 }
 
 void warn_geometry_before_near_plane(const RenderScene& scene, const StereoRig& rig, const Executor& executor) {

@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "renderer/image.hpp"
 #include "renderer/parallel.hpp"
 #include "renderer/render_scene.hpp"
 #include "renderer/rig.hpp"
@@ -126,6 +127,12 @@ void prepare_output_file_folder(const std::string& file, const char* option);
 /// (pixels_before_near_plane): the rasterizing pipelines clip it, ray tracing and the ground
 /// truths show it, so their images differ there for the camera's sake, not the pipeline's.
 void warn_geometry_before_near_plane(const RenderScene& scene, const StereoRig& rig, const Executor& executor);
+/// Warns when the scene lies so far from the origin for its size that float positions cost
+/// shadows and detail (the shadow-ray offset beyond a thousandth of its size).
+void warn_scene_far_from_origin(const RenderScene& scene);
+/// Warns when both eyes of a render show background only (a rig of another scale than the
+/// scene's, a camera looking away).
+void warn_if_no_surface_seen(const Image& left, const Image& right, const StereoRig& rig);
 
 /// Checks a --threads value: 0 (all cores) or 1..1024; more than the cores is taken as the
 /// cores, with a note (the scheduler would run no more, yet the results would record them).

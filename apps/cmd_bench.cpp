@@ -138,6 +138,7 @@ void run_bench_command(const BenchArgs& a) {
              prepared.rays().memory_bytes() / 1048576.0);
   const BenchResult r = run_bench(prepared, rig, config, executor,
                                   [](const std::string& line) { fmt::print(stderr, "  {}\n", line); });
+  warn_scene_far_from_origin(prepared);
   warn_geometry_before_near_plane(prepared, rig, executor);
 
   std::vector<std::string> names;

@@ -109,8 +109,10 @@ void run_render(const RenderArgs& a) {
   }
   const RenderScene prepared(scene);
   require_frame_memory(rig.params().width, rig.params().height, fmt::format("render {}", entry.name));
+  warn_scene_far_from_origin(prepared);
   warn_geometry_before_near_plane(prepared, rig, executor);
   const StereoResult result = pipeline.render(prepared, rig, options, RenderContext{executor});
+  warn_if_no_surface_seen(result.left, result.right, rig);
   // Scored against the true disocclusions outside the pipeline's timings.
   const std::optional<HoleAnalysis> holes = analyze_holes(prepared, rig, result.right, executor);
   nlohmann::json record = io::result_to_json(entry.name, prepared, rig, result, executor.threads(), options);

@@ -201,6 +201,7 @@ void run_validate(const ValidateArgs& a) {
              target.truth.render.seconds,
              100.0 * double(target.disocclusions.count()) / double(target.truth_srgb8.pixel_count()));
   print_warnings(validation::truth_warnings(target.truth.render));
+  warn_scene_far_from_origin(prepared);
   warn_geometry_before_near_plane(prepared, rig, executor);
 
   // Every file is made whole under a temporary name, and all are renamed into place at the end,

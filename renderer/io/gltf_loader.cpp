@@ -630,7 +630,10 @@ class Converter {
         mat.alpha_mode = Material::AlphaMode::blend;
         warn("alpha:BLEND", "alphaMode BLEND (rendered as OPAQUE: surfaces are not blended)");
       }
-      for (const auto& [ext, value] : gm.extensions) warn("ext:" + ext, fmt::format("material extension '{}' is ignored", ext));
+      // An extension the file lists in extensionsUsed was reported there, once.
+      for (const auto& [ext, value] : gm.extensions)
+        if (std::find(m_.extensionsUsed.begin(), m_.extensionsUsed.end(), ext) == m_.extensionsUsed.end())
+          warn("ext:" + ext, fmt::format("material extension '{}' is ignored", ext));
       const int t = gm.pbrMetallicRoughness.baseColorTexture.index;
       if (t >= 0 && options_.load_textures) {
         mat.texcoord = gm.pbrMetallicRoughness.baseColorTexture.texCoord;
@@ -699,6 +702,12 @@ class Converter {
       tex.repeat_t = s.wrapT != TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
       if (s.wrapS == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT || s.wrapT == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT)
         warn("mirrored", "MIRRORED_REPEAT wrapping (treated as REPEAT)");
+      // Textures are filtered trilinearly (DESIGN §3): a sampler asking for nearest texels (pixel art)
+      // comes out smoothed.
+      if (s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST || s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST ||
+          s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST ||
+          s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR)
+        warn("nearest", "NEAREST texture filtering (textures are filtered trilinearly)");
     }
     scene.textures.push_back(std::move(tex));
     return static_cast<int>(scene.textures.size() - 1);
@@ -1099,7 +1108,8 @@ class Converter {
     const tinygltf::Node& n = m_.nodes[static_cast<size_t>(ni)];
     const tinygltf::Camera& gc = m_.cameras[static_cast<size_t>(n.camera)];
     if (gc.type != "perspective") {
-      warn("ortho", "orthographic cameras are ignored");
+      warn("ortho", "orthographic cameras are ignored, with their pose: without a perspective camera the rig frames "
+                    "the scene's bounds from +Z (give a perspective camera to keep the view)");
       return;
     }
     if (!within_scene_range(dvec3(world[3])))

@@ -469,7 +469,12 @@ TEST(GltfLoader, UnsupportedFeaturesAreNamedOnce) {
   const uint8_t px[] = {255, 255, 255, 255};
   const std::vector<unsigned char> png = io::encode_png(px, 1, 1, 4);
   g.doc["images"] = json::array({{{"bufferView", g.add_view(png.data(), png.size())}, {"mimeType", "image/png"}}});
-  g.doc["textures"] = json::array({{{"source", 0}}});
+  // A sampler asking for nearest texels (pixel art), which trilinear filtering smooths.
+  g.doc["samplers"] = json::array({{{"magFilter", 9728}, {"minFilter", 9728}}});
+  g.doc["textures"] = json::array({{{"source", 0}, {"sampler", 0}}});
+  // One material with an extension the file lists in extensionsUsed: named once, not "2 occurrences".
+  g.doc["materials"][1]["extensions"] = {{"KHR_materials_unlit", json::object()}};
+  g.doc["materials"][0]["pbrMetallicRoughness"] = {{"baseColorTexture", {{"index", 0}}}};
   const int m = g.add_mesh(json::array({{{"attributes", {{"POSITION", pos}, {"COLOR_0", colour}}}, {"material", 0}},
                                         {{"attributes", {{"POSITION", pos}}}, {"material", 1}},
                                         {{"attributes", {{"POSITION", pos}}}, {"mode", 1}}}));
@@ -487,9 +492,12 @@ TEST(GltfLoader, UnsupportedFeaturesAreNamedOnce) {
   EXPECT_EQ(normal_warnings, 1);
   EXPECT_EQ(line_warnings, 1);
   EXPECT_EQ(ext_warnings, 1);
+  for (const std::string& w : scene.warnings)
+    EXPECT_EQ(w.find("KHR_materials_unlit' is ignored (2 occurrences)"), std::string::npos) << w;
   // Inputs the Lambertian shading does not use are named too.
   for (const char* named : {"vertex colours (COLOR_n) are ignored", "occlusion textures are ignored",
-                            "metallic-roughness textures are ignored"})
+                            "metallic-roughness textures are ignored",
+                            "NEAREST texture filtering (textures are filtered trilinearly)"})
     EXPECT_EQ(std::count_if(scene.warnings.begin(), scene.warnings.end(),
                             [&](const std::string& w) { return w.find(named) != std::string::npos; }),
               1)
