@@ -86,13 +86,18 @@ void generate_scenes(const GenerateArgs& args) {
   }
   io::check_no_folder_at(files, "give another --out");
   prepare_output_folder(args.out_dir, "--out");
-  fmt::print("{:<15} {:>12} {:>10} {:>7} {:>12} {:>9}  {}\n", "scene", "triangles", "vertices", "lights", "bytes",
-             "seconds", "file");
+  bool header_printed = false;
   for (const std::string& n : names) {
     // Default scenes are stamped so that commands naming them reuse the file; another seed or
     // parameters get a file name of their own, so that they never stand in for the default.
     const scenes::GenerateResult r =
         builtin ? scenes::generate_builtin(n, args.out_dir) : scenes::generate(n, opt, file_of(n));
+    // The table starts with its first row: a scene refused once built (too many triangles) is
+    // reported without an empty table above it.
+    if (!header_printed)
+      fmt::print("{:<15} {:>12} {:>10} {:>7} {:>12} {:>9}  {}\n", "scene", "triangles", "vertices", "lights", "bytes",
+                 "seconds", "file");
+    header_printed = true;
     fmt::print("{:<15} {:>12} {:>10} {:>7} {:>12} {:>9.2f}  {}\n", n, r.triangles, r.vertices, r.lights, r.bytes,
                r.seconds, r.path.string());
   }

@@ -101,6 +101,12 @@ TEST(SceneRegistry, RejectsUnknownAndOutOfRangeParameters) {
   expect_input_error([&] { (void)generate("spheres", o, out); },
                      {"count=100000 segments=256", "6502400000 triangles", "1500000000"});
   EXPECT_FALSE(fs::exists(out));
+  // On the command line no empty table precedes the refusal (its header was printed first).
+  const test::CliRun cli = test::run_cli("scenes generate spheres --param count=100000 --param segments=256 --out " +
+                                         quoted(dir / "cli"));
+  EXPECT_EQ(cli.code, 3) << cli.out;
+  EXPECT_NE(cli.out.find("6502400000 triangles"), std::string::npos) << cli.out;
+  EXPECT_EQ(cli.out.find("triangles   vertices"), std::string::npos) << cli.out;
 }
 
 TEST(SceneRegistry, AWriteThatFailsNamesTheFileAndLeavesNothing) {
