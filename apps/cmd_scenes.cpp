@@ -85,7 +85,19 @@ void generate_scenes(const GenerateArgs& args) {
     if (builtin) files.push_back(scenes::stamp_path(files.back()));  // only the defaults are stamped
   }
   io::check_no_folder_at(files, "give another --out");
+  std::error_code ec;
+  const bool folder_existed = fs::exists(args.out_dir, ec);
   prepare_output_folder(args.out_dir, "--out");
+  // A scene refused once built leaves no empty folder that this run made (fs::remove takes an
+  // empty folder only).
+  struct RemoveIfEmpty {
+    const fs::path folder;
+    bool armed;
+    ~RemoveIfEmpty() {
+      std::error_code ignored;
+      if (armed) fs::remove(folder, ignored);
+    }
+  } made{args.out_dir, !folder_existed};
   bool header_printed = false;
   for (const std::string& n : names) {
     // Default scenes are stamped so that commands naming them reuse the file; another seed or
@@ -100,6 +112,7 @@ void generate_scenes(const GenerateArgs& args) {
     header_printed = true;
     fmt::print("{:<15} {:>12} {:>10} {:>7} {:>12} {:>9.2f}  {}\n", n, r.triangles, r.vertices, r.lights, r.bytes,
                r.seconds, r.path.string());
+    made.armed = false;
   }
 }
 

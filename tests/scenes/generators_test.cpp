@@ -107,6 +107,7 @@ TEST(SceneRegistry, RejectsUnknownAndOutOfRangeParameters) {
   EXPECT_EQ(cli.code, 3) << cli.out;
   EXPECT_NE(cli.out.find("6502400000 triangles"), std::string::npos) << cli.out;
   EXPECT_EQ(cli.out.find("triangles   vertices"), std::string::npos) << cli.out;
+  EXPECT_FALSE(fs::exists(dir / "cli")) << "an empty --out was left";
 }
 
 TEST(SceneRegistry, AWriteThatFailsNamesTheFileAndLeavesNothing) {
