@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -14,13 +16,20 @@ namespace sb {
 namespace {
 
 /// The index k of the key interval [times[k], times[k+1]] holding t, and t's fraction u of it;
-/// t outside the keys clamps to the first or the last key (k = n - 1, u = 0 for the last).
+/// t outside the keys clamps to the first or the last key (k = n - 1, u = 0 for the last); t a few
+/// float ulps before a key is at that key (u = 0).
 std::pair<size_t, double> key_interval(const std::vector<double>& times, double t) {
   const size_t n = times.size();
   if (n == 1 || t <= times.front()) return {0, 0.0};
   if (t >= times.back()) return {n - 1, 0.0};
   const size_t k = static_cast<size_t>(std::upper_bound(times.begin(), times.end(), t) - times.begin()) - 1;
-  return {k, (t - times[k]) / (times[k + 1] - times[k])};
+  // Key times are float32 in the file and frame times are computed in double: a frame meant to
+  // fall on a key lands a few float ulps before it (1/24 s in double is below 1/24 s in float), and
+  // a STEP change showed a frame late. A time within a few float ulps of the next key is at it.
+  const double next = times[k + 1];
+  if (next - t <= 4.0 * static_cast<double>(std::numeric_limits<float>::epsilon()) * std::max(std::fabs(next), 1e-3))
+    return {k + 1, 0.0};
+  return {k, (t - times[k]) / (next - times[k])};
 }
 
 /// Component c of key k's value (for a cubic spline: of its value, between the tangents).

@@ -153,6 +153,30 @@ TEST(GltfAnimation, RotationSlerpsStepHoldsAndCubicSplineFollowsHermite) {
   animator.apply(2);
   EXPECT_NEAR(extent(), 1.5, 1e-5) << "scaled 3x from the second key";
 
+  // Key times are float32 in the file, frame times doubles: 45 frames over keys at 0, 1/24, 5/24
+  // and 44/24 s (Blender frames 0, 1, 5 and 44 at 24 fps) put frame 1 at 1/24 s a few float ulps
+  // below the stored key, and a STEP change showed a frame late. Frame k now shows key k.
+  test::ScratchDir dir_step("stepframes");
+  AnimatedScene st;
+  const std::vector<float> step_times = {0.0f, 1.0f / 24.0f, 5.0f / 24.0f, 44.0f / 24.0f};
+  const std::vector<float> step_scales = {1, 1, 1, 3, 3, 3, 1, 1, 1, 3, 3, 3};
+  st.builder.add_animation_channel(st.still, "scale", step_times, step_scales, "STEP");
+  Scene stepped = st.load(dir_step);
+  SceneAnimator step_animator(stepped, gltf_path(45));
+  ASSERT_LT(step_animator.time_of(1), static_cast<double>(1.0f / 24.0f)) << "the case this guards against";
+  const auto still_extent = [&] {
+    double x = 0.0;
+    for (const Mesh& m : stepped.meshes)
+      if (m.node == st.still)
+        for (const vec3& p : m.positions) x = std::max(x, static_cast<double>(p.x));
+    return x;
+  };
+  for (const auto& [frame, size] : {std::pair{0, 0.5}, std::pair{1, 1.5}, std::pair{4, 1.5}, std::pair{5, 0.5},
+                                    std::pair{43, 0.5}, std::pair{44, 1.5}}) {
+    step_animator.apply(frame);
+    EXPECT_NEAR(still_extent(), size, 1e-5) << "frame " << frame;
+  }
+
   // Keys that are not unit (normalized BYTE keys are unit only to their quantization; here twice
   // as long) turn the same way: glm's slerp of the raw keys fell back to a linear blend, 133
   // pixels off at 160x90 a quarter of the way.
