@@ -3,6 +3,9 @@
 
 #include <chrono>
 
+#include <fmt/format.h>
+
+#include "renderer/error.hpp"
 #include "renderer/io/render_output.hpp"
 #include "validation/validate.hpp"
 
@@ -50,10 +53,14 @@ void run_path(Scene& scene, const PathRun& run, const Executor& executor,
     animator.apply(frame);
     const double animate_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     // Frame 0's BVH is the one just built; later frames update it.
-    const double bvh_s = frame == 0 ? prepared.bvh_build_seconds()
-                                    : (animator.moves_geometry()
-                                           ? prepared.update_geometry(animator.moving_mesh_indices())
-                                           : 0.0);
+    double bvh_s = prepared.bvh_build_seconds();
+    try {
+      if (frame > 0) bvh_s = animator.moves_geometry() ? prepared.update_geometry(animator.moving_mesh_indices()) : 0.0;
+    } catch (const InputError& e) {
+      // Geometry the animation moves out of range: named with the frame that moved it there.
+      throw InputError(fmt::format("frame {} of the path (animation time {:g} s): {}", frame, animator.time_of(frame),
+                                   e.what()));
+    }
     const CameraPose pose = animator.camera_at(frame, run.pose);
     const StereoRig rig(pose, run.rig);
     const ValidationTarget target =

@@ -90,6 +90,25 @@ TEST(PathCommand, TheScenesGltfAnimationMovesItsMeshAndCamera) {
   EXPECT_NE(none.out.find("has no glTF node animation"), std::string::npos) << none.out;
 }
 
+TEST(PathCommand, AnAnimationThatMovesGeometryOutOfRangeNamesTheFrame) {
+  // A box keyed to 1e16 m at 2 s: refused at the frame that moves it there, which the message now
+  // names (it named neither frame nor time).
+  test::ScratchDir dir;
+  scenes::GltfBuilder b("far-animation-test", 1);
+  const int grey = b.add_material("grey", vec3(0.6f));
+  const int box = b.add_node("box", b.add_mesh("box", scenes::make_box(vec3(-0.3f, 0.0f, -0.3f), vec3(0.3f, 0.6f, 0.3f)), grey));
+  b.add_point_light("lamp", vec3(1.0f, 2.0f, 2.0f), vec3(1.0f), 15.0f);
+  const std::vector<float> times = {0.0f, 2.0f};
+  const std::vector<float> keys = {0, 0, 0, 1e16f, 0, 0};
+  b.add_animation_channel(box, "translation", times, keys);
+  b.write(dir / "far.gltf");
+  const test::CliRun r = test::run_cli("path --scene '" + (dir / "far.gltf").string() + "' --threads 2 --out '" +
+                                       (dir / "out").string() +
+                                       "' --frames 3 --gltf-animation --pipelines plain-rt --resolution 32x18");
+  EXPECT_EQ(r.code, 3) << r.out;
+  EXPECT_NE(r.out.find("frame 1 of the path (animation time 1 s): "), std::string::npos) << r.out;
+}
+
 TEST(PathCommand, FramesWithSpinAndCameraKeys) {
   test::ScratchDir dir;
   const test::CliRun r =
