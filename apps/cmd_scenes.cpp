@@ -88,31 +88,27 @@ void generate_scenes(const GenerateArgs& args) {
   std::error_code ec;
   const bool folder_existed = fs::exists(args.out_dir, ec);
   prepare_output_folder(args.out_dir, "--out");
-  // A scene refused once built leaves no empty folder that this run made (fs::remove takes an
-  // empty folder only).
-  struct RemoveIfEmpty {
-    const fs::path folder;
-    bool armed;
-    ~RemoveIfEmpty() {
-      std::error_code ignored;
-      if (armed) fs::remove(folder, ignored);
+  try {
+    bool header_printed = false;
+    for (const std::string& n : names) {
+      // Default scenes are stamped so that commands naming them reuse the file; another seed or
+      // parameters get a file name of their own, so that they never stand in for the default.
+      const scenes::GenerateResult r =
+          builtin ? scenes::generate_builtin(n, args.out_dir) : scenes::generate(n, opt, file_of(n));
+      // The table starts with its first row: a scene refused once built (too many triangles) is
+      // reported without an empty table above it.
+      if (!header_printed)
+        fmt::print("{:<15} {:>12} {:>10} {:>7} {:>12} {:>9}  {}\n", "scene", "triangles", "vertices", "lights",
+                   "bytes", "seconds", "file");
+      header_printed = true;
+      fmt::print("{:<15} {:>12} {:>10} {:>7} {:>12} {:>9.2f}  {}\n", n, r.triangles, r.vertices, r.lights, r.bytes,
+                 r.seconds, r.path.string());
     }
-  } made{args.out_dir, !folder_existed};
-  bool header_printed = false;
-  for (const std::string& n : names) {
-    // Default scenes are stamped so that commands naming them reuse the file; another seed or
-    // parameters get a file name of their own, so that they never stand in for the default.
-    const scenes::GenerateResult r =
-        builtin ? scenes::generate_builtin(n, args.out_dir) : scenes::generate(n, opt, file_of(n));
-    // The table starts with its first row: a scene refused once built (too many triangles) is
-    // reported without an empty table above it.
-    if (!header_printed)
-      fmt::print("{:<15} {:>12} {:>10} {:>7} {:>12} {:>9}  {}\n", "scene", "triangles", "vertices", "lights", "bytes",
-                 "seconds", "file");
-    header_printed = true;
-    fmt::print("{:<15} {:>12} {:>10} {:>7} {:>12} {:>9.2f}  {}\n", n, r.triangles, r.vertices, r.lights, r.bytes,
-               r.seconds, r.path.string());
-    made.armed = false;
+  } catch (...) {
+    // A scene refused once built leaves no empty folder this run made (fs::remove takes an empty
+    // folder only).
+    if (!folder_existed) fs::remove(args.out_dir, ec);
+    throw;
   }
 }
 

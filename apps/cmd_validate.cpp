@@ -54,23 +54,26 @@ std::vector<PipelineEntry> chosen_pipelines(const std::vector<std::string>& name
 /// non-zero MSE (its PSNR finite) never reads 0.000.
 std::string mse_text(double v) { return v > 0.0 && v < 0.001 ? fmt::format("{:.1e}", v) : table_number(v, 3); }
 
-/// The records of `scene_stem` (scene and truth) that the earlier summary in `out` lists and this
+/// The records an earlier summary lists: none when there is no summary or it cannot be read (a
+/// damaged summary is replaced; its records stay as they are).
+json earlier_records(const fs::path& summary) {
+  try {
+    if (!fs::is_regular_file(summary)) return json::array();
+    const json earlier = json::parse(io::read_file(summary));
+    if (earlier.is_object() && earlier.contains("records") && earlier["records"].is_array()) return earlier["records"];
+  } catch (const std::exception&) {
+  }
+  return json::array();
+}
+
+/// The records of `scene_stem` (scene and truth) among `earlier` (its earlier summary's) that this
 /// run does not write, retired from `set` with the images of their own: this run replaces the
 /// truth and disocclusion images they point to, so they would describe another truth (another rig,
-/// another scene file of that name). The names of their pipelines; none when there is no earlier
-/// summary or it cannot be read.
-std::vector<std::string> retire_earlier_records(io::StagedFiles& set, const fs::path& out, const fs::path& summary,
+/// another scene file of that name). The names of their pipelines.
+std::vector<std::string> retire_earlier_records(io::StagedFiles& set, const fs::path& out, const json& earlier,
                                                 const std::string& scene_stem, const std::vector<std::string>& names) {
   std::vector<std::string> retired;
-  json earlier;
-  try {
-    if (!fs::is_regular_file(summary)) return retired;
-    earlier = json::parse(io::read_file(summary));
-  } catch (const std::exception&) {
-    return retired;  // a damaged summary is replaced; its records stay as they are
-  }
-  if (!earlier.is_object() || !earlier.contains("records") || !earlier["records"].is_array()) return retired;
-  for (const json& r : earlier["records"]) {
+  for (const json& r : earlier) {
     if (!r.is_object() || !r.contains("pipeline") || !r["pipeline"].is_string()) continue;
     const std::string pipeline = r["pipeline"].get<std::string>();
     if (std::find(names.begin(), names.end(), pipeline) != names.end()) continue;
@@ -95,45 +98,30 @@ std::string work_folder_name(const std::string& scene_stem, const std::string& t
   return fmt::format("{}_{}", scene_stem, truth_key.substr(0, work_key_digits));
 }
 
-/// The truth commands of the records an earlier summary lists (none when there is none or it cannot
-/// be read): each names the work folder it renders in.
-std::vector<std::string> earlier_truth_commands(const fs::path& summary) {
-  std::vector<std::string> commands;
-  try {
-    if (!fs::is_regular_file(summary)) return commands;
-    const json earlier = json::parse(io::read_file(summary));
-    if (!earlier.is_object() || !earlier.contains("records") || !earlier["records"].is_array()) return commands;
-    for (const json& r : earlier["records"])
-      if (r.is_object() && r.contains("truth") && r["truth"].is_object() && r["truth"].contains("command") &&
-          r["truth"]["command"].is_string())
-        commands.push_back(r["truth"]["command"].get<std::string>());
-  } catch (const std::exception&) {
-  }
-  return commands;
-}
-
-/// Removes the work folders of `scene_stem` (`<scene_stem>_<key digits>`) other than `kept` that the
-/// commands of the records this run replaced name: no record names them any more. A folder no such
-/// record names (one another run into this --out is rendering in) is left; one that cannot be
-/// removed is left with a warning.
+/// Removes the work folders of `scene_stem` (`<scene_stem>_<key digits>`) other than `kept` whose
+/// path the truth command of one of `earlier` (the records this run replaced) names: no record
+/// names them any more. A folder no such record names (one another run into this --out is
+/// rendering in) is left; one that cannot be removed is left with a warning.
 void remove_earlier_work_folders(const fs::path& work, const std::string& scene_stem, const std::string& kept,
-                                 const std::vector<std::string>& earlier_commands) {
+                                 const json& earlier) {
   std::error_code ec;
-  if (earlier_commands.empty() || !fs::is_directory(work, ec)) return;
+  if (earlier.empty() || !fs::is_directory(work, ec)) return;
   const std::string prefix = scene_stem + "_";
-  std::vector<fs::path> earlier;
+  const auto named = [&](const std::string& name) {
+    return std::any_of(earlier.begin(), earlier.end(), [&](const json& r) {
+      const json* truth = r.is_object() && r.contains("truth") && r["truth"].is_object() ? &r["truth"] : nullptr;
+      return truth != nullptr && truth->contains("command") && (*truth)["command"].is_string() &&
+             (*truth)["command"].get<std::string>().find("/" + name) != std::string::npos;
+    });
+  };
+  std::vector<fs::path> replaced;
   for (const fs::directory_entry& entry : fs::directory_iterator(work, ec)) {
     const std::string name = entry.path().filename().string();
-    if (name == kept || name.size() != prefix.size() + work_key_digits || name.rfind(prefix, 0) != 0) continue;
-    if (!std::all_of(name.begin() + static_cast<std::ptrdiff_t>(prefix.size()), name.end(),
-                     [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'); }))
-      continue;
-    const bool named = std::any_of(earlier_commands.begin(), earlier_commands.end(), [&](const std::string& command) {
-      return command.find("/" + name) != std::string::npos;
-    });
-    if (named && entry.is_directory(ec)) earlier.push_back(entry.path());
+    if (name != kept && name.size() == prefix.size() + work_key_digits && name.rfind(prefix, 0) == 0 &&
+        entry.is_directory(ec) && named(name))
+      replaced.push_back(entry.path());
   }
-  for (const fs::path& folder : earlier) {
+  for (const fs::path& folder : replaced) {
     fs::remove_all(folder, ec);
     if (ec)
       print_warning(fmt::format("could not remove {}, the work folder of a truth this run replaced: {}",
@@ -208,6 +196,9 @@ void run_validate(const ValidateArgs& a) {
   // the summary last: a run that stops on the way (an image it cannot write, a full disk) leaves an
   // earlier run's summary, records and images as they were.
   io::StagedFiles set;
+  // The earlier summary's records: those this run does not write are retired with it, and the work
+  // folders they named go once this run's set is in place.
+  const json earlier = earlier_records(summary);
   std::vector<std::string> retired;  // pipelines of earlier records this run removes
   validation::ImageFileOptions image_options;
   image_options.staged = &set;
@@ -250,14 +241,13 @@ void run_validate(const ValidateArgs& a) {
                  "pipeline", name_w, "PSNR dB", "SSIM", "MSE", "err %");
       for (const std::string& line : left_lines) fmt::print("{}\n", line);
     }
-    retired = retire_earlier_records(set, out, summary, scene_stem, names);
+    retired = retire_earlier_records(set, out, earlier, scene_stem, names);
     const std::string summary_text =
         io::json_text(json{{"kind", "stereobench.validation_summary"}, {"records", records}}, 2) + "\n";
     set.add(summary, [&](const fs::path& tmp) { io::write_text_atomically(tmp, summary_text); });
   }
-  const std::vector<std::string> earlier_commands = earlier_truth_commands(summary);
   set.commit();  // the summary, added last, is the set's marker
-  remove_earlier_work_folders(out / "work", scene_stem, work_name, earlier_commands);
+  remove_earlier_work_folders(out / "work", scene_stem, work_name, earlier);
   fmt::print("\nwrote {} (one record per pipeline beside it, images under {})\n", summary.string(), out.string());
   if (!retired.empty())
     fmt::print("removed the earlier records of {} with their images: not validated in this run, they described the "

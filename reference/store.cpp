@@ -80,6 +80,16 @@ std::optional<double> optional_quantity(const json& j, const char* key, const ch
   return v.get<double>();
 }
 
+/// `path` with its folder's links and ".." resolved and its own name kept: a linked scene file is the
+/// link (its name gives the id, its buffers and textures lie beside it), and "link/../x" is the x
+/// beside the link's target. The path as given, made absolute and normal, where the folder cannot
+/// be resolved.
+fs::path with_folder_resolved(const fs::path& path) {
+  std::error_code ec;
+  const fs::path folder = fs::weakly_canonical(path.parent_path(), ec);
+  return ec ? path.lexically_normal() : folder / path.filename();
+}
+
 json spec_to_json_fields(const ReferenceSpec& s) {
   return {{"scene", s.scene},
           {"lights", optional_json(s.lights)},
@@ -221,9 +231,8 @@ ReferenceSpec spec_in(const json& provenance, const fs::path& file) {
   if (recorded.contains("scene_from_store") && recorded.at("scene_from_store").is_string()) {
     std::error_code ec;
     const fs::path relative(recorded.at("scene_from_store").get<std::string>());
-    const fs::path folder = fs::weakly_canonical(file.parent_path().parent_path() / relative.parent_path(), ec);
-    const fs::path beside = folder / relative.filename();
-    if (!ec && !relative.filename().empty() && fs::is_regular_file(beside, ec)) spec.scene = beside.string();
+    const fs::path beside = with_folder_resolved(file.parent_path().parent_path() / relative);
+    if (!relative.filename().empty() && fs::is_regular_file(beside, ec)) spec.scene = beside.string();
   }
   const std::vector<std::string> providers = validation::truth_provider_names();
   if (std::find(providers.begin(), providers.end(), spec.provider) == providers.end())
@@ -451,20 +460,14 @@ void replace_folder(const fs::path& staged, const fs::path& dir) {
   fs::remove_all(old, ec);
 }
 
-/// The scene argument as the store records and compares it: a glTF path absolute, its folders'
-/// links and ".." resolved (so that `verify` and `update` find it from any working folder;
-/// "link/../x" is the x beside the link's target), the file's own name kept (a linked scene file
-/// keeps its name, which the id gives, and its buffers and textures are found beside the link), a
+/// The scene argument as the store records and compares it: a glTF path absolute with its folder
+/// resolved (with_folder_resolved: `verify` and `update` find it from any working folder), a
 /// built-in name as given. A path that is not UTF-8 cannot be recorded in the provenance (JSON) as
 /// it is, and is refused.
 std::string stored_scene(const std::string& scene) {
   if (!scenes::is_scene_file_spec(scene)) return scene;
   // Not normalized as text first: "link/.." is the link target's folder, not the link's.
-  const fs::path absolute = fs::absolute(scene);
-  std::error_code ec;
-  const fs::path folder = fs::weakly_canonical(absolute.parent_path(), ec);
-  const std::string stored =
-      ec ? absolute.lexically_normal().string() : (folder / absolute.filename()).string();
+  const std::string stored = with_folder_resolved(fs::absolute(scene)).string();
   if (!io::is_utf8(stored))
     throw InputError(fmt::format("--scene {}: the path {} is not valid UTF-8, and the provenance (JSON) could not "
                                  "record it as it is; rename the file or its folders",
@@ -603,7 +606,7 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
   const Prepared p = prepare(stored, scenes_dir);
   const Scene& scene = p.loaded.scene;
   // An entry made when the scene's field of view or light count differed from the spec's keeps its
-  // folder (reference_ids); otherwise the id reference_id gives.
+  // folder (reference_ids); otherwise the first of reference_ids, the id an entry is made under.
   const std::vector<std::string> candidates = reference_ids(scene, stored, *p.rig, p.loaded.lights_in_file);
   const auto existing = std::find_if(candidates.begin(), candidates.end(),
                                      [&](const std::string& c) { return fs::exists(root_ / c / kProvenance); });

@@ -237,7 +237,8 @@ void require_psnr_of_mse(const json& root, const std::string& where, const std::
 }
 
 /// The metrics at `metrics` (psnr, ssim, an optional mse): each a number, "inf" or null, within what a
-/// measurement gives, the PSNR the one its MSE gives.
+/// measurement gives (on 8-bit codes MSE is at most 255^2, so PSNR = 10 log10(255^2 / MSE) is at
+/// least 0, inf when equal), the PSNR the one its MSE gives.
 void require_metrics(const json& root, const std::string& where, const std::string& prefix, const std::string& metrics) {
   for (const char* m : {"psnr", "ssim", "mse"})
     require(root, where, prefix, metrics + "." + m, Kind::metric, m == std::string("mse"));
@@ -464,11 +465,7 @@ void check_cell_record(const json& line, const std::string& where) {
     if (!p.is_object()) throw InputError(fmt::format("{}: field 'pipelines.{}' must be an object", where, name));
     for (const Field& f : kPipelineFields) require(p, where, prefix, f.path, f.kind, f.optional);
     constexpr double kMax = std::numeric_limits<double>::max();
-    // On 8-bit codes: MSE at most 255^2, so PSNR = 10 log10(255^2 / MSE) at least 0 (inf when equal).
-    require_within(p, where, prefix, "validation.metrics.psnr", 0.0, std::numeric_limits<double>::infinity());
-    require_within(p, where, prefix, "validation.metrics.ssim", -1.0, 1.0);
-    require_within(p, where, prefix, "validation.metrics.mse", 0.0, 255.0 * 255.0);
-    require_psnr_of_mse(p, where, prefix, "validation.metrics");
+    require_metrics(p, where, prefix, "validation.metrics");
     for (const char* f : {"validation.metrics.error_fraction", "validation.holes.hole_fraction",
                           "validation.holes.not_reprojected.recall", "validation.holes.not_reprojected.precision"})
       require_within(p, where, prefix, f, 0.0, 1.0);

@@ -570,17 +570,23 @@ TEST(Cli, AFarSceneAndARigThatSeesNothingAreWarnedAbout) {
   test::ScratchDir dir("far");
   // A triangle and its camera 100 km from the origin: float positions there put shadow rays 1.5 m
   // off the surfaces, and small objects lost their shadows without a word.
-  const auto write_scene = [&](const std::string& file, double x, double camera_z) {
+  // A triangle `size` m across at x, and its camera looking at it from `size` m away.
+  const auto write_scene = [&](const std::string& file, double x, double size) {
     test::MiniGltf g;
     g.add_triangle();
     g.doc["nodes"][0]["translation"] = {x, 0.0, 0.0};
-    g.add_node({{"camera", 0}, {"translation", {x + 0.2, 0.2, camera_z}}});
-    g.doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 1.0}, {"znear", 0.01}, {"zfar", 100.0}}}}};
+    g.doc["nodes"][0]["scale"] = {size, size, size};
+    g.add_node({{"camera", 0}, {"translation", {x + 0.2 * size, 0.2 * size, size}}});
+    g.doc["cameras"] = {
+        {{"type", "perspective"}, {"perspective", {{"yfov", 1.0}, {"znear", 0.01 * size}, {"zfar", 100.0}}}}};
     g.doc["scenes"][0]["extras"] = {{"stereobench", {{"ambient", 1.0}}}};
     g.write_gltf(dir / file);
   };
   write_scene("far.gltf", 100000.0, 1.0);
   write_scene("near.gltf", 0.0, 1.0);
+  // A triangle of 1 mm seen from 1 mm: the default rig's eyes stand 32 mm either side and both miss
+  // it (a scene in millimetres rendered black without a word).
+  write_scene("tiny.gltf", 0.0, 0.001);
   const auto render = [&](const std::string& file) {
     return run("render --pipeline plain-rt --scene " + test::quoted(dir / file) + " --resolution 32x18 --out " +
                test::quoted(dir / "out"));
@@ -595,15 +601,6 @@ TEST(Cli, AFarSceneAndARigThatSeesNothingAreWarnedAbout) {
   ASSERT_EQ(near.code, 0) << near.out;
   EXPECT_EQ(near.out.find("from the origin"), std::string::npos) << near.out;
   EXPECT_EQ(near.out.find("neither eye sees a surface"), std::string::npos) << near.out;
-  // A camera 1 mm from a triangle far wider than the default rig's 32 mm eye offset is fine; one
-  // 1 mm from a triangle of 1 mm is not: with the 64 mm interaxial both eyes miss it (a scene in
-  // millimetres rendered black without a word).
-  test::MiniGltf tiny;
-  tiny.add_triangle();
-  tiny.doc["nodes"][0]["scale"] = {0.001, 0.001, 0.001};
-  tiny.add_node({{"camera", 0}, {"translation", {0.0002, 0.0002, 0.002}}});
-  tiny.doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 1.0}, {"znear", 0.0001}, {"zfar", 1.0}}}}};
-  tiny.write_gltf(dir / "tiny.gltf");
   const CliRun black = render("tiny.gltf");
   ASSERT_EQ(black.code, 0) << black.out;
   EXPECT_NE(black.out.find("warning: neither eye sees a surface: every pixel is background. The eyes stand 0.032 m "

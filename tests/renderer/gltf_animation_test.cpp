@@ -52,6 +52,15 @@ struct AnimatedScene {
 };
 
 /// The centre of mesh `name`'s vertices.
+/// The largest x of the vertices of the meshes on `node` (a box centred on x = 0: half its width).
+double max_x_of(const Scene& scene, int node) {
+  double x = 0.0;
+  for (const Mesh& m : scene.meshes)
+    if (m.node == node)
+      for (const vec3& p : m.positions) x = std::max(x, static_cast<double>(p.x));
+  return x;
+}
+
 dvec3 centre_of(const Scene& scene, const std::string& node_name, int node) {
   for (const Mesh& m : scene.meshes) {
     if (m.node != node) continue;
@@ -139,19 +148,10 @@ TEST(GltfAnimation, RotationSlerpsStepHoldsAndCubicSplineFollowsHermite) {
   const double angle = 22.5 * std::acos(-1.0) / 180.0;
   expect_near(centre_of(scene, "rider", a.rider), dvec3(2.0 * std::cos(angle), 0.0, -2.0 * std::sin(angle)), 1e-5,
               "rider at 22.5 degrees");
-  animator.apply(2);  // 1 s: the scale keys' end, where STEP switches
-  const auto extent = [&] {
-    double x = 0.0;
-    for (const Mesh& m : scene.meshes)
-      if (m.node == a.still)
-        for (const vec3& p : m.positions) x = std::max(x, static_cast<double>(p.x));
-    return x;
-  };
   // STEP (keys at 0 s and 1 s): until the second key the first value holds, from it the second.
-  animator.apply(1);
-  EXPECT_NEAR(extent(), 0.5, 1e-6) << "the box keeps its 1 m size at 0.5 s";
-  animator.apply(2);
-  EXPECT_NEAR(extent(), 1.5, 1e-5) << "scaled 3x from the second key";
+  EXPECT_NEAR(max_x_of(scene, a.still), 0.5, 1e-6) << "the box keeps its 1 m size at 0.5 s";
+  animator.apply(2);  // 1 s: the scale keys' end, where STEP switches
+  EXPECT_NEAR(max_x_of(scene, a.still), 1.5, 1e-5) << "scaled 3x from the second key";
 
   // Key times are float32 in the file, frame times doubles: 45 frames over keys at 0, 1/24, 5/24
   // and 44/24 s (Blender frames 0, 1, 5 and 44 at 24 fps) put frame 1 at 1/24 s a few float ulps
@@ -164,17 +164,10 @@ TEST(GltfAnimation, RotationSlerpsStepHoldsAndCubicSplineFollowsHermite) {
   Scene stepped = st.load(dir_step);
   SceneAnimator step_animator(stepped, gltf_path(45));
   ASSERT_LT(step_animator.time_of(1), static_cast<double>(1.0f / 24.0f)) << "the case this guards against";
-  const auto still_extent = [&] {
-    double x = 0.0;
-    for (const Mesh& m : stepped.meshes)
-      if (m.node == st.still)
-        for (const vec3& p : m.positions) x = std::max(x, static_cast<double>(p.x));
-    return x;
-  };
   for (const auto& [frame, size] : {std::pair{0, 0.5}, std::pair{1, 1.5}, std::pair{4, 1.5}, std::pair{5, 0.5},
                                     std::pair{43, 0.5}, std::pair{44, 1.5}}) {
     step_animator.apply(frame);
-    EXPECT_NEAR(still_extent(), size, 1e-5) << "frame " << frame;
+    EXPECT_NEAR(max_x_of(stepped, st.still), size, 1e-5) << "frame " << frame;
   }
 
   // Keys that are not unit (normalized BYTE keys are unit only to their quantization; here twice
