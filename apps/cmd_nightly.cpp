@@ -133,9 +133,12 @@ ChosenRun choose_run_dir(const fs::path& out, const SweepDefinition& d, const fs
     if (!fs::exists(newest / kRunDoneFile, ec)) {
       const ResultsFile r = read_results(newest / "results.jsonl");
       // A run stopped before its first cell was recorded holds no line to tell: its folder's
-      // sweep marker (written before the first cell) does, when it has one.
-      const bool same = r.cells.empty() ? validation::out_folder_is_for(d, newest)
-                                        : r.cells.front().value("definition_sha256", "") == d.sha256;
+      // sweep marker (written before the first cell) does, when it has one. One whose cells this
+      // build cannot join (another pipeline set, where the definition lists "all") is left too.
+      const bool same =
+          r.cells.empty()
+              ? validation::out_folder_is_for(d, newest)
+              : !validation::why_not_resumable(d, validation::expand_cells(d).size(), r.cells.front()).has_value();
       if (same) {
         std::optional<io::FileLock> claim = claim_run_id(history_file, ids.back());
         if (!claim)
@@ -148,9 +151,9 @@ ChosenRun choose_run_dir(const fs::path& out, const SweepDefinition& d, const fs
         chosen.claim = std::move(*claim);
         return chosen;
       }
-      fmt::print(stderr, "note: the unfinished run {} is not a run of {} as it is now (its results or its sweep "
-                 "marker name another definition, or the marker is damaged); starting a new run, and leaving that "
-                 "folder as it is\n",
+      fmt::print(stderr, "note: the unfinished run {} is not a run of {} as this build runs it (its results or its "
+                 "sweep marker name another definition or another set of pipelines, or the marker is damaged); "
+                 "starting a new run, and leaving that folder as it is\n",
                  newest.string(), d.file.string());
     }
   }

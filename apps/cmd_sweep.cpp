@@ -120,6 +120,7 @@ void run_sweep(const SweepRunArgs& a) {
   o.scenes_dir = a.scenes_dir;
   if (!a.cache.empty()) o.truth_cache = fs::path(a.cache);
   o.definition_label = a.definition;
+  o.shard = shard;
   o.jobs = a.jobs;
   o.threads = checked_threads(a.threads);
   validation::refuse_local_run_of_slurm_folder(o.out_dir, o.results);
@@ -217,7 +218,7 @@ void register_csv(CLI::App& sweep) {
   CLI::App* csv = sweep.add_subcommand(
       "csv", "Export a results file as CSV: one row per (cell, pipeline) with the rig, metrics, holes and times");
   csv->add_option("results", a->results, "Results file (results.jsonl)")->required();
-  csv->add_option("--out,-o", a->out, "CSV file to write (default: standard output)");
+  csv->add_option("--out,-o", a->out, "CSV file to write ('-' or none: standard output)");
   csv->callback([a] {
     if (!fs::exists(a->results)) throw InputError(fmt::format("{}: results file does not exist", a->results));
     refuse_overwriting({{"results", &a->results}}, {{"--out", &a->out}});
@@ -228,7 +229,7 @@ void register_csv(CLI::App& sweep) {
                                    "the results file it wrote",
                                    a->results));
     const std::string text = results_csv(r.cells);
-    if (a->out.empty()) {
+    if (a->out.empty() || a->out == "-") {
       fmt::print("{}", text);
     } else {
       write_option_file("--out", a->out, text);
@@ -245,7 +246,10 @@ void register_collect(CLI::App& sweep) {
   auto a = std::make_shared<Args>();
   CLI::App* collect = sweep.add_subcommand(
       "collect", "Merge the results files of shards into one, ordered by cell_index (identical duplicates collapse)");
-  collect->add_option("out", a->out, "Merged results file to write")->required();
+  collect->add_option("out", a->out,
+                      "Merged results file to write ('-': standard output, image paths then relative to the current "
+                      "folder)")
+      ->required();
   collect->add_option("inputs", a->inputs, "Results files of the shards")->required();
   collect->callback([a] {
     std::vector<fs::path> inputs(a->inputs.begin(), a->inputs.end());
@@ -257,6 +261,13 @@ void register_collect(CLI::App& sweep) {
       throw InputError(fmt::format("the {} input file(s) hold no finished cell; {} not written (check that the shards "
                                    "ran, and their results paths)",
                                    inputs.size(), a->out));
+    if (a->out == "-") {
+      std::string text = results_text(cells);
+      text.pop_back();  // print_to_stdout ends the last line
+      print_to_stdout(text);
+      fmt::print(stderr, "merged {} cells from {} files\n", cells.size(), inputs.size());
+      return;
+    }
     write_option_file("the merged results file", a->out, results_text(cells));
     // The shards of a Slurm submission merged into the sweep's results file (as the executor
     // advises when it does not wait): recorded as the executor's own merge, which a later run with

@@ -20,12 +20,15 @@
 #include "renderer/text.hpp"
 #include "scenes/catalog.hpp"
 #include "validation/results_file.hpp"
+#include "validation/slurm.hpp"
+#include "validation/sweep_run.hpp"
 
 namespace sb::validation {
 
 namespace {
 
 using nlohmann::json;
+namespace fs = std::filesystem;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr const char* kToleranceKey = "regression_tolerance";
 
@@ -744,24 +747,55 @@ namespace {
 /// Whether the results hold every cell of their sweep: a results file left by a sweep that stopped
 /// early (killed, a full disk) must not pass, nor one whose records do not say how many cells the
 /// sweep has (a line without cell_count: edited, or of an older version). Nothing for no cells.
+/// The shard I/N (N > 1) whose run wrote every record, when one did: a shard's results file.
+std::optional<std::pair<uint64_t, uint64_t>> shard_of(const std::vector<const json*>& records) {
+  std::optional<std::pair<uint64_t, uint64_t>> shard;
+  for (const json* r : records) {
+    const json shard_record = r->value("shard", json::object());
+    if (!shard_record.is_object()) return std::nullopt;
+    const json index = shard_record.value("index", json()), count = shard_record.value("count", json());
+    if (!index.is_number_integer() || !count.is_number_integer()) return std::nullopt;  // older lines
+    const std::pair<uint64_t, uint64_t> mine{index.get<uint64_t>(), count.get<uint64_t>()};
+    if (shard && *shard != mine) return std::nullopt;  // collected from several shards
+    shard = mine;
+  }
+  return shard && shard->second > 1 ? shard : std::nullopt;
+}
+
 std::optional<GateCheck> completeness_check(const GateResults& results) {
   if (results.cells.empty()) return std::nullopt;
   std::vector<const json*> records;
-  std::string definition;
+  std::string definition, out;
   for (const GateCell& cell : results.cells) {
     records.push_back(&cell.record);
     if (definition.empty() && cell.record.value("definition", json()).is_string())
       definition = cell.record["definition"].get<std::string>();
+    if (out.empty() && cell.record.value("out", json()).is_string()) out = cell.record["out"].get<std::string>();
   }
+  // Lines from before "out" was recorded: the results file's folder, sweep run's default.
+  if (out.empty()) out = results.file.parent_path().empty() ? "." : results.file.parent_path().string();
   const std::optional<CellCoverage> coverage = cell_coverage(records);
+  const std::optional<std::pair<uint64_t, uint64_t>> shard = shard_of(records);
+  // A Slurm task's results file lies in the Slurm folder of the sweep's --out.
+  std::error_code ec;
+  const bool slurm_task =
+      shard && fs::weakly_canonical(fs::absolute(results.file).parent_path(), ec) ==
+                   fs::weakly_canonical(fs::absolute(slurm_layout(out).dir), ec);
   GateCheck check;
   check.check = kCompleteCheck;
   check.cell_id = "(all cells)";
   check.pipeline = "(all)";
-  check.reproduce = fmt::format("stereobench sweep run {} --out {}", definition.empty() ? "DEFINITION" : shell_quote(definition),
-                                shell_quote(results.file.parent_path().empty() ? "." : results.file.parent_path().string()));
-  // sweep run resumes <out>/results.jsonl unless told otherwise.
-  if (results.file.filename() != "results.jsonl") check.reproduce += " --results " + shell_quote(results.file.string());
+  const std::string run = fmt::format("stereobench sweep run {} --out {}",
+                                      definition.empty() ? "DEFINITION" : shell_quote(definition), shell_quote(out));
+  if (slurm_task) {
+    check.reproduce = run + " --executor slurm --wait";
+  } else {
+    check.reproduce = run;
+    if (shard) check.reproduce += fmt::format(" --shard {}/{}", shard->first, shard->second);
+    // sweep run resumes <out>/results.jsonl unless told otherwise.
+    if (results.file.lexically_normal() != (fs::path(out) / "results.jsonl").lexically_normal())
+      check.reproduce += " --results " + shell_quote(results.file.string());
+  }
   if (!coverage) {
     check.measured = kNaN;
     check.verdict = Verdict::fail;
@@ -779,9 +813,28 @@ std::optional<GateCheck> completeness_check(const GateResults& results) {
     return check;
   }
   check.verdict = Verdict::fail;
-  check.message = fmt::format("{} holds {} of the sweep's {} cells: the sweep did not finish; run it again with the "
-                              "same --out to resume it",
-                              results.file.string(), coverage->present, expected);
+  if (slurm_task) {
+    check.message = fmt::format(
+        "{} holds {} of the sweep's {} cells: it is the results file of Slurm task {} of {}, not the sweep's; gate "
+        "{}, which the executor merges from every task once all have ended (the command below waits for them, "
+        "submitting the cells left again)",
+        results.file.string(), coverage->present, expected, shard->first, shard->second,
+        (fs::path(out) / "results.jsonl").string());
+  } else if (shard) {
+    const size_t in_shard = shard_cells(expected, {shard->first, shard->second}).size();
+    check.message = fmt::format(
+        "{} holds {} of the sweep's {} cells: it is the results file of shard {}/{}{}; merge every shard's results "
+        "file with `stereobench sweep collect` and gate the merged file",
+        results.file.string(), coverage->present, expected, shard->first, shard->second,
+        coverage->present >= in_shard
+            ? fmt::format(", which has all of its {} cells", in_shard)
+            : fmt::format(", which holds {} of its {} cells: the command below finishes the shard",
+                          coverage->present, in_shard));
+  } else {
+    check.message = fmt::format("{} holds {} of the sweep's {} cells: the sweep did not finish; run it again with the "
+                                "same --out to resume it",
+                                results.file.string(), coverage->present, expected);
+  }
   return check;
 }
 

@@ -275,6 +275,10 @@ constexpr Field kCellFields[] = {
     {"rig.convergence_m", Kind::number},
     {"rig.max_disparity_px", Kind::number},
     {"scene.triangles", Kind::integer_or_null, true},
+    {"out", Kind::string, true},
+    {"shard", Kind::object, true},
+    {"shard.index", Kind::integer, true},
+    {"shard.count", Kind::integer, true},
     {"baseline", Kind::string},
     {"pipelines", Kind::object},
 };
@@ -447,6 +451,15 @@ void check_cell_record(const json& line, const std::string& where) {
   if (line.contains("cell_count") && line["cell_index"].get<long long>() >= line["cell_count"].get<long long>())
     throw InputError(fmt::format("{}: cell_index {} is not below cell_count {}; the line is damaged or edited by hand",
                                  where, line["cell_index"].dump(), line["cell_count"].dump()));
+  if (const auto shard = line.find("shard"); shard != line.end()) {
+    const json index = shard->value("index", json()), count = shard->value("count", json());
+    if (!index.is_number_integer() || !count.is_number_integer() || index.get<long long>() < 0 ||
+        index.get<long long>() >= count.get<long long>() ||
+        line["cell_index"].get<long long>() % count.get<long long>() != index.get<long long>())
+      throw InputError(fmt::format("{}: shard {} is not a shard I/N (0 <= I < N) that holds cell_index {}; the line is "
+                                   "damaged or edited by hand",
+                                   where, shard->dump(), line["cell_index"].dump()));
+  }
   for (const char* f : {"rig.interaxial_m", "rig.convergence_m", "rig.max_disparity_px"})
     if (const double x = find(line, f)->get<double>(); !(x > 0.0 && std::isfinite(x)))
       throw InputError(fmt::format("{}: field '{}' is {}; a rig's interaxial, convergence and max disparity are "
@@ -546,46 +559,77 @@ void check_cell_record(const json& line, const std::string& where) {
   }
 }
 
+namespace {
+
+/// Holds cells read one after another (one results file, or the shards collected into one) to one
+/// sweep as one build ran it: the first cell's sweep and definition, pipelines and cell count, and
+/// for each scene one content (a scene edited between shards would mix two scenes in one sweep).
+class OneSweep {
+ public:
+  /// `where`: the cell's place in messages ("file:line"); `name`: how a later message names this
+  /// cell's place when it is the first ("line 3", or the file).
+  void check(const json& cell, const std::string& where, const std::string& name) {
+    if (!first_) {
+      first_ = cell;  // a copy: the caller's cells move
+      first_name_ = name;
+    }
+    const json& first = *first_;
+    if (cell["sweep"] != first["sweep"] ||
+        cell.value("definition_sha256", "") != first.value("definition_sha256", ""))
+      throw InputError(fmt::format(
+          "{}: a cell of sweep '{}' (definition sha256 {}), but {} is of sweep '{}' (sha256 {}); a results file "
+          "holds the cells of one sweep definition (the shards of one definition merge with `stereobench sweep "
+          "collect`)",
+          where, cell["sweep"].get<std::string>(), cell.value("definition_sha256", "?").substr(0, 12), first_name_,
+          first["sweep"].get<std::string>(), first.value("definition_sha256", "?").substr(0, 12)));
+    // Every cell of a definition validates every pipeline of it: a cell without one would let the
+    // gate pass that pipeline there unchecked.
+    const auto names = [](const json& c) {
+      std::vector<std::string> n;
+      for (const auto& [pipeline, p] : c["pipelines"].items()) n.push_back(pipeline);
+      return n;
+    };
+    if (names(cell) != names(first))
+      throw InputError(fmt::format("{}: the cell validates pipelines {}, but {} of the same definition validates {}; "
+                                   "every cell of a sweep validates every pipeline — cells run by builds with other "
+                                   "pipelines (where the definition lists \"all\"), or a file edited by hand",
+                                   where, fmt::join(names(cell), ", "), first_name_, fmt::join(names(first), ", ")));
+    if (cell.value("cell_count", json()) != first.value("cell_count", json()))
+      throw InputError(fmt::format("{}: cell_count {}, but {} of the same definition says {}; cells run by builds "
+                                   "that expand the definition differently, or a file edited by hand",
+                                   where, cell.value("cell_count", json()).dump(), first_name_,
+                                   first.value("cell_count", json()).dump()));
+    const json label = value_at(cell, "cell.scene"), content = value_at(cell, "scene.content_sha256");
+    if (!label.is_string() || !content.is_string()) return;  // lines from before content hashes
+    const auto [seen, fresh] = scenes_.try_emplace(label.get<std::string>(), content.get<std::string>(), where);
+    if (!fresh && seen->second.first != content.get<std::string>())
+      throw InputError(fmt::format("{}: the cell was measured on scene '{}' with content sha256 {}, but {} on content "
+                                   "{}: the scene changed between the runs of one sweep; rerun the cells of one of "
+                                   "the two (delete their results) on the scene as it is now",
+                                   where, label.get<std::string>(), content.get<std::string>().substr(0, 12),
+                                   seen->second.second, seen->second.first.substr(0, 12)));
+  }
+
+ private:
+  std::optional<json> first_;
+  std::string first_name_;
+  std::map<std::string, std::pair<std::string, std::string>> scenes_;  // label -> content, where first seen
+};
+
+}  // namespace
+
 ResultsFile read_results(const fs::path& file) {
   ResultsFile out;
   std::map<std::string, size_t> seen;        // cell_id -> line
   std::map<std::string, size_t> seen_index;  // cell_index -> line
+  OneSweep one;
   read_json_lines(
       file, "(a sweep killed while writing it) skipped; its cell runs again when the sweep resumes",
       "a results file holds one JSON object per line", out.warnings,
       [&](json&& cell, size_t line_no, const std::string& where) {
         check_cell_record(cell, where);
         // One definition per file: resuming, collecting, gating and reporting all speak of one sweep.
-        if (!out.cells.empty()) {
-          const json& first = out.cells.front();
-          if (cell["sweep"] != first["sweep"] ||
-              cell.value("definition_sha256", "") != first.value("definition_sha256", ""))
-            throw InputError(fmt::format(
-                "{}: a cell of sweep '{}' (definition sha256 {}), but line {} is of sweep '{}' (sha256 {}); a "
-                "results file holds the cells of one sweep definition (the shards of one definition merge with "
-                "`stereobench sweep collect`)",
-                where, cell["sweep"].get<std::string>(), cell.value("definition_sha256", "?").substr(0, 12),
-                out.lines.front(), first["sweep"].get<std::string>(),
-                first.value("definition_sha256", "?").substr(0, 12)));
-          // Every cell of a definition validates every pipeline of it: a cell without one would let
-          // the gate pass that pipeline there unchecked.
-          const auto names = [](const json& c) {
-            std::vector<std::string> n;
-            for (const auto& [name, p] : c["pipelines"].items()) n.push_back(name);
-            return n;
-          };
-          if (names(cell) != names(first))
-            throw InputError(fmt::format("{}: the cell validates pipelines {}, but line {} of the same definition "
-                                         "validates {}; every cell of a sweep validates every pipeline — the file is "
-                                         "damaged or edited by hand",
-                                         where, fmt::join(names(cell), ", "), out.lines.front(),
-                                         fmt::join(names(first), ", ")));
-          if (cell.value("cell_count", json()) != first.value("cell_count", json()))
-            throw InputError(fmt::format("{}: cell_count {}, but line {} of the same definition says {}; the file is "
-                                         "damaged or edited by hand",
-                                         where, cell.value("cell_count", json()).dump(), out.lines.front(),
-                                         first.value("cell_count", json()).dump()));
-        }
+        one.check(cell, where, fmt::format("line {}", line_no));
         require_unique_id(seen, cell["cell_id"].get<std::string>(), line_no, where, "cell_id",
                           "a results file holds each cell once — remove one of the lines, or merge shards with "
                           "`stereobench sweep collect`");
@@ -660,6 +704,7 @@ std::vector<json> collect_results(const std::vector<fs::path>& files, const fs::
   std::map<uint64_t, std::string> id_of_index;
   std::string sweep, sha;
   fs::path first;
+  OneSweep one;
   for (const fs::path& file : files) {
     std::error_code ec;
     if (!fs::exists(file, ec))
@@ -681,7 +726,11 @@ std::vector<json> collect_results(const std::vector<fs::path>& files, const fs::
                                    sha.substr(0, 12)));
     }
     const fs::path from = folder_of(file), to = folder_of(out);
-    for (json& cell : r.cells) {
+    for (size_t i = 0; i < r.cells.size(); ++i) {
+      json& cell = r.cells[i];
+      // The shards as one file: one set of pipelines, one cell count, one content per scene.
+      one.check(cell, fmt::format("{}:{}", file.string(), r.lines[i]),
+                fmt::format("{} line {}", file.string(), r.lines[i]));
       rebase_image_paths(cell, from, to);
       const std::string id = cell["cell_id"];
       const uint64_t index = cell["cell_index"];

@@ -61,8 +61,10 @@ struct ResultsFile {
 /// missing file reads as empty. An unterminated last line (a writer killed mid-write) is skipped
 /// with a warning naming the file and line. An InputError names the file and line for any other
 /// line that is not JSON or not a sweep-cell record of this schema version (check_cell_record), a
-/// cell_id or cell_index that appears twice, and a cell of another sweep definition than the
-/// first line's (a results file holds one definition's cells). IoError when it cannot be read.
+/// cell_id or cell_index that appears twice, and a cell unlike the first line's: of another sweep
+/// definition, with other pipelines or another cell count (a results file holds one definition's
+/// cells as one build ran them), or measured on another content of a scene. IoError when it cannot
+/// be read.
 [[nodiscard]] ResultsFile read_results(const std::filesystem::path& file);
 
 /// How much of its sweep a set of cell records holds: the distinct cell_index values and the
@@ -102,7 +104,9 @@ void rebase_image_paths(nlohmann::json& cell, const std::filesystem::path& from,
 /// Merges the cells of several results files (shards) ordered by cell_index, for a merged file
 /// written at `out`: every cell's image paths are rebased from its file's folder to out's. Identical
 /// duplicates collapse; a cell_id recorded with different content is an InputError naming it and
-/// both files, as are files written by different definitions (sweep name or definition_sha256).
+/// both files, as are files written by different definitions (sweep name or definition_sha256),
+/// and files whose cells read_results would refuse in one file (other pipelines, another cell
+/// count, another content of a scene).
 [[nodiscard]] std::vector<nlohmann::json> collect_results(const std::vector<std::filesystem::path>& files,
                                                           const std::filesystem::path& out,
                                                           std::vector<std::string>* warnings = nullptr);

@@ -22,6 +22,7 @@
 #include "validation/content_hash.hpp"
 #include "validation/process.hpp"
 #include "validation/results_file.hpp"
+#include "validation/sweep_run.hpp"
 
 namespace sb::validation {
 
@@ -195,6 +196,15 @@ SlurmLayout slurm_layout(const fs::path& out_dir) {
 void refuse_local_run_of_slurm_folder(const fs::path& out_dir, const fs::path& results) {
   const SlurmLayout l = slurm_layout(out_dir);
   std::error_code ec;
+  // The Slurm folder of a submitted sweep is no sweep's --out: its tasks write results-I.jsonl
+  // there, and a run into it would put cells/ and work/ beside them.
+  const fs::path parent = fs::absolute(out_dir).lexically_normal().parent_path();
+  if (const SlurmLayout above = slurm_layout(parent);
+      fs::exists(above.submission, ec) &&
+      fs::weakly_canonical(fs::absolute(out_dir), ec) == fs::weakly_canonical(above.dir, ec))
+    throw InputError(fmt::format("{} is the Slurm folder of the sweep submitted into {} ({}); continue that sweep with "
+                                 "`sweep run --executor slurm --out {}`, or give another --out",
+                                 out_dir.string(), parent.string(), above.submission.string(), parent.string()));
   if (!fs::exists(l.submission, ec)) return;
   if (fs::weakly_canonical(fs::absolute(results).parent_path(), ec) == fs::weakly_canonical(fs::absolute(l.dir), ec))
     return;
@@ -338,9 +348,18 @@ SlurmSubmission submit_sweep(const SweepDefinition& d, SlurmSweepOptions o) {
                                      job, o.out_dir.string(), job, job));
     }
     bool has_results = false;
-    for (const auto& entry : fs::directory_iterator(l.dir))
-      if (entry.path().filename().string().rfind("results-", 0) == 0 && fs::file_size(entry.path()) > 0)
-        has_results = true;
+    const size_t cell_count = expand_cells(d).size();
+    for (const auto& entry : fs::directory_iterator(l.dir)) {
+      if (entry.path().filename().string().rfind("results-", 0) != 0 || fs::file_size(entry.path()) == 0) continue;
+      has_results = true;
+      // A shard's cells that this build could not join (another pipeline set, where the
+      // definition lists "all") would stop its task at the start: refused here, before submitting.
+      const ResultsFile shard = read_results(entry.path());
+      if (!shard.cells.empty())
+        if (const auto why = why_not_resumable(d, cell_count, shard.cells.front()))
+          throw InputError(fmt::format("{} holds cells that this submission cannot continue: {}; use another --out",
+                                       entry.path().string(), *why));
+    }
     const size_t shards_before = before.value("shards", size_t{0});
     if (has_results && shards_before != o.shards)
       throw InputError(fmt::format("{} holds results of {} shards; submit with --shards {} to continue them, or "

@@ -33,6 +33,7 @@ struct SlurmLayout {
 /// Slurm log folder, when the folder was submitted to Slurm: its tasks may still be writing the
 /// same cells, and the next merge refuses a results file it did not write (docs/slurm.md).
 /// InputError naming the job and the way on. A Slurm task (its results in the log folder) passes.
+/// So is a run whose `out_dir` is itself the log folder of a submitted sweep's folder.
 void refuse_local_run_of_slurm_folder(const std::filesystem::path& out_dir, const std::filesystem::path& results);
 
 /// How a sweep is submitted.

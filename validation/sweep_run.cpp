@@ -18,6 +18,7 @@
 #include <thread>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "renderer/animation.hpp"
 #include "renderer/error.hpp"
@@ -83,6 +84,36 @@ std::vector<size_t> shard_cells(size_t cell_count, const Shard& shard) {
   return out;
 }
 
+std::optional<std::string> why_not_resumable(const SweepDefinition& definition, size_t cell_count,
+                                             const json& first) {
+  const std::string sweep = first["sweep"], sha = first.value("definition_sha256", "");
+  if (sweep != definition.name && sha == definition.sha256)
+    return fmt::format("they are cells of sweep '{}', and this definition ({}) has the same content but is named '{}' "
+                       "(without sweep.name a sweep is named by its file): resume with the definition under its "
+                       "first name, {}.toml, or give another --out",
+                       sweep, definition.file.string(), definition.name, sweep);
+  if (sweep != definition.name || sha != definition.sha256)
+    return fmt::format("they are cells of sweep '{}' (definition sha256 {}), not of this definition '{}' ({}, sha256 "
+                       "{}): the definition changed since those cells ran",
+                       sweep, sha.substr(0, 12), definition.name, definition.file.string(),
+                       definition.sha256.substr(0, 12));
+  std::vector<std::string> recorded;
+  if (const auto p = first.find("pipelines"); p != first.end() && p->is_object())
+    for (const auto& [name, record] : p->items()) recorded.push_back(name);
+  if (recorded != definition.pipelines)
+    return fmt::format("those cells validate the pipelines {}, but this build runs {} for {}: the pipelines this "
+                       "build registers differ from those of the build that ran them (a definition listing \"all\" "
+                       "follows the build), and every cell of a results file validates the same pipelines",
+                       fmt::join(recorded, ", "), fmt::join(definition.pipelines, ", "), definition.file.string());
+  if (first.value("baseline", "") != definition.baseline)
+    return fmt::format("those cells were timed against the baseline '{}', but this build takes '{}' for {}",
+                       first.value("baseline", "?"), definition.baseline, definition.file.string());
+  if (first.value("cell_count", json()) != json(cell_count))
+    return fmt::format("those cells belong to a sweep of {} cells, but {} expands to {} cells in this build",
+                       first.value("cell_count", json()).dump(), definition.file.string(), cell_count);
+  return std::nullopt;
+}
+
 SweepPlan plan_sweep(const SweepDefinition& definition, const fs::path& results, const Shard& shard) {
   SweepPlan plan;
   plan.cells = expand_cells(definition);
@@ -91,23 +122,12 @@ SweepPlan plan_sweep(const SweepDefinition& definition, const fs::path& results,
   std::set<std::string> known, done;
   for (const SweepCell& c : plan.cells) known.insert(c.id);
   // read_results holds a file to one definition, so its first line speaks for all.
-  if (!existing.cells.empty()) {
-    const json& first = existing.cells.front();
-    const std::string sweep = first["sweep"], sha = first.value("definition_sha256", "");
-    if (sweep != definition.name && sha == definition.sha256)
-      throw InputError(fmt::format(
-          "{} holds cells of sweep '{}', and this definition ({}) has the same content but is named '{}' (without "
-          "sweep.name a sweep is named by its file): resume with the definition under its first name, {}.toml, or "
-          "give another --out",
-          results.string(), sweep, definition.file.string(), definition.name, sweep));
-    if (sweep != definition.name || sha != definition.sha256)
-      throw InputError(fmt::format(
-          "{} holds cells of sweep '{}' (definition sha256 {}), not of this definition '{}' ({}, sha256 {}); "
-          "the definition changed since those cells ran: give another --out, or delete the sweep's output folder "
-          "(and this file, where --results put it elsewhere) to start over",
-          results.string(), sweep, sha.substr(0, 12), definition.name, definition.file.string(),
-          definition.sha256.substr(0, 12)));
-  }
+  if (!existing.cells.empty())
+    if (const auto why = why_not_resumable(definition, plan.cells.size(), existing.cells.front()))
+      throw InputError(fmt::format("{} holds cells that this run cannot join: {}; give another --out, or delete the "
+                                   "sweep's output folder (and this file, where --results put it elsewhere) to start "
+                                   "over",
+                                   results.string(), *why));
   for (const json& line : existing.cells) {
     const std::string id = line["cell_id"];
     if (!known.count(id))
@@ -359,6 +379,10 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
           {"sweep", d.name},
           {"description", d.description},
           {"definition", options.definition_label},
+          // Where the run was told to write, and its shard: what the gate's command to finish the
+          // sweep repeats (a shard's file alone is not the sweep).
+          {"out", options.out_dir.string()},
+          {"shard", {{"index", options.shard.index}, {"count", options.shard.count}}},
           {"definition_sha256", d.sha256},
           {"cell_id", cell.id},
           {"cell_index", cell.index},

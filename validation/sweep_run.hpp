@@ -33,6 +33,7 @@ struct SweepRunOptions {
   std::filesystem::path scenes_dir;  ///< where built-in scenes are generated
   std::optional<std::filesystem::path> truth_cache;  ///< cache of external ground truths
   std::string definition_label;      ///< the definition's path as recorded in every line
+  Shard shard;                       ///< the shard run, recorded in every line with out_dir
   int jobs = 1;                      ///< cells run at once
   int threads = 0;                   ///< threads per cell; 0: the machine's cores / jobs (at least 1)
 };
@@ -46,9 +47,17 @@ struct SweepPlan {
   std::vector<std::string> warnings;  ///< from reading the results file
 };
 
-/// Reads the results file (if any) and lists the shard's cells not in it. InputError when the file
-/// holds cells of another sweep or another version of the definition (definition_sha256), or
-/// cell ids the definition does not have.
+/// Why cells already recorded for a sweep (`first`: the first line of their results file, which
+/// read_results holds the file's other lines to) cannot be joined by cells of `definition` as this
+/// build runs it: another sweep or version of the definition (definition_sha256), or the same
+/// definition run with another set of pipelines, another baseline or another cell count (a
+/// definition listing "all" pipelines follows the build that runs it). nullopt when they can.
+[[nodiscard]] std::optional<std::string> why_not_resumable(const SweepDefinition& definition, size_t cell_count,
+                                                           const nlohmann::json& first);
+
+/// Reads the results file (if any) and lists the shard's cells not in it. InputError when its cells
+/// cannot be joined by this definition's (why_not_resumable), or hold cell ids the definition does
+/// not have.
 [[nodiscard]] SweepPlan plan_sweep(const SweepDefinition& definition, const std::filesystem::path& results,
                                    const Shard& shard = {});
 

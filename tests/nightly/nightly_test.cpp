@@ -280,6 +280,32 @@ TEST(NightlyTest, ARunStoppedBeforeItsFirstCellDoesNotHoldBackAnEditedDefinition
   EXPECT_NE(third.out.find("run " + resumed_run.filename().string() + " (resumed)"), std::string::npos) << third.out;
 }
 
+TEST(NightlyTest, AnUnfinishedRunOfAnotherPipelineSetIsLeftForANewRun) {
+  // An unfinished run whose cells a build with other pipelines recorded (a definition listing
+  // "all" follows the build): resumed, it took this build's cells beside them, the results file
+  // then held two pipeline sets, and every later nightly chose that run again and stopped on it.
+  test::ScratchDir dir;
+  write_inputs(dir);
+  ASSERT_EQ(test::run_cli(nightly_args(dir)).code, 0);
+  fs::path run;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs"))
+    if (e.is_directory()) run = e.path();
+  ASSERT_FALSE(run.empty());
+  fs::remove(run / "nightly.json");  // unfinished
+  std::vector<json> cells = json_lines(run / "results.jsonl");
+  ASSERT_EQ(cells.size(), 1u);
+  cells[0]["pipelines"].erase("repro-warp");
+  write_text(run / "results.jsonl", cells[0].dump() + "\n");
+  const test::CliRun again = test::run_cli(nightly_args(dir));
+  ASSERT_EQ(again.code, 0) << again.out;
+  EXPECT_NE(again.out.find("note: the unfinished run " + run.string() + " is not a run of "), std::string::npos)
+      << again.out;
+  EXPECT_EQ(json_lines(run / "results.jsonl").size(), 1u) << "the older run left as it was";
+  size_t folders = 0;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir / "runs")) folders += e.is_directory() ? 1 : 0;
+  EXPECT_EQ(folders, 2u);
+}
+
 TEST(NightlyTest, FailingGateExitsTwoAndIsRecorded) {
   test::ScratchDir dir;
   // 45 dB is above both reprojections' PSNR (39.88 and 32.67 dB measured); plain-rt is inf.

@@ -722,6 +722,128 @@ warmup = 0
   EXPECT_EQ(lines_of(results).size(), 2u);
 }
 
+TEST(SweepRun, ShardsOfAnotherSceneContentOrPipelineSetDoNotJoin) {
+  // Two shards of one definition, each in its own results file (as Slurm's tasks write them): the
+  // scene file is regenerated between them, so only a merge can see the two contents.
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli("scenes generate box-wall --out " + quoted(dir / "gen")).code, 0);
+  fs::copy_file(dir / "gen" / "box-wall.gltf", dir / "scene.gltf");
+  std::ofstream(dir / "two.toml") << R"([sweep]
+name = "two"
+scenes = ["scene.gltf"]
+pipelines = ["plain-rt", "repro-rt"]
+interaxial_m = [0.04, 0.064]
+resolutions = ["64x36"]
+[timing]
+repetitions = 1
+warmup = 0
+)";
+  const auto shard = [&](int i) {
+    return "sweep run " + quoted(dir / "two.toml") + " --out " + quoted(dir / "out") + " --threads 1 --shard " +
+           std::to_string(i) + "/2 --results " + quoted(dir / ("s" + std::to_string(i) + ".jsonl"));
+  };
+  ASSERT_EQ(test::run_cli(shard(0)).code, 0);
+  // Gated alone, a shard's file is not the sweep: the gate says so, and its command to finish
+  // runs that shard into that file (it ran every cell into it, and the merge then failed).
+  std::ofstream(dir / "gate.toml") << "[defaults]\nmin_psnr = 20\n";
+  const test::CliRun one_shard =
+      test::run_cli("gate --config " + quoted(dir / "gate.toml") + " --results " + quoted(dir / "s0.jsonl"));
+  EXPECT_EQ(one_shard.code, 2) << one_shard.out;
+  EXPECT_NE(one_shard.out.find("it is the results file of shard 0/2, which has all of its 1 cells; merge every "
+                               "shard's results file with `stereobench sweep collect`"),
+            std::string::npos)
+      << one_shard.out;
+  EXPECT_NE(one_shard.out.find(" --out " + (dir / "out").string() + " --shard 0/2 --results " +
+                               (dir / "s0.jsonl").string()),
+            std::string::npos)
+      << one_shard.out;
+  ASSERT_EQ(test::run_cli("scenes generate box-wall --param size=0.9 --out " + quoted(dir / "gen")).code, 0);
+  for (const auto& e : fs::directory_iterator(dir / "gen"))
+    if (e.path().extension() == ".gltf" && e.path().filename() != "box-wall.gltf")
+      fs::copy_file(e.path(), dir / "scene.gltf", fs::copy_options::overwrite_existing);
+  ASSERT_EQ(test::run_cli(shard(1)).code, 0);
+  const std::string collect =
+      "sweep collect " + quoted(dir / "all.jsonl") + " " + quoted(dir / "s0.jsonl") + " " + quoted(dir / "s1.jsonl");
+  const test::CliRun mixed = test::run_cli(collect);
+  EXPECT_EQ(mixed.code, 3) << mixed.out;
+  EXPECT_NE(mixed.out.find("was measured on scene 'scene.gltf' with content sha256"), std::string::npos) << mixed.out;
+  EXPECT_NE(mixed.out.find("the scene changed between the runs of one sweep"), std::string::npos) << mixed.out;
+  EXPECT_FALSE(fs::exists(dir / "all.jsonl"));
+  // Joined into one file by hand, the gate refuses the two contents as well.
+  std::ofstream(dir / "joined.jsonl") << test::read_text(dir / "s0.jsonl") << test::read_text(dir / "s1.jsonl");
+  const test::CliRun gated =
+      test::run_cli("gate --config " + quoted(dir / "gate.toml") + " --results " + quoted(dir / "joined.jsonl"));
+  EXPECT_EQ(gated.code, 3) << gated.out;
+  EXPECT_NE(gated.out.find("the scene changed between the runs of one sweep"), std::string::npos) << gated.out;
+
+  // Shard 1 as a build without repro-rt recorded it (the definition listing "all" pipelines, say):
+  // a merge refuses it, and a resume of it by this build is refused before any cell runs.
+  fs::copy_file(dir / "gen" / "box-wall.gltf", dir / "scene.gltf", fs::copy_options::overwrite_existing);
+  fs::remove(dir / "s1.jsonl");
+  ASSERT_EQ(test::run_cli(shard(1)).code, 0);
+  json older = json::parse(lines_of(dir / "s1.jsonl").at(0));
+  older["pipelines"].erase("repro-rt");
+  std::ofstream(dir / "s1.jsonl", std::ios::trunc) << older.dump() << "\n";
+  const test::CliRun other_set = test::run_cli(collect);
+  EXPECT_EQ(other_set.code, 3) << other_set.out;
+  EXPECT_NE(other_set.out.find("the cell validates pipelines plain-rt, but " + (dir / "s0.jsonl").string() +
+                               " line 1 of the same definition validates plain-rt, repro-rt"),
+            std::string::npos)
+      << other_set.out;
+  EXPECT_FALSE(fs::exists(dir / "all.jsonl"));
+  fs::copy_file(dir / "s1.jsonl", dir / "s1-before.jsonl");
+  const test::CliRun resumed = test::run_cli(shard(1));
+  EXPECT_EQ(resumed.code, 3) << resumed.out;
+  EXPECT_NE(resumed.out.find("those cells validate the pipelines plain-rt, but this build runs plain-rt, repro-rt"),
+            std::string::npos)
+      << resumed.out;
+  EXPECT_EQ(test::read_text(dir / "s1.jsonl"), test::read_text(dir / "s1-before.jsonl")) << "no cell ran";
+
+  // '-' is standard output for the merge and the CSV, not a file of that name.
+  fs::remove(dir / "s1.jsonl");
+  ASSERT_EQ(test::run_cli(shard(1)).code, 0);
+  const test::CliRun to_stdout = test::run_cli("sweep collect - " + quoted(dir / "s0.jsonl") + " " +
+                                               quoted(dir / "s1.jsonl"));
+  EXPECT_EQ(to_stdout.code, 0) << to_stdout.out;
+  EXPECT_NE(to_stdout.out.find("\"kind\":\"stereobench.sweep_cell\""), std::string::npos) << to_stdout.out;
+  EXPECT_NE(to_stdout.out.find("merged 2 cells from 2 files"), std::string::npos) << to_stdout.out;
+  const test::CliRun csv = test::run_cli("sweep csv " + quoted(dir / "s0.jsonl") + " --out -");
+  EXPECT_EQ(csv.code, 0) << csv.out;
+  EXPECT_NE(csv.out.find("cell_index,cell_id,sweep"), std::string::npos) << csv.out;
+  EXPECT_FALSE(fs::exists("-"));
+}
+
+TEST(SweepRun, TheGateSendsASlurmTasksResultsFileToTheExecutor) {
+  // A task's file (results-I.jsonl in <out>/slurm) gated alone: the command to finish the sweep is
+  // the Slurm executor's, with the sweep's --out (it named <out>/slurm as --out and no shard).
+  test::ScratchDir dir;
+  std::ofstream(dir / "two.toml") << R"([sweep]
+name = "two"
+scenes = ["box-wall"]
+pipelines = ["plain-rt", "repro-rt"]
+interaxial_m = [0.04, 0.064]
+resolutions = ["64x36"]
+[timing]
+repetitions = 1
+warmup = 0
+)";
+  const test::CliRun task = test::run_cli("sweep run " + quoted(dir / "two.toml") + " --out " + quoted(dir / "out") +
+                                          " --threads 1 --shard 1/2 --results " +
+                                          quoted(dir / "out" / "slurm" / "results-1.jsonl") + " --scenes-dir " +
+                                          quoted(dir / "scenes"));
+  ASSERT_EQ(task.code, 0) << task.out;
+  std::ofstream(dir / "gate.toml") << "[defaults]\nmin_psnr = 20\n";
+  const test::CliRun gated = test::run_cli("gate --config " + quoted(dir / "gate.toml") + " --results " +
+                                           quoted(dir / "out" / "slurm" / "results-1.jsonl"));
+  EXPECT_EQ(gated.code, 2) << gated.out;
+  EXPECT_NE(gated.out.find("it is the results file of Slurm task 1 of 2, not the sweep's; gate " +
+                           (dir / "out" / "results.jsonl").string()),
+            std::string::npos)
+      << gated.out;
+  EXPECT_NE(gated.out.find("--out " + (dir / "out").string() + " --executor slurm --wait"), std::string::npos)
+      << gated.out;
+}
+
 TEST(SweepRun, AnOutFolderThatCannotBeMadeIsNamed) {
   // A folder that cannot be created is named as such, not as a lock file that does not exist.
   test::ScratchDir dir;
@@ -750,6 +872,17 @@ TEST(SweepRun, TheLocalExecutorRefusesAFolderSubmittedToSlurm) {
   const test::CliRun task = test::run_cli("sweep run " + smoke + " --out " + quoted(dir / "out") +
                                           " --shard 39/40 --results " + quoted(dir / "out" / "slurm" / "results-39.jsonl"));
   EXPECT_EQ(task.code, 0) << task.out;
+  // The Slurm folder itself as --out (the folder of a task's results file, which the gate named
+  // as --out): it took cells/ and work/ beside the tasks' files.
+  const test::CliRun into_slurm = test::run_cli("sweep run " + smoke + " --out " + quoted(dir / "out" / "slurm") +
+                                                " --results " + quoted(dir / "out" / "slurm" / "results-0.jsonl"));
+  EXPECT_EQ(into_slurm.code, 3) << into_slurm.out;
+  EXPECT_NE(into_slurm.out.find((dir / "out" / "slurm").string() + " is the Slurm folder of the sweep submitted into " +
+                                (dir / "out").string()),
+            std::string::npos)
+      << into_slurm.out;
+  EXPECT_FALSE(fs::exists(dir / "out" / "slurm" / "cells"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "slurm" / "results-0.jsonl"));
 }
 
 }  // namespace
