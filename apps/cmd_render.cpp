@@ -76,9 +76,9 @@ void run_render(const RenderArgs& a) {
   const std::map<std::string, std::string> given = parse_key_values(a.options, "--option");
   // One pipeline, one value per option: a variant's own value and another by --option contradict.
   for (const auto& [key, value] : given)
-    if (const auto it = entry.fixed.find(key); it != entry.fixed.end() && it->second != value)
+    if (entry.fixes_otherwise(key, value))
       throw InputError(fmt::format("--option {}={}: the variant {} fixes {}={}; give the option once", key, value,
-                                   entry.name, key, it->second));
+                                   entry.name, key, entry.fixed.at(key)));
   const PipelineOptions options = entry.options(given);
   const io::StereoViews views = io::StereoViews::from_names(split_list(a.stereo, "--stereo"), "--stereo");
   const Executor executor(checked_threads(a.threads));
@@ -106,6 +106,11 @@ void run_render(const RenderArgs& a) {
     if (fs::equivalent(output, loaded.file, same_ec))
       throw InputError(fmt::format("--scene {}: the scene file is this render's output {}; give another --out",
                                    loaded.file.string(), output.string()));
+    for (const std::string& read : scene.files_read)
+      if (fs::equivalent(output, read, same_ec))
+        throw InputError(fmt::format("--scene {}: the file {} the scene reads (a buffer or an image) is this "
+                                     "render's output {}; give another --out",
+                                     loaded.file.string(), read, output.string()));
   }
   const RenderScene prepared(scene);
   require_frame_memory(rig.params().width, rig.params().height, fmt::format("render {}", entry.name));

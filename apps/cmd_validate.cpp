@@ -69,16 +69,17 @@ json earlier_records(const fs::path& summary) {
 /// The records of `scene_stem` (scene and truth) among `earlier` (its earlier summary's) that this
 /// run does not write, retired from `set` with the images of their own: this run replaces the
 /// truth and disocclusion images they point to, so they would describe another truth (another rig,
-/// another scene file of that name). The names of their pipelines.
+/// another scene file of that name). The images of the records it writes again are retired too,
+/// those it writes again kept by the set: an image an option asked for last time (partials,
+/// grid_overlay) would be left beside the new record as if it showed this run. The names of the
+/// pipelines whose records are retired.
 std::vector<std::string> retire_earlier_records(io::StagedFiles& set, const fs::path& out, const json& earlier,
                                                 const std::string& scene_stem, const std::vector<std::string>& names) {
   std::vector<std::string> retired;
   for (const json& r : earlier) {
     if (!r.is_object() || !r.contains("pipeline") || !r["pipeline"].is_string()) continue;
     const std::string pipeline = r["pipeline"].get<std::string>();
-    if (std::find(names.begin(), names.end(), pipeline) != names.end()) continue;
     const std::string own = fmt::format("{}_{}", scene_stem, entry_file_stem(pipeline));
-    set.retire(out / (own + ".json"));
     if (r.contains("images") && r["images"].is_object())
       for (const auto& [key, file] : r["images"].items())
         if (file.is_string()) {
@@ -86,6 +87,8 @@ std::vector<std::string> retire_earlier_records(io::StagedFiles& set, const fs::
           const std::string name = fs::path(file.get<std::string>()).filename().string();
           if (name.rfind(own + "_", 0) == 0) set.retire(out / name);
         }
+    if (std::find(names.begin(), names.end(), pipeline) != names.end()) continue;
+    set.retire(out / (own + ".json"));
     retired.push_back(pipeline);
   }
   return retired;
@@ -196,6 +199,8 @@ void run_validate(const ValidateArgs& a) {
   // the summary last: a run that stops on the way (an image it cannot write, a full disk) leaves an
   // earlier run's summary, records and images as they were.
   io::StagedFiles set;
+  set.keep(loaded.file, "the scene file");
+  for (const std::string& read : scene.files_read) set.keep(read, "the file the scene reads (a buffer or an image)");
   // The earlier summary's records: those this run does not write are retired with it, and the work
   // folders they named go once this run's set is in place.
   const json earlier = earlier_records(summary);

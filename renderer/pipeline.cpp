@@ -175,6 +175,12 @@ bool PipelineEntry::same_variant(const PipelineEntry& other) const {
   return true;
 }
 
+bool PipelineEntry::fixes_otherwise(const std::string& key, const std::string& value) const {
+  const auto it = fixed.find(key);
+  return it != fixed.end() &&
+         canonical_value(pipeline->info(), key, it->second) != canonical_value(pipeline->info(), key, value);
+}
+
 std::optional<std::string> find_same_variant(const std::vector<PipelineEntry>& listed, const PipelineEntry& entry) {
   const auto at = std::find_if(listed.begin(), listed.end(), [&](const PipelineEntry& e) { return e.same_variant(entry); });
   if (at == listed.end()) return std::nullopt;

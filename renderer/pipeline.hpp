@@ -126,6 +126,9 @@ struct PipelineEntry {
   /// values are the pipeline's defaults: options given for the pipeline (--option,
   /// [options.NAME]) apply under each entry's own.
   [[nodiscard]] bool same_variant(const PipelineEntry& other) const;
+  /// Whether the entry fixes option `key` to a value other than `value`, compared as same_variant
+  /// compares them (4 and 4.0 are one value).
+  [[nodiscard]] bool fixes_otherwise(const std::string& key, const std::string& value) const;
 };
 
 /// The name of the entry of `listed` that names the same variant as `entry`, if there is one.

@@ -184,6 +184,9 @@ struct NodeAnimation {
 /// A loaded scene.
 struct Scene {
   std::string path;  ///< file it came from
+  /// The external files its buffers and images were read from (beside `path`): an output of a
+  /// run must not take the place of one.
+  std::vector<std::string> files_read;
   std::string name;
   std::vector<Mesh> meshes;
   std::vector<Material> materials;

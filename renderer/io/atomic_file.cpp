@@ -393,7 +393,20 @@ void StagedFiles::add(const fs::path& given, const std::function<void(const fs::
   entries_.push_back(Entry{path, std::move(staged)});
 }
 
+void StagedFiles::keep(const fs::path& input, std::string what) { kept_.emplace_back(input, std::move(what)); }
+
 void StagedFiles::commit() {
+  for (const auto& [input, what] : kept_) {
+    std::vector<fs::path> touched;
+    for (const Entry& e : entries_) touched.push_back(e.path);
+    touched.insert(touched.end(), retired_.begin(), retired_.end());
+    for (const fs::path& output : touched) {
+      std::error_code ec;
+      if (fs::equivalent(output, input, ec))
+        throw InputError(fmt::format("{} {} is this run's output {}; give another --out (no file was replaced)", what,
+                                     input.string(), output.string()));
+    }
+  }
   // An ending signal waits for the renames (a few), so that no set is left half in place by it.
   g_commits.fetch_add(1, std::memory_order_acq_rel);
   struct Resume {
@@ -433,7 +446,12 @@ void StagedFiles::commit() {
     if (const fs::path f = folder_of(e.path); std::find(folders.begin(), folders.end(), f) == folders.end())
       folders.push_back(f);
   for (const fs::path& f : folders) sync_folder(f);
-  discard_output_files(retired_);
+  std::vector<fs::path> gone;
+  for (const fs::path& r : retired_)
+    if (std::none_of(entries_.begin(), entries_.end(),
+                     [&](const Entry& e) { return e.path.lexically_normal() == r.lexically_normal(); }))
+      gone.push_back(r);
+  discard_output_files(gone);
 }
 
 void sync_folder(const fs::path& folder) noexcept {

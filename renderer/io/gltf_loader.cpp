@@ -1271,6 +1271,7 @@ Scene load_gltf(const fs::path& path, const GltfLoadOptions& options) {
                                    file, i, model.buffers[i].data.size(), doc["buffers"][i]["byteLength"].get<uint64_t>()));
   Scene scene = Converter(model, doc, file, options).run();
   if (scene.name.empty()) scene.name = path.stem().string();
+  for (const auto& [key, read] : allowed) scene.files_read.push_back(read.string());
   return scene;
 }
 

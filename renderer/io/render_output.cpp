@@ -217,12 +217,12 @@ RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::st
   const std::vector<std::string> earlier = earlier_files(f.stats_json, stem);
   // The EXR's header holds the stats JSON's content, its file list included.
   ImageMetadata meta;
-  meta["stereobench/record"] = stats.dump();
+  meta["stereobench/record"] = json_text(stats);  // a scene path need not be UTF-8
 
   StagedFiles set;
   set.add(f.exr, [&](const fs::path& tmp) { write_exr_stereo(tmp, result.left, result.right, meta); });
   for (const auto& [file, image] : pngs) set.add(file, [&](const fs::path& tmp) { write_png_preview(tmp, *image); });
-  set.add(f.stats_json, [&](const fs::path& tmp) { write_text_atomically(tmp, stats.dump(2) + "\n"); });
+  set.add(f.stats_json, [&](const fs::path& tmp) { write_text_atomically(tmp, json_text(stats, 2) + "\n"); });
   for (const std::string& name : earlier)
     if (std::find(names.begin(), names.end(), name) == names.end()) set.retire(dir / name);
   set.commit();  // the stats JSON, added last, is the set's marker

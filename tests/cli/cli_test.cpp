@@ -511,6 +511,55 @@ TEST(Cli, OutputsAreNamedByTheSceneFileAndStayInTheOutputFolder) {
             0);
 }
 
+TEST(Cli, AnOutputNeverTakesThePlaceOfAFileTheSceneReads) {
+  // A texture beside the scene named as an output of the run was replaced by that output, the
+  // run ending in success; render refuses before rendering, validate before any file is placed.
+  test::ScratchDir dir("reads");
+  const std::string common = " --scenes-dir '" + (dir / "scenes").string() + "' --resolution 32x18";
+  ASSERT_EQ(run("scenes generate textured-plane --out '" + (dir / "scenes").string() + "'").code, 0);
+  ASSERT_EQ(run("render --pipeline plain-rt --scene textured-plane --out '" + (dir / "png").string() + "'" + common)
+                .code,
+            0);
+  auto doc = nlohmann::json::parse(test::read_text(dir / "scenes" / "textured-plane.gltf"));
+  const std::string texture = test::read_text(dir / "png" / "textured-plane_plain-rt_left.png");
+  const auto scene_reading = [&](const std::string& stem, const std::string& image) {
+    doc["images"][0] = {{"uri", image}};
+    std::ofstream(dir / (stem + ".gltf")) << doc.dump();
+    std::ofstream(dir / image, std::ios::binary) << texture;
+    return " --scene '" + (dir / (stem + ".gltf")).string() + "' --out '" + dir.path().string() + "'";
+  };
+  const CliRun rendered = run("render --pipeline plain-rt" + scene_reading("t", "t_plain-rt_left.png") + common);
+  EXPECT_EQ(rendered.code, 3) << rendered.out;
+  EXPECT_NE(rendered.out.find("the file " + (dir / "t_plain-rt_left.png").string() +
+                              " the scene reads (a buffer or an image) is this render's output"),
+            std::string::npos)
+      << rendered.out;
+  EXPECT_EQ(test::read_text(dir / "t_plain-rt_left.png"), texture);
+  const CliRun validated = run("validate --pipelines plain-rt" + scene_reading("v", "v_truth-full.png") + common);
+  EXPECT_EQ(validated.code, 3) << validated.out;
+  EXPECT_NE(validated.out.find("the file the scene reads (a buffer or an image) " +
+                               (dir / "v_truth-full.png").string() + " is this run's output"),
+            std::string::npos)
+      << validated.out;
+  EXPECT_EQ(test::read_text(dir / "v_truth-full.png"), texture);
+  EXPECT_FALSE(std::filesystem::exists(dir / "v_full_summary.json"));
+
+  // A scene path that is not UTF-8 renders: the stats JSON holds it with U+FFFD (it was an
+  // internal error once the render had finished, and nothing was written).
+  std::filesystem::copy_file(dir / "scenes" / "textured-plane.gltf", dir / "bad\xff.gltf");
+  const CliRun bad = run("render --pipeline plain-rt --scene '" + (dir / "bad\xff.gltf").string() + "' --out '" +
+                         (dir / "bad").string() + "'" + common);
+  ASSERT_EQ(bad.code, 0) << bad.out;
+  bool found = false;
+  for (const auto& e : std::filesystem::directory_iterator(dir / "bad"))
+    if (e.path().string().ends_with("_plain-rt_stats.json")) {
+      found = true;
+      EXPECT_NE(nlohmann::json::parse(test::read_text(e.path()))["scene"]["path"].get<std::string>().find("\xEF\xBF\xBD"),
+                std::string::npos);
+    }
+  EXPECT_TRUE(found);
+}
+
 TEST(Cli, AGeneratedVariantNeverTakesTheDefaultScenesFile) {
   // Commands naming `spheres` load <scenes>/spheres.glb; another seed or parameter written there
   // would be rendered and recorded as the default scene.
@@ -766,6 +815,10 @@ TEST(Cli, RenderAndBenchRejectBadArguments) {
     EXPECT_EQ(r.code, 3) << c.args << "\n" << r.out;
     EXPECT_NE(r.out.find(c.expect), std::string::npos) << c.args << "\nexpected: " << c.expect << "\ngot: " << r.out;
   }
+  // The variant's own value written another way is the same value (it was refused as another).
+  const CliRun same = run("render --scene box-wall --pipeline repro-rt:threshold_arcmin=4 --option "
+                          "threshold_arcmin=4.0" + common);
+  EXPECT_EQ(same.code, 0) << same.out;
 }
 
 }  // namespace

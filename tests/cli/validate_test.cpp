@@ -332,6 +332,16 @@ TEST(Validate, ARunIntoAnEarlierOnesFolderRemovesTheRecordsItLeavesBehind) {
   const json summary = json::parse(test::read_text(out / "box-wall_full_summary.json"));
   ASSERT_EQ(summary["records"].size(), 1u);
   EXPECT_EQ(summary["records"][0]["rig"]["interaxial_m"], 0.12);
+
+  // A pipeline validated again without the option that asked for an image last time: that image
+  // (the grid overlay here; partials alike) stayed beside the new record, showing the old rig.
+  ASSERT_EQ(test::run_cli(base_args(dir) + " --pipelines repro-rt --option grid_overlay=true").code, 0);
+  ASSERT_TRUE(fs::exists(out / "box-wall_full_repro-rt_grid.png"));
+  const test::CliRun again = test::run_cli(base_args(dir) + " --interaxial 0.1 --pipelines repro-rt");
+  ASSERT_EQ(again.code, 0) << again.out;
+  EXPECT_FALSE(fs::exists(out / "box-wall_full_repro-rt_grid.png"));
+  for (const char* kept : {"box-wall_full_repro-rt.json", "box-wall_full_repro-rt_right.png"})
+    EXPECT_TRUE(fs::exists(out / kept)) << kept << ": written again, so kept";
 }
 
 TEST(Validate, WhatARigForbidsIsRefusedBeforeAnythingRendersAndAStopLeavesNoSummary) {
