@@ -72,13 +72,17 @@ PipelineValidation validate_pipeline(const ValidationTarget& target, const Pipel
       compare_regions(v.right_srgb8, target.truth_srgb8, regions, metric_options, &v.ssim);
   v.whole = metrics[0];
   for (size_t r = 0; r < std::size(kRegionNames); ++r) v.regions.emplace_back(kRegionNames[r], metrics[r + 1]);
-  // A left eye the pipeline did not render whole is measured too (against plain-rt's left eye).
+  // A left eye the pipeline did not render whole is measured too (against plain-rt's left eye):
+  // one with pixels warped in, inpainted or left as holes. Pixels it rasterized or traced itself,
+  // in its first pass or afterwards (bidir-warp-rt's traced holes), are rendered.
   const uint32_t* left_source = v.result.left.data_u32(planes::source);
-  for (size_t i = 0; i < v.result.left.pixel_count(); ++i)
-    v.left_synthesized += left_source[i] != static_cast<uint32_t>(Source::rasterized) &&
-                                  left_source[i] != static_cast<uint32_t>(Source::traced)
+  for (size_t i = 0; i < v.result.left.pixel_count(); ++i) {
+    const auto s = static_cast<Source>(left_source[i]);
+    v.left_synthesized += s != Source::rasterized && s != Source::traced && s != Source::reshaded_traced &&
+                                  s != Source::reshaded_raster
                               ? 1
                               : 0;
+  }
   double tracing = 0.0;  // the left reference's tracing, when this call did it (recorded apart)
   if (v.left_synthesized > 0) {
     LeftReference& reference = *target.left;

@@ -221,7 +221,10 @@ class BwWarp final : public Pipeline {
          {"filter", "linear",
           "linear: disparity and radiance interpolated between left pixel centres (not across a disparity step of "
           "0.5 px or more); nearest: the left pixel containing the position"},
-         {"max_crack", "2", "widest run of unresolved pixels in a row that is filled by linear interpolation"}},
+         {"max_crack", "2",
+          "widest run of holes in a row (pixels whose source lies outside the left image, at its borders) filled by "
+          "linear interpolation; pixels where the iteration does not converge take the background side instead "
+          "(tagged inpainted), so at most rigs this changes nothing"}},
         50.0, 26.5, [](const PipelineOptions& o) { (void)BwSettings::from(o); }};
     return i;
   }

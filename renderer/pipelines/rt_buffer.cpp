@@ -3,6 +3,7 @@
 // the right pixel takes the entry with the largest source x, each reprojected right pixel is
 // validated by a length-restricted ray, and missed or blocked pixels are traced.
 #include <cmath>
+#include <memory>
 
 #include <fmt/format.h>
 
@@ -57,17 +58,19 @@ class RtBuffer final : public Pipeline {
     trace_left_eye(scene, rig, ctx.executor, r);
     const PixelReprojector reprojector(rig);
     const size_t slots = static_cast<size_t>(t);
-    std::vector<int32_t> buffer;
+    std::unique_ptr<int32_t[]> buffer;
     std::vector<uint64_t> collisions(static_cast<size_t>(h), 0);
     {
       ScopedStage stage(r.timings, "reproject", StageEye::right);
-      buffer.resize(static_cast<size_t>(w) * h * slots);
+      // Uninitialised: each row task fills its own rows below (zeroing it first as well was a
+      // serial pass over all w x h x t entries: dragon 600x600, t = 200, reproject 17.6 -> 11.4 ms).
+      buffer = std::make_unique_for_overwrite<int32_t[]>(static_cast<size_t>(w) * h * slots);
       const float* depth = r.left.data_f32(planes::depth);
       // A row's reprojections stay in that row, so a task owns whole rows: no two tasks write one
       // entry, and within a row the writes go in source order.
       ctx.executor.for_range(static_cast<size_t>(h), 4, [&](size_t begin, size_t end) {
         for (size_t y = begin; y < end; ++y) {
-          int32_t* row = buffer.data() + y * w * slots;
+          int32_t* row = buffer.get() + y * w * slots;
           std::fill(row, row + static_cast<size_t>(w) * slots, kNoSource);
           for (int x = 0; x < w; ++x) {
             const int32_t target = reprojector.target(x, static_cast<int>(y), depth[y * w + x]);
@@ -88,7 +91,7 @@ class RtBuffer final : public Pipeline {
       sources.column.resize(static_cast<size_t>(w) * h);
       ctx.executor.for_range(sources.column.size(), 4096, [&](size_t begin, size_t end) {
         for (size_t p = begin; p < end; ++p) {
-          const int32_t* entries = buffer.data() + p * slots;
+          const int32_t* entries = buffer.get() + p * slots;
           sources.column[p] = *std::max_element(entries, entries + slots);
         }
       });
