@@ -66,6 +66,13 @@ void RigParams::validate() const {
     throw InputError(fmt::format("vertical field of view {:g} degrees at {} px height gives a focal length of {:g} px, "
                                  "beyond the {:g} px a rig may have; widen the field of view",
                                  radians_to_degrees(vfov), height, f, kMaxFocalPx));
+  if (const double corner = radians_to_degrees(std::atan(0.5 * std::hypot(double(width), double(height)) /
+                                                         focal_px(vfov, height)));
+      !(corner <= kMaxCornerAngleDeg))
+    throw InputError(fmt::format("vertical field of view {:g} degrees at {}x{} px puts the image corners {:.5f} "
+                                 "degrees off the optical axis, beyond the {:g} a rig's rays hold in single "
+                                 "precision; narrow the field of view",
+                                 radians_to_degrees(vfov), width, height, corner, kMaxCornerAngleDeg));
   check_disparity(*this);
   require_positive(znear, "znear", "the near plane must lie in front of the camera");
   if (!std::isfinite(zfar) || zfar <= znear)

@@ -26,6 +26,10 @@ constexpr double kMaxDisparityPx = 1e6;
 /// The rasterizer projects in single precision, which a vanishing field of view (1e-100 degrees,
 /// 1e102 px) overflows: it drew nothing where the ray tracer saw the scene.
 constexpr double kMaxFocalPx = 1e12;
+/// The widest angle between the optical axis and an image corner's ray a rig may have, in degrees.
+/// Nearer to 90 the rays' forward component drowns in single precision: a vertical field of view
+/// within a hair of 180 degrees rendered a black image with depths of the wrong sign.
+constexpr double kMaxCornerAngleDeg = 89.9;
 
 /// The rig's parameters. Lengths are meters, angles radians.
 struct RigParams {

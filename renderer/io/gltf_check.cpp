@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <initializer_list>
 #include <set>
 #include <string_view>
@@ -271,6 +272,18 @@ class Checker {
     const std::string& version = string(*member(*asset, "version", "/asset", true), "/asset/version");
     if (version.rfind("2.", 0) != 0)
       fail("/asset/version", fmt::format("glTF version '{}' is not supported; only 2.x files load", version));
+    // A file that needs a later 2.x than 2.0 must not be loaded by a 2.0 reader (glTF 2.0, asset).
+    if (const json* min = member(*asset, "minVersion", "/asset")) {
+      const std::string& needed = string(*min, "/asset/minVersion");
+      int major = 0, minor = 0, end = 0;
+      if (std::sscanf(needed.c_str(), "%d.%d%n", &major, &minor, &end) != 2 ||
+          static_cast<size_t>(end) != needed.size() || major < 0 || minor < 0)
+        fail("/asset/minVersion", fmt::format("'{}' is not a glTF version <major>.<minor>", needed));
+      if (major > 2 || (major == 2 && minor > 0))
+        fail("/asset/minVersion", fmt::format("the file needs glTF {} at least; this reader reads glTF 2.0, and the "
+                                              "format says such a file must not be loaded; export it for glTF 2.0",
+                                              needed));
+    }
 
     for (const char* key : {"extensionsUsed", "extensionsRequired"})
       if (const json* a = member(doc_, key, "")) {

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 
 #include <fmt/format.h>
@@ -263,6 +264,10 @@ fs::path resolve_uri(const std::string& uri, const fs::path& dir, const std::str
                                  "folder below or beside it) and make the URI relative to the scene file",
                                  file, where, uri, uri.substr(0, uri.find(':') + 1), kUriRule));
   const std::string path = percent_decode(uri);
+  if (path.find('\0') != std::string::npos)
+    throw InputError(fmt::format("{}: {}: '{}' decodes to a path with a NUL byte (%00), which no file name holds; fix "
+                                 "the uri",
+                                 file, where, uri));
   if (is_absolute_path(path))
     throw InputError(fmt::format("{}: {}: '{}' is an absolute path; {} — make the URI relative to the scene "
                                  "file's folder '{}'",
@@ -575,10 +580,18 @@ class Converter {
     const unsigned char* idx = span_of(a.sparse.indices.bufferView, a.sparse.indices.byteOffset, n * isize, sp + "/indices");
     const size_t elem = v.component_size * static_cast<size_t>(v.components);
     const unsigned char* val = span_of(a.sparse.values.bufferView, a.sparse.values.byteOffset, n * elem, sp + "/values");
+    std::optional<uint32_t> previous;
     for (size_t i = 0; i < n; ++i) {
       const uint32_t target = read_index(idx + i * isize, a.sparse.indices.componentType);
       if (target >= v.count)
         fail(sp + "/indices", fmt::format("sparse index {} at element {} is out of range for {} elements", target, i, v.count));
+      // glTF requires strictly increasing indices: with one given twice, which value wins is
+      // the reader's choice, and another tool's may differ.
+      if (previous && target <= *previous)
+        fail(sp + "/indices", fmt::format("sparse index {} at element {} follows {}; the indices must increase "
+                                          "strictly (glTF 2.0, accessor.sparse.indices)",
+                                          target, i, *previous));
+      previous = target;
       set(target, val + i * elem);
     }
   }
@@ -926,6 +939,16 @@ class Converter {
     if (scene.nodes_not_loaded > 0 && m_.scenes.size() <= 1)
       warn("orphan-nodes", fmt::format("{} node(s) with a mesh or light are in no scene and are not loaded",
                                        scene.nodes_not_loaded));
+    // A camera the loaded scene does not reach is not the rig's pose: without another, the rig
+    // frames the scene from +Z instead, which a render alone would not tell.
+    if (scene.cameras.empty())
+      for (size_t i = 0; i < m_.nodes.size(); ++i)
+        if (!visited[i] && m_.nodes[i].camera >= 0) {
+          note("orphan-camera", fmt::format("the camera of node {} is in no loaded scene and is not used: the rig "
+                                            "frames the scene from +Z instead; add the node to the scene",
+                                            i));
+          break;
+        }
   }
 
   /// Whether a primitive's POSITION accessor has neither a bufferView nor sparse values: glTF
@@ -958,7 +981,15 @@ class Converter {
     if (doc_.at("nodes")[static_cast<size_t>(ni)].contains("skin"))  // skins are not handed to tinygltf
       warn("node-skin", "skinned nodes render in their bind pose");
     if (n.mesh >= 0) convert_mesh(scene, ni, n.mesh, world);
-    if (n.camera >= 0) convert_camera(scene, ni, world);
+    if (n.camera >= 0) {
+      convert_camera(scene, ni, world);
+    } else if (const json& node_json = doc_.at("nodes").at(static_cast<size_t>(ni));
+               node_json.contains("extras") && node_json["extras"].is_object() &&
+               node_json["extras"].contains("stereobench")) {
+      note("stray-rig-extras", fmt::format("/nodes/{}/extras/stereobench is on a node without a camera and is "
+                                           "ignored: the rig's defaults are read from the first camera's node",
+                                           ni));
+    }
     auto ext = n.extensions.find("KHR_lights_punctual");
     if (ext != n.extensions.end()) {
       const int li = ext->second.Get("light").GetNumberAsInt();

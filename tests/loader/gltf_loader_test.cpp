@@ -531,6 +531,21 @@ TEST(GltfLoader, NodesOutsideTheLoadedSceneAreCounted) {
   one.add_triangle();
   one.write_gltf(dir / "one.gltf");
   EXPECT_EQ(io::load_gltf(dir / "one.gltf").nodes_not_loaded, 0u);
+
+  // A camera on a node in no scene, and rig extras on a node without a camera: both were ignored
+  // without a word, the rig framing the scene from +Z.
+  MiniGltf cam;
+  cam.add_triangle();
+  cam.doc["cameras"] = json::array({{{"type", "perspective"}, {"perspective", {{"yfov", 0.7}, {"znear", 0.1}}}}});
+  cam.add_node({{"camera", 0}, {"translation", {0, 0, 3}}}, false);
+  cam.doc["nodes"][0]["extras"] = {{"stereobench", {{"interaxial", 0.1}}}};
+  cam.write_gltf(dir / "camera.gltf");
+  const Scene unplaced = io::load_gltf(dir / "camera.gltf");
+  EXPECT_TRUE(unplaced.cameras.empty());
+  const std::string said = fmt::format("{}", fmt::join(unplaced.warnings, "\n"));
+  EXPECT_NE(said.find("the camera of node 1 is in no loaded scene and is not used"), std::string::npos) << said;
+  EXPECT_NE(said.find("/nodes/0/extras/stereobench is on a node without a camera and is ignored"), std::string::npos)
+      << said;
 }
 
 TEST(GltfLoader, AnUnlitSceneIsWarnedAbout) {

@@ -166,6 +166,20 @@ TEST(Rig, BadParametersAreInputErrors) {
   narrow.vfov = degrees_to_radians(1e-3);
   narrow.interaxial = 1e-6;
   EXPECT_NO_THROW((void)resolve_rig(empty, narrow));
+  // One within a hair of 180 degrees: a focal length of a fraction of a pixel rendered a black
+  // image (depths of the wrong sign) without a word. Refused; 170 degrees renders.
+  RigOverrides wide_view;
+  wide_view.height = 90;
+  wide_view.width = 160;
+  wide_view.vfov = degrees_to_radians(179.99);
+  try {
+    (void)resolve_rig(empty, wide_view);
+    ADD_FAILURE() << "a field of view of 179.99 degrees at 90 px was accepted";
+  } catch (const InputError& err) {
+    EXPECT_NE(std::string(err.what()).find("puts the image corners 89.99"), std::string::npos) << err.what();
+  }
+  wide_view.vfov = degrees_to_radians(170.0);
+  EXPECT_NO_THROW((void)resolve_rig(empty, wide_view));
 }
 
 TEST(Rig, ACameraAspectRatioBeyondAnyImageIsRefusedUnlessTheWidthIsGiven) {

@@ -68,6 +68,11 @@ inline std::vector<BadCase> bad_scene_corpus() {
   c.push_back({"top_level_array", "a.gltf", [](auto& p) { write_text(p, "[1,2,3]"); }, "expected a JSON object"});
   c.push_back({"no_asset", "a.gltf", [](auto& p) { write_text(p, "{}"); }, "/asset: required property is missing"});
   c.push_back({"version_1", "a.gltf", [](auto& p) { write_text(p, R"({"asset":{"version":"1.0"}})"); }, "/asset/version"});
+  // glTF: a 2.0 reader must not load a file whose minVersion is later (it loaded, exit 0).
+  c.push_back({"min_version_2_1", "a.gltf", edited([](MiniGltf& g) { g.doc["asset"]["minVersion"] = "2.1"; }),
+               "/asset/minVersion: the file needs glTF 2.1 at least"});
+  c.push_back({"min_version_not_a_version", "a.gltf", edited([](MiniGltf& g) { g.doc["asset"]["minVersion"] = "2"; }),
+               "/asset/minVersion: '2' is not a glTF version"});
   c.push_back({"empty_scene", "a.gltf", [](auto& p) { write_text(p, R"({"asset":{"version":"2.0"}})"); }, "no triangles"});
   c.push_back({"empty_node_list", "a.gltf", [](auto& p) { write_text(p, R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[]}],"scene":0})"); }, "no triangles"});
   // Triangles of zero area render as background only, which every comparison passes.
@@ -151,6 +156,14 @@ inline std::vector<BadCase> bad_scene_corpus() {
     g.write_gltf(p);
     std::filesystem::remove(p.parent_path() / "a.bin");
   }, "/buffers/0/uri: referenced file"});
+  // "%00" decoded to a NUL that ended the file name: "a.bin%00.txt" read a.bin.
+  c.push_back({"uri_with_nul", "a.gltf", [](const std::filesystem::path& p) {
+    MiniGltf g;
+    g.add_triangle();
+    g.write_gltf(p);
+    g.doc["buffers"][0]["uri"] = "a.bin%00.txt";
+    MiniGltf::write_text(p, g.doc.dump());
+  }, "/buffers/0/uri: 'a.bin%00.txt' decodes to a path with a NUL byte"});
   c.push_back({"truncated_bin", "a.gltf", [](const std::filesystem::path& p) {
     MiniGltf g;
     g.add_triangle();
@@ -234,6 +247,15 @@ inline std::vector<BadCase> bad_scene_corpus() {
                                        {"indices", {{"bufferView", 0}, {"componentType", 5123}, {"byteOffset", 4294967296ULL}}},
                                        {"values", {{"bufferView", 0}}}};
   }), "/accessors/0/sparse/indices/byteOffset: value 4294967296 is out of range [0, 2147483647]"});
+  // Sparse indices must increase strictly: with one given twice, which value wins was the reader's
+  // choice (it loaded, exit 0).
+  c.push_back({"sparse_indices_not_increasing", "a.gltf", edited([](MiniGltf& g) {
+    const int indices = g.add_view(std::vector<uint16_t>{2, 1});
+    const int values = g.add_view(std::vector<float>{0, 0, 0, 1, 1, 1});
+    g.doc["accessors"][0]["sparse"] = {{"count", 2},
+                                       {"indices", {{"bufferView", indices}, {"componentType", 5123}}},
+                                       {"values", {{"bufferView", values}}}};
+  }), "/accessors/0/sparse/indices: sparse index 1 at element 1 follows 2"});
   // Sampler enums: 2^32 + 33071 was read as CLAMP_TO_EDGE.
   c.push_back({"sampler_wrap_not_an_enum", "a.gltf", edited([](MiniGltf& g) { g.doc["samplers"] = json::array({{{"wrapS", 4294967296ULL + 33071}}}); }),
                "/samplers/0/wrapS: 4295000367 is not one of 33071 CLAMP_TO_EDGE"});
