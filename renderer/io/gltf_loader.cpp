@@ -661,6 +661,13 @@ class Converter {
     }
   }
 
+  /// What a texture takes per texel beyond its decoded values (4 B per channel), at the peak,
+  /// which comes when the scene is prepared: its RGBA floats (16 B), beside them the mip chain's
+  /// level 0 (16 B), the first level's row pass in double (16 B) and the coarser levels (5.3 B),
+  /// with the decoder's buffers. With an RGB image's 12 B that is 62 B per texel; measured: 60.6 B
+  /// (4.07 GB peak for an 8192x8192 RGB PNG, `scenes info`).
+  static constexpr uint64_t kTextureBytesPerTexel = 50;
+
   int convert_texture(Scene& scene, int t, const std::string& path) {
     const tinygltf::Texture& gt = m_.textures[static_cast<size_t>(t)];
     if (gt.source < 0) {
@@ -673,21 +680,18 @@ class Converter {
       fail(ipath, fmt::format("image has no data (used by {})", path));
     DecodedImage img;
     try {
-      img = decode_image(gi.image, fmt::format("{} {}", file_, ipath));
+      // Checked once for the whole, before decoding: each stage checked alone against what was
+      // left fitted, and together a 20000x20000 PNG of 1.2 MB took the whole machine.
+      img = decode_image(gi.image, fmt::format("{} {}", file_, ipath), kTextureBytesPerTexel);
     } catch (const ResourceError&) {
       throw;  // too large for this machine, not malformed
     } catch (const Error& e) {
       fail(ipath, fmt::format("cannot decode the image: {}", e.what()));
     }
-    // The texture's own RGBA copy (16 B per texel) and, when the scene is prepared, its mip chain.
-    require_memory(uint64_t{16} * static_cast<uint64_t>(img.width) * static_cast<uint64_t>(img.height),
-                   fmt::format("the texture of {} {} ({}x{})", file_, ipath, img.width, img.height),
-                   "use smaller textures, or run on a machine with more memory");
     Texture tex;
     tex.name = gi.name.empty() ? (gi.uri.empty() || is_data_uri(gi.uri) ? fmt::format("image{}", gt.source) : gi.uri) : gi.name;
     tex.width = img.width;
     tex.height = img.height;
-    tex.rgba.resize(static_cast<size_t>(img.width) * img.height * 4);
     const int ch = img.channels;
     // PNG and JPEG decode to [0, 1]; another format OpenImageIO reads (a float TIFF or EXR, a
     // Radiance file) may hold anything, and a NaN or negative colour would reach the images.
@@ -699,16 +703,20 @@ class Converter {
                                 texel % static_cast<size_t>(img.width), texel / static_cast<size_t>(img.width),
                                 i % static_cast<size_t>(ch), img.values[i]));
       }
+    // An RGBA image becomes the texture in place; another is copied out, and its values freed.
+    if (ch == 4) tex.rgba = std::move(img.values);
+    else tex.rgba.resize(static_cast<size_t>(img.width) * img.height * 4);
     for (size_t p = 0; p < static_cast<size_t>(img.width) * img.height; ++p) {
-      const float* s = img.values.data() + p * ch;
-      float r = s[0], g = ch >= 3 ? s[1] : s[0], b = ch >= 3 ? s[2] : s[0];
-      float a = ch == 4 ? s[3] : ch == 2 ? s[1] : 1.0f;
+      const float* s = (ch == 4 ? tex.rgba.data() : img.values.data()) + p * ch;
+      const float r = s[0], g = ch >= 3 ? s[1] : s[0], b = ch >= 3 ? s[2] : s[0];
+      const float a = ch == 4 ? s[3] : ch == 2 ? s[1] : 1.0f;
       // glTF base colour textures are sRGB-encoded.
       tex.rgba[p * 4 + 0] = srgb_to_linear(r);
       tex.rgba[p * 4 + 1] = srgb_to_linear(g);
       tex.rgba[p * 4 + 2] = srgb_to_linear(b);
       tex.rgba[p * 4 + 3] = a;
     }
+    img.values = {};
     if (gt.sampler >= 0) {
       const tinygltf::Sampler& s = m_.samplers[static_cast<size_t>(gt.sampler)];
       tex.repeat_s = s.wrapS != TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;

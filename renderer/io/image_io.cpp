@@ -826,7 +826,7 @@ bool is_srgb(const OIIO::ImageSpec& spec) {
   return colour_space.empty() || colour_space.find("linear") == std::string::npos;
 }
 
-DecodedImage decode_from(OIIO::ImageInput& in, const std::string& name) {
+DecodedImage decode_from(OIIO::ImageInput& in, const std::string& name, uint64_t then_per_pixel = 0) {
   const OIIO::ImageSpec spec = in.spec();
   if (spec.deep || spec.depth > 1)
     throw InputError(fmt::format("image {} is a deep or volume image; textures must be flat 2D images", name));
@@ -835,9 +835,10 @@ DecodedImage decode_from(OIIO::ImageInput& in, const std::string& name) {
     throw InputError(fmt::format("image {} has an unsupported shape {}x{} with {} channels; {}", name, spec.width,
                                  spec.height, spec.nchannels, kCorruptHint));
   // Decoded whole, every channel as float: a file of a few kilobytes can declare gigabytes.
-  require_memory(uint64_t{4} * static_cast<uint64_t>(spec.width) * static_cast<uint64_t>(spec.height) *
-                     static_cast<uint64_t>(spec.nchannels),
-                 fmt::format("decoding image {} ({}x{}, {} channels)", name, spec.width, spec.height, spec.nchannels),
+  require_memory((uint64_t{4} * static_cast<uint64_t>(spec.nchannels) + then_per_pixel) *
+                     static_cast<uint64_t>(spec.width) * static_cast<uint64_t>(spec.height),
+                 fmt::format("decoding image {} ({}x{}, {} channels){}", name, spec.width, spec.height, spec.nchannels,
+                             then_per_pixel > 0 ? " and what is made of it" : ""),
                  "use a smaller image, or run on a machine with more memory");
   DecodedImage image;
   image.width = spec.width;
@@ -1070,7 +1071,8 @@ std::string image_file_format(const fs::path& path) {
   return sniff_format(std::span<const unsigned char>(head, static_cast<size_t>(in.gcount())));
 }
 
-DecodedImage decode_image(std::span<const unsigned char> bytes, const std::string& name_for_errors) {
+DecodedImage decode_image(std::span<const unsigned char> bytes, const std::string& name_for_errors,
+                          uint64_t then_per_pixel) {
   const std::string& name = name_for_errors;
   if (bytes.empty()) throw InputError(fmt::format("image {} is empty (0 bytes); {}", name, kCorruptHint));
   std::string format = sniff_format(bytes);
@@ -1093,7 +1095,7 @@ DecodedImage decode_image(std::span<const unsigned char> bytes, const std::strin
       if (!in->set_ioproxy(&proxy) || !in->open(name, spec, straight_alpha_config()))
         throw InputError(
             fmt::format("cannot decode image {} as {}: {}; {}", name, format, oiio_error(in.get()), kCorruptHint));
-      DecodedImage image = decode_from(*in, name);
+      DecodedImage image = decode_from(*in, name, then_per_pixel);
       in->close();
       return image;
     }
@@ -1103,7 +1105,7 @@ DecodedImage decode_image(std::span<const unsigned char> bytes, const std::strin
     if (!in->open(tmp.path().string(), spec, straight_alpha_config()))
       throw InputError(
           fmt::format("cannot decode image {} as {}: {}; {}", name, format, oiio_error(in.get()), kCorruptHint));
-    DecodedImage image = decode_from(*in, name);
+    DecodedImage image = decode_from(*in, name, then_per_pixel);
     in->close();
     return image;
   });

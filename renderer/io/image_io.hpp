@@ -127,7 +127,11 @@ struct DecodedImage {
 /// Decodes an image file held in memory (PNG, JPEG, EXR, TIFF, BMP, HDR, ... whatever
 /// OpenImageIO reads; the format is found from the bytes). `name_for_errors` names the image in
 /// messages (e.g. "scene.glb image 3"). InputError if the bytes are not a readable image.
-[[nodiscard]] DecodedImage decode_image(std::span<const unsigned char> bytes, const std::string& name_for_errors);
+/// ResourceError, before the pixels are decoded, when the decoded values and `then_per_pixel`
+/// bytes per pixel more (what the caller makes of them: a texture and its mip chain) would not
+/// fit in the memory left: each stage checked alone fits where the whole does not.
+[[nodiscard]] DecodedImage decode_image(std::span<const unsigned char> bytes, const std::string& name_for_errors,
+                                        uint64_t then_per_pixel = 0);
 
 /// Reads an image file as decode_image does. InputError if missing or unreadable.
 [[nodiscard]] DecodedImage read_image(const std::filesystem::path& path);

@@ -57,11 +57,11 @@ void put_chunk(std::vector<unsigned char>& out, const char* type, const std::vec
 
 /// A 200-byte PNG whose header declares a 60000 x 60000 RGBA image (its pixel data is one byte
 /// long): decoded as float it would take 53.6 GiB.
-std::vector<unsigned char> huge_png() {
+std::vector<unsigned char> huge_png(uint32_t side = 60000) {
   std::vector<unsigned char> png = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   std::vector<unsigned char> ihdr;
-  put_u32(ihdr, 60000);
-  put_u32(ihdr, 60000);
+  put_u32(ihdr, side);
+  put_u32(ihdr, side);
   ihdr.insert(ihdr.end(), {8, 6, 0, 0, 0});  // 8 bits, RGBA, deflate, adaptive filters, no interlace
   put_chunk(png, "IHDR", ihdr);
   // A zlib stream of one stored block holding one zero byte.
@@ -156,9 +156,18 @@ TEST(MemoryLimit, AnImageDeclaringGigapixelsIsRefusedBeforeDecoding) {
   CliRun r = run_limited("scenes info " + test::quoted(dir / "textured.gltf"));
   EXPECT_EQ(r.code, 4) << r.out;
   EXPECT_NE(r.out.find("decoding image " + (dir / "textured.gltf").string() +
-                       " /images/0 (60000x60000, 4 channels) needs about 53.64 GiB of memory"),
+                       " /images/0 (60000x60000, 4 channels) and what is made of it needs about 221.28 GiB of memory"),
             std::string::npos)
       << r.out;
+  // One whose decoded values fit (0.73 GiB) but not with the texture and mip chain made of them
+  // (3.0 GiB): each stage checked alone fitted, and together took the whole machine.
+  test::MiniGltf::write_bytes(dir / "huge.png", huge_png(7000));
+  r = run_limited("scenes info " + test::quoted(dir / "textured.gltf"));
+  EXPECT_EQ(r.code, 4) << r.out;
+  EXPECT_NE(r.out.find("/images/0 (7000x7000, 4 channels) and what is made of it needs about 3.01 GiB of memory"),
+            std::string::npos)
+      << r.out;
+  test::MiniGltf::write_bytes(dir / "huge.png", huge_png());
 
   // As an image to compare.
   r = run_limited("compare " + test::quoted(dir / "huge.png") + " " + test::quoted(dir / "huge.png"));
