@@ -244,6 +244,28 @@ void prepare_output_folder(const std::string& folder, const char* option) {
     throw IoError(fmt::format("{} {}: {}; give a folder you can write", option, folder, *why));
 }
 
+void in_output_folder(const std::string& folder, const char* option, const std::function<void()>& work) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  // The outermost folder this call makes: the first of the path's folders that does not exist.
+  fs::path made;
+  for (fs::path p = fs::path(folder).lexically_normal(); !p.empty() && !fs::exists(fs::symlink_status(p, ec));
+       p = p.parent_path())
+    made = p;
+  prepare_output_folder(folder, option);
+  try {
+    work();
+  } catch (...) {
+    if (!made.empty()) {
+      bool holds_a_file = false;
+      for (fs::recursive_directory_iterator it(made, ec), end; !ec && it != end && !holds_a_file; it.increment(ec))
+        holds_a_file = !it->is_directory(ec);
+      if (!ec && !holds_a_file) fs::remove_all(made, ec);
+    }
+    throw;
+  }
+}
+
 void print_to_stdout(const std::string& text) {
   errno = 0;
   fmt::print(stdout, "{}\n", text);

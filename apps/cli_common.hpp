@@ -79,6 +79,11 @@ void check_output_folder(const std::string& folder, const char* option);
 /// the work. IoError naming the option, the folder and the reason.
 void prepare_output_folder(const std::string& folder, const char* option);
 
+/// prepare_output_folder, then `work`. When `work` throws, the folders this call made are removed
+/// again if nothing was written into them (no file at any depth), and the error passed on: a run
+/// that stops (a full disk, an input refused once read) leaves no empty output folder behind.
+void in_output_folder(const std::string& folder, const char* option, const std::function<void()>& work);
+
 /// Removes what an earlier run left at an output path before this run writes anything, so that a
 /// run stopped on the way leaves no output that looks like its own (a CI step publishing a JUnit
 /// file finds none; records do not sit beside an earlier run's summary). `what` names the output

@@ -114,60 +114,62 @@ void run_path_command(const PathArgs& a) {
   const SceneAnimator animation(loaded.scene, run.path);
   provider->check_scene(loaded.scene, loaded.file);
   validation::check_path_truth(*provider, loaded.scene, run.path, loaded.file);
-  // Made once the input is known to be good: a refused run leaves no empty folder behind.
-  prepare_output_folder(a.out, "--out");
-  fmt::print("path on {} ({} triangles): {} frames, {}{}; {}, truth {}\n", loaded.scene.name,
-             loaded.scene.triangle_count(), a.frames,
-             run.path.camera_keys.empty() ? "the scene's camera" : fmt::format("{} camera key{}", run.path.camera_keys.size(), run.path.camera_keys.size() == 1 ? "" : "s"),
-             a.spin_deg ? fmt::format(", meshes turning {} deg per frame (BVH {})", *a.spin_deg, bvh)
-             : run.path.gltf_animation
-                 ? fmt::format(", the scene's glTF animation ({}) from {:g} s to {:g} s, {} mesh(es) and {} light(s) "
-                               "moving (BVH {})",
-                               animation.clip(), animation.time_of(0), animation.time_of(a.frames - 1),
-                               animation.turning_meshes(), animation.moving_lights(), bvh)
-                                : "",
-             describe(rig), provider->name());
-  // The frames go to <stem>_path.jsonl.partial as they finish, renamed to the final name when
-  // the last is in: a run stopped on the way leaves the frames it finished under a name that says
-  // so, and no file under the final name (an earlier run's is removed before the first frame).
-  const fs::path lines = fs::path(a.out) / fmt::format("{}_path.jsonl", loaded.scene.file_stem());
-  const fs::path partial = fs::path(lines).concat(".partial");
-  remove_earlier_output(lines, "path file");
-  io::LineFile out(partial);
-  std::map<std::string, std::vector<double>> frame_s, psnr;
-  std::vector<double> bvh_s;
-  try {
-    validation::run_path(loaded.scene, run, executor, [&](const json& f) {
-      out.append(io::json_text(f));
-      // Frame 0 builds the BVH; later frames update it, unless the path moves no geometry ("static").
-      if (f["frame"].get<int>() > 0 && f["bvh"] != "static") bvh_s.push_back(f["bvh_update_s"].get<double>());
-      std::string line = fmt::format("frame {:>4}", f["frame"].get<int>());
-      for (const auto& [name, p] : f["pipelines"].items()) {
-        frame_s[name].push_back(p["total_s"].get<double>());
-        // PSNR is a string ("inf") for a frame identical to the truth.
-        const json& m = p["metrics"]["psnr"];
-        const double db = m.is_number() ? m.get<double>() : std::numeric_limits<double>::infinity();
-        psnr[name].push_back(db);
-        line += fmt::format("  {} {:.1f} ms {} dB", name, 1e3 * p["total_s"].get<double>(), decibels(db));
-      }
-      fmt::print(stderr, "{}\n", line);
-    });
-  } catch (...) {
-    if (out.lines() > 0)
-      fmt::print(stderr, "stereobench: the {} frames finished before the error are in {}\n", out.lines(),
-                 partial.string());
-    throw;
-  }
-  out.finish(lines);
-  std::vector<std::string> names;
-  for (const auto& entry : frame_s) names.push_back(entry.first);
-  const size_t name_w = pipeline_column(names);
-  fmt::print("\n{:<{}} {:>14} {:>14} {:>12}\n", "pipeline", name_w, "median ms", "95th pct ms", "median PSNR");
-  for (const auto& [name, s] : frame_s)
-    fmt::print("{:<{}} {:>14.2f} {:>14.2f} {:>12}\n", name, name_w, 1e3 * median(s), 1e3 * percentile(s, 0.95),
-               decibels(median(psnr[name])));
-  if (!bvh_s.empty()) fmt::print("BVH {} per frame: median {:.2f} ms\n", bvh, 1e3 * median(bvh_s));
-  fmt::print("wrote {}\n", lines.string());
+  // Made once the input is known to be good, and removed again if the run stops before writing
+  // into it: a refused or failed run leaves no empty folder behind.
+  in_output_folder(a.out, "--out", [&] {
+    fmt::print("path on {} ({} triangles): {} frames, {}{}; {}, truth {}\n", loaded.scene.name,
+               loaded.scene.triangle_count(), a.frames,
+               run.path.camera_keys.empty() ? "the scene's camera" : fmt::format("{} camera key{}", run.path.camera_keys.size(), run.path.camera_keys.size() == 1 ? "" : "s"),
+               a.spin_deg ? fmt::format(", meshes turning {} deg per frame (BVH {})", *a.spin_deg, bvh)
+               : run.path.gltf_animation
+                   ? fmt::format(", the scene's glTF animation ({}) from {:g} s to {:g} s, {} mesh(es) and {} light(s) "
+                                 "moving (BVH {})",
+                                 animation.clip(), animation.time_of(0), animation.time_of(a.frames - 1),
+                                 animation.turning_meshes(), animation.moving_lights(), bvh)
+                                  : "",
+               describe(rig), provider->name());
+    // The frames go to <stem>_path.jsonl.partial as they finish, renamed to the final name when
+    // the last is in: a run stopped on the way leaves the frames it finished under a name that says
+    // so, and no file under the final name (an earlier run's is removed before the first frame).
+    const fs::path lines = fs::path(a.out) / fmt::format("{}_path.jsonl", loaded.scene.file_stem());
+    const fs::path partial = fs::path(lines).concat(".partial");
+    remove_earlier_output(lines, "path file");
+    io::LineFile out(partial);
+    std::map<std::string, std::vector<double>> frame_s, psnr;
+    std::vector<double> bvh_s;
+    try {
+      validation::run_path(loaded.scene, run, executor, [&](const json& f) {
+        out.append(io::json_text(f));
+        // Frame 0 builds the BVH; later frames update it, unless the path moves no geometry ("static").
+        if (f["frame"].get<int>() > 0 && f["bvh"] != "static") bvh_s.push_back(f["bvh_update_s"].get<double>());
+        std::string line = fmt::format("frame {:>4}", f["frame"].get<int>());
+        for (const auto& [name, p] : f["pipelines"].items()) {
+          frame_s[name].push_back(p["total_s"].get<double>());
+          // PSNR is a string ("inf") for a frame identical to the truth.
+          const json& m = p["metrics"]["psnr"];
+          const double db = m.is_number() ? m.get<double>() : std::numeric_limits<double>::infinity();
+          psnr[name].push_back(db);
+          line += fmt::format("  {} {:.1f} ms {} dB", name, 1e3 * p["total_s"].get<double>(), decibels(db));
+        }
+        fmt::print(stderr, "{}\n", line);
+      });
+    } catch (...) {
+      if (out.lines() > 0)
+        fmt::print(stderr, "stereobench: the {} frames finished before the error are in {}\n", out.lines(),
+                   partial.string());
+      throw;
+    }
+    out.finish(lines);
+    std::vector<std::string> names;
+    for (const auto& entry : frame_s) names.push_back(entry.first);
+    const size_t name_w = pipeline_column(names);
+    fmt::print("\n{:<{}} {:>14} {:>14} {:>12}\n", "pipeline", name_w, "median ms", "95th pct ms", "median PSNR");
+    for (const auto& [name, s] : frame_s)
+      fmt::print("{:<{}} {:>14.2f} {:>14.2f} {:>12}\n", name, name_w, 1e3 * median(s), 1e3 * percentile(s, 0.95),
+                 decibels(median(psnr[name])));
+    if (!bvh_s.empty()) fmt::print("BVH {} per frame: median {:.2f} ms\n", bvh, 1e3 * median(bvh_s));
+    fmt::print("wrote {}\n", lines.string());
+  });
 }
 
 }  // namespace

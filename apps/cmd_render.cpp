@@ -88,57 +88,59 @@ void run_render(const RenderArgs& a) {
   const size_t lights_in_file = loaded.lights_in_file;
   const StereoRig rig = resolve_rig(scene, overrides);
   entry.check_rig(options, rig);
-  // Made once the input is known to be good: a refused run leaves no empty folder behind.
-  prepare_output_folder(a.out, "--out");
-  // A scene file that is one of the outputs (<stem>.exr, <stem>_left.png, ..., <stem>_stats.json,
-  // or a diagnostic <stem>_NAME.png already there), by name or through a link either way, would be
-  // replaced by it.
-  const std::string stem = fmt::format("{}_{}", scene.file_stem(), entry_file_stem(entry.name));
-  std::vector<fs::path> outputs = io::render_file_names(a.out, stem, views).all();
-  io::check_no_folder_at(outputs, "give another --out");  // before the render, not after it
-  std::error_code ec;
-  for (fs::directory_iterator it(a.out, ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string name = it->path().filename().string();
-    if (name.starts_with(stem + "_") && name.ends_with(".png")) outputs.push_back(it->path());
-  }
-  for (const fs::path& output : outputs) {
-    std::error_code same_ec;
-    if (fs::equivalent(output, loaded.file, same_ec))
-      throw InputError(fmt::format("--scene {}: the scene file is this render's output {}; give another --out",
-                                   loaded.file.string(), output.string()));
-    for (const std::string& read : scene.files_read)
-      if (fs::equivalent(output, read, same_ec))
-        throw InputError(fmt::format("--scene {}: the file {} the scene reads (a buffer or an image) is this "
-                                     "render's output {}; give another --out",
-                                     loaded.file.string(), read, output.string()));
-  }
-  const RenderScene prepared(scene);
-  require_frame_memory(rig.params().width, rig.params().height, fmt::format("render {}", entry.name));
-  warn_scene_far_from_origin(prepared);
-  warn_geometry_before_near_plane(prepared, rig, executor);
-  const StereoResult result = pipeline.render(prepared, rig, options, RenderContext{executor});
-  warn_if_no_surface_seen(result.left, result.right, rig);
-  // Scored against the true disocclusions outside the pipeline's timings.
-  const std::optional<HoleAnalysis> holes = analyze_holes(prepared, rig, result.right, executor);
-  nlohmann::json record = io::result_to_json(entry.name, prepared, rig, result, executor.threads(), options);
-  if (holes) record["holes"] = io::holes_to_json(*holes);
-  record["scene"]["lights"] = scene.lights.size();
-  record["scene"]["lights_in_file"] = lights_in_file;
-  const io::RenderFiles files =
-      io::write_render_outputs(a.out, stem, result, record, holes ? &holes->overlay : nullptr, views);
-  fmt::print("{} on {} ({} triangles, {}), {}, {} threads\n", entry.name, scene.name, scene.triangle_count(),
-             describe_lights(scene.lights.size(), lights_in_file), describe(rig), executor.threads());
-  fmt::print("  {:<22} {:>10.2f} ms ({:.1f} MiB)\n", "bvh build (once)", prepared.bvh_build_seconds() * 1e3,
-             prepared.rays().memory_bytes() / 1048576.0);
-  print_timings(result);
-  // Counters in one column, as wide as the longest name needs (hole_pixels_occluding_edge is 26).
-  const auto counters = result.counters.snapshot();
-  size_t width = 22;
-  for (const auto& counter : counters) width = std::max(width, counter.first.size());
-  for (const auto& [name, value] : counters) fmt::print("  {:<{}} {:>12}\n", name, width, value);
-  if (holes) print_holes(*holes, result.right.pixel_count());
-  const std::vector<fs::path> written = files.all();
-  for (size_t i = 0; i < written.size(); ++i) fmt::print("{}{}\n", i == 0 ? "wrote " : "      ", written[i].string());
+  // Made once the input is known to be good, and removed again if the run stops before writing
+  // into it: a refused or failed run leaves no empty folder behind.
+  in_output_folder(a.out, "--out", [&] {
+    // A scene file that is one of the outputs (<stem>.exr, <stem>_left.png, ..., <stem>_stats.json,
+    // or a diagnostic <stem>_NAME.png already there), by name or through a link either way, would be
+    // replaced by it.
+    const std::string stem = fmt::format("{}_{}", scene.file_stem(), entry_file_stem(entry.name));
+    std::vector<fs::path> outputs = io::render_file_names(a.out, stem, views).all();
+    io::check_no_folder_at(outputs, "give another --out");  // before the render, not after it
+    std::error_code ec;
+    for (fs::directory_iterator it(a.out, ec), end; !ec && it != end; it.increment(ec)) {
+      const std::string name = it->path().filename().string();
+      if (name.starts_with(stem + "_") && name.ends_with(".png")) outputs.push_back(it->path());
+    }
+    for (const fs::path& output : outputs) {
+      std::error_code same_ec;
+      if (fs::equivalent(output, loaded.file, same_ec))
+        throw InputError(fmt::format("--scene {}: the scene file is this render's output {}; give another --out",
+                                     loaded.file.string(), output.string()));
+      for (const std::string& read : scene.files_read)
+        if (fs::equivalent(output, read, same_ec))
+          throw InputError(fmt::format("--scene {}: the file {} the scene reads (a buffer or an image) is this "
+                                       "render's output {}; give another --out",
+                                       loaded.file.string(), read, output.string()));
+    }
+    const RenderScene prepared(scene);
+    require_frame_memory(rig.params().width, rig.params().height, fmt::format("render {}", entry.name));
+    warn_scene_far_from_origin(prepared);
+    warn_geometry_before_near_plane(prepared, rig, executor);
+    const StereoResult result = pipeline.render(prepared, rig, options, RenderContext{executor});
+    warn_if_no_surface_seen(result.left, result.right, rig);
+    // Scored against the true disocclusions outside the pipeline's timings.
+    const std::optional<HoleAnalysis> holes = analyze_holes(prepared, rig, result.right, executor);
+    nlohmann::json record = io::result_to_json(entry.name, prepared, rig, result, executor.threads(), options);
+    if (holes) record["holes"] = io::holes_to_json(*holes);
+    record["scene"]["lights"] = scene.lights.size();
+    record["scene"]["lights_in_file"] = lights_in_file;
+    const io::RenderFiles files =
+        io::write_render_outputs(a.out, stem, result, record, holes ? &holes->overlay : nullptr, views);
+    fmt::print("{} on {} ({} triangles, {}), {}, {} threads\n", entry.name, scene.name, scene.triangle_count(),
+               describe_lights(scene.lights.size(), lights_in_file), describe(rig), executor.threads());
+    fmt::print("  {:<22} {:>10.2f} ms ({:.1f} MiB)\n", "bvh build (once)", prepared.bvh_build_seconds() * 1e3,
+               prepared.rays().memory_bytes() / 1048576.0);
+    print_timings(result);
+    // Counters in one column, as wide as the longest name needs (hole_pixels_occluding_edge is 26).
+    const auto counters = result.counters.snapshot();
+    size_t width = 22;
+    for (const auto& counter : counters) width = std::max(width, counter.first.size());
+    for (const auto& [name, value] : counters) fmt::print("  {:<{}} {:>12}\n", name, width, value);
+    if (holes) print_holes(*holes, result.right.pixel_count());
+    const std::vector<fs::path> written = files.all();
+    for (size_t i = 0; i < written.size(); ++i) fmt::print("{}{}\n", i == 0 ? "wrote " : "      ", written[i].string());
+  });
 }
 
 void list_pipelines() {

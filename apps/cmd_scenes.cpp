@@ -85,10 +85,8 @@ void generate_scenes(const GenerateArgs& args) {
     if (builtin) files.push_back(scenes::stamp_path(files.back()));  // only the defaults are stamped
   }
   io::check_no_folder_at(files, "give another --out");
-  std::error_code ec;
-  const bool folder_existed = fs::exists(args.out_dir, ec);
-  prepare_output_folder(args.out_dir, "--out");
-  try {
+  // A scene refused once built leaves no empty folder this run made.
+  in_output_folder(args.out_dir, "--out", [&] {
     bool header_printed = false;
     for (const std::string& n : names) {
       // Default scenes are stamped so that commands naming them reuse the file; another seed or
@@ -104,12 +102,7 @@ void generate_scenes(const GenerateArgs& args) {
       fmt::print("{:<15} {:>12} {:>10} {:>7} {:>12} {:>9.2f}  {}\n", n, r.triangles, r.vertices, r.lights, r.bytes,
                  r.seconds, r.path.string());
     }
-  } catch (...) {
-    // A scene refused once built leaves no empty folder this run made (fs::remove takes an empty
-    // folder only).
-    if (!folder_existed) fs::remove(args.out_dir, ec);
-    throw;
-  }
+  });
 }
 
 struct InfoArgs {

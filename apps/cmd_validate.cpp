@@ -155,109 +155,113 @@ void run_validate(const ValidateArgs& a) {
   for (size_t i = 0; i < chosen.size(); ++i) chosen[i].check_rig(options[i], rig);
   // What the ground truth's tool cannot render exactly is refused now too (resolve_truth checks again).
   provider->check_scene(scene, loaded.file);
-  // Made once the input is known to be good: a refused run leaves no empty folder behind.
-  prepare_output_folder(a.out, "--out");
-  const RenderScene prepared(scene);
-  fmt::print("validating {} pipeline(s) on {} ({} triangles, {}), {}, {} threads, truth: {}\n", chosen.size(),
-             scene.name, scene.triangle_count(), describe_lights(scene.lights.size(), lights_in_file),
-             describe(rig), executor.threads(), provider->name());
+  // Made once the input is known to be good, and removed again if the run stops before writing
+  // into it: a refused or failed run leaves no empty folder behind.
+  in_output_folder(a.out, "--out", [&] {
+    const RenderScene prepared(scene);
+    fmt::print("validating {} pipeline(s) on {} ({} triangles, {}), {}, {} threads, truth: {}\n", chosen.size(),
+               scene.name, scene.triangle_count(), describe_lights(scene.lights.size(), lights_in_file),
+               describe(rig), executor.threads(), provider->name());
 
-  const fs::path out = a.out;
-  const std::string scene_stem = fmt::format("{}_{}", scene.file_stem(), provider->name());
-  const fs::path summary = out / fmt::format("{}_summary.json", scene_stem);
-  const auto record_file = [&](const std::string& pipeline) {
-    return out / fmt::format("{}_{}.json", scene_stem, entry_file_stem(pipeline));
-  };
-  const std::optional<validation::TruthCache> cache =
-      a.no_cache || a.cache.empty() ? std::nullopt
-                                    : std::optional<validation::TruthCache>(validation::TruthCache(a.cache));
-  // A work folder per scene, provider and truth (its cache key: scene contents, rig, provider): the
-  // command a record gives to render its truth again runs there. Another scene or rig validated
-  // into the same --out works in a folder of its own, so a run that fails after its truth rendered
-  // leaves the earlier records' commands rendering what they describe.
-  // A truth from the cache was rendered in another run's work folder, which may be gone or hold
-  // another render by now: the export and script are made ready in this one's, and the record gives
-  // the command that renders the truth again there.
-  // The built-in provider writes no files there: its scene is not hashed for a name it never uses.
-  const std::string work_name =
-      provider->name() == "full"
-          ? scene_stem
-          : work_folder_name(scene_stem,
-                             validation::truth_key(*provider, {prepared, loaded.file, rig, {}, executor.threads(), true}));
-  const validation::ValidationTarget target =
-      validation::prepare_target(prepared, loaded.file, rig, *provider, cache ? &*cache : nullptr,
-                                 out / "work" / work_name, executor, /*prepare_on_cache_hit=*/true);
-  fmt::print("truth: {} ({}), {}{:.2f} s; true disocclusions {:.3f} % of the image\n", provider->name(),
-             target.truth.render.tool_version, target.truth.cached ? "from the cache, rendered in " : "",
-             target.truth.render.seconds,
-             100.0 * double(target.disocclusions.count()) / double(target.truth_srgb8.pixel_count()));
-  print_warnings(validation::truth_warnings(target.truth.render));
-  warn_scene_far_from_origin(prepared);
-  warn_geometry_before_near_plane(prepared, rig, executor);
+    const fs::path out = a.out;
+    const std::string scene_stem = fmt::format("{}_{}", scene.file_stem(), provider->name());
+    const fs::path summary = out / fmt::format("{}_summary.json", scene_stem);
+    const auto record_file = [&](const std::string& pipeline) {
+      return out / fmt::format("{}_{}.json", scene_stem, entry_file_stem(pipeline));
+    };
+    const std::optional<validation::TruthCache> cache =
+        a.no_cache || a.cache.empty() ? std::nullopt
+                                      : std::optional<validation::TruthCache>(validation::TruthCache(a.cache));
+    // A work folder per scene, provider and truth (its cache key: scene contents, rig, provider): the
+    // command a record gives to render its truth again runs there. Another scene or rig validated
+    // into the same --out works in a folder of its own, so a run that fails after its truth rendered
+    // leaves the earlier records' commands rendering what they describe.
+    // A truth from the cache was rendered in another run's work folder, which may be gone or hold
+    // another render by now: the export and script are made ready in this one's, and the record gives
+    // the command that renders the truth again there.
+    // The built-in provider writes no files there: its scene is not hashed for a name it never uses.
+    const std::string work_name =
+        provider->name() == "full"
+            ? scene_stem
+            : work_folder_name(scene_stem,
+                               validation::truth_key(*provider,
+                                                     {prepared, loaded.file, rig, {}, executor.threads(), true}));
+    const validation::ValidationTarget target =
+        validation::prepare_target(prepared, loaded.file, rig, *provider, cache ? &*cache : nullptr,
+                                   out / "work" / work_name, executor, /*prepare_on_cache_hit=*/true);
+    fmt::print("truth: {} ({}), {}{:.2f} s; true disocclusions {:.3f} % of the image\n", provider->name(),
+               target.truth.render.tool_version, target.truth.cached ? "from the cache, rendered in " : "",
+               target.truth.render.seconds,
+               100.0 * double(target.disocclusions.count()) / double(target.truth_srgb8.pixel_count()));
+    print_warnings(validation::truth_warnings(target.truth.render));
+    warn_scene_far_from_origin(prepared);
+    warn_geometry_before_near_plane(prepared, rig, executor);
 
-  // Every file is made whole under a temporary name, and all are renamed into place at the end,
-  // the summary last: a run that stops on the way (an image it cannot write, a full disk) leaves an
-  // earlier run's summary, records and images as they were.
-  io::StagedFiles set;
-  set.keep(loaded.file, "the scene file");
-  for (const std::string& read : scene.files_read) set.keep(read, "the file the scene reads (a buffer or an image)");
-  // The earlier summary's records: those this run does not write are retired with it, and the work
-  // folders they named go once this run's set is in place.
-  const json earlier = earlier_records(summary);
-  std::vector<std::string> retired;  // pipelines of earlier records this run removes
-  validation::ImageFileOptions image_options;
-  image_options.staged = &set;
-  {
-    const json shared_images = validation::write_target_images(out, scene.file_stem(), target, executor, image_options);
+    // Every file is made whole under a temporary name, and all are renamed into place at the end,
+    // the summary last: a run that stops on the way (an image it cannot write, a full disk) leaves an
+    // earlier run's summary, records and images as they were.
+    io::StagedFiles set;
+    set.keep(loaded.file, "the scene file");
+    for (const std::string& read : scene.files_read) set.keep(read, "the file the scene reads (a buffer or an image)");
+    // The earlier summary's records: those this run does not write are retired with it, and the work
+    // folders they named go once this run's set is in place.
+    const json earlier = earlier_records(summary);
+    std::vector<std::string> retired;  // pipelines of earlier records this run removes
+    validation::ImageFileOptions image_options;
+    image_options.staged = &set;
+    {
+      const json shared_images =
+          validation::write_target_images(out, scene.file_stem(), target, executor, image_options);
 
-    const validation::MetricOptions metric_options{a.error_threshold};
-    json records = json::array();
-    std::vector<std::string> left_lines;  // pipelines whose left eye is in part synthesized
-    std::vector<std::string> names;
-    for (const PipelineEntry& e : chosen) names.push_back(e.name);
-    const size_t name_w = pipeline_column(names);
-    fmt::print("\n{:<{}} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10}\n", "pipeline", name_w, "PSNR dB", "SSIM",
-               "MSE", "err %", "holes %", "recall", "prec.", "time ms");
-    for (size_t i = 0; i < chosen.size(); ++i) {
-      const validation::PipelineValidation v =
-          validation::validate_pipeline(target, chosen[i], options[i], executor, metric_options);
-      const std::string stem = fmt::format("{}_{}", scene_stem, entry_file_stem(v.pipeline));
-      json images = validation::write_pipeline_images(out, stem, target, v, executor, image_options);
-      images.update(shared_images);
-      const json record = validation::validation_record(target, v, executor.threads(), images);
-      set.add(record_file(v.pipeline),
-              [&](const fs::path& tmp) { io::write_text_atomically(tmp, io::json_text(record, 2) + "\n"); });
-      records.push_back(record);
-      const validation::HoleStatistics& h = v.holes;
-      fmt::print("{:<{}} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10.1f}\n", v.pipeline, name_w,
-                 table_number(v.whole.psnr, 2), table_number(v.whole.ssim, 4), mse_text(v.whole.mse),
-                 table_number(100.0 * v.whole.error_fraction, 3), table_number(100.0 * h.hole_fraction, 3),
-                 table_number(h.scores.recall, 4), table_number(h.scores.precision, 4),
-                 v.result.timings.total() * 1e3);
-      if (v.left)
-        left_lines.push_back(fmt::format(
-            "{:<{}} {:>8} {:>7} {:>9} {:>7}  ({:.3f} % of its pixels not rendered by the left eye)", v.pipeline,
-            name_w, table_number(v.left->psnr, 2), table_number(v.left->ssim, 4), mse_text(v.left->mse),
-            table_number(100.0 * v.left->error_fraction, 3),
-            100.0 * static_cast<double>(v.left_synthesized) / static_cast<double>(v.result.left.pixel_count())));
+      const validation::MetricOptions metric_options{a.error_threshold};
+      json records = json::array();
+      std::vector<std::string> left_lines;  // pipelines whose left eye is in part synthesized
+      std::vector<std::string> names;
+      for (const PipelineEntry& e : chosen) names.push_back(e.name);
+      const size_t name_w = pipeline_column(names);
+      fmt::print("\n{:<{}} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10}\n", "pipeline", name_w, "PSNR dB", "SSIM",
+                 "MSE", "err %", "holes %", "recall", "prec.", "time ms");
+      for (size_t i = 0; i < chosen.size(); ++i) {
+        const validation::PipelineValidation v =
+            validation::validate_pipeline(target, chosen[i], options[i], executor, metric_options);
+        const std::string stem = fmt::format("{}_{}", scene_stem, entry_file_stem(v.pipeline));
+        json images = validation::write_pipeline_images(out, stem, target, v, executor, image_options);
+        images.update(shared_images);
+        const json record = validation::validation_record(target, v, executor.threads(), images);
+        set.add(record_file(v.pipeline),
+                [&](const fs::path& tmp) { io::write_text_atomically(tmp, io::json_text(record, 2) + "\n"); });
+        records.push_back(record);
+        const validation::HoleStatistics& h = v.holes;
+        fmt::print("{:<{}} {:>8} {:>7} {:>9} {:>7} {:>7} {:>7} {:>7} {:>10.1f}\n", v.pipeline, name_w,
+                   table_number(v.whole.psnr, 2), table_number(v.whole.ssim, 4), mse_text(v.whole.mse),
+                   table_number(100.0 * v.whole.error_fraction, 3), table_number(100.0 * h.hole_fraction, 3),
+                   table_number(h.scores.recall, 4), table_number(h.scores.precision, 4),
+                   v.result.timings.total() * 1e3);
+        if (v.left)
+          left_lines.push_back(fmt::format(
+              "{:<{}} {:>8} {:>7} {:>9} {:>7}  ({:.3f} % of its pixels not rendered by the left eye)", v.pipeline,
+              name_w, table_number(v.left->psnr, 2), table_number(v.left->ssim, 4), mse_text(v.left->mse),
+              table_number(100.0 * v.left->error_fraction, 3),
+              100.0 * static_cast<double>(v.left_synthesized) / static_cast<double>(v.result.left.pixel_count())));
+      }
+      if (!left_lines.empty()) {
+        fmt::print("\nleft eyes synthesized in part, against plain-rt's left eye:\n{:<{}} {:>8} {:>7} {:>9} {:>7}\n",
+                   "pipeline", name_w, "PSNR dB", "SSIM", "MSE", "err %");
+        for (const std::string& line : left_lines) fmt::print("{}\n", line);
+      }
+      retired = retire_earlier_records(set, out, earlier, scene_stem, names);
+      const std::string summary_text =
+          io::json_text(json{{"kind", "stereobench.validation_summary"}, {"records", records}}, 2) + "\n";
+      set.add(summary, [&](const fs::path& tmp) { io::write_text_atomically(tmp, summary_text); });
     }
-    if (!left_lines.empty()) {
-      fmt::print("\nleft eyes synthesized in part, against plain-rt's left eye:\n{:<{}} {:>8} {:>7} {:>9} {:>7}\n",
-                 "pipeline", name_w, "PSNR dB", "SSIM", "MSE", "err %");
-      for (const std::string& line : left_lines) fmt::print("{}\n", line);
-    }
-    retired = retire_earlier_records(set, out, earlier, scene_stem, names);
-    const std::string summary_text =
-        io::json_text(json{{"kind", "stereobench.validation_summary"}, {"records", records}}, 2) + "\n";
-    set.add(summary, [&](const fs::path& tmp) { io::write_text_atomically(tmp, summary_text); });
-  }
-  set.commit();  // the summary, added last, is the set's marker
-  remove_earlier_work_folders(out / "work", scene_stem, work_name, earlier);
-  fmt::print("\nwrote {} (one record per pipeline beside it, images under {})\n", summary.string(), out.string());
-  if (!retired.empty())
-    fmt::print("removed the earlier records of {} with their images: not validated in this run, they described the "
-               "truth this run replaced (validate them together, or into another --out, to keep both)\n",
-               fmt::join(retired, ", "));
+    set.commit();  // the summary, added last, is the set's marker
+    remove_earlier_work_folders(out / "work", scene_stem, work_name, earlier);
+    fmt::print("\nwrote {} (one record per pipeline beside it, images under {})\n", summary.string(), out.string());
+    if (!retired.empty())
+      fmt::print("removed the earlier records of {} with their images: not validated in this run, they described the "
+                 "truth this run replaced (validate them together, or into another --out, to keep both)\n",
+                 fmt::join(retired, ", "));
+  });
 }
 
 }  // namespace

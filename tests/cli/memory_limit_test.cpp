@@ -91,6 +91,9 @@ TEST(MemoryLimit, AResolutionBeyondTheMemoryIsRefusedBeforeRendering) {
         << r.out;
   }
   EXPECT_EQ(files_under(dir / "render") + files_under(dir / "validate"), 0u) << "nothing is written";
+  // Nor is the output folder left, made before the refusal and empty (it was).
+  EXPECT_FALSE(std::filesystem::exists(dir / "render"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "validate"));
 }
 
 TEST(MemoryLimit, ASceneDeclaringMoreVerticesThanTheMemoryHoldsIsRefusedBeforeReadingThem) {
