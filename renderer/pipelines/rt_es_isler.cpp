@@ -1,5 +1,7 @@
 // rt-es-isler: Es and Isler's parallelisation of the scan-line stereo ray tracer: Algorithm 1 per
 // scan-line, scan-lines processed in parallel (here in bands of the ray packets' height).
+#include <chrono>
+
 #include "renderer/pipeline.hpp"
 #include "renderer/stages/eye_image.hpp"
 #include "renderer/stages/scanline_reprojection.hpp"
@@ -33,15 +35,22 @@ class RtEsIsler final : public Pipeline {
       r.left = make_eye_image(w, h, PlaneInit::unset);
       r.right = make_eye_image(w, h, PlaneInit::unset);
     }
-    {
-      ScopedStage stage(r.timings, "scanlines", StageEye::both);
-      ctx.executor.for_each(bands, [&](size_t b) {
-        const int y0 = static_cast<int>(b) * kScanlineBand;
-        scanline_band(scene, reprojector, y0, std::min(y0 + kScanlineBand, h), r.left, r.right, per_band[b]);
-      });
-    }
+    const auto start = std::chrono::steady_clock::now();
+    ctx.executor.for_each(bands, [&](size_t b) {
+      const int y0 = static_cast<int>(b) * kScanlineBand;
+      scanline_band(scene, reprojector, y0, std::min(y0 + kScanlineBand, h), r.left, r.right, per_band[b]);
+    });
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     ScanlineCounts counts;
     for (const ScanlineCounts& c : per_band) counts.add(c);
+    // The scan-lines interleave both eyes' work on every thread: the pass's wall time is shared out
+    // as rt-adelson's stages in proportion to the thread time each part took, so that the stages
+    // still add up to the render's time and the right eye's share can be read beside the left's.
+    const double busy = counts.left_seconds + counts.reproject_seconds + counts.right_seconds;
+    const auto share = [&](double part) { return busy > 0.0 ? wall * part / busy : 0.0; };
+    r.timings.add("left_trace", busy > 0.0 ? share(counts.left_seconds) : wall, StageEye::left);
+    r.timings.add("reproject", share(counts.reproject_seconds), StageEye::right);
+    r.timings.add("right_trace", share(counts.right_seconds), StageEye::right);
     add_scanline_counters(r, counts, rig);
     return r;
   }

@@ -312,7 +312,7 @@ TEST(SweepRun, SmokeSweepRunsAndEveryLineIsWellFormed) {
       EXPECT_GT(t["median_s"].get<double>(), 0.0);
       EXPECT_GT(t["speedup_median"].get<double>(), 0.0);
       // The right eye's share of the left's, where the stages split between the eyes.
-      const bool shared = name.rfind("bidir-warp", 0) == 0 || name == "rt-es-isler";
+      const bool shared = name.rfind("bidir-warp", 0) == 0;
       ASSERT_TRUE(t.contains("right_over_left_median")) << t.dump();
       EXPECT_EQ(t.at("right_over_left_median").is_null(), shared) << t.dump();
       if (!shared) {
