@@ -28,10 +28,19 @@ void RigCli::add_to(CLI::App& app) {
                  "Give the interaxial as the disparity at infinity in pixels, f_px*e/c")
       ->group(g)
       ->excludes("--interaxial");
-  app.add_option("--convergence,-c", convergence, "Zero-parallax distance in meters (default: the scene camera's; for a scene without a camera, the distance that frames it)")->group(g);
-  app.add_option("--resolution,-r", resolution, "Image size per eye: WxH, hd (1920x1080), 4k, 720p, qhd, 8k")
+  app.add_option("--convergence,-c", convergence,
+                 "Zero-parallax distance in meters (default: the scene camera's extras.stereobench convergence, else "
+                 "2.0; for a scene without a camera, the distance that frames it)")
       ->group(g);
-  app.add_option("--vfov", vfov_deg, "Vertical field of view in degrees (default: the scene camera's)")->group(g);
+  app.add_option("--resolution,-r", resolution,
+                 "Image size per eye: WxH, or hd/fhd/1080p (1920x1080), 720p (1280x720), qhd (2560x1440), 4k/uhd "
+                 "(3840x2160), 8k (7680x4320) (default: the scene camera's extras.stereobench width and height, the "
+                 "width else from its aspectRatio; else 1920x1080)")
+      ->group(g);
+  app.add_option("--vfov", vfov_deg,
+                 "Vertical field of view in degrees (default: the scene camera's yfov; 40 for a scene without a "
+                 "camera)")
+      ->group(g);
 }
 
 namespace {

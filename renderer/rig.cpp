@@ -219,18 +219,6 @@ StereoRig resolve_rig(const Scene& scene, const RigOverrides& o) {
     p.vfov = cam.yfov;
     p.znear = cam.znear;
     if (cam.zfar > 0.0) p.zfar = cam.zfar;
-    if (cam.aspect > 0.0) {
-      // The camera's aspect ratio sets the width unless the scene's extras or an override do.
-      const double width = p.height * cam.aspect;
-      const bool in_range = width >= 0.5 && width < kMaxImageSide + 0.5;
-      if (in_range) {
-        p.width = static_cast<int>(std::lround(width));
-      } else if (!scene.rig.width && !o.width) {
-        throw InputError(fmt::format("scene '{}': its camera's aspectRatio {:g} gives a width of {:g} px at {} px "
-                                     "height, outside 1..{}; fix the camera's aspectRatio, or give --resolution",
-                                     scene.name, cam.aspect, width, p.height, kMaxImageSide));
-      }
-    }
   } else {
     // Frame the bounding sphere from +Z.
     const dvec3 c = b.empty() ? dvec3(0.0) : dvec3(b.center());
@@ -239,12 +227,24 @@ StereoRig resolve_rig(const Scene& scene, const RigOverrides& o) {
     p.znear = std::max(1e-3, 1e-4 * dist);
     p.convergence = dist;
   }
-  if (scene.rig.width) p.width = *scene.rig.width;
   if (scene.rig.height) p.height = *scene.rig.height;
+  if (o.height) p.height = *o.height;
+  if (scene.rig.width) {
+    p.width = *scene.rig.width;
+  } else if (!o.width && !scene.cameras.empty() && scene.cameras.front().aspect > 0.0) {
+    // The camera's aspect ratio sets the width, at the height the rig has (the scene's extras may
+    // give one), unless the scene's extras or an override give the width.
+    const double aspect = scene.cameras.front().aspect;
+    const double width = p.height * aspect;
+    if (!(width >= 0.5 && width < kMaxImageSide + 0.5))
+      throw InputError(fmt::format("scene '{}': its camera's aspectRatio {:g} gives a width of {:g} px at {} px "
+                                   "height, outside 1..{}; fix the camera's aspectRatio, or give --resolution",
+                                   scene.name, aspect, width, p.height, kMaxImageSide));
+    p.width = static_cast<int>(std::lround(width));
+  }
   if (scene.rig.interaxial) p.interaxial = *scene.rig.interaxial;
   if (scene.rig.convergence) p.convergence = *scene.rig.convergence;
   if (o.width) p.width = *o.width;
-  if (o.height) p.height = *o.height;
   if (o.vfov) p.vfov = *o.vfov;
   if (o.convergence) p.convergence = *o.convergence;
   if (o.interaxial && o.max_disparity_px)
@@ -299,8 +299,9 @@ ivec2 parse_resolution(const std::string& text) {
   const long w = x == std::string::npos ? -1 : parse_side(lower.substr(0, x));
   const long h = x == std::string::npos ? -1 : parse_side(lower.substr(x + 1));
   if (w < 0 || h < 0)
-    throw InputError(fmt::format("resolution '{}' is not WIDTHxHEIGHT (e.g. 1920x1080) or one of hd, 720p, "
-                                 "qhd, 4k, 8k", text));
+    throw InputError(fmt::format("resolution '{}' is not WIDTHxHEIGHT (e.g. 1920x1080) or one of hd, fhd, 1080p, "
+                                 "720p, qhd, 4k, uhd, 8k (any case)",
+                                 text));
   if (w < 1 || h < 1 || w > kMaxImageSide || h > kMaxImageSide)
     throw InputError(fmt::format("resolution {}x{} is out of range; each side must be 1..{}", w, h, kMaxImageSide));
   return {static_cast<int>(w), static_cast<int>(h)};

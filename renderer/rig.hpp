@@ -129,8 +129,8 @@ struct RigOverrides {
 /// Without a camera the pose frames the scene's bounds from +Z. Throws InputError on bad values.
 [[nodiscard]] StereoRig resolve_rig(const Scene& scene, const RigOverrides& overrides);
 
-/// Parses "WxH" or a name: hd (1920x1080, the papers' HD), 4k / uhd (3840x2160), 720p (1280x720),
-/// qhd (2560x1440), 8k (7680x4320). InputError for anything else or a side outside 1..16384.
+/// Parses "WxH" or a name (any case): hd / fhd / 1080p (1920x1080, the papers' HD), 4k / uhd
+/// (3840x2160), 720p (1280x720), qhd (2560x1440), 8k (7680x4320). InputError for anything else or a side outside 1..16384.
 [[nodiscard]] ivec2 parse_resolution(const std::string& text);
 
 /// One-line human description: "1920x1080, vfov 40.0°, e 0.0640 m, c 2.000 m, max disparity 47.9 px".

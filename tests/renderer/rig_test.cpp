@@ -204,6 +204,13 @@ TEST(Rig, ACameraAspectRatioBeyondAnyImageIsRefusedUnlessTheWidthIsGiven) {
   EXPECT_EQ(resolve_rig(scene, given).params().width, 320);
   scene.cameras[0].aspect = 16.0 / 9.0;
   EXPECT_EQ(resolve_rig(scene, RigOverrides{}).params().width, 1920);
+  // The aspect ratio gives the width at the height the scene's extras give (it was taken at the
+  // default 1080: aspect 2 at 720 px made 2160x720).
+  scene.cameras[0].aspect = 2.0;
+  scene.rig.height = 720;
+  const RigParams at_720 = resolve_rig(scene, RigOverrides{}).params();
+  EXPECT_EQ(at_720.width, 1440);
+  EXPECT_EQ(at_720.height, 720);
 }
 
 TEST(Rig, ResolutionNamesAndErrors) {
