@@ -164,7 +164,8 @@ struct WarpStats {
 /// The grid drawn over the source radiance for viewing (the paper's Fig. 4): the image darkened,
 /// cells that exceed the parallax threshold tinted red, the other subdivided cells (the flagged
 /// cells' neighbours, and cells where a disocclusion gap opens) tinted orange (both at native
-/// resolution), and the two triangles of every coarse cell outlined.
+/// resolution), and the triangles of every coarse cell outlined: two, or beside a subdivided cell
+/// the fan that closes its T-junctions (an edge per pixel of the shared side: a white wedge).
 [[nodiscard]] Image grid_overlay(const WarpGrid& grid, const Image& source);
 
 }  // namespace sb
