@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
@@ -234,9 +235,13 @@ void register_scenes_command(CLI::App& root) {
   gen->out_dir = scenes::default_scenes_dir().string();
   CLI::App* g = scenes->add_subcommand("generate", "Generate built-in scenes as glTF (seeded, deterministic)");
   g->add_option("names", gen->names, "Scenes to generate (see `scenes list`)");
+  std::vector<std::string> on_demand;
+  for (const scenes::GeneratorInfo& info : scenes::generators())
+    if (!info.builtin) on_demand.push_back(info.name);
   g->add_flag("--all", gen->all,
-              "Generate every built-in scene with default parameters, but for those marked on demand in `scenes "
-              "list` (fence), which a command naming them generates");
+              fmt::format("Generate every built-in scene with default parameters, but for those marked on demand in "
+                          "`scenes list` ({}), which a command naming them generates",
+                          fmt::join(on_demand, ", ")));
   g->add_option("--out,-o", gen->out_dir, "Output folder")->capture_default_str();
   g->add_option("--seed", gen->seed,
                 "Random seed; same seed, same file. With another seed than 1 or a --param the file is named\n"

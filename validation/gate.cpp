@@ -744,10 +744,7 @@ std::string reproduce_command(const GateCell& cell, const std::string& pipeline,
 
 namespace {
 
-/// Whether the results hold every cell of their sweep: a results file left by a sweep that stopped
-/// early (killed, a full disk) must not pass, nor one whose records do not say how many cells the
-/// sweep has (a line without cell_count: edited, or of an older version). Nothing for no cells.
-/// The shard I/N (N > 1) whose run wrote every record, when one did: a shard's results file.
+/// The shard I/N whose run wrote every record, when one did.
 std::optional<std::pair<uint64_t, uint64_t>> shard_of(const std::vector<const json*>& records) {
   std::optional<std::pair<uint64_t, uint64_t>> shard;
   for (const json* r : records) {
@@ -759,9 +756,15 @@ std::optional<std::pair<uint64_t, uint64_t>> shard_of(const std::vector<const js
     if (shard && *shard != mine) return std::nullopt;  // collected from several shards
     shard = mine;
   }
-  return shard && shard->second > 1 ? shard : std::nullopt;
+  return shard;
 }
 
+/// Whether the results hold every cell of their sweep: a results file left by a sweep that stopped
+/// early (killed, a full disk) must not pass, nor one whose records do not say how many cells the
+/// sweep has (a line without cell_count: edited, or of an older version). Nothing for no cells.
+/// Its command to finish the sweep: sweep run with the recorded --out; for a shard's own results
+/// file, that shard into that file; for a Slurm task's file, or the merged file of a folder
+/// submitted to Slurm, the Slurm executor.
 std::optional<GateCheck> completeness_check(const GateResults& results) {
   if (results.cells.empty()) return std::nullopt;
   std::vector<const json*> records;
@@ -775,26 +778,32 @@ std::optional<GateCheck> completeness_check(const GateResults& results) {
   // Lines from before "out" was recorded: the results file's folder, sweep run's default.
   if (out.empty()) out = results.file.parent_path().empty() ? "." : results.file.parent_path().string();
   const std::optional<CellCoverage> coverage = cell_coverage(records);
-  const std::optional<std::pair<uint64_t, uint64_t>> shard = shard_of(records);
-  // A Slurm task's results file lies in the Slurm folder of the sweep's --out.
+  // A Slurm task's results file lies in the Slurm folder of the sweep's --out; the sweep's own
+  // results file there is the Slurm executor's merge once the folder was submitted.
   std::error_code ec;
-  const bool slurm_task =
-      shard && fs::weakly_canonical(fs::absolute(results.file).parent_path(), ec) ==
-                   fs::weakly_canonical(fs::absolute(slurm_layout(out).dir), ec);
+  const SlurmLayout slurm = slurm_layout(out);
+  const bool slurm_task = fs::weakly_canonical(fs::absolute(results.file).parent_path(), ec) ==
+                          fs::weakly_canonical(fs::absolute(slurm.dir), ec);
+  const bool sweeps_own = fs::weakly_canonical(fs::absolute(results.file), ec) ==
+                          fs::weakly_canonical(fs::absolute(fs::path(out) / "results.jsonl"), ec);
+  const bool slurm_merge = sweeps_own && fs::exists(slurm.submission, ec);
+  // A shard's own file (--shard I/N --results FILE): shards sharing the sweep's file are not one.
+  const std::optional<std::pair<uint64_t, uint64_t>> recorded_shard = shard_of(records);
+  std::optional<std::pair<uint64_t, uint64_t>> shard = recorded_shard;
+  if (shard && (shard->second < 2 || sweeps_own)) shard.reset();
   GateCheck check;
   check.check = kCompleteCheck;
   check.cell_id = "(all cells)";
   check.pipeline = "(all)";
   const std::string run = fmt::format("stereobench sweep run {} --out {}",
                                       definition.empty() ? "DEFINITION" : shell_quote(definition), shell_quote(out));
-  if (slurm_task) {
+  if (slurm_task || slurm_merge) {
     check.reproduce = run + " --executor slurm --wait";
   } else {
     check.reproduce = run;
     if (shard) check.reproduce += fmt::format(" --shard {}/{}", shard->first, shard->second);
     // sweep run resumes <out>/results.jsonl unless told otherwise.
-    if (results.file.lexically_normal() != (fs::path(out) / "results.jsonl").lexically_normal())
-      check.reproduce += " --results " + shell_quote(results.file.string());
+    if (!sweeps_own) check.reproduce += " --results " + shell_quote(results.file.string());
   }
   if (!coverage) {
     check.measured = kNaN;
@@ -815,10 +824,12 @@ std::optional<GateCheck> completeness_check(const GateResults& results) {
   check.verdict = Verdict::fail;
   if (slurm_task) {
     check.message = fmt::format(
-        "{} holds {} of the sweep's {} cells: it is the results file of Slurm task {} of {}, not the sweep's; gate "
-        "{}, which the executor merges from every task once all have ended (the command below waits for them, "
-        "submitting the cells left again)",
-        results.file.string(), coverage->present, expected, shard->first, shard->second,
+        "{} holds {} of the sweep's {} cells: it is the results file of {}, not the sweep's; gate {}, which the "
+        "executor merges from every task once all have ended (the command below waits for them, submitting the "
+        "cells left again)",
+        results.file.string(), coverage->present, expected,
+        recorded_shard ? fmt::format("Slurm task {} of {}", recorded_shard->first, recorded_shard->second)
+                       : std::string("a Slurm task"),
         (fs::path(out) / "results.jsonl").string());
   } else if (shard) {
     const size_t in_shard = shard_cells(expected, {shard->first, shard->second}).size();
@@ -832,8 +843,9 @@ std::optional<GateCheck> completeness_check(const GateResults& results) {
                           coverage->present, in_shard));
   } else {
     check.message = fmt::format("{} holds {} of the sweep's {} cells: the sweep did not finish; run it again with the "
-                                "same --out to resume it",
-                                results.file.string(), coverage->present, expected);
+                                "same --out to resume it{}",
+                                results.file.string(), coverage->present, expected,
+                                slurm_merge ? " (it was submitted to Slurm: with the Slurm executor)" : "");
   }
   return check;
 }

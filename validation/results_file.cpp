@@ -453,9 +453,8 @@ void check_cell_record(const json& line, const std::string& where) {
                                  where, line["cell_index"].dump(), line["cell_count"].dump()));
   if (const auto shard = line.find("shard"); shard != line.end()) {
     const json index = shard->value("index", json()), count = shard->value("count", json());
-    if (!index.is_number_integer() || !count.is_number_integer() || index.get<long long>() < 0 ||
-        index.get<long long>() >= count.get<long long>() ||
-        line["cell_index"].get<long long>() % count.get<long long>() != index.get<long long>())
+    if (!index.is_number_unsigned() || !count.is_number_unsigned() || index.get<uint64_t>() >= count.get<uint64_t>() ||
+        line["cell_index"].get<uint64_t>() % count.get<uint64_t>() != index.get<uint64_t>())
       throw InputError(fmt::format("{}: shard {} is not a shard I/N (0 <= I < N) that holds cell_index {}; the line is "
                                    "damaged or edited by hand",
                                    where, shard->dump(), line["cell_index"].dump()));
@@ -559,6 +558,13 @@ void check_cell_record(const json& line, const std::string& where) {
   }
 }
 
+std::vector<std::string> recorded_pipelines(const json& cell) {
+  std::vector<std::string> names;
+  if (const auto p = cell.find("pipelines"); p != cell.end() && p->is_object())
+    for (const auto& [name, record] : p->items()) names.push_back(name);
+  return names;
+}
+
 namespace {
 
 /// Holds cells read one after another (one results file, or the shards collected into one) to one
@@ -584,11 +590,7 @@ class OneSweep {
           first["sweep"].get<std::string>(), first.value("definition_sha256", "?").substr(0, 12)));
     // Every cell of a definition validates every pipeline of it: a cell without one would let the
     // gate pass that pipeline there unchecked.
-    const auto names = [](const json& c) {
-      std::vector<std::string> n;
-      for (const auto& [pipeline, p] : c["pipelines"].items()) n.push_back(pipeline);
-      return n;
-    };
+    const auto names = recorded_pipelines;
     if (names(cell) != names(first))
       throw InputError(fmt::format("{}: the cell validates pipelines {}, but {} of the same definition validates {}; "
                                    "every cell of a sweep validates every pipeline — cells run by builds with other "
@@ -599,14 +601,19 @@ class OneSweep {
                                    "that expand the definition differently, or a file edited by hand",
                                    where, cell.value("cell_count", json()).dump(), first_name_,
                                    first.value("cell_count", json()).dump()));
-    const json label = value_at(cell, "cell.scene"), content = value_at(cell, "scene.content_sha256");
-    if (!label.is_string() || !content.is_string()) return;  // lines from before content hashes
-    const auto [seen, fresh] = scenes_.try_emplace(label.get<std::string>(), content.get<std::string>(), where);
+    // By the scene's label (name and parameters): the variants of one generator are scenes of
+    // their own, each with its content.
+    const json content = value_at(cell, "scene.content_sha256");
+    if (!content.is_string()) return;  // lines from before content hashes
+    std::map<std::string, double> params;
+    for (const auto& [key, value] : cell["cell"]["scene_params"].items()) params[key] = value.get<double>();
+    const std::string label = scene_label(cell["cell"]["scene"].get<std::string>(), params);
+    const auto [seen, fresh] = scenes_.try_emplace(label, content.get<std::string>(), where);
     if (!fresh && seen->second.first != content.get<std::string>())
       throw InputError(fmt::format("{}: the cell was measured on scene '{}' with content sha256 {}, but {} on content "
                                    "{}: the scene changed between the runs of one sweep; rerun the cells of one of "
                                    "the two (delete their results) on the scene as it is now",
-                                   where, label.get<std::string>(), content.get<std::string>().substr(0, 12),
+                                   where, label, content.get<std::string>().substr(0, 12),
                                    seen->second.second, seen->second.first.substr(0, 12)));
   }
 

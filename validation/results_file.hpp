@@ -57,6 +57,9 @@ struct ResultsFile {
   std::vector<std::string> warnings;  ///< e.g. a torn last line skipped, naming file and line
 };
 
+/// The pipelines a results line validates, by name in the order the line holds them (sorted).
+[[nodiscard]] std::vector<std::string> recorded_pipelines(const nlohmann::json& cell);
+
 /// Reads a results file; every consumer (sweep resume, collect, gate, report) reads it here. A
 /// missing file reads as empty. An unterminated last line (a writer killed mid-write) is skipped
 /// with a warning naming the file and line. An InputError names the file and line for any other

@@ -198,7 +198,7 @@ void refuse_local_run_of_slurm_folder(const fs::path& out_dir, const fs::path& r
   std::error_code ec;
   // The Slurm folder of a submitted sweep is no sweep's --out: its tasks write results-I.jsonl
   // there, and a run into it would put cells/ and work/ beside them.
-  const fs::path parent = fs::absolute(out_dir).lexically_normal().parent_path();
+  const fs::path parent = fs::weakly_canonical(fs::absolute(out_dir), ec).parent_path();  // "x/slurm/" too
   if (const SlurmLayout above = slurm_layout(parent);
       fs::exists(above.submission, ec) &&
       fs::weakly_canonical(fs::absolute(out_dir), ec) == fs::weakly_canonical(above.dir, ec))

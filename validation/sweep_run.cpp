@@ -90,16 +90,14 @@ std::optional<std::string> why_not_resumable(const SweepDefinition& definition, 
   if (sweep != definition.name && sha == definition.sha256)
     return fmt::format("they are cells of sweep '{}', and this definition ({}) has the same content but is named '{}' "
                        "(without sweep.name a sweep is named by its file): resume with the definition under its "
-                       "first name, {}.toml, or give another --out",
+                       "first name, {}.toml",
                        sweep, definition.file.string(), definition.name, sweep);
   if (sweep != definition.name || sha != definition.sha256)
     return fmt::format("they are cells of sweep '{}' (definition sha256 {}), not of this definition '{}' ({}, sha256 "
                        "{}): the definition changed since those cells ran",
                        sweep, sha.substr(0, 12), definition.name, definition.file.string(),
                        definition.sha256.substr(0, 12));
-  std::vector<std::string> recorded;
-  if (const auto p = first.find("pipelines"); p != first.end() && p->is_object())
-    for (const auto& [name, record] : p->items()) recorded.push_back(name);
+  const std::vector<std::string> recorded = recorded_pipelines(first);
   if (recorded != definition.pipelines)
     return fmt::format("those cells validate the pipelines {}, but this build runs {} for {}: the pipelines this "
                        "build registers differ from those of the build that ran them (a definition listing \"all\" "
@@ -108,9 +106,12 @@ std::optional<std::string> why_not_resumable(const SweepDefinition& definition, 
   if (first.value("baseline", "") != definition.baseline)
     return fmt::format("those cells were timed against the baseline '{}', but this build takes '{}' for {}",
                        first.value("baseline", "?"), definition.baseline, definition.file.string());
-  if (first.value("cell_count", json()) != json(cell_count))
+  if (!first.contains("cell_count"))
+    return "those cells predate the cell_count the lines now record (an older version wrote them), and every line "
+           "of a results file records the same";
+  if (first["cell_count"] != json(cell_count))
     return fmt::format("those cells belong to a sweep of {} cells, but {} expands to {} cells in this build",
-                       first.value("cell_count", json()).dump(), definition.file.string(), cell_count);
+                       first["cell_count"].dump(), definition.file.string(), cell_count);
   return std::nullopt;
 }
 

@@ -68,8 +68,9 @@ struct PipelineValidation {
   HoleStatistics holes;
   SsimMap ssim;
   double seconds_metrics = 0.0;  ///< time to measure (not part of the pipeline's timings)
-  /// Left-eye pixels the pipeline did not render itself (tagged other than rasterized or traced:
-  /// bidir-warp's, warped in from the right eye's share, filled or left as holes).
+  /// Left-eye pixels the pipeline did not render itself (tagged other than rasterized, traced,
+  /// reshaded_traced or reshaded_raster: bidir-warp's, warped in from the right eye's share,
+  /// filled or left as holes).
   uint64_t left_synthesized = 0;
   /// With left_synthesized > 0: the left eye's metrics against plain-rt's left eye, and the left
   /// eye in sRGB (empty otherwise).

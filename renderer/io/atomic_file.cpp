@@ -403,8 +403,9 @@ void StagedFiles::commit() {
     for (const fs::path& output : touched) {
       std::error_code ec;
       if (fs::equivalent(output, input, ec))
-        throw InputError(fmt::format("{} {} is this run's output {}; give another --out (no file was replaced)", what,
-                                     input.string(), output.string()));
+        throw InputError(fmt::format("{} {} would be replaced or removed by this run as its output {}; give another "
+                                     "--out (no file was replaced)",
+                                     what, input.string(), output.string()));
     }
   }
   // An ending signal waits for the renames (a few), so that no set is left half in place by it.
@@ -446,10 +447,14 @@ void StagedFiles::commit() {
     if (const fs::path f = folder_of(e.path); std::find(folders.begin(), folders.end(), f) == folders.end())
       folders.push_back(f);
   for (const fs::path& f : folders) sync_folder(f);
+  // A retired path the set wrote again stays, also where one of the two names is a link to the
+  // other (an entry is placed at its link's target).
   std::vector<fs::path> gone;
   for (const fs::path& r : retired_)
-    if (std::none_of(entries_.begin(), entries_.end(),
-                     [&](const Entry& e) { return e.path.lexically_normal() == r.lexically_normal(); }))
+    if (std::none_of(entries_.begin(), entries_.end(), [&](const Entry& e) {
+          std::error_code ec;
+          return e.path.lexically_normal() == r.lexically_normal() || fs::equivalent(e.path, r, ec);
+        }))
       gone.push_back(r);
   discard_output_files(gone);
 }

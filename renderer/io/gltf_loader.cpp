@@ -664,8 +664,9 @@ class Converter {
   /// What a texture takes per texel beyond its decoded values (4 B per channel), at the peak,
   /// which comes when the scene is prepared: its RGBA floats (16 B), beside them the mip chain's
   /// level 0 (16 B), the first level's row pass in double (16 B) and the coarser levels (5.3 B),
-  /// with the decoder's buffers. With an RGB image's 12 B that is 62 B per texel; measured: 60.6 B
-  /// (4.07 GB peak for an 8192x8192 RGB PNG, `scenes info`).
+  /// 53.3 B with the decoder's and the process's own memory on top. Calibrated on the measured
+  /// peak of an 8192x8192 RGB PNG, 60.6 B per texel (4.07 GB, `scenes info`): 50 B more than the
+  /// decoded values' 12 B gives 62 B.
   static constexpr uint64_t kTextureBytesPerTexel = 50;
 
   int convert_texture(Scene& scene, int t, const std::string& path) {

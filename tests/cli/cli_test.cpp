@@ -538,7 +538,7 @@ TEST(Cli, AnOutputNeverTakesThePlaceOfAFileTheSceneReads) {
   const CliRun validated = run("validate --pipelines plain-rt" + scene_reading("v", "v_truth-full.png") + common);
   EXPECT_EQ(validated.code, 3) << validated.out;
   EXPECT_NE(validated.out.find("the file the scene reads (a buffer or an image) " +
-                               (dir / "v_truth-full.png").string() + " is this run's output"),
+                               (dir / "v_truth-full.png").string() + " would be replaced or removed by this run"),
             std::string::npos)
       << validated.out;
   EXPECT_EQ(test::read_text(dir / "v_truth-full.png"), texture);

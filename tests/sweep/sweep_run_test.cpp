@@ -677,21 +677,22 @@ TEST(SweepRun, TwoDefinitionsStartedTogetherIntoOneFolderDoNotBothRun) {
   EXPECT_EQ(json::parse(test::read_text(dir / "out" / ".stereobench-sweep.json"))["sweep"], "a");
 }
 
+/// Writes DIR/two.toml: two cells (two interaxial distances) of plain-rt and repro-rt at 64x36 on
+/// `scene`; "scene.gltf" is first generated there as box-wall, which the caller may then change.
+void write_two_cell_sweep(const test::ScratchDir& dir, const std::string& scene) {
+  if (scene == "scene.gltf") {
+    ASSERT_EQ(test::run_cli("scenes generate box-wall --out " + quoted(dir / "gen")).code, 0);
+    fs::copy_file(dir / "gen" / "box-wall.gltf", dir / "scene.gltf");
+  }
+  std::ofstream(dir / "two.toml") << "[sweep]\nname = \"two\"\nscenes = [\"" << scene
+                                  << "\"]\npipelines = [\"plain-rt\", \"repro-rt\"]\ninteraxial_m = [0.04, 0.064]\n"
+                                     "resolutions = [\"64x36\"]\n[timing]\nrepetitions = 1\nwarmup = 0\n";
+}
+
 TEST(SweepRun, AResumeRefusesNewCellsOfASceneThatChanged) {
   // Two cells on a scene file; the first measured, then the file regenerated with a larger box.
   test::ScratchDir dir;
-  ASSERT_EQ(test::run_cli("scenes generate box-wall --out " + quoted(dir / "gen")).code, 0);
-  fs::copy_file(dir / "gen" / "box-wall.gltf", dir / "scene.gltf");
-  std::ofstream(dir / "two.toml") << R"([sweep]
-name = "two"
-scenes = ["scene.gltf"]
-pipelines = ["plain-rt", "repro-rt"]
-interaxial_m = [0.04, 0.064]
-resolutions = ["64x36"]
-[timing]
-repetitions = 1
-warmup = 0
-)";
+  write_two_cell_sweep(dir, "scene.gltf");
   const std::string run = "sweep run " + quoted(dir / "two.toml") + " --out " + quoted(dir / "out") + " --threads 1";
   ASSERT_EQ(test::run_cli(run).code, 0);
   const fs::path results = dir / "out" / "results.jsonl";
@@ -726,18 +727,7 @@ TEST(SweepRun, ShardsOfAnotherSceneContentOrPipelineSetDoNotJoin) {
   // Two shards of one definition, each in its own results file (as Slurm's tasks write them): the
   // scene file is regenerated between them, so only a merge can see the two contents.
   test::ScratchDir dir;
-  ASSERT_EQ(test::run_cli("scenes generate box-wall --out " + quoted(dir / "gen")).code, 0);
-  fs::copy_file(dir / "gen" / "box-wall.gltf", dir / "scene.gltf");
-  std::ofstream(dir / "two.toml") << R"([sweep]
-name = "two"
-scenes = ["scene.gltf"]
-pipelines = ["plain-rt", "repro-rt"]
-interaxial_m = [0.04, 0.064]
-resolutions = ["64x36"]
-[timing]
-repetitions = 1
-warmup = 0
-)";
+  write_two_cell_sweep(dir, "scene.gltf");
   const auto shard = [&](int i) {
     return "sweep run " + quoted(dir / "two.toml") + " --out " + quoted(dir / "out") + " --threads 1 --shard " +
            std::to_string(i) + "/2 --results " + quoted(dir / ("s" + std::to_string(i) + ".jsonl"));
@@ -813,20 +803,34 @@ warmup = 0
   EXPECT_FALSE(fs::exists("-"));
 }
 
-TEST(SweepRun, TheGateSendsASlurmTasksResultsFileToTheExecutor) {
-  // A task's file (results-I.jsonl in <out>/slurm) gated alone: the command to finish the sweep is
-  // the Slurm executor's, with the sweep's --out (it named <out>/slurm as --out and no shard).
+TEST(SweepRun, TwoVariantsOfOneGeneratorAreTwoScenesWithContentsOfTheirOwn) {
+  // Kim's complexity preset sweeps one generator at three triangle counts: each variant has its
+  // own content, which the one-content-per-scene check must not take for an edited scene.
   test::ScratchDir dir;
-  std::ofstream(dir / "two.toml") << R"([sweep]
-name = "two"
-scenes = ["box-wall"]
+  std::ofstream(dir / "variants.toml") << R"([sweep]
+name = "variants"
+scenes = ["box-wall:size=0.5", "box-wall:size=0.9"]
 pipelines = ["plain-rt", "repro-rt"]
-interaxial_m = [0.04, 0.064]
-resolutions = ["64x36"]
+resolutions = ["32x18"]
 [timing]
 repetitions = 1
 warmup = 0
 )";
+  const test::CliRun ran = test::run_cli("sweep run " + quoted(dir / "variants.toml") + " --out " +
+                                         quoted(dir / "out") + " --threads 1 --scenes-dir " + quoted(dir / "scenes"));
+  ASSERT_EQ(ran.code, 0) << ran.out;
+  const std::vector<json> cells = validation::read_results(dir / "out" / "results.jsonl").cells;
+  ASSERT_EQ(cells.size(), 2u);
+  EXPECT_NE(cells[0]["scene"]["content_sha256"], cells[1]["scene"]["content_sha256"]);
+  const test::CliRun csv = test::run_cli("sweep csv " + quoted(dir / "out" / "results.jsonl"));
+  EXPECT_EQ(csv.code, 0) << csv.out;
+}
+
+TEST(SweepRun, TheGateSendsASlurmTasksResultsFileToTheExecutor) {
+  // A task's file (results-I.jsonl in <out>/slurm) gated alone: the command to finish the sweep is
+  // the Slurm executor's, with the sweep's --out (it named <out>/slurm as --out and no shard).
+  test::ScratchDir dir;
+  write_two_cell_sweep(dir, "box-wall");
   const test::CliRun task = test::run_cli("sweep run " + quoted(dir / "two.toml") + " --out " + quoted(dir / "out") +
                                           " --threads 1 --shard 1/2 --results " +
                                           quoted(dir / "out" / "slurm" / "results-1.jsonl") + " --scenes-dir " +
@@ -842,6 +846,21 @@ warmup = 0
       << gated.out;
   EXPECT_NE(gated.out.find("--out " + (dir / "out").string() + " --executor slurm --wait"), std::string::npos)
       << gated.out;
+
+  // Shards sharing the sweep's own results file: with one shard run, that file is the sweep's,
+  // unfinished, and the command resumes the whole sweep (it named the shard, which had no cell
+  // left to run).
+  ASSERT_EQ(test::run_cli("sweep run " + quoted(dir / "two.toml") + " --out " + quoted(dir / "shared") +
+                          " --threads 1 --shard 0/2 --scenes-dir " + quoted(dir / "scenes"))
+                .code,
+            0);
+  const test::CliRun shared = test::run_cli("gate --config " + quoted(dir / "gate.toml") + " --results " +
+                                            quoted(dir / "shared" / "results.jsonl"));
+  EXPECT_EQ(shared.code, 2) << shared.out;
+  EXPECT_NE(shared.out.find("holds 1 of the sweep's 2 cells: the sweep did not finish"), std::string::npos)
+      << shared.out;
+  EXPECT_NE(shared.out.find("--out " + (dir / "shared").string() + "\n"), std::string::npos) << shared.out;
+  EXPECT_EQ(shared.out.find("--shard"), std::string::npos) << shared.out;
 }
 
 TEST(SweepRun, AnOutFolderThatCannotBeMadeIsNamed) {
