@@ -253,6 +253,27 @@ void prepare_output_folder(const std::string& folder, const char* option) {
     throw IoError(fmt::format("{} {}: {}; give a folder you can write", option, folder, *why));
 }
 
+void refuse_replacing_inputs(const std::filesystem::path& scene_file, const Scene& scene,
+                             const std::filesystem::path& out, const std::vector<std::string>& prefixes,
+                             const std::string& run) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  for (fs::directory_iterator it(out, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (std::none_of(prefixes.begin(), prefixes.end(), [&](const std::string& p) { return name.starts_with(p); }))
+      continue;
+    std::error_code same;
+    if (fs::equivalent(it->path(), scene_file, same))
+      throw InputError(fmt::format("--scene {}: the scene file is this {}'s output {}; give another --out",
+                                   scene_file.string(), run, it->path().string()));
+    for (const std::string& read : scene.files_read)
+      if (fs::equivalent(it->path(), read, same))
+        throw InputError(fmt::format("--scene {}: the file {} the scene reads (a buffer or an image) is this {}'s "
+                                     "output {}; give another --out",
+                                     scene_file.string(), read, run, it->path().string()));
+  }
+}
+
 void in_output_folder(const std::string& folder, const char* option, const std::function<void()>& work) {
   namespace fs = std::filesystem;
   std::error_code ec;

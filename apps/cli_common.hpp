@@ -79,6 +79,15 @@ void check_output_folder(const std::string& folder, const char* option);
 /// the work. IoError naming the option, the folder and the reason.
 void prepare_output_folder(const std::string& folder, const char* option);
 
+/// Refuses (InputError) a run into `out` whose outputs would replace or remove its scene file or a
+/// file the scene reads (a texture or buffer beside it named like an output), by name or through a
+/// link either way: every entry of `out` whose name starts with one of `prefixes` (the names the
+/// run writes, and the earlier files of those names it replaces or removes) is compared with them.
+/// Called before the work, which may take hours; `run` names the run in the message ("render").
+void refuse_replacing_inputs(const std::filesystem::path& scene_file, const Scene& scene,
+                             const std::filesystem::path& out, const std::vector<std::string>& prefixes,
+                             const std::string& run);
+
 /// prepare_output_folder, then `work`. When `work` throws, the folders this call made are removed
 /// again if nothing was written into them (no file at any depth), and the error passed on: a run
 /// that stops (a full disk, an input refused once read) leaves no empty output folder behind.

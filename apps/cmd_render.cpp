@@ -91,28 +91,12 @@ void run_render(const RenderArgs& a) {
   // Made once the input is known to be good, and removed again if the run stops before writing
   // into it: a refused or failed run leaves no empty folder behind.
   in_output_folder(a.out, "--out", [&] {
-    // A scene file that is one of the outputs (<stem>.exr, <stem>_left.png, ..., <stem>_stats.json,
-    // or a diagnostic <stem>_NAME.png already there), by name or through a link either way, would be
-    // replaced by it.
+    // Its outputs are <stem>.exr and <stem>_*: <stem>_left.png, ..., <stem>_stats.json, and the
+    // earlier diagnostic images of the set it replaces.
     const std::string stem = fmt::format("{}_{}", scene.file_stem(), entry_file_stem(entry.name));
-    std::vector<fs::path> outputs = io::render_file_names(a.out, stem, views).all();
-    io::check_no_folder_at(outputs, "give another --out");  // before the render, not after it
-    std::error_code ec;
-    for (fs::directory_iterator it(a.out, ec), end; !ec && it != end; it.increment(ec)) {
-      const std::string name = it->path().filename().string();
-      if (name.starts_with(stem + "_") && name.ends_with(".png")) outputs.push_back(it->path());
-    }
-    for (const fs::path& output : outputs) {
-      std::error_code same_ec;
-      if (fs::equivalent(output, loaded.file, same_ec))
-        throw InputError(fmt::format("--scene {}: the scene file is this render's output {}; give another --out",
-                                     loaded.file.string(), output.string()));
-      for (const std::string& read : scene.files_read)
-        if (fs::equivalent(output, read, same_ec))
-          throw InputError(fmt::format("--scene {}: the file {} the scene reads (a buffer or an image) is this "
-                                       "render's output {}; give another --out",
-                                       loaded.file.string(), read, output.string()));
-    }
+    io::check_no_folder_at(io::render_file_names(a.out, stem, views).all(),
+                           "give another --out");  // before the render, not after it
+    refuse_replacing_inputs(loaded.file, scene, a.out, {stem + "_", stem + "."}, "render");
     const RenderScene prepared(scene);
     require_frame_memory(rig.params().width, rig.params().height, fmt::format("render {}", entry.name));
     warn_scene_far_from_origin(prepared);

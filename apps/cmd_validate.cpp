@@ -132,28 +132,6 @@ void remove_earlier_work_folders(const fs::path& work, const std::string& scene_
   }
 }
 
-/// Refuses, before the truth renders (with Blender, hours), a scene file or a file the scene reads
-/// that lies in `out` under a name this run's outputs take: `<stem>_<provider>_...`,
-/// `<stem>_truth-...`, `<stem>_disocclusions-...`. The file set checks the exact names again when
-/// it is placed (StagedFiles::keep).
-void refuse_inputs_named_as_outputs(const scenes::LoadedScene& loaded, const fs::path& out, const std::string& provider) {
-  const std::string stem = loaded.scene.file_stem();
-  const std::string prefixes[] = {fmt::format("{}_{}_", stem, provider), stem + "_truth-", stem + "_disocclusions-"};
-  std::vector<fs::path> inputs{loaded.file};
-  inputs.insert(inputs.end(), loaded.scene.files_read.begin(), loaded.scene.files_read.end());
-  for (const fs::path& input : inputs) {
-    std::error_code ec;
-    const std::string name = input.filename().string();
-    if (fs::equivalent(input.has_parent_path() ? input.parent_path() : fs::path("."), out, ec) &&
-        std::any_of(std::begin(prefixes), std::end(prefixes),
-                    [&](const std::string& p) { return name.rfind(p, 0) == 0; }))
-      throw InputError(fmt::format("{} {} lies in --out {} under a name this run's outputs take ({}*); give another "
-                                   "--out",
-                                   input == loaded.file ? "the scene file" : "the file the scene reads", input.string(),
-                                   out.string(), stem));
-  }
-}
-
 void run_validate(const ValidateArgs& a) {
   const RigOverrides overrides = a.rig.overrides();
   const std::vector<PipelineEntry> chosen = chosen_pipelines(a.pipelines);
@@ -180,7 +158,13 @@ void run_validate(const ValidateArgs& a) {
   // Made once the input is known to be good, and removed again if the run stops before writing
   // into it: a refused or failed run leaves no empty folder behind.
   in_output_folder(a.out, "--out", [&] {
-    refuse_inputs_named_as_outputs(loaded, a.out, provider->name());
+    // Before the truth renders (with Blender, hours): every file this run writes or retires is
+    // named <stem>_<provider>_..., <stem>_truth-... or <stem>_disocclusions-....
+    const std::string file_stem = scene.file_stem();
+    refuse_replacing_inputs(loaded.file, scene, a.out,
+                            {fmt::format("{}_{}_", file_stem, provider->name()), file_stem + "_truth-",
+                             file_stem + "_disocclusions-"},
+                            "validation");
     const RenderScene prepared(scene);
     fmt::print("validating {} pipeline(s) on {} ({} triangles, {}), {}, {} threads, truth: {}\n", chosen.size(),
                scene.name, scene.triangle_count(), describe_lights(scene.lights.size(), lights_in_file),
@@ -224,8 +208,6 @@ void run_validate(const ValidateArgs& a) {
     // the summary last: a run that stops on the way (an image it cannot write, a full disk) leaves an
     // earlier run's summary, records and images as they were.
     io::StagedFiles set;
-    set.keep(loaded.file, "the scene file");
-    for (const std::string& read : scene.files_read) set.keep(read, "the file the scene reads (a buffer or an image)");
     // The earlier summary's records: those this run does not write are retired with it, and the work
     // folders they named go once this run's set is in place.
     const json earlier = earlier_records(summary);

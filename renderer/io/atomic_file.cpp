@@ -393,21 +393,7 @@ void StagedFiles::add(const fs::path& given, const std::function<void(const fs::
   entries_.push_back(Entry{path, std::move(staged)});
 }
 
-void StagedFiles::keep(const fs::path& input, std::string what) { kept_.emplace_back(input, std::move(what)); }
-
 void StagedFiles::commit() {
-  for (const auto& [input, what] : kept_) {
-    std::vector<fs::path> touched;
-    for (const Entry& e : entries_) touched.push_back(e.path);
-    touched.insert(touched.end(), retired_.begin(), retired_.end());
-    for (const fs::path& output : touched) {
-      std::error_code ec;
-      if (fs::equivalent(output, input, ec))
-        throw InputError(fmt::format("{} {} would be replaced or removed by this run as its output {}; give another "
-                                     "--out (no file was replaced)",
-                                     what, input.string(), output.string()));
-    }
-  }
   // An ending signal waits for the renames (a few), so that no set is left half in place by it.
   g_commits.fetch_add(1, std::memory_order_acq_rel);
   struct Resume {

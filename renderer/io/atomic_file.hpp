@@ -9,7 +9,6 @@
 #include <optional>
 #include <span>
 #include <string>
-#include <utility>
 #include <vector>
 
 namespace sb::io {
@@ -49,10 +48,6 @@ class StagedFiles {
   /// An earlier file of the set: removed once the set is in place (best effort), never before,
   /// unless the set writes it again (added under the same path).
   void retire(const std::filesystem::path& path);
-  /// An input of the run that no file of the set may replace or remove (the scene file, a texture
-  /// it read): commit() refuses, before any file is touched, when a file added or retired is that
-  /// file, by name or through a link. `what` names it in the message ("the scene file").
-  void keep(const std::filesystem::path& input, std::string what);
   /// Removes the earlier file of the marker (the file added last; its links followed) when the set
   /// has more than one file, then renames every file added into place, in order, the marker last,
   /// then removes the retired ones. So a set whose marker is in place is whole, whenever the run
@@ -66,7 +61,6 @@ class StagedFiles {
   std::mutex mutex_;  ///< guards entries_ while files are added side by side
   std::vector<Entry> entries_;
   std::vector<std::filesystem::path> retired_;
-  std::vector<std::pair<std::filesystem::path, std::string>> kept_;
 };
 
 /// Whether write_atomically writes `path` in place (a device, pipe or socket, or a path through a

@@ -537,8 +537,8 @@ TEST(Cli, AnOutputNeverTakesThePlaceOfAFileTheSceneReads) {
   EXPECT_EQ(test::read_text(dir / "t_plain-rt_left.png"), texture);
   const CliRun validated = run("validate --pipelines plain-rt" + scene_reading("v", "v_truth-full.png") + common);
   EXPECT_EQ(validated.code, 3) << validated.out;
-  EXPECT_NE(validated.out.find("the file the scene reads " + (dir / "v_truth-full.png").string() +
-                               " lies in --out " + dir.path().string() + " under a name this run's outputs take"),
+  EXPECT_NE(validated.out.find("the file " + (dir / "v_truth-full.png").string() +
+                               " the scene reads (a buffer or an image) is this validation's output"),
             std::string::npos)
       << validated.out;
   EXPECT_EQ(validated.out.find("truth: full"), std::string::npos) << "refused before the truth renders";
