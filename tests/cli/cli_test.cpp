@@ -528,21 +528,18 @@ TEST(Cli, AnOutputNeverTakesThePlaceOfAFileTheSceneReads) {
     std::ofstream(dir / image, std::ios::binary) << texture;
     return " --scene '" + (dir / (stem + ".gltf")).string() + "' --out '" + dir.path().string() + "'";
   };
-  const CliRun rendered = run("render --pipeline plain-rt" + scene_reading("t", "t_plain-rt_left.png") + common);
-  EXPECT_EQ(rendered.code, 3) << rendered.out;
-  EXPECT_NE(rendered.out.find("the file " + (dir / "t_plain-rt_left.png").string() +
-                              " the scene reads (a buffer or an image) is this render's output"),
-            std::string::npos)
-      << rendered.out;
-  EXPECT_EQ(test::read_text(dir / "t_plain-rt_left.png"), texture);
-  const CliRun validated = run("validate --pipelines plain-rt" + scene_reading("v", "v_truth-full.png") + common);
-  EXPECT_EQ(validated.code, 3) << validated.out;
-  EXPECT_NE(validated.out.find("the file " + (dir / "v_truth-full.png").string() +
-                               " the scene reads (a buffer or an image) is this validation's output"),
-            std::string::npos)
-      << validated.out;
-  EXPECT_EQ(validated.out.find("truth: full"), std::string::npos) << "refused before the truth renders";
-  EXPECT_EQ(test::read_text(dir / "v_truth-full.png"), texture);
+  struct Case { const char* command; const char* stem; const char* image; const char* run; };
+  for (const Case& c : {Case{"render --pipeline plain-rt", "t", "t_plain-rt_left.png", "render"},
+                        Case{"validate --pipelines plain-rt", "v", "v_truth-full.png", "validation"}}) {
+    const CliRun r = run(c.command + scene_reading(c.stem, c.image) + common);
+    EXPECT_EQ(r.code, 3) << r.out;
+    EXPECT_NE(r.out.find("the file " + (dir / c.image).string() + " the scene reads (a buffer or an image) is this " +
+                         c.run + "'s output"),
+              std::string::npos)
+        << r.out;
+    EXPECT_EQ(r.out.find("truth: full"), std::string::npos) << "refused before the truth renders";
+    EXPECT_EQ(test::read_text(dir / c.image), texture);
+  }
   EXPECT_FALSE(std::filesystem::exists(dir / "v_full_summary.json"));
 
   // A scene path that is not UTF-8 renders: the stats JSON holds it with U+FFFD (it was an
