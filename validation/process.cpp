@@ -1,11 +1,12 @@
-// Runs external programs with posix_spawn: the child leads its own process group, both output
-// pipes are drained with poll(), and a time limit stops the whole group (SIGTERM, then SIGKILL).
+// Runs external programs with fork and exec: the child leads its own process group and dies with
+// the thread that started it, both output pipes are drained with poll(), and a time limit stops
+// the whole group (SIGTERM, then SIGKILL).
 #include "validation/process.hpp"
 
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
-#include <spawn.h>
+#include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <sys/syscall.h>
@@ -124,21 +125,78 @@ class ChildGuard {
   pid_t pid_ = -1;  ///< the child (and its process group), -1 once reaped
 };
 
-/// posix_spawn's attribute and file-action objects, destroyed on every path.
-struct SpawnSetup {
-  posix_spawnattr_t attr{};
-  posix_spawn_file_actions_t actions{};
-  SpawnSetup() {
-    posix_spawnattr_init(&attr);
-    posix_spawn_file_actions_init(&actions);
-  }
-  SpawnSetup(const SpawnSetup&) = delete;
-  SpawnSetup& operator=(const SpawnSetup&) = delete;
-  ~SpawnSetup() {
-    posix_spawn_file_actions_destroy(&actions);
-    posix_spawnattr_destroy(&attr);
-  }
+/// What the child does between fork and exec, all prepared before the fork: after it only
+/// async-signal-safe calls are made (another thread may hold the allocator's lock).
+struct ChildSetup {
+  const char* executable = nullptr;
+  char* const* argv = nullptr;
+  char* const* envp = nullptr;
+  const char* cwd = nullptr;  ///< nullptr: stay in this process's folder
+  int stdout_fd = -1;         ///< a pipe's write end, or -1 for /dev/null
+  int stderr_fd = -1;         ///< a pipe's write end, -1 for /dev/null
+  bool stderr_to_stdout = false;
+  pid_t parent = 0;
+  int error_fd = -1;  ///< close-on-exec: the errno of a failed step is written here
 };
+
+/// In the forked child: its own process group; SIGKILL when the thread that started it ends, so a
+/// stereobench killed outright (SIGKILL, which no handler sees) does not leave Blender or POV-Ray
+/// rendering on; the defaulted signals and an empty mask; stdin from /dev/null and the output
+/// streams; the working folder; then exec. Never returns: a failed step writes its errno to
+/// error_fd and exits 127.
+[[noreturn]] void become_child(const ChildSetup& c) {
+  int step_errno = 0;
+  const auto fail = [&]() {
+    step_errno = errno;
+    [[maybe_unused]] const ssize_t w = ::write(c.error_fd, &step_errno, sizeof step_errno);
+    ::_exit(127);
+  };
+  if (::setpgid(0, 0) != 0) fail();
+  if (::prctl(PR_SET_PDEATHSIG, SIGKILL) != 0) fail();
+  if (::getppid() != c.parent) ::_exit(127);  // the parent ended before the line above
+  // Handlers first, then the mask: a stop signal held back by the mask must not run this
+  // process's handler (which removes the parent's temporary files) in the child.
+  struct sigaction defaulted {};
+  defaulted.sa_handler = SIG_DFL;
+  sigemptyset(&defaulted.sa_mask);
+  for (const int sig : kDefaultedSignals) ::sigaction(sig, &defaulted, nullptr);
+  sigset_t none;
+  sigemptyset(&none);
+  if (::sigprocmask(SIG_SETMASK, &none, nullptr) != 0) fail();
+  const auto null_onto = [&](int target, int flags) {
+    const int fd = ::open("/dev/null", flags | O_CLOEXEC);
+    if (fd < 0 || ::dup2(fd, target) < 0) fail();
+    if (fd != target) ::close(fd);
+  };
+  null_onto(0, O_RDONLY);
+  if (c.stdout_fd >= 0) {
+    if (::dup2(c.stdout_fd, 1) < 0) fail();
+  } else {
+    null_onto(1, O_WRONLY);
+  }
+  if (c.stderr_fd >= 0) {
+    if (::dup2(c.stderr_fd, 2) < 0) fail();
+  } else if (c.stderr_to_stdout) {
+    if (::dup2(1, 2) < 0) fail();
+  } else {
+    null_onto(2, O_WRONLY);
+  }
+  if (c.cwd != nullptr && ::chdir(c.cwd) != 0) fail();
+  ::execve(c.executable, c.argv, c.envp);
+  fail();
+  ::_exit(127);  // not reached: fail() exits
+}
+
+/// Reads what the child wrote to its error pipe before exec: 0 when exec succeeded (the pipe
+/// closed on exec), else the errno of the step that failed.
+int child_start_error(int read_fd) {
+  int err = 0;
+  for (;;) {
+    const ssize_t n = ::read(read_fd, &err, sizeof err);
+    if (n < 0 && errno == EINTR) continue;
+    return n == static_cast<ssize_t>(sizeof err) ? err : 0;
+  }
+}
 
 /// This process's environment with `options`' changes applied, as "NAME=value" strings.
 std::vector<std::string> child_environment(const ProcessOptions& options) {
@@ -287,44 +345,38 @@ ProcessResult run_process(const std::vector<std::string>& argv, const ProcessOpt
   if (capture_out) open_pipe(read_ends[0], write_ends[0], program);
   if (capture_err) open_pipe(read_ends[1], write_ends[1], program);
 
-  SpawnSetup setup;
-  sigset_t no_signals, defaulted;
-  sigemptyset(&no_signals);
-  sigemptyset(&defaulted);
-  for (int s : kDefaultedSignals) sigaddset(&defaulted, s);
-  posix_spawnattr_setflags(&setup.attr,
-                           static_cast<short>(POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF));
-  posix_spawnattr_setpgroup(&setup.attr, 0);
-  posix_spawnattr_setsigmask(&setup.attr, &no_signals);
-  posix_spawnattr_setsigdefault(&setup.attr, &defaulted);
-  posix_spawn_file_actions_t* fa = &setup.actions;
-  posix_spawn_file_actions_addopen(fa, 0, "/dev/null", O_RDONLY, 0);
-  if (capture_out)
-    posix_spawn_file_actions_adddup2(fa, write_ends[0].get(), 1);
-  else
-    posix_spawn_file_actions_addopen(fa, 1, "/dev/null", O_WRONLY, 0);  // ChildOutput::discard
-  if (capture_err)
-    posix_spawn_file_actions_adddup2(fa, write_ends[1].get(), 2);
-  else if (merged)
-    posix_spawn_file_actions_adddup2(fa, 1, 2);
-  else
-    posix_spawn_file_actions_addopen(fa, 2, "/dev/null", O_WRONLY, 0);  // ChildOutput::discard
   const std::string cwd = options.cwd.string();
-  if (!cwd.empty()) posix_spawn_file_actions_addchdir_np(fa, cwd.c_str());
+  io::UniqueFd error_read, error_write;  // the child's errno when a step before exec fails
+  open_pipe(error_read, error_write, program);
+  ChildSetup setup;
+  setup.executable = executable.c_str();
+  setup.argv = args.data();
+  setup.envp = envp.data();
+  setup.cwd = cwd.empty() ? nullptr : cwd.c_str();
+  setup.stdout_fd = capture_out ? write_ends[0].get() : -1;
+  setup.stderr_fd = capture_err ? write_ends[1].get() : -1;
+  setup.stderr_to_stdout = merged;
+  setup.parent = ::getpid();
+  setup.error_fd = error_write.get();
 
   install_stop_handler();
   ChildGuard child;
   const Clock::time_point start = Clock::now();
-  pid_t pid = 0;
   // The stop signals wait while the child is made and listed: one in between would leave it
-  // running unlisted. (The child's own mask is set empty above.)
+  // running unlisted. (The child defaults and unblocks them before exec.)
   sigset_t stop_signals, before;
   sigemptyset(&stop_signals);
   for (const int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) sigaddset(&stop_signals, sig);
   ::pthread_sigmask(SIG_BLOCK, &stop_signals, &before);
-  const int spawn_error = ::posix_spawn(&pid, executable.c_str(), fa, &setup.attr, args.data(), envp.data());
-  if (spawn_error == 0) child.adopt(pid);
+  const pid_t pid = ::fork();
+  if (pid == 0) become_child(setup);
+  const int fork_error = pid < 0 ? errno : 0;
+  if (pid > 0) child.adopt(pid);
   ::pthread_sigmask(SIG_SETMASK, &before, nullptr);
+  error_write.reset();
+  // Returns once the child has exec'd (its copy of the pipe closes) or failed before: by then it
+  // leads its own group, so the group may be signalled.
+  const int spawn_error = pid > 0 ? child_start_error(error_read.get()) : fork_error;
   if (spawn_error != 0)
     throw ToolError(fmt::format("cannot start '{}'{}: {}", executable.string(),
                                 cwd.empty() ? "" : fmt::format(" in '{}'", cwd), std::strerror(spawn_error)));

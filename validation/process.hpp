@@ -66,7 +66,8 @@ struct ProcessResult {
 /// Runs `argv` (argv[0]: a path, or a name looked up on PATH) and waits for it, reading both
 /// output pipes as they fill. The child leads its own process group; after it ends, whatever it
 /// left running in that group is killed, so no descendant outlives the call (one that moved to
-/// another group or session is out of reach). If the call ends by an exception, the group is
+/// another group or session is out of reach). The child gets SIGKILL when this process dies,
+/// even by a SIGKILL that no handler sees (the OOM killer, `kill -9`). If the call ends by an exception, the group is
 /// killed and the child reaped before it propagates. ToolError when the program cannot be found
 /// or started, or the working folder does not exist.
 [[nodiscard]] ProcessResult run_process(const std::vector<std::string>& argv, const ProcessOptions& options = {});

@@ -162,6 +162,49 @@ TEST(ProcessRun, ReportsTheSignalThatEndedIt) {
   expect_nothing_left(r);
 }
 
+TEST(ProcessRun, TheChildDiesWithAProcessKilledOutright) {
+  // A SIGKILL (the OOM killer, `kill -9`, a job's hard end) runs no handler: the child must still
+  // go, or Blender renders on into a work folder no one reads.
+  const test::ScratchDir dir;
+  const fs::path pid_file = dir / "child.pid";
+  const std::string script = "echo $$ > '" + pid_file.string() + ".tmp' && mv '" + pid_file.string() + ".tmp' '" +
+                             pid_file.string() + "' && exec sleep 100";
+  const pid_t caller = ::fork();
+  ASSERT_GE(caller, 0);
+  if (caller == 0) {
+    (void)run_process({"/bin/sh", "-c", script});
+    ::_exit(0);
+  }
+  const auto end = Clock::now() + 10s;
+  while (!fs::exists(pid_file) && Clock::now() < end) std::this_thread::sleep_for(10ms);
+  ASSERT_TRUE(fs::exists(pid_file)) << "the child did not start";
+  pid_t child = 0;
+  std::ifstream(pid_file) >> child;
+  ASSERT_GT(child, 0);
+  EXPECT_TRUE(is_alive(child));
+  ::kill(caller, SIGKILL);
+  int status = 0;
+  ASSERT_EQ(::waitpid(caller, &status, 0), caller);
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL);
+  EXPECT_TRUE(dies_within(child, 2s)) << "the child " << child << " outlived the process that started it";
+  if (is_alive(child)) ::kill(child, SIGKILL);
+}
+
+TEST(ProcessRun, AFailedExecIsAToolErrorWithItsReason) {
+  // A file that passes the executable check but cannot be exec'd (no #! line and not a binary).
+  const test::ScratchDir dir;
+  const fs::path bogus = dir / "bogus-tool";
+  std::ofstream(bogus, std::ios::binary) << std::string("\x7f" "ELF\x01\x01garbage", 12);
+  fs::permissions(bogus, fs::perms::owner_all);
+  try {
+    (void)run_process({bogus.string()});
+    ADD_FAILURE() << "a file that is no program started";
+  } catch (const ToolError& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot start '" + bogus.string() + "'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("Exec format error"), std::string::npos) << e.what();
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Program, folder and environment.
 
