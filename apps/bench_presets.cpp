@@ -255,13 +255,11 @@ size_t rows_to_run(const PresetSeries& series, int rows_per_series) {
 
 void check_series_rigs(const PresetRun& run, const PresetSeries& series, size_t rows, const fs::path& loaded,
                        const Scene& scene, RowRig rig_of) {
-  const std::vector<BenchEntry> entries = run.config.entries();
   for (size_t i = 0; i < rows; ++i) {
     const PresetRow& row = series.rows[i];
     if (scenes::builtin_path(row.scene, row.scene_params, run.scenes_dir) != loaded) continue;
     try {
-      const StereoRig rig = rig_of(scene, run, row);
-      for (const BenchEntry& e : entries) e.entry.check_rig(e.options, rig);
+      check_bench(rig_of(scene, run, row), run.config);  // the frames' memory too, before any row renders
     } catch (const InputError& e) {
       throw InputError(fmt::format("{}, row {} = {}: {} (no row of the series has run)", series.name, series.swept,
                                    row.value, e.what()));

@@ -296,12 +296,15 @@ void in_output_folder(const std::string& folder, const char* option, const std::
   }
 }
 
-void print_to_stdout(const std::string& text) {
+void print_to(std::FILE* stream, const std::string& text) {
   errno = 0;
-  fmt::print(stdout, "{}\n", text);
-  if (std::fflush(stdout) != 0 || std::ferror(stdout) != 0)
-    throw IoError(fmt::format("cannot write to standard output: {}", errno != 0 ? std::strerror(errno) : "write error"));
+  const bool written = std::fwrite(text.data(), 1, text.size(), stream) == text.size();
+  if (!written || std::fflush(stream) != 0 || std::ferror(stream) != 0)
+    throw IoError(fmt::format("cannot write to standard {}: {}", stream == stderr ? "error" : "output",
+                              errno != 0 ? std::strerror(errno) : "write error"));
 }
+
+void print_to_stdout(const std::string& text) { print_to(stdout, text + "\n"); }
 
 void prepare_output_file_folder(const std::string& file, const char* option) {
   if (file.empty() || file == "-" || io::written_in_place(file)) return;
@@ -314,7 +317,10 @@ void prepare_output_file_folder(const std::string& file, const char* option) {
                               option, file, target.string()));
   const std::filesystem::path folder = std::filesystem::path(file).parent_path();
   if (folder.empty()) return;  // the current folder
-  if (const auto why = io::unwritable_folder(folder))
+  // A missing folder is not made here but by the write (io::write_atomically): a run refused
+  // after this check (a bad scene, too little memory) leaves no empty folder behind.
+  const bool exists = std::filesystem::exists(std::filesystem::symlink_status(folder, ec));
+  if (const auto why = exists ? io::unwritable_folder(folder) : io::folder_cannot_be_made(folder))
     throw IoError(
         fmt::format("{} {}: its folder {}: {}; give a path you can write", option, file, folder.string(), *why));
 }

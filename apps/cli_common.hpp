@@ -1,6 +1,7 @@
 // Options shared by several subcommands (rig, scene folder), declared once with their help.
 #pragma once
 
+#include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <initializer_list>
@@ -133,8 +134,14 @@ void write_option_file(const std::string& option, const std::string& path, const
 /// success with the JSON lost.
 void print_to_stdout(const std::string& text);
 
-/// The same for the folder of an output file (a --json written after a long benchmark); nothing
-/// for "" (no file), "-" (standard output) or a bare file name (the current folder).
+/// Writes `text` as it is to `stream` (standard output or error) and flushes it: IoError (exit 4)
+/// when the stream cannot take it.
+void print_to(std::FILE* stream, const std::string& text);
+
+/// Checks, before the work, that the folder of an output file named by `option` (a --json written
+/// after a long benchmark) can be written, or made where it is missing, without making it: the
+/// file's write makes it, so a run refused later leaves no empty folder. IoError naming the option
+/// and the reason; nothing for "" (no file), "-" (standard output) or a bare file name.
 void prepare_output_file_folder(const std::string& file, const char* option);
 
 /// Warns on standard error when either eye sees geometry in front of its near plane

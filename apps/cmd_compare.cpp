@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstdio>
+#include <iterator>
 #include <memory>
 #include <optional>
 #include <string>
@@ -206,6 +207,39 @@ int run_compare(const CompareArgs& a) {
   record["warnings"] = warnings;
   record["exit_code"] = static_cast<int>(code);
 
+  // The human summary, printed after the outputs are written; on stderr when stdout carries the
+  // JSON.
+  std::string text;
+  const auto out = std::back_inserter(text);
+  const auto describe = [](const std::string& path, const validation::Srgb8File& f) {
+    return fmt::format("{} ({}{})", path, f.encoding, f.eye.empty() ? "" : ", " + f.eye + " eye");
+  };
+  fmt::format_to(out, "A: {}\nB: {}\n", describe(a.a, fa), describe(a.b, fb));
+  if (region)
+    fmt::format_to(out, "region: mask {}, {} of {} pixels\n", a.mask, m.pixels, fa.image.pixel_count());
+  else
+    fmt::format_to(out, "region: the whole image, {}x{} = {} pixels\n", fa.image.width, fa.image.height, m.pixels);
+  fmt::format_to(out, "  {:<14} {:.6f}\n", "MSE", m.mse);
+  fmt::format_to(out, "  {:<14} {} dB\n", "PSNR", format_psnr(m.psnr));
+  if (std::isnan(m.ssim))
+    fmt::format_to(out, "  {:<14} undefined (needs 11x11 images and region pixels outside the 5-pixel border)\n", "SSIM");
+  else
+    fmt::format_to(out, "  {:<14} {:.6f} (over {} pixels)\n", "SSIM", m.ssim, m.ssim_pixels);
+  fmt::format_to(out, "  {:<14} {:.4f} % ({} pixels with a channel difference > {}/255)\n", "error pixels",
+             100.0 * m.error_fraction, m.error_pixels, m.error_threshold);
+  if (m.max_error == 0)
+    fmt::format_to(out, "  {:<14} 0 (identical)\n", "max error");
+  else
+    fmt::format_to(out, "  {:<14} {}/255 at ({}, {})\n", "max error", m.max_error, m.max_x, m.max_y);
+  for (const std::string& w : warnings) fmt::format_to(out, "warning: {}\n", w);  // a verdict line, beside failure: and verdict:
+  for (const std::string& f : failures) fmt::format_to(out, "failure: {}\n", f);
+  fmt::format_to(out, "verdict: {}\n",
+             code == ExitCode::gate_failure   ? "FAIL"
+             : code == ExitCode::gate_warning ? "WARN"
+                                              : "PASS");
+  if (!a.diff.empty()) fmt::format_to(out, "wrote {}\n", a.diff);
+  if (!a.ssim_map.empty()) fmt::format_to(out, "wrote {}\n", a.ssim_map);
+  if (!a.json.empty() && a.json != "-") fmt::format_to(out, "wrote {}\n", a.json);
   try {
     // Pictures first, so that a failing comparison still leaves them to look at.
     if (!a.diff.empty())
@@ -218,43 +252,15 @@ int run_compare(const CompareArgs& a) {
       print_to_stdout(io::json_text(record, 2));
     else if (!a.json.empty())
       write_option_file("--json", a.json, io::json_text(record, 2) + "\n");
+    // A summary that cannot be printed (a full disk behind a redirection) fails the run too: its
+    // files go with it, as the help promises for exit 4.
+    print_to(a.json == "-" ? stderr : stdout, text);
   } catch (const std::exception&) {
     // An output that cannot be written takes the others of this run with it.
     discard_outputs(outputs);
     throw;
   }
 
-  // The human summary; on stderr when stdout carries the JSON.
-  std::FILE* out = a.json == "-" ? stderr : stdout;
-  const auto describe = [](const std::string& path, const validation::Srgb8File& f) {
-    return fmt::format("{} ({}{})", path, f.encoding, f.eye.empty() ? "" : ", " + f.eye + " eye");
-  };
-  fmt::print(out, "A: {}\nB: {}\n", describe(a.a, fa), describe(a.b, fb));
-  if (region)
-    fmt::print(out, "region: mask {}, {} of {} pixels\n", a.mask, m.pixels, fa.image.pixel_count());
-  else
-    fmt::print(out, "region: the whole image, {}x{} = {} pixels\n", fa.image.width, fa.image.height, m.pixels);
-  fmt::print(out, "  {:<14} {:.6f}\n", "MSE", m.mse);
-  fmt::print(out, "  {:<14} {} dB\n", "PSNR", format_psnr(m.psnr));
-  if (std::isnan(m.ssim))
-    fmt::print(out, "  {:<14} undefined (needs 11x11 images and region pixels outside the 5-pixel border)\n", "SSIM");
-  else
-    fmt::print(out, "  {:<14} {:.6f} (over {} pixels)\n", "SSIM", m.ssim, m.ssim_pixels);
-  fmt::print(out, "  {:<14} {:.4f} % ({} pixels with a channel difference > {}/255)\n", "error pixels",
-             100.0 * m.error_fraction, m.error_pixels, m.error_threshold);
-  if (m.max_error == 0)
-    fmt::print(out, "  {:<14} 0 (identical)\n", "max error");
-  else
-    fmt::print(out, "  {:<14} {}/255 at ({}, {})\n", "max error", m.max_error, m.max_x, m.max_y);
-  for (const std::string& w : warnings) fmt::print(out, "warning: {}\n", w);  // a verdict line, beside failure: and verdict:
-  for (const std::string& f : failures) fmt::print(out, "failure: {}\n", f);
-  fmt::print(out, "verdict: {}\n",
-             code == ExitCode::gate_failure   ? "FAIL"
-             : code == ExitCode::gate_warning ? "WARN"
-                                              : "PASS");
-  if (!a.diff.empty()) fmt::print(out, "wrote {}\n", a.diff);
-  if (!a.ssim_map.empty()) fmt::print(out, "wrote {}\n", a.ssim_map);
-  if (!a.json.empty() && a.json != "-") fmt::print(out, "wrote {}\n", a.json);
   return static_cast<int>(code);
 }
 

@@ -16,6 +16,7 @@
 #include "apps/cli_common.hpp"
 #include "apps/commands.hpp"
 #include "renderer/error.hpp"
+#include "renderer/text.hpp"
 #include "renderer/io/json_text.hpp"
 #include "renderer/io/line_file.hpp"
 #include "scenes/catalog.hpp"
@@ -112,13 +113,20 @@ void run_path_command(const PathArgs& a) {
 
   // The path checked against the scene before the first frame (run_path plays it on its own animator).
   const SceneAnimator animation(loaded.scene, run.path);
+  if (!a.bvh.empty() && !animation.moves_geometry())
+    throw InputError(fmt::format("--bvh {}: the path moves none of the scene's meshes ({}), so there is no BVH to "
+                                 "update; drop --bvh",
+                                 a.bvh,
+                                 run.path.gltf_animation
+                                     ? fmt::format("its glTF animation {} moves only cameras or lights", animation.clip())
+                                     : "nothing turns"));
   provider->check_scene(loaded.scene, loaded.file);
   validation::check_path_truth(*provider, loaded.scene, run.path, loaded.file);
   // Made once the input is known to be good, and removed again if the run stops before writing
   // into it: a refused or failed run leaves no empty folder behind.
   in_output_folder(a.out, "--out", [&] {
-    fmt::print("path on {} ({} triangles): {} frames, {}{}; {}, truth {}\n", loaded.scene.name,
-               loaded.scene.triangle_count(), a.frames,
+    fmt::print("path on {} ({} triangles): {}, {}{}; {}, truth {}\n", loaded.scene.name,
+               loaded.scene.triangle_count(), counted(a.frames, "frame"),
                run.path.camera_keys.empty() ? "the scene's camera" : fmt::format("{} camera key{}", run.path.camera_keys.size(), run.path.camera_keys.size() == 1 ? "" : "s"),
                a.spin_deg ? fmt::format(", meshes turning {} deg per frame (BVH {})", *a.spin_deg, bvh)
                : run.path.gltf_animation
@@ -155,8 +163,8 @@ void run_path_command(const PathArgs& a) {
       });
     } catch (...) {
       if (out.lines() > 0)
-        fmt::print(stderr, "stereobench: the {} frames finished before the error are in {}\n", out.lines(),
-                   partial.string());
+        fmt::print(stderr, "stereobench: the {} finished before the error {} in {}\n", counted(out.lines(), "frame"),
+                   out.lines() == 1 ? "is" : "are", partial.string());
       throw;
     }
     out.finish(lines);

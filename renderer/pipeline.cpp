@@ -2,6 +2,7 @@
 #include "renderer/pipeline.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <optional>
@@ -98,6 +99,11 @@ PipelineEntry parse_pipeline_entry(const std::string& name) {
   // The name is part of file names (entry_file_stem), beside a scene name, a provider, a suffix and
   // a temporary file's decoration, within the 255 bytes a file name may have.
   constexpr size_t kMaxEntry = 160;
+  if (!name.empty() && (std::isspace(static_cast<unsigned char>(name.front())) != 0 ||
+                        std::isspace(static_cast<unsigned char>(name.back())) != 0))
+    throw InputError(fmt::format("pipeline entry '{}' has blanks around it; list the pipelines without blanks after "
+                                 "the commas (e.g. plain-rt,ideal-copy)",
+                                 name));
   if (name.size() > kMaxEntry)
     throw InputError(fmt::format("pipeline entry '{}...' is {} characters long; it names files, so keep it within {}",
                                  name.substr(0, 40), name.size(), kMaxEntry));
@@ -193,7 +199,13 @@ std::vector<PipelineEntry> parse_pipeline_entries(const std::vector<std::string>
   std::vector<PipelineEntry> entries;
   std::map<std::string, std::string> stems;  // stem -> entry
   for (const std::string& name : names) {
-    PipelineEntry entry = parse_pipeline_entry(name);
+    PipelineEntry entry = [&] {
+      try {
+        return parse_pipeline_entry(name);
+      } catch (const InputError& e) {
+        throw InputError(prefix + e.what());
+      }
+    }();
     // One variant under two names (its options in another order) would be rendered and measured
     // twice.
     if (const auto same = find_same_variant(entries, entry); same && *same != name)

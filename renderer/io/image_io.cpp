@@ -389,6 +389,10 @@ InputFile open_file(const fs::path& path) {
       throw InputError(fmt::format("image {} is a volume ({} slices), not a flat image", path.string(), spec.depth));
     const int pw = spec.full_width > 0 ? spec.full_width : spec.width;
     const int ph = spec.full_height > 0 ? spec.full_height : spec.height;
+    // The data window is read whole (an EXR's may reach beyond the display window).
+    if (spec.width > kMaxImageDimension || spec.height > kMaxImageDimension)
+      throw InputError(fmt::format("image {}: part {} has a data window of {}x{}; each side must be in 1..{}",
+                                   path.string(), p, spec.width, spec.height, kMaxImageDimension));
     if (pw != file.width || ph != file.height)
       throw InputError(fmt::format("image {}: part {} is {}x{} but part 0 is {}x{}; all parts must have the same size",
                                    path.string(), p, pw, ph, file.width, file.height));
@@ -724,12 +728,20 @@ void copy_channel(const InputFile& file, const OIIO::ImageSpec& spec, const std:
 std::vector<Image> build_images(InputFile& file, const std::vector<std::vector<PlanePlan>>& images_plans) {
   // The planes (4 B per channel and pixel) and the largest part read whole beside them.
   uint64_t channels = 0, largest_part = 0;
+  const OIIO::ImageSpec* largest = nullptr;
   for (const auto& plans : images_plans)
     for (const PlanePlan& plan : plans) channels += plan.sources.size();
-  for (const OIIO::ImageSpec& spec : file.parts) largest_part = std::max<uint64_t>(largest_part, spec.image_bytes());
+  for (const OIIO::ImageSpec& spec : file.parts)
+    if (spec.image_bytes() >= largest_part) {
+      largest_part = spec.image_bytes();
+      largest = &spec;
+    }
+  const std::string window = largest != nullptr && (largest->width != file.width || largest->height != file.height)
+                                 ? fmt::format(", data window {}x{}", largest->width, largest->height)
+                                 : "";
   require_memory(uint64_t{4} * channels * static_cast<uint64_t>(file.width) * static_cast<uint64_t>(file.height) +
                      largest_part,
-                 fmt::format("reading image {} ({}x{})", file.path.string(), file.width, file.height),
+                 fmt::format("reading image {} ({}x{}{})", file.path.string(), file.width, file.height, window),
                  "use a smaller image, or run on a machine with more memory");
   std::vector<Image> images;
   for (const auto& plans : images_plans) {

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -144,7 +146,10 @@ TEST(BenchPreset, BadPresetsAndLightCountsExitWith3AndSayWhy) {
       {"bench --scene box-wall --resolution 32x18 --json '" + (dir / "scenes" / "box-wall.gltf.stamp").string() + "'" +
            quick,
        {"names the same file as the scene file's stamp"}},
-      {"bench --preset al-hagri-lights --pipelines plain-rt,warp-drive" + sd, {"unknown pipeline 'warp-drive'"}},
+      {"bench --preset al-hagri-lights --pipelines plain-rt,warp-drive" + sd,
+       {"--pipelines: unknown pipeline 'warp-drive'"}},
+      {"bench --scene box-wall --resolution 32x18 --pipelines 'plain-rt, ideal-copy' -n 1 -w 0" + sd,
+       {"--pipelines: pipeline entry ' ideal-copy' has blanks around it"}},
       {"bench --scene box-wall --resolution 32x18 --lights 0" + quick, {"--lights 0", "'box-wall'", "has 1 light", "1..1"}},
       {"bench --scene box-wall --resolution 32x18 --lights 99" + quick, {"--lights 99", "'box-wall'", "has 1 light"}},
       {"render --scene box-wall --resolution 32x18 --lights 99 --out '" + dir.path().string() + "'" + sd,
@@ -179,6 +184,10 @@ TEST(BenchPreset, BadPresetsAndLightCountsExitWith3AndSayWhy) {
     EXPECT_EQ(r.code, 3) << args << "\n" << r.out;
     EXPECT_EQ(test::read_text(keep), "{\"earlier\": true}\n") << args;
   }
+  // A refused run leaves no folder it would have written its --json into.
+  const CliRun nosuch = test::run_cli("bench --scene nosuch" + quick + " --json '" + (dir / "made" / "here" / "x.json").string() + "'");
+  EXPECT_EQ(nosuch.code, 3) << nosuch.out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "made"));
   // Nothing of a preset is generated on bad input (box-wall is, by the --lights cases).
   EXPECT_FALSE(std::filesystem::exists(dir / "scenes" / "dragon_lights-10.glb"));
   if (std::filesystem::exists(dir / "scenes"))
@@ -345,6 +354,24 @@ TEST(BenchPreset, ARigARowRefusesIsNamedBeforeTheSeriesTable) {
   EXPECT_EQ(r.code, 3) << r.out;
   EXPECT_NE(r.out.find("(no row of the series has run)"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("rt-buffer ms"), std::string::npos) << "a table header before the refusal:\n" << r.out;
+}
+
+TEST(BenchPresetKim, FramesThatCannotFitAreRefusedBeforeAnyRowRendersOrTheEarlierJsonGoes) {
+  test::ScratchDir dir("kimframes");
+  // Under an 8 GB address-space limit a 8192x8192 row (about 20 GiB of frames) cannot fit. The
+  // complexity preset's row estimate comes from the triangle count alone, and the focal preset
+  // rendered its quality images before any check: both ran into the allocation.
+  for (const char* preset : {"kim-complexity", "kim-focal"}) {
+    SCOPED_TRACE(preset);
+    const std::filesystem::path earlier = dir / (std::string(preset) + ".json");
+    std::ofstream(earlier) << "an earlier run's\n";
+    const CliRun r = test::run_shell("ulimit -v 8000000; " + std::string(SB_CLI_PATH) + " bench --preset " + preset +
+                                     " -r 8192x8192 --preset-rows 1 -n 1 -w 0 --scenes-dir '" +
+                                     (dir / "scenes").string() + "' --json '" + earlier.string() + "'");
+    EXPECT_EQ(r.code, 4) << r.out;
+    EXPECT_NE(r.out.find("benchmark at 8192x8192 needs about 20.00 GiB of memory"), std::string::npos) << r.out;
+    EXPECT_EQ(test::read_text(earlier), "an earlier run's\n") << "a refused run keeps the earlier file";
+  }
 }
 
 TEST(BenchPresetKim, ARowARigRefusesStopsTheSeriesBeforeItsFirstRow) {

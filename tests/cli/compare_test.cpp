@@ -218,6 +218,12 @@ TEST_F(Compare, AStoppedComparisonLeavesNoOutputs) {
   EXPECT_NE(r.out.find("--json: cannot write /dev/full: No space left on device"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("give --json a path you can write"), std::string::npos) << r.out;
   for (const char* name : {"d.png", "s.png"}) EXPECT_FALSE(fs::exists(path(name))) << name;
+  // A summary that standard output cannot take (a full disk behind a redirection) is exit 4 too,
+  // and the files go with it (they stayed, the JSON's verdict beside an exit 4).
+  r = test::run_shell("(" + std::string(SB_CLI_PATH) + " compare " + ab() + outputs + " --fail-psnr 90 > /dev/full)");
+  EXPECT_EQ(r.code, 4) << r.out;
+  EXPECT_NE(r.out.find("cannot write to standard output: No space left on device"), std::string::npos) << r.out;
+  none_left("v.json");
   // So do the pictures' options (their errors named neither the option nor what to do), through a
   // link named as a picture.
   fs::create_symlink("/dev/full", path("full.png"));

@@ -28,6 +28,36 @@ std::vector<json> frame_lines(const std::filesystem::path& file) {
   return frames;
 }
 
+TEST(PathCommand, ABvhUpdateIsRefusedWhereTheAnimationMovesNoMesh) {
+  test::ScratchDir dir;
+  // Only the camera is keyed: no mesh moves, so no BVH is ever updated.
+  scenes::GltfBuilder b("camera-only-animation", 1);
+  const int grey = b.add_material("grey", vec3(0.6f));
+  b.add_node("box", b.add_mesh("box", scenes::make_box(vec3(-0.3f, 0.0f, -0.3f), vec3(0.3f, 0.6f, 0.3f)), grey));
+  b.add_point_light("lamp", vec3(1.0f, 2.0f, 2.0f), vec3(1.0f), 15.0f);
+  RigDefaults rig;
+  rig.width = 64;
+  rig.height = 36;
+  const int camera = b.set_camera("camera", CameraPose::look_at(dvec3(0.0, 1.0, 4.0), dvec3(0.0, 0.6, 3.0)), 0.8,
+                                  0.05, 0.0, rig);
+  const std::vector<float> times = {0.0f, 1.0f};
+  const std::vector<float> keys = {0, 1, 4, 0.5f, 1, 4};
+  b.add_animation_channel(camera, "translation", times, keys);
+  b.write(dir / "camera-only.gltf");
+  const std::string base = "path --scene '" + (dir / "camera-only.gltf").string() + "' --out '" +
+                           (dir / "out").string() + "' --frames 2 --pipelines plain-rt --gltf-animation";
+  const test::CliRun refused = test::run_cli(base + " --bvh rebuild");
+  EXPECT_EQ(refused.code, 3) << refused.out;
+  EXPECT_NE(refused.out.find("--bvh rebuild: the path moves none of the scene's meshes (its glTF animation"),
+            std::string::npos)
+      << refused.out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+  const test::CliRun plain = test::run_cli(base);
+  EXPECT_EQ(plain.code, 0) << plain.out;
+  EXPECT_NE(plain.out.find(": 2 frames, "), std::string::npos) << plain.out;
+  EXPECT_EQ(frame_lines(dir / "out" / "camera-only_path.jsonl")[1]["bvh"], "static");
+}
+
 TEST(PathCommand, TheScenesGltfAnimationMovesItsMeshAndCamera) {
   test::ScratchDir dir;
   // A box on a floor before a wall, the box keyed 1 m along +X and the camera 0.5 m along +X in 2 s.

@@ -269,6 +269,18 @@ TEST_F(ImageIoTest, PlainRgbaHalfExrFromAnotherToolIsRead) {
   EXPECT_EQ(window.rgb_at(2, 2), (std::array<float, 3>{1, 2, 3}));
   EXPECT_EQ(window.rgb_at(0, 0), (std::array<float, 3>{0, 0, 0}));
   EXPECT_EQ(window.rgb_at(3, 1), (std::array<float, 3>{0, 0, 0}));
+
+  // A data window beyond the largest image side, around a small display window, is named as such
+  // (it is what would be read: the message named the display window's size).
+  run("oiiotool --pattern constant:color=1,2,3 70000x1 3 -d half --fullsize 4x3+0+0 -o " + path("wide.exr").string());
+  try {
+    (void)io::read_exr(path("wide.exr"));
+    ADD_FAILURE() << "a 70000-pixel data window was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("part 0 has a data window of 70000x1; each side must be in 1..65536"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST_F(ImageIoTest, BlenderMultilayerNamesMapToStandardPlanes) {
