@@ -75,19 +75,61 @@
     return path.split('/').map((s) => (s === '..' || s === '.' ? s : encodeURIComponent(s))).join('/');
   }
 
-  const palette = ['#1f5fbf', '#d9480f', '#2b8a3e', '#862e9c', '#c92a2a', '#0b7285', '#e8590c', '#5c940d',
-    '#364fc7', '#a61e4d', '#087f5b', '#495057', '#f08c00', '#6741d9'];
+  // Fourteen colours of distinct hue or lightness, eight markers and four dash patterns. Style k
+  // takes colour k mod 14, marker k mod 8 and dash floor(k / 7) mod 4: of the first 56 styles, any
+  // two with the same marker and dash have colours at least 80 apart in RGB.
+  const palette = ['#1f5fbf', '#d9480f', '#2b8a3e', '#862e9c', '#c92a2a', '#0b7285', '#f08c00', '#74b816',
+    '#212529', '#e64980', '#22b8cf', '#868e96', '#8d5524', '#7048e8'];
   const dashes = [[], [8, 4], [2, 3], [10, 3, 2, 3]];
   const markers = ['circle', 'triangle', 'rect', 'rectRot', 'star', 'crossRot', 'rectRounded', 'cross'];
-  /** The colour of a pipeline, the same in every chart. */
-  function colorOf(pipeline) {
-    const i = pipelines.indexOf(pipeline);
-    return palette[(i < 0 ? 0 : i) % palette.length];
+  /** Line style k: its colour, marker and dash pattern. */
+  function lineStyle(k) {
+    const i = k < 0 ? 0 : k;
+    return { color: palette[i % palette.length], marker: markers[i % markers.length],
+      dash: dashes[Math.floor(i / 7) % dashes.length] };
+  }
+  /** Distinct colours for the stages of the stacked bars: hues spread by the golden angle, and
+   * three lightness levels and two saturations, so that stages whose hues come close (i and i + 8,
+   * i + 13, i + 21 apart) differ in lightness or saturation. */
+  function stageColor(i) {
+    return `hsl(${Math.round((i * 137.508 + 210) % 360)}, ${Math.floor(i / 12) % 2 ? 45 : 75}%, ${[40, 54, 68][i % 3]}%)`;
   }
 
-  /** Distinct colours for the stages of the stacked bars (hues spread by the golden angle). */
-  function stageColor(i) {
-    return `hsl(${Math.round((i * 137.508 + 210) % 360)}, 65%, ${i % 2 ? 42 : 55}%)`;
+  /**
+   * Chart.js's legend below a chart takes at most half of the canvas and drops what does not fit,
+   * without a word. The legend here takes what it needs, and this plugin grows or shrinks the
+   * chart's box so that the plot area keeps `plot` pixels of height, whatever the number of
+   * entries and the width of the page.
+   */
+  function keepPlotHeight(plot) {
+    return { id: 'keepPlotHeight', afterLayout(chart) {
+      const box = chart.canvas.parentNode;
+      const area = chart.chartArea;
+      if (!box || !area) return;
+      const want = Math.round(box.clientHeight + plot - (area.bottom - area.top));
+      if (Math.abs(want - box.clientHeight) > 2) box.style.height = `${want}px`;  // Chart.js follows its box
+    } };
+  }
+
+  /** The reason pipelines are missing from a chart: those whose every value is ∞ (`infiniteWhy`)
+   * and those with no value at all, named apart. '' when none is missing. */
+  function omittedNote(infinite, missing, infiniteWhy) {
+    const parts = [];
+    if (infinite.length) parts.push(`${infiniteWhy || 'no finite value'}: ${infinite.join(', ')}`);
+    if (missing.length) parts.push(`no value recorded: ${missing.join(', ')}`);
+    return parts.length ? ` Not plotted (${parts.join('; ')}).` : '';
+  }
+
+  /** The radius of line markers for `points` points along a line: markers on every point of a long
+   * series merge into bands, so smaller, then none (the line and the tooltips remain). */
+  function markerRadius(points) {
+    return points <= 30 ? 5 : points <= 120 ? 2 : 0;
+  }
+
+  /** Metres as given, to nine significant digits (0.501 m is not 0.50 m). */
+  function metres(v) {
+    const n = num(v);
+    return n === null || !Number.isFinite(n) ? fmt(v, 2) : String(Number(n.toPrecision(9)));
   }
 
   function resolutionLabel(c) {
@@ -113,8 +155,8 @@
 
   /** A one-line description of a cell's axes. */
   function cellLabel(c) {
-    const parts = [c.scene, resolutionLabel(c), `e = ${interaxialMm(c)} mm (${fmt(c.max_disparity_px, 1)} px)`,
-      `c = ${fmt(c.convergence_m, 2)} m`, `lights ${lightsLabel(c)}`, `truth ${c.truth}`];
+    const parts = [axisDefs.scene(c), resolutionLabel(c), `e = ${interaxialMm(c)} mm (${fmt(c.max_disparity_px, 1)} px)`,
+      `c = ${metres(c.convergence_m)} m`, `lights ${lightsLabel(c)}`, `truth ${c.truth}`];
     if (c.path !== null && c.path !== undefined) parts.push(`path ${c.path}`);
     if (c.frame !== null && c.frame !== undefined) parts.push(`frame ${c.frame}`);
     return parts.join(' · ');
@@ -183,6 +225,7 @@
         return;
       }
       canvas.chart = new Chart(canvas, config);
+      canvas.chart.resize();  // to the box keepPlotHeight set in the first layout, at once
     });
     return fig;
   }
@@ -196,7 +239,7 @@
     scene: (c) => c.scene + (Object.keys(c.scene_params || {}).length ? ` ${JSON.stringify(c.scene_params)}` : ''),
     resolution: resolutionLabel,
     interaxial: (c) => `e = ${interaxialKey(c)} ${interaxialUnit}`,
-    convergence: (c) => `c = ${fmt(c.convergence_m, 2)} m`,
+    convergence: (c) => `c = ${metres(c.convergence_m)} m`,
     lights: (c) => `lights ${lightsLabel(c)}`,
     truth: (c) => `truth ${c.truth}`,
     path: (c) => (c.path === null || c.path === undefined ? '' : `path ${c.path}`),
@@ -224,25 +267,29 @@
     const build = (group) => {
       const keys = distinct(group.map(opts.key)).sort((a, b) => opts.order(a) - opts.order(b));
       const datasets = [];
-      const omitted = [];
+      const infinite = [];
+      const missing = [];
       for (const p of opts.pipelines) {
         const points = keys.map((k) => {
           const m = median(group.filter((c) => opts.key(c) === k && rec(c, p)).map((c) => opts.value(c, p)));
           return m === null || !Number.isFinite(m) ? null : m;
         });
         if (points.every((v) => v === null)) {
-          if (group.some((c) => rec(c, p))) omitted.push(p);
+          const ran = group.filter((c) => rec(c, p));
+          if (ran.some((c) => Math.abs(num(opts.value(c, p))) === Infinity)) infinite.push(p);
+          else if (ran.length) missing.push(p);
           continue;
         }
         // Pipelines with equal values (e.g. two exact ones) overlap: each has its own marker and
         // dash pattern, and the first pipelines are drawn last (on top, datasets are added in
         // reverse and the legend reversed back), so that both stay visible; clip keeps edge markers whole.
-        const k = pipelines.indexOf(p);
+        const style = lineStyle(pipelines.indexOf(p));
         datasets.unshift({ label: p, data: opts.linear ? keys.map((key, i) => ({ x: opts.order(key), y: points[i] })) : points,
-          borderColor: colorOf(p), backgroundColor: colorOf(p), pointStyle: markers[k % markers.length], pointRadius: 5,
-          borderWidth: 2, borderDash: dashes[k % dashes.length], spanGaps: true, clip: 8 });
+          borderColor: style.color, backgroundColor: style.color, pointStyle: style.marker,
+          pointRadius: points.filter((v) => v !== null).length < 2 ? 5 : markerRadius(keys.length), pointHitRadius: 6,
+          borderWidth: 2, borderDash: style.dash, spanGaps: true, clip: 8 });
       }
-      let why = omitted.length ? ` Not plotted (no finite value${opts.omittedWhy ? ': ' + opts.omittedWhy : ''}): ${omitted.join(', ')}.` : '';
+      let why = omittedNote(infinite, missing, opts.omittedWhy);
       if (keys.length === 1) why += ` These cells share one value of the ${opts.axis}: one point per pipeline.`;
       return { data: { labels: opts.linear ? undefined : keys.map(opts.label), datasets }, why, count: group.length };
     };
@@ -254,10 +301,11 @@
       x: opts.linear ? axis(opts.xTitle, Object.assign({ type: 'linear' }, opts.xExtra || {})) : axis(opts.xTitle, { offset: true }),
       y: axis(opts.yTitle, opts.yExtra || {}),
     };
-    const config = { type: 'line', data: first.data,
-      options: { scales, plugins: { legend: { position: 'bottom', reverse: true, labels: { usePointStyle: true } } } } };
+    const config = { type: 'line', data: first.data, plugins: [keepPlotHeight(200)],
+      options: { scales, plugins: { legend: { position: 'bottom', reverse: true, maxHeight: 100000, labels: { usePointStyle: true } } } } };
     const context = (g, b) => (g.label ? ` Shown: ${g.label} (${b.count} of ${cells.length} cells).` : '');
-    // The plot keeps about 230 px; the legend below takes a row per five pipelines.
+    // A first guess of the box: the plot and a legend row per five pipelines (keepPlotHeight
+    // corrects it as laid out).
     const height = 230 + 24 * Math.ceil(opts.pipelines.length / 5);
     const fig = chartFigure(opts.title, opts.caption + context(groups[0], first) + first.why, config, height);
     if (groups.length > 1) {
@@ -313,7 +361,7 @@
 
   function overviewSection() {
     const truths = distinct(cells.map((c) => c.truth));
-    const scenes = distinct(cells.map((c) => c.scene));
+    const scenes = distinct(cells.map(axisDefs.scene));
     const resolutions = distinct(cells.map(resolutionLabel));
     const interaxials = distinct(cells.map(interaxialKey)).sort((a, b) => a - b);
     const v = data.versions || {};
@@ -451,8 +499,10 @@
     const caption = (g) => `Median time of each stage${g.label ? ` at ${g.label}` : ''} (${g.cells.length} cell${g.cells.length === 1 ? '' : 's'}); stages are the pipelines' own timers.`;
     const config = { type: 'bar', data: build(groups[0].cells),
       options: { indexAxis: 'y', scales: { x: axis('time (ms)', { stacked: true }), y: { stacked: true, ticks: { autoSkip: false } } },
-        plugins: { legend: { position: 'bottom' } } } };
-    // A 24-px bar per pipeline, the axis, and a legend row per six stages; the figure spans the grid.
+        plugins: { legend: { position: 'bottom', maxHeight: 100000 } } },
+      plugins: [keepPlotHeight(30 + 24 * pipelines.length)] };
+    // A first guess: a 24-px bar per pipeline, the axis, and a legend row per six stages; the
+    // figure spans the grid.
     const height = 70 + 24 * pipelines.length + 22 * Math.ceil(stages.length / 6);
     const fig = chartFigure('Per-stage time', caption(groups[0]), config, height, true);
     if (groups.length > 1) {
@@ -886,7 +936,12 @@
   /** A link to a cell's viewer (#cell-NNNN: the tables' cell links, or the page opened at one)
    * opens that cell, which loads its images, and shows it. */
   function openLinkedCell() {
-    const id = decodeURIComponent(window.location.hash.slice(1));
+    let id = '';
+    try {
+      id = decodeURIComponent(window.location.hash.slice(1));
+    } catch (e) {
+      return;  // a fragment that is no valid percent-encoding names no cell
+    }
     const target = id ? document.getElementById(id) : null;
     if (!target || !target.matches('details.cell')) return;
     target.open = true;
@@ -917,39 +972,37 @@
     const tickLabel = (i) => (oneADay ? days[i] : labels[i].slice(0, 16));
     const runAxis = (extra) => axis('run (UTC)', Object.assign({ ticks: { maxRotation: 0, autoSkip: true, autoSkipPadding: 12,
       callback: (value) => tickLabel(value) } }, extra));
-    // Markers on every run merge into bands in a long history: smaller, then none (the line and
-    // the tooltips remain).
-    const radius = runs.length <= 30 ? 5 : runs.length <= 120 ? 2 : 0;
-    // This report's pipelines first (their colours as elsewhere), then those only earlier runs had.
+    const radius = markerRadius(runs.length);
+    // This report's pipelines first (their styles as elsewhere), then those only earlier runs had,
+    // with the styles after this report's.
     const names = distinct([...pipelines, ...runs.flatMap((r) => Object.keys(r.pipelines || {}))])
       .filter((p) => runs.some((r) => (r.pipelines || {})[p]));
     const extra = names.filter((p) => !pipelines.includes(p));
-    const colour = (p) => (pipelines.includes(p) ? colorOf(p) : palette[(pipelines.length + extra.indexOf(p)) % palette.length]);
+    const styleOf = (p) => lineStyle(pipelines.includes(p) ? pipelines.indexOf(p) : pipelines.length + extra.indexOf(p));
     const runText = `${runs.length} run${runs.length === 1 ? '' : 's'} from ${labels[0]} to ${labels[labels.length - 1]} UTC`;
 
     const lineChart = (title, key, scale, yTitle, caption, omittedWhy) => {
       const datasets = [];
-      const omitted = [];
-      names.forEach((p, k) => {
-        const points = runs.map((r) => {
-          const v = num(((r.pipelines || {})[p] || {})[key]);
-          return v === null || !Number.isFinite(v) ? null : v * scale;
-        });
+      const infinite = [];
+      const missing = [];
+      names.forEach((p) => {
+        const values = runs.map((r) => num(((r.pipelines || {})[p] || {})[key]));
+        const points = values.map((v) => (v === null || !Number.isFinite(v) ? null : v * scale));
         if (points.every((v) => v === null)) {
-          omitted.push(p);
+          (values.some((v) => Math.abs(v) === Infinity) ? infinite : missing).push(p);
           return;
         }
-        datasets.unshift({ label: p, data: points, borderColor: colour(p), backgroundColor: colour(p),
+        const style = styleOf(p);
+        datasets.unshift({ label: p, data: points, borderColor: style.color, backgroundColor: style.color,
           // A pipeline with one finite value has no line to show it: its marker stays.
-          pointStyle: markers[k % markers.length], pointRadius: points.filter((v) => v !== null).length < 2 ? 5 : radius,
-          pointHitRadius: 6, borderWidth: 2,
-          borderDash: dashes[k % dashes.length], spanGaps: true, clip: 8 });
+          pointStyle: style.marker, pointRadius: points.filter((v) => v !== null).length < 2 ? 5 : radius,
+          pointHitRadius: 6, borderWidth: 2, borderDash: style.dash, spanGaps: true, clip: 8 });
       });
       if (datasets.length === 0) return null;
-      const why = omitted.length ? ` Not plotted (no finite value${omittedWhy ? ': ' + omittedWhy : ''}): ${omitted.join(', ')}.` : '';
-      const config = { type: 'line', data: { labels, datasets },
+      const why = omittedNote(infinite, missing, omittedWhy);
+      const config = { type: 'line', data: { labels, datasets }, plugins: [keepPlotHeight(200)],
         options: { scales: { x: runAxis({ offset: true }), y: axis(yTitle) },
-          plugins: { legend: { position: 'bottom', reverse: true, labels: { usePointStyle: true } } } } };
+          plugins: { legend: { position: 'bottom', reverse: true, maxHeight: 100000, labels: { usePointStyle: true } } } } };
       return chartFigure(title, `${caption} ${runText}.${why}`, config, 230 + 24 * Math.ceil(names.length / 5));
     };
 

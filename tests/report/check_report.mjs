@@ -113,6 +113,11 @@ try {
     const wrong = cellShares.filter(([pipeline, text], i) => !expected[i] || expected[i][0] !== pipeline || !shown(expected[i][1], text));
     if (wrong.length) problems.push(`cells table: right / left shown wrongly in ${wrong.length} row(s), e.g. ${JSON.stringify(wrong[0])}`);
   }
+  // Each cell's viewer label names all its axes: no two cells alike (convergences rounded to
+  // centimetres merged 0.5 and 0.501 m).
+  const cellLabels = await page.evaluate(() => [...document.querySelectorAll('details.cell > summary .sub')].map((s) => s.textContent));
+  if (new Set(cellLabels).size !== cellLabels.length)
+    problems.push(`viewer: ${cellLabels.length - new Set(cellLabels).size} cell label(s) repeat another cell's`);
   // Left eyes synthesized in part: a section exactly when some record measured one, with a summary
   // row per such pipeline and a row per measured (cell, pipeline) showing its left PSNR.
   const hasLeft = (p) => p && p.left_synthesized_fraction !== null && p.left_synthesized_fraction !== undefined;
@@ -188,7 +193,32 @@ try {
     const xScale = chart.scales.x;
     const fractionalFrames = xScale && xScale.options.title && xScale.options.title.text === 'frame'
       ? xScale.ticks.filter((t) => !Number.isInteger(t.value)).length : 0;
-    return { title: canvas.getAttribute('aria-label').split('.')[0], pixels: saturated, positions: positions.size, fractionalFrames };
+    // Every legend entry drawn whole inside the legend and the canvas (Chart.js drops or cuts what
+    // exceeds its legend's height), the plot area kept, and no two lines alike in colour, marker
+    // and dash pattern.
+    const lg = chart.legend;
+    const cut = lg && lg.options.display !== false
+      ? lg.legendItems.length - lg.legendHitBoxes.filter((b) => b.top >= lg.top - 1 && b.top + b.height <= lg.bottom + 1
+        && b.top + b.height <= chart.height + 1).length : 0;
+    // Alike: the same marker and dash, and colours less than 80 apart in RGB (two blues 29 apart
+    // shared both, 8 pipelines apart; the palette's nearest colours, 43 apart, differ in marker).
+    const rgb = (c) => (/^#[0-9a-f]{6}$/i.test(c) ? [1, 3, 5].map((i) => parseInt(c.slice(i, i + 2), 16)) : null);
+    const lines = chart.config.type === 'line' ? chart.data.datasets : [];
+    let alike = 0;
+    for (let i = 0; i < lines.length; i++)
+      for (let j = i + 1; j < lines.length; j++) {
+        const a = lines[i], b = lines[j];
+        if (a.pointStyle !== b.pointStyle || JSON.stringify(a.borderDash || []) !== JSON.stringify(b.borderDash || [])) continue;
+        const ca = rgb(a.borderColor), cb = rgb(b.borderColor);
+        const apart = ca && cb ? Math.hypot(ca[0] - cb[0], ca[1] - cb[1], ca[2] - cb[2]) : (a.borderColor === b.borderColor ? 0 : 255);
+        if (apart < 80) alike++;
+      }
+    // The plot keeps its height: 200 px for lines, 24 px a bar for the stage bars (a bar chart
+    // along time, the gate's, keeps its fixed box).
+    const bars = chart.config.type === 'bar' && chart.options.indexAxis === 'y' ? chart.data.labels.length : 0;
+    const plotNeed = chart.config.type === 'line' ? 150 : bars ? 20 * bars : 0;
+    return { title: canvas.getAttribute('aria-label').split('.')[0], pixels: saturated, positions: positions.size,
+      fractionalFrames, cut, alike, plotHeight: a.bottom - a.top, plotNeed };
   }));
   // The charts of every report: speed-up vs resolution, PSNR, SSIM, MSE and holes vs interaxial,
   // per-stage time (a chart without a finite value is left out and named in the caption).
@@ -200,8 +230,13 @@ try {
     else if (c.pixels < need)
       problems.push(`chart "${c.title}": ${c.pixels} data pixels (< ${need})${c.missing ? ', no chart object' : ''}`);
   }
-  for (const c of charts)
+  for (const c of charts) {
     if (c.fractionalFrames) problems.push(`chart "${c.title}": ${c.fractionalFrames} ticks between whole frames`);
+    if (c.cut) problems.push(`chart "${c.title}": ${c.cut} legend entries cut off or missing`);
+    if (c.alike) problems.push(`chart "${c.title}": ${c.alike} lines drawn alike (colour, marker and dash)`);
+    if (!c.missing && c.plotHeight < c.plotNeed)
+      problems.push(`chart "${c.title}": plot area ${c.plotHeight.toFixed(0)} px high (< ${c.plotNeed})`);
+  }
   report.charts = charts.map((c) => `${c.title}: ${c.pixels}`);
 
   // Trends (a report written with a history file): the median-time and gate-verdict charts always,

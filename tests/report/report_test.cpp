@@ -220,6 +220,33 @@ TEST(Report, APathSweepsFrameChartCountsWholeFrames) {
   EXPECT_NE(checked.find("Frame time along the path"), std::string::npos) << checked;
 }
 
+TEST(Report, ManyPipelinesKeepEveryLegendEntryAndStyleAndCloseConvergencesStayApart) {
+  require_browser_tools();
+  if (HasFatalFailure()) return;
+  test::ScratchDir dir;
+  // Every pipeline and eleven variants (26 lines): Chart.js's legend, capped at half the chart,
+  // dropped entries, and lines 8 apart shared marker, dash and a near colour; convergences 0.5 and
+  // 0.501 m were labelled alike and merged in the charts.
+  write_text(dir / "many.toml",
+             "[sweep]\nname = \"many\"\nscenes = [\"box-wall\"]\n"
+             "pipelines = [\"all\", \"bidir-warp:occlusion=ztest\", \"bidir-warp:occlusion=ztest:clipped=both:max_crack=4\", "
+             "\"repro-rt:threshold_arcmin=0.5:discontinuity_px=0.1:occluding_edge_px=0\", "
+             "\"repro-rt:discard=interpolated:source_frustum=false\", \"repro-reraster:threshold_arcmin=2\", "
+             "\"fw-warp:warp=rows:max_crack=1\", \"fw-warp:background=false\", "
+             "\"bw-warp:iterations=8:start=far:filter=nearest\", \"rt-atomic:confirm=true\", "
+             "\"rt-buffer:depth=8:margin=0.02\", \"bidir-warp-rt:occlusion=ztest:clipped=both\"]\n"
+             "interaxial_m = [0.03, 0.064]\nconvergence_m = [0.5, 0.501]\nresolutions = [\"64x36\"]\n"
+             "[timing]\nrepetitions = 1\nwarmup = 0\n");
+  const test::CliRun run = test::run_cli("sweep run " + quoted(dir / "many.toml") + " --out " + quoted(dir / "sweep") +
+                                         " --threads 2 --scenes-dir " +
+                                         quoted(fs::path(SB_BINARY_DIR) / "Testing" / "scenes-cache"));
+  ASSERT_EQ(run.code, 0) << run.out;
+  const test::CliRun report =
+      test::run_cli("report " + quoted(dir / "sweep" / "results.jsonl") + " --out " + quoted(dir / "report"));
+  ASSERT_EQ(report.code, 0) << report.out;
+  (void)check_in_browser(dir / "report" / "index.html", dir / "report.png", true);
+}
+
 /// A minimal valid results line (no images: the report shows them as unavailable).
 json minimal_line(const std::string& id, int index) {
   const json metrics{{"psnr", 40.5}, {"ssim", 0.99}, {"mse", test::mse_of_psnr(40.5)}, {"error_fraction", 0.01}};
