@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <set>
 #include <sstream>
@@ -799,6 +800,16 @@ std::optional<GateCheck> completeness_check(const GateResults& results) {
                                       definition.empty() ? "DEFINITION" : shell_quote(definition), shell_quote(out));
   if (slurm_task || slurm_merge) {
     check.reproduce = run + " --executor slurm --wait";
+    // A submission continues only with its shard count (the default, one shard per cell, differs
+    // from any other --shards it was made with): the submission's record, else the lines'.
+    std::optional<uint64_t> shards;
+    if (std::ifstream in(slurm.submission); in) {
+      const json submission = json::parse(in, nullptr, false);
+      if (submission.is_object() && submission.value("shards", json()).is_number_unsigned())
+        shards = submission["shards"].get<uint64_t>();
+    }
+    if (!shards && recorded_shard) shards = recorded_shard->second;
+    if (shards) check.reproduce += fmt::format(" --shards {}", *shards);
   } else {
     check.reproduce = run;
     if (shard) check.reproduce += fmt::format(" --shard {}/{}", shard->first, shard->second);

@@ -474,7 +474,7 @@ class Converter {
       scene.warnings.push_back(fmt::format(
           "{}: the scene is unlit ({}, ambient 0): every surface renders black, so a comparison sees at most "
           "silhouettes against the background and cannot tell pipelines apart; add a KHR_lights_punctual light or set "
-          "the scene's extras.ambient",
+          "the scene's extras.stereobench.ambient",
           file_, scene.lights.empty() ? "no lights" : "every light has zero intensity or colour"));
     return scene;
   }

@@ -562,6 +562,8 @@ TEST(GltfLoader, AnUnlitSceneIsWarnedAbout) {
   const std::string dark = unlit_warning([](MiniGltf&) {});
   EXPECT_NE(dark.find("(no lights, ambient 0): every surface renders black"), std::string::npos) << dark;
   EXPECT_NE(dark.find("s.gltf"), std::string::npos) << dark;
+  // The key it names is the one the loader reads (it named extras.ambient, which is ignored).
+  EXPECT_NE(dark.find("set the scene's extras.stereobench.ambient"), std::string::npos) << dark;
   const auto light = [](double intensity) {
     return [intensity](MiniGltf& g) {
       g.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array({{{"type", "point"}, {"intensity", intensity}}});

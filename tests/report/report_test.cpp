@@ -59,6 +59,18 @@ std::string check_in_browser(const fs::path& index, const fs::path& screenshot, 
   return r.out;
 }
 
+/// Runs the sweep `definition` (TOML text) into dir/sweep and writes its report into dir/report.
+void report_of_sweep(const test::ScratchDir& dir, const std::string& definition) {
+  write_text(dir / "sweep.toml", definition);
+  const test::CliRun run = test::run_cli("sweep run " + quoted(dir / "sweep.toml") + " --out " + quoted(dir / "sweep") +
+                                         " --threads 2 --scenes-dir " +
+                                         quoted(fs::path(SB_BINARY_DIR) / "Testing" / "scenes-cache"));
+  ASSERT_EQ(run.code, 0) << run.out;
+  const test::CliRun report =
+      test::run_cli("report " + quoted(dir / "sweep" / "results.jsonl") + " --out " + quoted(dir / "report"));
+  ASSERT_EQ(report.code, 0) << report.out;
+}
+
 TEST(Report, SmokeSweepReportsPassTheBrowserCheck) {
   require_browser_tools();
   if (HasFatalFailure()) return;
@@ -204,18 +216,12 @@ TEST(Report, APathSweepsFrameChartCountsWholeFrames) {
   if (HasFatalFailure()) return;
   test::ScratchDir dir;
   // Four frames of spheres spinning: the frame axis had ticks at 0, 0.5, 1, 1.5, ...
-  write_text(dir / "path.toml",
-             "[sweep]\nname = \"spin\"\nscenes = [\"spheres\"]\npipelines = [\"plain-rt\", \"repro-rt\"]\n"
-             "baseline = \"plain-rt\"\nmax_disparity_px = [4, 8]\nresolutions = [\"64x36\"]\n"
-             "[path]\nframes = 4\nbvh = \"refit\"\n[path.spin]\naxis = [0, 1, 0]\ndegrees_per_frame = 5.0\n"
-             "mesh_prefix = \"sphere\"\n[timing]\nrepetitions = 1\nwarmup = 0\n");
-  const test::CliRun run = test::run_cli("sweep run " + quoted(dir / "path.toml") + " --out " + quoted(dir / "sweep") +
-                                         " --threads 2 --scenes-dir " +
-                                         quoted(fs::path(SB_BINARY_DIR) / "Testing" / "scenes-cache"));
-  ASSERT_EQ(run.code, 0) << run.out;
-  const test::CliRun report =
-      test::run_cli("report " + quoted(dir / "sweep" / "results.jsonl") + " --out " + quoted(dir / "report"));
-  ASSERT_EQ(report.code, 0) << report.out;
+  report_of_sweep(dir,
+                  "[sweep]\nname = \"spin\"\nscenes = [\"spheres\"]\npipelines = [\"plain-rt\", \"repro-rt\"]\n"
+                  "baseline = \"plain-rt\"\nmax_disparity_px = [4, 8]\nresolutions = [\"64x36\"]\n"
+                  "[path]\nframes = 4\nbvh = \"refit\"\n[path.spin]\naxis = [0, 1, 0]\ndegrees_per_frame = 5.0\n"
+                  "mesh_prefix = \"sphere\"\n[timing]\nrepetitions = 1\nwarmup = 0\n");
+  if (HasFatalFailure()) return;
   const std::string checked = check_in_browser(dir / "report" / "index.html", dir / "report.png", true);
   EXPECT_NE(checked.find("Frame time along the path"), std::string::npos) << checked;
 }
@@ -227,7 +233,7 @@ TEST(Report, ManyPipelinesKeepEveryLegendEntryAndStyleAndCloseConvergencesStayAp
   // Every pipeline and eleven variants (26 lines): Chart.js's legend, capped at half the chart,
   // dropped entries, and lines 8 apart shared marker, dash and a near colour; convergences 0.5 and
   // 0.501 m were labelled alike and merged in the charts.
-  write_text(dir / "many.toml",
+  report_of_sweep(dir,
              "[sweep]\nname = \"many\"\nscenes = [\"box-wall\"]\n"
              "pipelines = [\"all\", \"bidir-warp:occlusion=ztest\", \"bidir-warp:occlusion=ztest:clipped=both:max_crack=4\", "
              "\"repro-rt:threshold_arcmin=0.5:discontinuity_px=0.1:occluding_edge_px=0\", "
@@ -237,13 +243,7 @@ TEST(Report, ManyPipelinesKeepEveryLegendEntryAndStyleAndCloseConvergencesStayAp
              "\"rt-buffer:depth=8:margin=0.02\", \"bidir-warp-rt:occlusion=ztest:clipped=both\"]\n"
              "interaxial_m = [0.03, 0.064]\nconvergence_m = [0.5, 0.501]\nresolutions = [\"64x36\"]\n"
              "[timing]\nrepetitions = 1\nwarmup = 0\n");
-  const test::CliRun run = test::run_cli("sweep run " + quoted(dir / "many.toml") + " --out " + quoted(dir / "sweep") +
-                                         " --threads 2 --scenes-dir " +
-                                         quoted(fs::path(SB_BINARY_DIR) / "Testing" / "scenes-cache"));
-  ASSERT_EQ(run.code, 0) << run.out;
-  const test::CliRun report =
-      test::run_cli("report " + quoted(dir / "sweep" / "results.jsonl") + " --out " + quoted(dir / "report"));
-  ASSERT_EQ(report.code, 0) << report.out;
+  if (HasFatalFailure()) return;
   (void)check_in_browser(dir / "report" / "index.html", dir / "report.png", true);
 }
 

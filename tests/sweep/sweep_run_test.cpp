@@ -828,7 +828,8 @@ warmup = 0
 
 TEST(SweepRun, TheGateSendsASlurmTasksResultsFileToTheExecutor) {
   // A task's file (results-I.jsonl in <out>/slurm) gated alone: the command to finish the sweep is
-  // the Slurm executor's, with the sweep's --out (it named <out>/slurm as --out and no shard).
+  // the Slurm executor's, with the sweep's --out and shard count (it named <out>/slurm as --out,
+  // then left out --shards).
   test::ScratchDir dir;
   write_two_cell_sweep(dir, "box-wall");
   const test::CliRun task = test::run_cli("sweep run " + quoted(dir / "two.toml") + " --out " + quoted(dir / "out") +
@@ -844,7 +845,10 @@ TEST(SweepRun, TheGateSendsASlurmTasksResultsFileToTheExecutor) {
                            (dir / "out" / "results.jsonl").string()),
             std::string::npos)
       << gated.out;
-  EXPECT_NE(gated.out.find("--out " + (dir / "out").string() + " --executor slurm --wait"), std::string::npos)
+  // With the shard count the sweep was submitted with: the default (a shard per cell) is refused
+  // by a folder that holds results of another count.
+  EXPECT_NE(gated.out.find("--out " + (dir / "out").string() + " --executor slurm --wait --shards 2"),
+            std::string::npos)
       << gated.out;
 
   // Shards sharing the sweep's own results file: with one shard run, that file is the sweep's,
