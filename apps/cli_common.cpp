@@ -274,14 +274,25 @@ void refuse_replacing_inputs(const std::filesystem::path& scene_file, const Scen
   }
 }
 
+namespace {
+
+/// The first of a path's folders, from the outside in, that does not exist (what making the path
+/// makes first); empty when the path exists.
+std::filesystem::path outermost_missing_folder(const std::filesystem::path& folder) {
+  std::error_code ec;
+  std::filesystem::path missing;
+  for (std::filesystem::path p = folder.lexically_normal();
+       !p.empty() && !std::filesystem::exists(std::filesystem::symlink_status(p, ec)); p = p.parent_path())
+    missing = p;
+  return missing;
+}
+
+}  // namespace
+
 void in_output_folder(const std::string& folder, const char* option, const std::function<void()>& work) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  // The outermost folder this call makes: the first of the path's folders that does not exist.
-  fs::path made;
-  for (fs::path p = fs::path(folder).lexically_normal(); !p.empty() && !fs::exists(fs::symlink_status(p, ec));
-       p = p.parent_path())
-    made = p;
+  const fs::path made = outermost_missing_folder(folder);  // the outermost folder this call makes
   prepare_output_folder(folder, option);
   try {
     work();
@@ -317,10 +328,17 @@ void prepare_output_file_folder(const std::string& file, const char* option) {
                               option, file, target.string()));
   const std::filesystem::path folder = std::filesystem::path(file).parent_path();
   if (folder.empty()) return;  // the current folder
-  // A missing folder is not made here but by the write (io::write_atomically): a run refused
-  // after this check (a bad scene, too little memory) leaves no empty folder behind.
-  const bool exists = std::filesystem::exists(std::filesystem::symlink_status(folder, ec));
-  if (const auto why = exists ? io::unwritable_folder(folder) : io::folder_cannot_be_made(folder))
+  // A missing folder is made and probed, then removed again: the write makes it for good
+  // (io::write_atomically), so a run refused after this check (a bad scene, too little memory)
+  // leaves no empty folder behind. (Only making it tells: /proc lets root pass an access check.)
+  const std::filesystem::path made = outermost_missing_folder(folder);
+  const std::optional<std::string> why = io::unwritable_folder(folder);
+  if (!made.empty())
+    for (std::filesystem::path p = folder.lexically_normal(); !p.empty(); p = p.parent_path()) {
+      std::filesystem::remove(p, ec);  // empty folders only; one holding a file stays
+      if (p == made) break;
+    }
+  if (why)
     throw IoError(
         fmt::format("{} {}: its folder {}: {}; give a path you can write", option, file, folder.string(), *why));
 }
