@@ -6,6 +6,8 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <map>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -163,6 +165,23 @@ size_t Scene::triangle_count() const {
   size_t n = 0;
   for (const Mesh& m : meshes) n += m.triangle_count();
   return n;
+}
+
+bool Mesh::is_closed() const {
+  using Corner = std::array<float, 3>;
+  std::map<std::pair<Corner, Corner>, int> edges;  // directed edge -> how often it occurs
+  const auto corner = [this](uint32_t i) { return Corner{positions[i].x, positions[i].y, positions[i].z}; };
+  for (size_t t = 0; t + 2 < indices.size(); t += 3) {
+    const Corner c[3] = {corner(indices[t]), corner(indices[t + 1]), corner(indices[t + 2])};
+    if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) continue;  // a collapsed triangle (a pole's)
+    for (int k = 0; k < 3; ++k) ++edges[{c[k], c[(k + 1) % 3]}];
+  }
+  if (edges.empty()) return false;
+  for (const auto& [edge, count] : edges) {
+    const auto back = edges.find({edge.second, edge.first});
+    if (count != 1 || back == edges.end() || back->second != 1) return false;
+  }
+  return true;
 }
 
 bool Mesh::zero_area(size_t t) const {

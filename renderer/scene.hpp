@@ -67,6 +67,10 @@ struct Mesh {
   /// Whether triangle t has zero area (its vertices coincide or lie on one line): it covers no
   /// pixel and no ray hits it.
   [[nodiscard]] bool zero_area(size_t t) const;
+  /// Whether the mesh is closed and consistently wound: every edge of a triangle with three
+  /// distinct corners (by position, so that vertices repeated along a seam count as one) is met
+  /// once in each direction. Seen from outside, such a mesh never shows a back face.
+  [[nodiscard]] bool is_closed() const;
 };
 
 /// A punctual light (KHR_lights_punctual). Intensity is used as radiometric: a point light of

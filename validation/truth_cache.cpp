@@ -67,12 +67,14 @@ void warn_once(const Scene& scene, const std::string& provider, const char* topi
 
 /// Says once per scene file and provider, on standard error, that an external tool shows what
 /// this suite's renderer culls: glTF's single-sided materials (doubleSided false, the default)
-/// hide their back faces from camera rays here, while Cycles and POV-Ray draw both sides.
+/// hide their back faces from camera rays here, while Cycles and POV-Ray draw both sides. Closed
+/// meshes (spheres, boxes) are left out: no eye outside them sees a back face.
 void note_single_sided(const Scene& scene, const std::string& provider) {
   if (provider == "full") return;
   size_t meshes = 0;
   for (const Mesh& m : scene.meshes)
-    if (m.material >= 0 && !scene.materials[static_cast<size_t>(m.material)].double_sided && m.triangle_count() > 0)
+    if (m.material >= 0 && !scene.materials[static_cast<size_t>(m.material)].double_sided && m.triangle_count() > 0 &&
+        !m.is_closed())
       ++meshes;
   if (meshes == 0) return;
   warn_once(scene, provider, "single-sided",

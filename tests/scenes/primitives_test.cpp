@@ -5,7 +5,9 @@
 #include <cmath>
 #include <set>
 #include <string>
+#include <utility>
 
+#include "renderer/scene.hpp"
 #include "scenes/architecture.hpp"
 #include "scenes/primitives.hpp"
 
@@ -57,6 +59,29 @@ TEST(Primitives, BoxIsAClosedSolidWithFlatFaces) {
   const Bounds3 b = box.bounds();
   EXPECT_EQ(b.lo, vec3(-1.0f, 0.0f, -2.0f));
   EXPECT_EQ(b.hi, vec3(1.0f, 3.0f, 2.0f));
+}
+
+/// A scene mesh of a generated one's positions and triangles.
+Mesh as_scene_mesh(const MeshData& data) {
+  Mesh m;
+  m.positions = data.positions;
+  m.indices = data.indices;
+  return m;
+}
+
+TEST(Primitives, ClosedSolidsAreClosedAndOpenOrMiswoundMeshesAreNot) {
+  // What decides whether an external truth's note on single-sided materials is due: a closed mesh
+  // never shows a back face.
+  EXPECT_TRUE(as_scene_mesh(make_box({-1.0f, 0.0f, -2.0f}, {1.0f, 3.0f, 2.0f})).is_closed());
+  EXPECT_TRUE(as_scene_mesh(make_uv_sphere(0.37f, 24, 12)).is_closed()) << "the seam's repeated vertices count as one";
+  EXPECT_FALSE(as_scene_mesh(make_plane({4.0f, 2.0f}, {4, 2}, 0.5f)).is_closed());
+  Mesh open = as_scene_mesh(make_box({0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}));
+  open.indices.resize(open.indices.size() - 6);  // one face gone
+  EXPECT_FALSE(open.is_closed());
+  Mesh flipped = as_scene_mesh(make_box({0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}));
+  std::swap(flipped.indices[0], flipped.indices[1]);  // one triangle wound the other way
+  EXPECT_FALSE(flipped.is_closed());
+  EXPECT_FALSE(Mesh{}.is_closed());
 }
 
 TEST(Primitives, PlaneFacesUp) {
