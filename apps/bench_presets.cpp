@@ -258,11 +258,17 @@ void check_series_rigs(const PresetRun& run, const PresetSeries& series, size_t 
   for (size_t i = 0; i < rows; ++i) {
     const PresetRow& row = series.rows[i];
     if (scenes::builtin_path(row.scene, row.scene_params, run.scenes_dir) != loaded) continue;
+    // The frames' memory too: a series whose largest row cannot fit is refused before its first
+    // row renders, naming that row.
+    const auto where = [&](const char* what) {
+      return fmt::format("{}, row {} = {}: {} (no row of the series has run)", series.name, series.swept, row.value, what);
+    };
     try {
-      check_bench(rig_of(scene, run, row), run.config);  // the frames' memory too, before any row renders
+      check_bench(rig_of(scene, run, row), run.config);
     } catch (const InputError& e) {
-      throw InputError(fmt::format("{}, row {} = {}: {} (no row of the series has run)", series.name, series.swept,
-                                   row.value, e.what()));
+      throw InputError(where(e.what()));
+    } catch (const ResourceError& e) {
+      throw ResourceError(where(e.what()));
     }
   }
 }

@@ -11,6 +11,8 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <tuple>
+#include <utility>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -72,18 +74,19 @@ bool contains(const std::vector<std::string>& items, const std::string& name) {
   return std::find(items.begin(), items.end(), name) != items.end();
 }
 
-/// Whether a row's image size is --resolution's (the preset leaves it open and it was given) rather
-/// than the row's own.
-bool row_takes_resolution(const PresetRun& run) { return run.overrides.width && run.preset->resolution_open; }
+/// A Kim row's image size: --resolution's where the preset leaves it open and it was given, else
+/// the row's own.
+std::pair<int, int> row_size(const PresetRun& run, const PresetRow& row) {
+  if (run.overrides.width && run.overrides.height && run.preset->resolution_open)
+    return {*run.overrides.width, *run.overrides.height};
+  return {row.width, row.height};
+}
 
-/// The rig of a Kim row: the preset's interaxial and convergence, the row's image size unless
-/// --resolution replaced it, and what else the command line left open (--vfov, --convergence).
+/// The rig of a Kim row: the preset's interaxial and convergence, the row's image size, and what
+/// else the command line left open (--vfov, --convergence).
 StereoRig row_rig(const Scene& scene, const PresetRun& run, const PresetRow& row) {
   RigOverrides o = run.overrides;
-  if (!row_takes_resolution(run)) {
-    o.width = row.width;
-    o.height = row.height;
-  }
+  std::tie(o.width, o.height) = row_size(run, row);
   o.max_disparity_px.reset();
   o.interaxial = row.interaxial;
   if (row.convergence) o.convergence = row.convergence;
@@ -358,8 +361,8 @@ void run_kim_complexity(const PresetRun& run, const Executor& executor) {
   for (const PresetSeries& series : preset.series)
     for (size_t i = 0; i < rows_to_run(series, run.rows_per_series); ++i) {
       const PresetRow& row = series.rows[i];
-      const bool given = row_takes_resolution(run);
-      require_frame_memory(given ? *run.overrides.width : row.width, given ? *run.overrides.height : row.height,
+      const auto [width, height] = row_size(run, row);
+      require_frame_memory(width, height,
                            fmt::format("--preset {}, row {} = {}: the benchmark", preset.name, series.swept, row.value));
     }
   const uint64_t base_rss = resident_bytes();
@@ -402,8 +405,14 @@ void run_kim_complexity(const PresetRun& run, const Executor& executor) {
       malloc_trim(0);
       const uint64_t rss_before = resident_bytes();
       const MemoryBudget budget = budget_now();
-      const uint64_t estimate = estimate_peak_bytes(peaks, base_rss, triangles, kPriorFixedBytes, kPriorBytesPerTriangle);
-      std::string basis = "prior (1 GiB + 1 KiB per triangle)";
+      // Before a row is measured, the prior by triangles and the row's frames; a measured row's
+      // peak holds its frames already.
+      const auto [width, height] = row_size(run, row);
+      const uint64_t frames = peaks.empty() ? static_cast<uint64_t>(width) * static_cast<uint64_t>(height) * kFrameBytesPerPixel : 0;
+      const uint64_t estimate =
+          estimate_peak_bytes(peaks, base_rss, triangles, kPriorFixedBytes, kPriorBytesPerTriangle) + frames;
+      std::string basis = fmt::format("prior (1 GiB + 1 KiB per triangle, and {} of frames at {}x{})", gib(frames),
+                                      width, height);
       if (peaks.size() == 1) basis = "proportional to the " + measured_values.back() + " row";
       if (peaks.size() >= 2)
         basis = "line through the " + measured_values[measured_values.size() - 2] + " and " + measured_values.back() + " rows";

@@ -139,9 +139,9 @@ void print_to_stdout(const std::string& text);
 void print_to(std::FILE* stream, const std::string& text);
 
 /// Checks, before the work, that the folder of an output file named by `option` (a --json written
-/// after a long benchmark) can be written, or made where it is missing, without making it: the
-/// file's write makes it, so a run refused later leaves no empty folder. IoError naming the option
-/// and the reason; nothing for "" (no file), "-" (standard output) or a bare file name.
+/// after a long benchmark) can be written: a missing one is made, probed and removed again (the
+/// file's write makes it for good), so a run refused later leaves no empty folder. IoError naming
+/// the option and the reason; nothing for "" (no file), "-" (standard output) or a bare file name.
 void prepare_output_file_folder(const std::string& file, const char* option);
 
 /// Warns on standard error when either eye sees geometry in front of its near plane

@@ -252,15 +252,17 @@ int run_compare(const CompareArgs& a) {
       print_to_stdout(io::json_text(record, 2));
     else if (!a.json.empty())
       write_option_file("--json", a.json, io::json_text(record, 2) + "\n");
-    // A summary that cannot be printed (a full disk behind a redirection) fails the run too: its
-    // files go with it, as the help promises for exit 4.
-    print_to(a.json == "-" ? stderr : stdout, text);
+    // A summary standard output cannot take (a full disk behind a redirection) fails the run
+    // too: its files go with it, as the help promises for exit 4. With --json - the summary goes
+    // to standard error, as a courtesy: the JSON on standard output is the run's result.
+    if (a.json != "-") print_to(stdout, text);
   } catch (const std::exception&) {
     // An output that cannot be written takes the others of this run with it.
     discard_outputs(outputs);
     throw;
   }
 
+  if (a.json == "-") std::fputs(text.c_str(), stderr);
   return static_cast<int>(code);
 }
 

@@ -101,8 +101,8 @@ PipelineEntry parse_pipeline_entry(const std::string& name) {
   constexpr size_t kMaxEntry = 160;
   if (!name.empty() && (std::isspace(static_cast<unsigned char>(name.front())) != 0 ||
                         std::isspace(static_cast<unsigned char>(name.back())) != 0))
-    throw InputError(fmt::format("pipeline entry '{}' has blanks around it; list the pipelines without blanks after "
-                                 "the commas (e.g. plain-rt,ideal-copy)",
+    throw InputError(fmt::format("pipeline entry '{}' has blanks around it; write pipeline names without blanks "
+                                 "(e.g. plain-rt,ideal-copy)",
                                  name));
   if (name.size() > kMaxEntry)
     throw InputError(fmt::format("pipeline entry '{}...' is {} characters long; it names files, so keep it within {}",

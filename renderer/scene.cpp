@@ -6,8 +6,8 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
-#include <map>
 #include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -169,19 +169,27 @@ size_t Scene::triangle_count() const {
 
 bool Mesh::is_closed() const {
   using Corner = std::array<float, 3>;
-  std::map<std::pair<Corner, Corner>, int> edges;  // directed edge -> how often it occurs
+  using Edge = std::pair<Corner, Corner>;
+  std::vector<Edge> edges;  // directed, from each triangle with three distinct corners
+  edges.reserve(indices.size());
+  double volume6 = 0.0;  // six times the signed volume enclosed
   const auto corner = [this](uint32_t i) { return Corner{positions[i].x, positions[i].y, positions[i].z}; };
   for (size_t t = 0; t + 2 < indices.size(); t += 3) {
     const Corner c[3] = {corner(indices[t]), corner(indices[t + 1]), corner(indices[t + 2])};
     if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) continue;  // a collapsed triangle (a pole's)
-    for (int k = 0; k < 3; ++k) ++edges[{c[k], c[(k + 1) % 3]}];
+    for (int k = 0; k < 3; ++k) edges.emplace_back(c[k], c[(k + 1) % 3]);
+    const dvec3 p0(positions[indices[t]]), p1(positions[indices[t + 1]]), p2(positions[indices[t + 2]]);
+    volume6 += glm::dot(p0, glm::cross(p1, p2));
   }
   if (edges.empty()) return false;
-  for (const auto& [edge, count] : edges) {
-    const auto back = edges.find({edge.second, edge.first});
-    if (count != 1 || back == edges.end() || back->second != 1) return false;
+  std::sort(edges.begin(), edges.end());
+  for (size_t i = 0; i < edges.size(); ++i) {
+    if (i + 1 < edges.size() && edges[i + 1] == edges[i]) return false;  // an edge met twice one way
+    if (!std::binary_search(edges.begin(), edges.end(), Edge{edges[i].second, edges[i].first})) return false;
   }
-  return true;
+  // Wound outwards (triangles counter-clockwise seen from outside, as the positions and indices
+  // of a mirrored mesh are too): an inside-out mesh shows only back faces from outside.
+  return volume6 > 0.0;
 }
 
 bool Mesh::zero_area(size_t t) const {

@@ -67,9 +67,10 @@ struct Mesh {
   /// Whether triangle t has zero area (its vertices coincide or lie on one line): it covers no
   /// pixel and no ray hits it.
   [[nodiscard]] bool zero_area(size_t t) const;
-  /// Whether the mesh is closed and consistently wound: every edge of a triangle with three
-  /// distinct corners (by position, so that vertices repeated along a seam count as one) is met
-  /// once in each direction. Seen from outside, such a mesh never shows a back face.
+  /// Whether the mesh is closed and wound outwards: every edge of a triangle with three distinct
+  /// corners (by position, so that vertices repeated along a seam count as one) is met once in
+  /// each direction, and the volume it encloses is positive (triangles counter-clockwise seen
+  /// from outside). An eye outside such a mesh never sees a back face of it.
   [[nodiscard]] bool is_closed() const;
 };
 

@@ -1,10 +1,11 @@
-// Runs external programs with fork and exec: the child leads its own process group and dies with
-// the thread that started it, both output pipes are drained with poll(), and a time limit stops
-// the whole group (SIGTERM, then SIGKILL).
+// Runs external programs with clone (CLONE_VM | CLONE_VFORK, as posix_spawn does) and exec: the
+// child leads its own process group and dies with the thread that started it, both output pipes
+// are drained with poll(), and a time limit stops the whole group (SIGTERM, then SIGKILL).
 #include "validation/process.hpp"
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sched.h>
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/stat.h>
@@ -125,8 +126,8 @@ class ChildGuard {
   pid_t pid_ = -1;  ///< the child (and its process group), -1 once reaped
 };
 
-/// What the child does between fork and exec, all prepared before the fork: after it only
-/// async-signal-safe calls are made (another thread may hold the allocator's lock).
+/// What the child does between its start and exec, all prepared before: the child shares this
+/// process's memory until it execs (CLONE_VM), so it only makes system calls and touches no lock.
 struct ChildSetup {
   const char* executable = nullptr;
   char* const* argv = nullptr;
@@ -139,32 +140,41 @@ struct ChildSetup {
   int error_fd = -1;  ///< close-on-exec: the errno of a failed step is written here
 };
 
-/// In the forked child: its own process group; SIGKILL when the thread that started it ends, so a
-/// stereobench killed outright (SIGKILL, which no handler sees) does not leave Blender or POV-Ray
-/// rendering on; the defaulted signals and an empty mask; stdin from /dev/null and the output
-/// streams; the working folder; then exec. Never returns: a failed step writes its errno to
-/// error_fd and exits 127.
-[[noreturn]] void become_child(const ChildSetup& c) {
-  int step_errno = 0;
-  const auto fail = [&]() {
-    step_errno = errno;
+/// The child (started by clone with CLONE_VM | CLONE_VFORK, as posix_spawn starts one, so nothing
+/// of this process's memory is copied): its own process group; SIGKILL when the thread that
+/// started it ends, so a stereobench killed outright (SIGKILL, which no handler sees) does not
+/// leave Blender or POV-Ray rendering on; every caught signal and the defaulted ones back to their
+/// default action, then an empty mask; stdin from /dev/null and the output streams; the working
+/// folder; then exec. Never returns: a failed step writes its errno to error_fd and exits 127.
+int become_child(void* arg) {
+  const ChildSetup& c = *static_cast<const ChildSetup*>(arg);
+  const auto fail = [&c]() {
+    const int step_errno = errno;
     [[maybe_unused]] const ssize_t w = ::write(c.error_fd, &step_errno, sizeof step_errno);
     ::_exit(127);
   };
   if (::setpgid(0, 0) != 0) fail();
   if (::prctl(PR_SET_PDEATHSIG, SIGKILL) != 0) fail();
   if (::getppid() != c.parent) ::_exit(127);  // the parent ended before the line above
-  // Handlers first, then the mask: a stop signal held back by the mask must not run this
-  // process's handler (which removes the parent's temporary files) in the child.
+  // Handlers first, then the mask (the parent blocked every signal around the start): a signal
+  // held back must not run one of this process's handlers in the child, which shares its memory.
   struct sigaction defaulted {};
   defaulted.sa_handler = SIG_DFL;
   sigemptyset(&defaulted.sa_mask);
+  for (int sig = 1; sig < NSIG; ++sig) {
+    struct sigaction now {};
+    if (::sigaction(sig, nullptr, &now) != 0) continue;  // a signal number the kernel does not use
+    const bool caught = (now.sa_flags & SA_SIGINFO) != 0 || (now.sa_handler != SIG_DFL && now.sa_handler != SIG_IGN);
+    if (caught) ::sigaction(sig, &defaulted, nullptr);
+  }
   for (const int sig : kDefaultedSignals) ::sigaction(sig, &defaulted, nullptr);
   sigset_t none;
   sigemptyset(&none);
   if (::sigprocmask(SIG_SETMASK, &none, nullptr) != 0) fail();
-  const auto null_onto = [&](int target, int flags) {
-    const int fd = ::open("/dev/null", flags | O_CLOEXEC);
+  // /dev/null without close-on-exec: where this process runs with a standard descriptor closed,
+  // open() returns that very number, and dup2 onto itself would leave the flag set.
+  const auto null_onto = [&fail](int target, int flags) {
+    const int fd = ::open("/dev/null", flags);
     if (fd < 0 || ::dup2(fd, target) < 0) fail();
     if (fd != target) ::close(fd);
   };
@@ -184,8 +194,12 @@ struct ChildSetup {
   if (c.cwd != nullptr && ::chdir(c.cwd) != 0) fail();
   ::execve(c.executable, c.argv, c.envp);
   fail();
-  ::_exit(127);  // not reached: fail() exits
+  return 127;  // not reached: fail() exits
 }
+
+/// The child's own stack while it shares this process's memory (it runs become_child on it until
+/// exec): system calls only, so a little is plenty.
+constexpr size_t kChildStackBytes = 64 * 1024;
 
 /// Reads what the child wrote to its error pipe before exec: 0 when exec succeeded (the pipe
 /// closed on exec), else the errno of the step that failed.
@@ -362,14 +376,16 @@ ProcessResult run_process(const std::vector<std::string>& argv, const ProcessOpt
   install_stop_handler();
   ChildGuard child;
   const Clock::time_point start = Clock::now();
-  // The stop signals wait while the child is made and listed: one in between would leave it
-  // running unlisted. (The child defaults and unblocks them before exec.)
-  sigset_t stop_signals, before;
-  sigemptyset(&stop_signals);
-  for (const int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) sigaddset(&stop_signals, sig);
-  ::pthread_sigmask(SIG_BLOCK, &stop_signals, &before);
-  const pid_t pid = ::fork();
-  if (pid == 0) become_child(setup);
+  // Every signal waits while the child is made and listed: a stop signal in between would leave
+  // it running unlisted, and any handler would run in the child, which shares this memory until
+  // it execs. (The child defaults the handlers and unblocks before exec.)
+  std::vector<char> child_stack(kChildStackBytes);
+  sigset_t all_signals, before;
+  sigfillset(&all_signals);
+  ::pthread_sigmask(SIG_BLOCK, &all_signals, &before);
+  // Returns once the child has exec'd or exited (CLONE_VFORK); the stack grows down from its end.
+  const pid_t pid = ::clone(become_child, child_stack.data() + child_stack.size(), CLONE_VM | CLONE_VFORK | SIGCHLD,
+                            &setup);
   const int fork_error = pid < 0 ? errno : 0;
   if (pid > 0) child.adopt(pid);
   ::pthread_sigmask(SIG_SETMASK, &before, nullptr);

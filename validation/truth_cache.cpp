@@ -5,7 +5,9 @@
 
 #include <cerrno>
 #include <cmath>
+#include <functional>
 #include <mutex>
+#include <optional>
 #include <set>
 
 #include <fmt/format.h>
@@ -56,32 +58,36 @@ class WorkFolderLock {
   bool waited_ = false;
 };
 
-/// Prints a warning on standard error once per scene file and provider.
-void warn_once(const Scene& scene, const std::string& provider, const char* topic, const std::string& text) {
+/// Prints on standard error, once per scene file and provider, the warning `text` makes (nothing
+/// where it makes none): `text` runs only the first time, so that a costly look at the scene is
+/// not repeated for every cell and frame.
+void warn_once(const Scene& scene, const std::string& provider, const char* topic,
+               const std::function<std::optional<std::string>()>& text) {
   static std::mutex mutex;
   static std::set<std::string> said;
   const std::lock_guard lock(mutex);
   if (!said.insert(scene.path + "\n" + provider + "\n" + topic).second) return;
-  print_warning(text);
+  if (const std::optional<std::string> warning = text()) print_warning(*warning);
 }
 
 /// Says once per scene file and provider, on standard error, that an external tool shows what
 /// this suite's renderer culls: glTF's single-sided materials (doubleSided false, the default)
 /// hide their back faces from camera rays here, while Cycles and POV-Ray draw both sides. Closed
-/// meshes (spheres, boxes) are left out: no eye outside them sees a back face.
+/// meshes wound outwards (spheres, boxes) are left out: no eye outside them sees a back face.
 void note_single_sided(const Scene& scene, const std::string& provider) {
   if (provider == "full") return;
-  size_t meshes = 0;
-  for (const Mesh& m : scene.meshes)
-    if (m.material >= 0 && !scene.materials[static_cast<size_t>(m.material)].double_sided && m.triangle_count() > 0 &&
-        !m.is_closed())
-      ++meshes;
-  if (meshes == 0) return;
-  warn_once(scene, provider, "single-sided",
-            fmt::format("{} mesh(es) of {} use single-sided materials: this suite's renderer hides their back faces "
-                        "from the eye, as glTF asks, while the {} ground truth shows them; where an eye sees one, the "
-                        "images differ for that reason (mark the materials doubleSided to compare like with like)",
-                        meshes, scene.path, provider));
+  warn_once(scene, provider, "single-sided", [&]() -> std::optional<std::string> {
+    size_t meshes = 0;
+    for (const Mesh& m : scene.meshes)
+      if (m.material >= 0 && !scene.materials[static_cast<size_t>(m.material)].double_sided && m.triangle_count() > 0 &&
+          !m.is_closed())
+        ++meshes;
+    if (meshes == 0) return std::nullopt;
+    return fmt::format("{} mesh(es) of {} use single-sided materials: this suite's renderer hides their back faces "
+                       "from the eye, as glTF asks, while the {} ground truth shows them; where an eye sees one, the "
+                       "images differ for that reason (mark the materials doubleSided to compare like with like)",
+                       meshes, scene.path, provider);
+  });
 }
 
 /// Says once per scene file and provider that an external tool samples textures without
@@ -89,18 +95,19 @@ void note_single_sided(const Scene& scene, const std::string& provider) {
 /// (docs/ground_truth.md, "the textured gap").
 void note_textured(const Scene& scene, const std::string& provider) {
   if (provider == "full") return;
-  size_t meshes = 0;
-  for (const Mesh& m : scene.meshes)
-    if (m.material >= 0 && scene.materials[static_cast<size_t>(m.material)].base_color_texture >= 0 &&
-        m.triangle_count() > 0)
-      ++meshes;
-  if (meshes == 0) return;
-  warn_once(scene, provider, "textured",
-            fmt::format("{} mesh(es) of {} are textured: the {} ground truth takes one bilinear texture sample per "
-                        "pixel, without the mip-mapping this suite's renderers use, so minified textures alias there "
-                        "and the per-pixel metrics measure mostly that (docs/ground_truth.md, the textured gap); "
-                        "compare textured scenes against --truth full",
-                        meshes, scene.path, provider));
+  warn_once(scene, provider, "textured", [&]() -> std::optional<std::string> {
+    size_t meshes = 0;
+    for (const Mesh& m : scene.meshes)
+      if (m.material >= 0 && scene.materials[static_cast<size_t>(m.material)].base_color_texture >= 0 &&
+          m.triangle_count() > 0)
+        ++meshes;
+    if (meshes == 0) return std::nullopt;
+    return fmt::format("{} mesh(es) of {} are textured: the {} ground truth takes one bilinear texture sample per "
+                       "pixel, without the mip-mapping this suite's renderers use, so minified textures alias there "
+                       "and the per-pixel metrics measure mostly that (docs/ground_truth.md, the textured gap); "
+                       "compare textured scenes against --truth full",
+                       meshes, scene.path, provider);
+  });
 }
 
 }  // namespace

@@ -112,11 +112,11 @@
   }
 
   /** The reason pipelines are missing from a chart: those whose every value is ∞ (`infiniteWhy`)
-   * and those with no value at all, named apart. '' when none is missing. */
+   * and those with no finite value otherwise (missing, NaN), named apart. '' when none is missing. */
   function omittedNote(infinite, missing, infiniteWhy) {
     const parts = [];
     if (infinite.length) parts.push(`${infiniteWhy || 'no finite value'}: ${infinite.join(', ')}`);
-    if (missing.length) parts.push(`no value recorded: ${missing.join(', ')}`);
+    if (missing.length) parts.push(`no finite value: ${missing.join(', ')}`);
     return parts.length ? ` Not plotted (${parts.join('; ')}).` : '';
   }
 

@@ -110,6 +110,23 @@ TEST(SceneRegistry, RejectsUnknownAndOutOfRangeParameters) {
   EXPECT_FALSE(fs::exists(dir / "cli")) << "an empty --out was left";
 }
 
+TEST(SceneRegistry, TheSpheresAreClosedSingleSidedMeshesAsLoaded) {
+  // Their back faces are culled (Kim's bidirectional warping assumes it), and the external truths'
+  // note on single-sided materials leaves them out as closed: both as the loader gives them.
+  ScratchDir dir("closedspheres");
+  GenerateOptions o;
+  o.params = {{"count", 12.0}};
+  const fs::path file = dir / "spheres.glb";
+  (void)generate("spheres", o, file);
+  const Scene scene = io::load_gltf(file);
+  ASSERT_EQ(scene.meshes.size(), 12u);
+  for (const Mesh& m : scene.meshes) {
+    ASSERT_GE(m.material, 0) << m.name;
+    EXPECT_FALSE(scene.materials[static_cast<size_t>(m.material)].double_sided) << m.name;
+    EXPECT_TRUE(m.is_closed()) << m.name;
+  }
+}
+
 TEST(SceneRegistry, AWriteThatFailsNamesTheFileAndLeavesNothing) {
   // A full disk, made by a file-size limit of 1 KiB (the signal sent at the limit ignored, so the
   // write fails with EFBIG): exit 4 naming the scene file and the cause, and no file left.

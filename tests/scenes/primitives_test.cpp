@@ -81,6 +81,9 @@ TEST(Primitives, ClosedSolidsAreClosedAndOpenOrMiswoundMeshesAreNot) {
   Mesh flipped = as_scene_mesh(make_box({0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}));
   std::swap(flipped.indices[0], flipped.indices[1]);  // one triangle wound the other way
   EXPECT_FALSE(flipped.is_closed());
+  Mesh inside_out = as_scene_mesh(make_box({0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}));
+  for (size_t t = 0; t < inside_out.indices.size(); t += 3) std::swap(inside_out.indices[t + 1], inside_out.indices[t + 2]);
+  EXPECT_FALSE(inside_out.is_closed()) << "closed, but only its back faces show from outside";
   EXPECT_FALSE(Mesh{}.is_closed());
 }
 
