@@ -274,35 +274,13 @@ void refuse_replacing_inputs(const std::filesystem::path& scene_file, const Scen
   }
 }
 
-namespace {
-
-/// The first of a path's folders, from the outside in, that does not exist (what making the path
-/// makes first); empty when the path exists.
-std::filesystem::path outermost_missing_folder(const std::filesystem::path& folder) {
-  std::error_code ec;
-  std::filesystem::path missing;
-  for (std::filesystem::path p = folder.lexically_normal();
-       !p.empty() && !std::filesystem::exists(std::filesystem::symlink_status(p, ec)); p = p.parent_path())
-    missing = p;
-  return missing;
-}
-
-}  // namespace
-
 void in_output_folder(const std::string& folder, const char* option, const std::function<void()>& work) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  const fs::path made = outermost_missing_folder(folder);  // the outermost folder this call makes
+  const std::filesystem::path made = io::outermost_missing_folder(folder);  // the outermost folder this call makes
   prepare_output_folder(folder, option);
   try {
     work();
   } catch (...) {
-    if (!made.empty()) {
-      bool holds_a_file = false;
-      for (fs::recursive_directory_iterator it(made, ec), end; !ec && it != end && !holds_a_file; it.increment(ec))
-        holds_a_file = !it->is_directory(ec);
-      if (!ec && !holds_a_file) fs::remove_all(made, ec);
-    }
+    io::remove_if_no_file(made);
     throw;
   }
 }
@@ -328,17 +306,9 @@ void prepare_output_file_folder(const std::string& file, const char* option) {
                               option, file, target.string()));
   const std::filesystem::path folder = std::filesystem::path(file).parent_path();
   if (folder.empty()) return;  // the current folder
-  // A missing folder is made and probed, then removed again: the write makes it for good
-  // (io::write_atomically), so a run refused after this check (a bad scene, too little memory)
-  // leaves no empty folder behind. (Only making it tells: /proc lets root pass an access check.)
-  const std::filesystem::path made = outermost_missing_folder(folder);
-  const std::optional<std::string> why = io::unwritable_folder(folder);
-  if (!made.empty())
-    for (std::filesystem::path p = folder.lexically_normal(); !p.empty(); p = p.parent_path()) {
-      std::filesystem::remove(p, ec);  // empty folders only; one holding a file stays
-      if (p == made) break;
-    }
-  if (why)
+  // A missing folder is made for the probe and removed again; the write makes it for good
+  // (io::write_atomically), so a run refused after this check leaves no empty folder behind.
+  if (const std::optional<std::string> why = io::folder_cannot_be_made(folder))
     throw IoError(
         fmt::format("{} {}: its folder {}: {}; give a path you can write", option, file, folder.string(), *why));
 }

@@ -70,8 +70,8 @@ struct NamedPath {
 /// another spelling of it, or through a link. Empty paths and "-" (standard output) are skipped.
 void refuse_overwriting(std::initializer_list<NamedPath> inputs, std::initializer_list<NamedPath> outputs);
 
-/// Refuses, before any work, an output folder named by `option` that plainly cannot be made or
-/// written (io::folder_cannot_be_made), without making it: prepare_output_folder makes it once the
+/// Refuses, before any work, an output folder named by `option` that cannot be made or written
+/// (io::folder_cannot_be_made, which leaves nothing made): prepare_output_folder makes it once the
 /// input is known to be good, so that a refused run leaves no empty folder. IoError as there.
 void check_output_folder(const std::string& folder, const char* option);
 

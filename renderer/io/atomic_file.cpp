@@ -548,17 +548,29 @@ std::optional<std::string> unwritable_folder(const fs::path& folder) {
   return std::nullopt;
 }
 
-std::optional<std::string> folder_cannot_be_made(const fs::path& folder) {
+fs::path outermost_missing_folder(const fs::path& folder) {
   std::error_code ec;
-  fs::path existing = folder;
-  while (!existing.empty() && !fs::exists(fs::symlink_status(existing, ec))) existing = existing.parent_path();
-  if (existing.empty()) existing = ".";
-  const bool whole = existing == folder;
-  if (!fs::is_directory(existing, ec)) return fmt::format("cannot create the folder ({})", std::strerror(ENOTDIR));
-  if (::access(existing.c_str(), W_OK | X_OK) != 0)
-    return whole ? fmt::format("cannot create a file in it ({})", std::strerror(errno))
-                 : fmt::format("cannot create the folder ({})", std::strerror(errno));
-  return std::nullopt;
+  fs::path missing;
+  for (fs::path p = folder.lexically_normal(); !p.empty() && !fs::exists(fs::symlink_status(p, ec)); p = p.parent_path())
+    missing = p;
+  return missing;
+}
+
+void remove_if_no_file(const fs::path& made) {
+  if (made.empty()) return;
+  std::error_code ec;
+  bool holds_a_file = false;
+  for (fs::recursive_directory_iterator it(made, ec), end; !ec && it != end && !holds_a_file; it.increment(ec))
+    holds_a_file = !it->is_directory(ec);
+  if (!ec && !holds_a_file) fs::remove_all(made, ec);
+}
+
+std::optional<std::string> folder_cannot_be_made(const fs::path& folder) {
+  // Tried, not guessed: an access check lets root pass /proc, where no folder can be made.
+  const fs::path made = outermost_missing_folder(folder);
+  std::optional<std::string> why = unwritable_folder(folder);
+  remove_if_no_file(made);
+  return why;
 }
 
 std::string read_file(const fs::path& path) {

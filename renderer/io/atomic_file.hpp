@@ -105,11 +105,18 @@ void write_text_atomically(const std::filesystem::path& path, const std::string&
 /// not when the first is written. Why the folder cannot be written, or nothing.
 [[nodiscard]] std::optional<std::string> unwritable_folder(const std::filesystem::path& folder);
 
-/// Why `folder` could not be made or written, as far as it shows without making anything: its
-/// nearest existing ancestor is not a folder or may not be written. The text matches
-/// unwritable_folder's. Nothing when it looks possible (unwritable_folder, once the input is known
-/// to be good, has the last word).
+/// Why `folder` could not be made or written, as unwritable_folder finds, leaving nothing behind:
+/// the folders it makes for the probe are removed again. For a check before the work, so that a
+/// run refused later leaves no empty folder; nothing when it can be.
 [[nodiscard]] std::optional<std::string> folder_cannot_be_made(const std::filesystem::path& folder);
+
+/// The first of a path's folders, from the outside in, that does not exist (what making the path
+/// makes first); empty when the path exists.
+[[nodiscard]] std::filesystem::path outermost_missing_folder(const std::filesystem::path& folder);
+
+/// Removes `made`, a folder a run made, with the folders below it, when no file lies in it at any
+/// depth (best effort): a run that stops before writing leaves no empty folder. Nothing for "".
+void remove_if_no_file(const std::filesystem::path& made);
 
 /// Reads a whole file, or a pipe to its end; InputError for a folder or a device (which may never
 /// end), IoError naming the path if it cannot be read.

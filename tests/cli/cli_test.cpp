@@ -241,6 +241,12 @@ TEST(Cli, APathUnderProcThatIsNoOpenFileIsAnUnwritableFolderNamedByItsOption) {
   EXPECT_EQ(r.code, 4) << r.out;
   EXPECT_NE(r.out.find("--json /proc/x/y.json: its folder /proc/x"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("per-stage"), std::string::npos) << "refused before the timing: " << r.out;
+  // An --out there is refused before the scene is even looked up: the check made before the work
+  // tries the folder (it asked access(), which lets root pass /proc, and the refusal came once the
+  // scene had loaded).
+  r = test::run_cli("render --scene no-such-scene --resolution 32x18 --out /proc/x/out");
+  EXPECT_EQ(r.code, 4) << r.out;
+  EXPECT_NE(r.out.find("--out /proc/x/out: cannot create the folder"), std::string::npos) << r.out;
   test::ScratchDir dir("procscenes");
   r = test::run_cli("render --scene lit-plane --resolution 32x18 --scenes-dir /proc/x --out " + test::quoted(dir / "o"));
   EXPECT_EQ(r.code, 4) << r.out;
