@@ -158,12 +158,11 @@ void run_validate(const ValidateArgs& a) {
   // Made once the input is known to be good, and removed again if the run stops before writing
   // into it: a refused or failed run leaves no empty folder behind.
   in_output_folder(a.out, "--out", [&] {
+    const std::string scene_stem = fmt::format("{}_{}", scene.file_stem(), provider->name());
     // Before the truth renders (with Blender, hours): every file this run writes or retires is
-    // named <stem>_<provider>_..., <stem>_truth-... or <stem>_disocclusions-....
-    const std::string file_stem = scene.file_stem();
+    // named <scene_stem>_..., <stem>_truth-... or <stem>_disocclusions-....
     refuse_replacing_inputs(loaded.file, scene, a.out,
-                            {fmt::format("{}_{}_", file_stem, provider->name()), file_stem + "_truth-",
-                             file_stem + "_disocclusions-"},
+                            {scene_stem + "_", scene.file_stem() + "_truth-", scene.file_stem() + "_disocclusions-"},
                             "validation");
     const RenderScene prepared(scene);
     fmt::print("validating {} pipeline(s) on {} ({} triangles, {}), {}, {} threads, truth: {}\n", chosen.size(),
@@ -171,7 +170,6 @@ void run_validate(const ValidateArgs& a) {
                describe(rig), executor.threads(), provider->name());
 
     const fs::path out = a.out;
-    const std::string scene_stem = fmt::format("{}_{}", scene.file_stem(), provider->name());
     const fs::path summary = out / fmt::format("{}_summary.json", scene_stem);
     const auto record_file = [&](const std::string& pipeline) {
       return out / fmt::format("{}_{}.json", scene_stem, entry_file_stem(pipeline));

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <set>
 #include <sstream>
@@ -17,6 +16,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
+#include "renderer/io/json_text.hpp"
 #include "renderer/pipeline.hpp"
 #include "renderer/text.hpp"
 #include "scenes/catalog.hpp"
@@ -803,11 +803,13 @@ std::optional<GateCheck> completeness_check(const GateResults& results) {
     // A submission continues only with its shard count (the default, one shard per cell, differs
     // from any other --shards it was made with): the submission's record, else the lines'.
     std::optional<uint64_t> shards;
-    if (std::ifstream in(slurm.submission); in) {
-      const json submission = json::parse(in, nullptr, false);
-      if (submission.is_object() && submission.value("shards", json()).is_number_unsigned())
-        shards = submission["shards"].get<uint64_t>();
-    }
+    if (fs::is_regular_file(slurm.submission, ec)) try {
+        const json submission = io::parse_json(io::read_file(slurm.submission));
+        if (submission.is_object() && submission.value("shards", json()).is_number_unsigned())
+          shards = submission["shards"].get<uint64_t>();
+      } catch (const std::exception&) {
+        // unreadable: the lines' count below
+      }
     if (!shards && recorded_shard) shards = recorded_shard->second;
     if (shards) check.reproduce += fmt::format(" --shards {}", *shards);
   } else {

@@ -590,12 +590,12 @@ class OneSweep {
           first["sweep"].get<std::string>(), first.value("definition_sha256", "?").substr(0, 12)));
     // Every cell of a definition validates every pipeline of it: a cell without one would let the
     // gate pass that pipeline there unchecked.
-    const auto names = recorded_pipelines;
-    if (names(cell) != names(first))
+    if (recorded_pipelines(cell) != recorded_pipelines(first))
       throw InputError(fmt::format("{}: the cell validates pipelines {}, but {} of the same definition validates {}; "
                                    "every cell of a sweep validates every pipeline — cells run by builds with other "
                                    "pipelines (where the definition lists \"all\"), or a file edited by hand",
-                                   where, fmt::join(names(cell), ", "), first_name_, fmt::join(names(first), ", ")));
+                                   where, fmt::join(recorded_pipelines(cell), ", "), first_name_,
+                                   fmt::join(recorded_pipelines(first), ", ")));
     if (cell.value("cell_count", json()) != first.value("cell_count", json()))
       throw InputError(fmt::format("{}: cell_count {}, but {} of the same definition says {}; cells run by builds "
                                    "that expand the definition differently, or a file edited by hand",

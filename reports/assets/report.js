@@ -111,20 +111,33 @@
     } };
   }
 
-  /** The reason pipelines are missing from a chart: those whose every value is ∞ (`infiniteWhy`)
-   * and those with no finite value otherwise (missing, NaN), named apart. '' when none is missing. */
+  /** Why pipelines are missing from a chart: where the chart says why a value is ∞
+   * (`infiniteWhy`), those whose values are ∞ apart from those with no finite value otherwise
+   * (missing, NaN); '' when none is missing. */
   function omittedNote(infinite, missing, infiniteWhy) {
     const parts = [];
-    if (infinite.length) parts.push(`${infiniteWhy || 'no finite value'}: ${infinite.join(', ')}`);
-    if (missing.length) parts.push(`no finite value: ${missing.join(', ')}`);
+    if (infinite.length && infiniteWhy) parts.push(`${infiniteWhy}: ${infinite.join(', ')}`);
+    const plain = infiniteWhy ? missing : [...infinite, ...missing];
+    if (plain.length) parts.push(`no finite value: ${plain.join(', ')}`);
     return parts.length ? ` Not plotted (${parts.join('; ')}).` : '';
   }
 
-  /** The radius of line markers for `points` points along a line: markers on every point of a long
-   * series merge into bands, so smaller, then none (the line and the tooltips remain). */
-  function markerRadius(points) {
-    return points <= 30 ? 5 : points <= 120 ? 2 : 0;
+  /**
+   * The line of pipeline `label` in a chart: its style, and markers whose radius suits `along`
+   * points per line (markers on every point of a long series merge into bands: smaller, then none;
+   * the line and the tooltips remain). A line with one finite value has no line to show it: its
+   * marker stays.
+   */
+  function lineDataset(label, data, style, along) {
+    const finite = data.filter((v) => v !== null && (typeof v !== 'object' || v.y !== null)).length;
+    return { label, data, borderColor: style.color, backgroundColor: style.color, pointStyle: style.marker,
+      pointRadius: finite < 2 || along <= 30 ? 5 : along <= 120 ? 2 : 0, pointHitRadius: 6, borderWidth: 2,
+      borderDash: style.dash, spanGaps: true, clip: 8 };
   }
+
+  /** The legend of the line charts: below the plot, the first pipelines first (their lines are
+   * drawn last, on top), as tall as it needs (keepPlotHeight keeps the plot's height). */
+  const lineLegend = { position: 'bottom', reverse: true, maxHeight: 100000, labels: { usePointStyle: true } };
 
   /** Metres as given, to nine significant digits (0.501 m is not 0.50 m). */
   function metres(v) {
@@ -283,11 +296,8 @@
         // Pipelines with equal values (e.g. two exact ones) overlap: each has its own marker and
         // dash pattern, and the first pipelines are drawn last (on top, datasets are added in
         // reverse and the legend reversed back), so that both stay visible; clip keeps edge markers whole.
-        const style = lineStyle(pipelines.indexOf(p));
-        datasets.unshift({ label: p, data: opts.linear ? keys.map((key, i) => ({ x: opts.order(key), y: points[i] })) : points,
-          borderColor: style.color, backgroundColor: style.color, pointStyle: style.marker,
-          pointRadius: points.filter((v) => v !== null).length < 2 ? 5 : markerRadius(keys.length), pointHitRadius: 6,
-          borderWidth: 2, borderDash: style.dash, spanGaps: true, clip: 8 });
+        datasets.unshift(lineDataset(p, opts.linear ? keys.map((key, i) => ({ x: opts.order(key), y: points[i] })) : points,
+          lineStyle(pipelines.indexOf(p)), keys.length));
       }
       let why = omittedNote(infinite, missing, opts.omittedWhy);
       if (keys.length === 1) why += ` These cells share one value of the ${opts.axis}: one point per pipeline.`;
@@ -302,7 +312,7 @@
       y: axis(opts.yTitle, opts.yExtra || {}),
     };
     const config = { type: 'line', data: first.data, plugins: [keepPlotHeight(200)],
-      options: { scales, plugins: { legend: { position: 'bottom', reverse: true, maxHeight: 100000, labels: { usePointStyle: true } } } } };
+      options: { scales, plugins: { legend: lineLegend } } };
     const context = (g, b) => (g.label ? ` Shown: ${g.label} (${b.count} of ${cells.length} cells).` : '');
     // A first guess of the box: the plot and a legend row per five pipelines (keepPlotHeight
     // corrects it as laid out).
@@ -972,7 +982,6 @@
     const tickLabel = (i) => (oneADay ? days[i] : labels[i].slice(0, 16));
     const runAxis = (extra) => axis('run (UTC)', Object.assign({ ticks: { maxRotation: 0, autoSkip: true, autoSkipPadding: 12,
       callback: (value) => tickLabel(value) } }, extra));
-    const radius = markerRadius(runs.length);
     // This report's pipelines first (their styles as elsewhere), then those only earlier runs had,
     // with the styles after this report's.
     const names = distinct([...pipelines, ...runs.flatMap((r) => Object.keys(r.pipelines || {}))])
@@ -992,17 +1001,13 @@
           (values.some((v) => Math.abs(v) === Infinity) ? infinite : missing).push(p);
           return;
         }
-        const style = styleOf(p);
-        datasets.unshift({ label: p, data: points, borderColor: style.color, backgroundColor: style.color,
-          // A pipeline with one finite value has no line to show it: its marker stays.
-          pointStyle: style.marker, pointRadius: points.filter((v) => v !== null).length < 2 ? 5 : radius,
-          pointHitRadius: 6, borderWidth: 2, borderDash: style.dash, spanGaps: true, clip: 8 });
+        datasets.unshift(lineDataset(p, points, styleOf(p), runs.length));
       });
       if (datasets.length === 0) return null;
       const why = omittedNote(infinite, missing, omittedWhy);
       const config = { type: 'line', data: { labels, datasets }, plugins: [keepPlotHeight(200)],
         options: { scales: { x: runAxis({ offset: true }), y: axis(yTitle) },
-          plugins: { legend: { position: 'bottom', reverse: true, maxHeight: 100000, labels: { usePointStyle: true } } } } };
+          plugins: { legend: lineLegend } } };
       return chartFigure(title, `${caption} ${runText}.${why}`, config, 230 + 24 * Math.ceil(names.length / 5));
     };
 

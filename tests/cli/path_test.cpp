@@ -28,22 +28,34 @@ std::vector<json> frame_lines(const std::filesystem::path& file) {
   return frames;
 }
 
+/// A box on a floor before a wall, lit by a lamp, its camera keyed 0.5 m along +X in 2 s; with
+/// `box_moves` the box too, 1 m along +X. Written to `file`.
+void write_keyed_box_scene(const std::filesystem::path& file, bool box_moves) {
+  scenes::GltfBuilder b("path-animation-test", 1);
+  const int grey = b.add_material("grey", vec3(0.6f));
+  const int box = b.add_node("box", b.add_mesh("box", scenes::make_box(vec3(-0.3f, 0.0f, -0.3f), vec3(0.3f, 0.6f, 0.3f)), grey));
+  b.add_node("wall", b.add_mesh("wall", scenes::make_box(vec3(-3.0f, 0.0f, -2.2f), vec3(3.0f, 2.5f, -2.0f)), grey));
+  b.add_node("floor", b.add_mesh("floor", scenes::make_box(vec3(-3.0f, -0.1f, -2.0f), vec3(3.0f, 0.0f, 2.0f)), grey));
+  b.add_point_light("lamp", vec3(1.0f, 2.0f, 2.0f), vec3(1.0f), 15.0f);
+  RigDefaults rig;
+  rig.width = 96;
+  rig.height = 54;
+  const int camera = b.set_camera("camera", CameraPose::look_at(dvec3(0.0, 1.0, 4.0), dvec3(0.0, 0.6, 4.0 - 1.0)), 0.8,
+                                  0.05, 0.0, rig);
+  const std::vector<float> times = {0.0f, 2.0f};
+  if (box_moves) {
+    const std::vector<float> box_keys = {0, 0, 0, 1, 0, 0};
+    b.add_animation_channel(box, "translation", times, box_keys);
+  }
+  const std::vector<float> camera_keys = {0, 1, 4, 0.5f, 1, 4};
+  b.add_animation_channel(camera, "translation", times, camera_keys);
+  b.write(file);
+}
+
 TEST(PathCommand, ABvhUpdateIsRefusedWhereTheAnimationMovesNoMesh) {
   test::ScratchDir dir;
   // Only the camera is keyed: no mesh moves, so no BVH is ever updated.
-  scenes::GltfBuilder b("camera-only-animation", 1);
-  const int grey = b.add_material("grey", vec3(0.6f));
-  b.add_node("box", b.add_mesh("box", scenes::make_box(vec3(-0.3f, 0.0f, -0.3f), vec3(0.3f, 0.6f, 0.3f)), grey));
-  b.add_point_light("lamp", vec3(1.0f, 2.0f, 2.0f), vec3(1.0f), 15.0f);
-  RigDefaults rig;
-  rig.width = 64;
-  rig.height = 36;
-  const int camera = b.set_camera("camera", CameraPose::look_at(dvec3(0.0, 1.0, 4.0), dvec3(0.0, 0.6, 3.0)), 0.8,
-                                  0.05, 0.0, rig);
-  const std::vector<float> times = {0.0f, 1.0f};
-  const std::vector<float> keys = {0, 1, 4, 0.5f, 1, 4};
-  b.add_animation_channel(camera, "translation", times, keys);
-  b.write(dir / "camera-only.gltf");
+  write_keyed_box_scene(dir / "camera-only.gltf", false);
   const std::string base = "path --scene '" + (dir / "camera-only.gltf").string() + "' --out '" +
                            (dir / "out").string() + "' --frames 2 --pipelines plain-rt --gltf-animation";
   const test::CliRun refused = test::run_cli(base + " --bvh rebuild");
@@ -60,24 +72,7 @@ TEST(PathCommand, ABvhUpdateIsRefusedWhereTheAnimationMovesNoMesh) {
 
 TEST(PathCommand, TheScenesGltfAnimationMovesItsMeshAndCamera) {
   test::ScratchDir dir;
-  // A box on a floor before a wall, the box keyed 1 m along +X and the camera 0.5 m along +X in 2 s.
-  scenes::GltfBuilder b("path-animation-test", 1);
-  const int grey = b.add_material("grey", vec3(0.6f));
-  const int box = b.add_node("box", b.add_mesh("box", scenes::make_box(vec3(-0.3f, 0.0f, -0.3f), vec3(0.3f, 0.6f, 0.3f)), grey));
-  b.add_node("wall", b.add_mesh("wall", scenes::make_box(vec3(-3.0f, 0.0f, -2.2f), vec3(3.0f, 2.5f, -2.0f)), grey));
-  b.add_node("floor", b.add_mesh("floor", scenes::make_box(vec3(-3.0f, -0.1f, -2.0f), vec3(3.0f, 0.0f, 2.0f)), grey));
-  b.add_point_light("lamp", vec3(1.0f, 2.0f, 2.0f), vec3(1.0f), 15.0f);
-  RigDefaults rig;
-  rig.width = 96;
-  rig.height = 54;
-  const int camera = b.set_camera("camera", CameraPose::look_at(dvec3(0.0, 1.0, 4.0), dvec3(0.0, 0.6, 4.0 - 1.0)), 0.8,
-                                  0.05, 0.0, rig);
-  const std::vector<float> times = {0.0f, 2.0f};
-  const std::vector<float> box_keys = {0, 0, 0, 1, 0, 0};
-  b.add_animation_channel(box, "translation", times, box_keys);
-  const std::vector<float> camera_keys = {0, 1, 4, 0.5f, 1, 4};
-  b.add_animation_channel(camera, "translation", times, camera_keys);
-  b.write(dir / "moving.gltf");
+  write_keyed_box_scene(dir / "moving.gltf", true);
   const std::string base = "path --scene '" + (dir / "moving.gltf").string() + "' --threads 2 --out '" +
                            (dir / "out").string() + "' --frames 3";
   const test::CliRun r = test::run_cli(base + " --gltf-animation --pipelines plain-rt,repro-rt");
