@@ -168,28 +168,73 @@ size_t Scene::triangle_count() const {
 }
 
 bool Mesh::is_closed() const {
-  using Corner = std::array<float, 3>;
-  using Edge = std::pair<Corner, Corner>;
-  std::vector<Edge> edges;  // directed, from each triangle with three distinct corners
+  // Corners by position: vertices repeated along a seam (other normals or texture coordinates)
+  // are one corner. Sorting the vertices by position numbers the distinct positions.
+  const size_t n = positions.size();
+  if (n == 0 || n >= (size_t{1} << 31)) return false;
+  for (const vec3& p : positions)
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return false;
+  std::vector<uint32_t> order(n);
+  for (size_t i = 0; i < n; ++i) order[i] = static_cast<uint32_t>(i);
+  const auto less = [this](uint32_t a, uint32_t b) {
+    const vec3 &p = positions[a], &q = positions[b];
+    return p.x != q.x ? p.x < q.x : p.y != q.y ? p.y < q.y : p.z < q.z;
+  };
+  std::sort(order.begin(), order.end(), less);
+  std::vector<uint32_t> corner(n);
+  uint32_t distinct = 0;
+  for (size_t k = 0; k < n; ++k) {
+    if (k > 0 && less(order[k - 1], order[k])) ++distinct;
+    corner[order[k]] = distinct;
+  }
+  // Every directed edge of a triangle with three distinct corners, keyed by its undirected edge
+  // (lower corner, higher corner) with its direction in the lowest bit; the corners joined into
+  // connected parts, each with six times the signed volume it encloses.
+  std::vector<uint64_t> edges;
   edges.reserve(indices.size());
-  double volume6 = 0.0;  // six times the signed volume enclosed
-  const auto corner = [this](uint32_t i) { return Corner{positions[i].x, positions[i].y, positions[i].z}; };
+  std::vector<uint32_t> part(distinct + 1);
+  for (uint32_t c = 0; c <= distinct; ++c) part[c] = c;
+  const auto root = [&part](uint32_t c) {
+    while (part[c] != c) c = part[c] = part[part[c]];
+    return c;
+  };
   for (size_t t = 0; t + 2 < indices.size(); t += 3) {
-    const Corner c[3] = {corner(indices[t]), corner(indices[t + 1]), corner(indices[t + 2])};
+    if (indices[t] >= n || indices[t + 1] >= n || indices[t + 2] >= n) return false;
+    const uint32_t c[3] = {corner[indices[t]], corner[indices[t + 1]], corner[indices[t + 2]]};
     if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) continue;  // a collapsed triangle (a pole's)
-    for (int k = 0; k < 3; ++k) edges.emplace_back(c[k], c[(k + 1) % 3]);
-    const dvec3 p0(positions[indices[t]]), p1(positions[indices[t + 1]]), p2(positions[indices[t + 2]]);
-    volume6 += glm::dot(p0, glm::cross(p1, p2));
+    for (int k = 0; k < 3; ++k) {
+      const uint64_t a = c[k], b = c[(k + 1) % 3];
+      edges.push_back((std::min(a, b) << 33) | (std::max(a, b) << 1) | (a > b ? 1u : 0u));
+    }
+    part[root(c[1])] = root(c[0]);
+    part[root(c[2])] = root(c[0]);
   }
   if (edges.empty()) return false;
+  // Closed: every edge is met as often in one direction as in the other (once each on a manifold
+  // surface; parts that share an edge, as boxes of a wall standing edge to edge, meet it twice).
   std::sort(edges.begin(), edges.end());
-  for (size_t i = 0; i < edges.size(); ++i) {
-    if (i + 1 < edges.size() && edges[i + 1] == edges[i]) return false;  // an edge met twice one way
-    if (!std::binary_search(edges.begin(), edges.end(), Edge{edges[i].second, edges[i].first})) return false;
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i;
+    int64_t balance = 0;
+    for (; j < edges.size() && (edges[j] >> 1) == (edges[i] >> 1); ++j) balance += (edges[j] & 1u) != 0 ? 1 : -1;
+    if (balance != 0) return false;
+    i = j;
   }
-  // Wound outwards (triangles counter-clockwise seen from outside, as the positions and indices
-  // of a mirrored mesh are too): an inside-out mesh shows only back faces from outside.
-  return volume6 > 0.0;
+  // Wound outwards, each part (triangles counter-clockwise seen from outside, as the positions and
+  // indices of a mirrored mesh are too): an inside-out part shows only back faces from outside.
+  std::vector<double> volume6(distinct + 1, 0.0);
+  std::vector<uint8_t> faces(distinct + 1, 0);  // parts of collapsed triangles alone enclose nothing
+  for (size_t t = 0; t + 2 < indices.size(); t += 3) {
+    const uint32_t c0 = corner[indices[t]], c1 = corner[indices[t + 1]], c2 = corner[indices[t + 2]];
+    if (c0 == c1 || c1 == c2 || c2 == c0) continue;
+    const dvec3 p0(positions[indices[t]]), p1(positions[indices[t + 1]]), p2(positions[indices[t + 2]]);
+    const uint32_t r = root(c0);
+    volume6[r] += glm::dot(p0, glm::cross(p1, p2));
+    faces[r] = 1;
+  }
+  for (uint32_t c = 0; c <= distinct; ++c)
+    if (faces[c] != 0 && !(volume6[c] > 0.0)) return false;
+  return true;
 }
 
 bool Mesh::zero_area(size_t t) const {

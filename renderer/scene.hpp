@@ -68,9 +68,10 @@ struct Mesh {
   /// pixel and no ray hits it.
   [[nodiscard]] bool zero_area(size_t t) const;
   /// Whether the mesh is closed and wound outwards: every edge of a triangle with three distinct
-  /// corners (by position, so that vertices repeated along a seam count as one) is met once in
-  /// each direction, and the volume it encloses is positive (triangles counter-clockwise seen
-  /// from outside). An eye outside such a mesh never sees a back face of it.
+  /// corners (by position, so that vertices repeated along a seam count as one) is met as often in
+  /// one direction as in the other (once each, or more where closed parts share an edge), and each
+  /// connected part encloses a positive volume (triangles counter-clockwise seen from outside). An
+  /// eye outside such a mesh never sees a back face of it.
   [[nodiscard]] bool is_closed() const;
 };
 

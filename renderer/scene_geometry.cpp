@@ -43,6 +43,9 @@ SceneGeometry::SceneGeometry(const Scene& s) : scene(&s) {
     cutout_of.push_back(m.material >= 0 && static_cast<size_t>(m.material) < s.materials.size()
                             ? material_cutout[static_cast<size_t>(m.material)]
                             : -1);
+  closed.reserve(s.meshes.size());
+  for (size_t m = 0; m < s.meshes.size(); ++m)
+    closed.push_back(single_sided[m] == 0 && cutout_of[m] < 0 && s.meshes[m].is_closed() ? 1 : 0);
 }
 
 bool SceneGeometry::opaque_at(uint32_t mesh, uint32_t tri, vec2 bary) const {

@@ -28,6 +28,10 @@ struct SceneGeometry {
   const Scene* scene = nullptr;
   std::vector<uint32_t> first_triangle;  ///< size meshes + 1 (prefix sums)
   std::vector<uint8_t> single_sided;     ///< per mesh: 1 = back faces are culled (material not double-sided)
+  /// Per mesh: 1 = double-sided, opaque everywhere, and closed and wound outwards as loaded
+  /// (Mesh::is_closed): seen from outside, with no plane cutting it open, its front faces hide every
+  /// back face, so culling them changes no image (Kim's redirection relies on that).
+  std::vector<uint8_t> closed;
   /// Per mesh: index into `cutouts`, or -1 for a mesh that is opaque everywhere.
   std::vector<int32_t> cutout_of;
   std::vector<Cutout> cutouts;

@@ -62,7 +62,9 @@ MeshData make_column(const ColumnSpec& s) {
     CylinderOptions o;
     o.radius_top = rt;
     o.rings = s.rings;
-    o.caps = false;
+    // Capped, though the caps lie hidden in the base and the capital: the column is then a closed
+    // solid, which lets Kim's redirection cull its back faces (culled_meshes).
+    o.caps = true;
     o.flutes = s.flutes;
     o.flute_depth = s.flute_depth;
     o.uv_per_meter = uv;

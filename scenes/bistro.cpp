@@ -83,7 +83,9 @@ MeshData make_chair() {
     const float a = 2.0f * kPiF * static_cast<float>(i) / 40.0f;
     loop.push_back({0.09f * std::sin(a), 0.7f + 0.1f * std::cos(a), -0.215f - 0.01f * std::cos(a)});
   }
-  append_mesh(m, make_tube(loop, std::vector<float>(loop.size(), 0.009f), 8, false));
+  // Capped: the loop's two ends meet only to rounding (and at different tilts), and the chair is
+  // then a closed solid, which lets Kim's redirection cull its back faces (culled_meshes).
+  append_mesh(m, make_tube(loop, std::vector<float>(loop.size(), 0.009f), 8, true));
   m.uvs.clear();
   return m;
 }

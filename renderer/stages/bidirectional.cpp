@@ -129,6 +129,11 @@ std::vector<OptionSpec> bidir_option_specs(bool traced) {
            "it; the other eye shows what lies behind it where only that eye sees it, as beside a wall wider than both "
            "images, and a sliver near a border can go to the eye that sees none of it) or both (each eye whose image "
            "it reaches rasterizes it)"},
+          {"cull_closed", "true",
+           "true: a double-sided mesh that is closed and wound outwards, with every vertex beyond both eyes' near "
+           "planes, has its back faces culled like a single-sided one's (they are hidden in a full render; Kim's "
+           "redirection assumes culling, and an eye that rasterizes such a mesh's back triangles shows its inside); "
+           "false: only single-sided materials are culled"},
           {"partials", "false",
            "also output each eye's partial image (<stem>_left_partial.png, <stem>_right_partial.png; render, validate and "
            "sweep cells write them)"}};
@@ -140,6 +145,7 @@ BidirSettings BidirSettings::from(const std::string& pipeline, const PipelineOpt
   s.max_crack = max_crack_option(pipeline, options);
   s.warp.segment = options.get_int("segment");
   s.keep_partials = options.get_bool("partials");
+  s.cull_closed = options.get_bool("cull_closed");
   if (s.warp.segment < 1)
     throw InputError(fmt::format("{}: option segment={} must be at least 1 pixel", pipeline, s.warp.segment));
   const std::string& occlusion = options.get("occlusion");
@@ -170,11 +176,16 @@ void render_bidirectional(const RenderScene& scene, const StereoRig& rig, const 
   std::vector<uint8_t> bits;
   {
     ScopedStage stage(r.timings, "redirect", StageEye::both);
-    bits = redirect_triangles(scene.geometry(), rig, executor, sent, settings.clipped);
+    uint64_t closed_culled = 0;
+    const std::vector<uint8_t> culled =
+        culled_meshes(scene.geometry(), rig, executor, settings.cull_closed, closed_culled);
+    bits = redirect_triangles(scene.geometry(), rig, culled, executor, sent, settings.clipped);
+    r.counters.set("meshes_closed_culled", closed_culled);
   }
   r.counters.set("triangles_to_left", sent.left);
   r.counters.set("triangles_to_right", sent.right);
   r.counters.set("triangles_to_both", sent.both);
+  r.counters.set("triangles_culled", sent.culled);
   Image left, right;
   if (settings.ztest) {
     std::tie(left, right) = ztest_partials(scene, rig, bits, settings, executor, r);

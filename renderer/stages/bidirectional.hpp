@@ -31,6 +31,9 @@ struct BidirSettings {
   bool ztest = false;
   /// Where a triangle both frusta clip goes (eq. (1) as published: one eye).
   ClippedRule clipped = ClippedRule::one;
+  /// Cull the back faces of double-sided closed meshes that both eyes see from outside
+  /// (culled_meshes), as those of single-sided ones.
+  bool cull_closed = true;
 
   /// From the options of bidir_option_specs(); InputError for values out of range.
   static BidirSettings from(const std::string& pipeline, const PipelineOptions& options);
@@ -43,7 +46,8 @@ struct BidirSettings {
 /// Renders both eyes of `result` (stages redirect, left_gbuffer, left_shading, right_gbuffer,
 /// right_shading, motion, warp, crack_fill; with ztest the G-buffers come first, then stage ztest,
 /// then the shading). Pixels no partial image covers stay tagged `hole` (radiance 0, depth +inf)
-/// for the caller to fill. Counts triangles sent left, right and both, pixels warped into each eye,
+/// for the caller to fill. Counts triangles sent left, right, both and to neither (culled), the
+/// double-sided closed meshes culled (meshes_closed_culled), pixels warped into each eye,
 /// the crack fill of each eye and, with ztest, each eye's pixels hidden from the other
 /// (pixels_hidden_in_other_<eye>). With keep_partials, the partial
 /// images go to result.extras as "left_partial" and "right_partial" (the paper's Fig. 3).

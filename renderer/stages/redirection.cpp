@@ -95,18 +95,54 @@ uint8_t redirect(const EyeCamera& left, const EyeCamera& right, const dvec3& v0,
   return redirect_from(left, right, xl, xr, v0, v1, v2, single_sided, clipped);
 }
 
-std::vector<uint8_t> redirect_triangles(const SceneGeometry& geometry, const StereoRig& rig, const Executor& executor,
+std::vector<uint8_t> culled_meshes(const SceneGeometry& geometry, const StereoRig& rig, const Executor& executor,
+                                   bool closed_too, uint64_t& closed_culled) {
+  const Scene& scene = *geometry.scene;
+  const EyeCamera eyes[2] = {rig.eye(Eye::left), rig.eye(Eye::right)};
+  std::vector<uint8_t> culled(geometry.single_sided);
+  std::atomic<uint64_t> n{0};
+  if (!closed_too) {
+    closed_culled = 0;
+    return culled;
+  }
+  executor.for_each(scene.meshes.size(), [&](size_t m) {
+    if (geometry.closed[m] == 0) return;
+    const Mesh& mesh = scene.meshes[m];
+    // A transform that mirrors turns the loaded winding inside out.
+    const double det = glm::determinant(dmat3(mesh.moved));
+    if (!(det > 0.0)) return;
+    std::atomic<bool> near{false};
+    executor.for_range(mesh.positions.size(), 16384, [&](size_t begin, size_t end) {
+      for (size_t v = begin; v < end && !near.load(std::memory_order_relaxed); ++v) {
+        const dvec3 p(mesh.positions[v]);
+        for (const EyeCamera& eye : eyes)
+          // Not beyond the near plane (NaN too): the plane may cut the mesh open, or the eye lie in it.
+          if (!(-glm::dot(p - eye.origin, eye.back) > eye.znear)) near.store(true, std::memory_order_relaxed);
+      }
+    });
+    if (near.load()) return;
+    culled[m] = 1;
+    ++n;
+  });
+  closed_culled = n;
+  return culled;
+}
+
+std::vector<uint8_t> redirect_triangles(const SceneGeometry& geometry, const StereoRig& rig,
+                                        const std::vector<uint8_t>& culled, const Executor& executor,
                                         RedirectionCounts& counts, ClippedRule clipped) {
   const Scene& scene = *geometry.scene;
+  if (culled.size() != scene.meshes.size())
+    throw std::logic_error("redirect_triangles: one culling flag per mesh expected");
   const EyeCamera left = rig.eye(Eye::left), right = rig.eye(Eye::right);
   std::vector<uint8_t> bits(geometry.triangle_count(), 0);
-  std::atomic<uint64_t> n_left{0}, n_right{0}, n_both{0};
+  std::atomic<uint64_t> n_left{0}, n_right{0}, n_both{0}, n_none{0};
   // Meshes in parallel, and a large mesh's vertices and triangles in parallel within it: every
   // vertex projected into both eyes once (a vertex is shared by about six triangles), then every
   // triangle compared from its vertices' projections. The decisions are those of redirect().
   executor.for_each(scene.meshes.size(), [&](size_t m) {
     const Mesh& mesh = scene.meshes[m];
-    const bool single_sided = geometry.single_sided[m] != 0;
+    const bool cull = culled[m] != 0;
     const size_t vertices = mesh.positions.size();
     std::vector<double> ndc(2 * vertices);
     executor.for_range(vertices, 4096, [&](size_t begin, size_t end) {
@@ -117,22 +153,27 @@ std::vector<uint8_t> redirect_triangles(const SceneGeometry& geometry, const Ste
       }
     });
     executor.for_range(mesh.triangle_count(), 4096, [&](size_t begin, size_t end) {
-      uint64_t l = 0, r = 0, b = 0;
+      uint64_t l = 0, r = 0, b = 0, none = 0;
       for (size_t t = begin; t < end; ++t) {
         const uint32_t i0 = mesh.indices[3 * t], i1 = mesh.indices[3 * t + 1], i2 = mesh.indices[3 * t + 2];
         const double xl[3] = {ndc[2 * i0], ndc[2 * i1], ndc[2 * i2]};
         const double xr[3] = {ndc[2 * i0 + 1], ndc[2 * i1 + 1], ndc[2 * i2 + 1]};
-        const uint8_t to = redirect_from(left, right, xl, xr, dvec3(mesh.positions[i0]), dvec3(mesh.positions[i1]),
-                                         dvec3(mesh.positions[i2]), single_sided, clipped);
+        const dvec3 v0(mesh.positions[i0]), v1(mesh.positions[i1]), v2(mesh.positions[i2]);
+        uint8_t to = redirect_from(left, right, xl, xr, v0, v1, v2, cull, clipped);
+        if (cull) {
+          if (!front_facing(v0, v1, v2, left.origin)) to &= static_cast<uint8_t>(~kRedirectLeft);
+          if (!front_facing(v0, v1, v2, right.origin)) to &= static_cast<uint8_t>(~kRedirectRight);
+        }
         bits[geometry.first_triangle[m] + t] = to;
-        (to == kRedirectBoth ? b : to == kRedirectLeft ? l : r)++;
+        (to == kRedirectBoth ? b : to == kRedirectLeft ? l : to == kRedirectRight ? r : none)++;
       }
       n_left += l;
       n_right += r;
       n_both += b;
+      n_none += none;
     });
   });
-  counts = {n_left, n_right, n_both};
+  counts = {n_left, n_right, n_both, n_none};
   return bits;
 }
 

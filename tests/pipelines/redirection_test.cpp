@@ -118,24 +118,70 @@ TEST(Redirection, EachEyeRasterizesOnlyItsShare) {
   const RenderScene prepared(scene);
   const StereoRig rig = test::rig_at(scene, 160, 90);
   const Executor executor(2);
-  RedirectionCounts counts;
-  const std::vector<uint8_t> bits = redirect_triangles(prepared.geometry(), rig, executor, counts);
-  ASSERT_EQ(bits.size(), prepared.geometry().triangle_count());
-  EXPECT_EQ(counts.left + counts.right + counts.both, bits.size());
-  EXPECT_GT(counts.left, 0u);
-  EXPECT_GT(counts.right, 0u);
-  for (const Eye e : {Eye::left, Eye::right}) {
-    RasterOptions o;
-    o.triangle_mask = bits.data();
-    o.triangle_bit = e == Eye::left ? kRedirectLeft : kRedirectRight;
-    RasterStats stats;
-    const GBuffer g = rasterize(prepared.geometry(), rig.eye(e), executor, o, &stats);
-    EXPECT_EQ(stats.triangles_skipped, e == Eye::left ? counts.right : counts.left);
-    for (const uint32_t prim : g.prim) {
-      if (prim == kNoPrimitiveId) continue;
-      ASSERT_NE(bits[prim] & o.triangle_bit, 0) << "triangle " << prim;
+  // As the materials say (every mesh double-sided: nothing culled), and with the closed box culled.
+  for (const bool closed_too : {false, true}) {
+    uint64_t closed_culled = 0;
+    const std::vector<uint8_t> culled = culled_meshes(prepared.geometry(), rig, executor, closed_too, closed_culled);
+    EXPECT_EQ(closed_culled, closed_too ? 1u : 0u);
+    RedirectionCounts counts;
+    const std::vector<uint8_t> bits = redirect_triangles(prepared.geometry(), rig, culled, executor, counts);
+    ASSERT_EQ(bits.size(), prepared.geometry().triangle_count());
+    EXPECT_EQ(counts.left + counts.right + counts.both + counts.culled, bits.size());
+    EXPECT_EQ(counts.culled > 0, closed_too) << "the box's bottom faces neither eye";
+    EXPECT_GT(counts.left, 0u);
+    EXPECT_GT(counts.right, 0u);
+    for (const Eye e : {Eye::left, Eye::right}) {
+      RasterOptions o;
+      o.triangle_mask = bits.data();
+      o.triangle_bit = e == Eye::left ? kRedirectLeft : kRedirectRight;
+      RasterStats stats;
+      const GBuffer g = rasterize(prepared.geometry(), rig.eye(e), executor, o, &stats);
+      EXPECT_EQ(stats.triangles_skipped, (e == Eye::left ? counts.right : counts.left) + counts.culled);
+      for (const uint32_t prim : g.prim) {
+        if (prim == kNoPrimitiveId) continue;
+        ASSERT_NE(bits[prim] & o.triangle_bit, 0) << "triangle " << prim;
+      }
     }
   }
+}
+
+/// The index of box-wall's box, the one closed mesh of the scene.
+size_t closed_box(const SceneGeometry& geometry) {
+  const auto it = std::find(geometry.closed.begin(), geometry.closed.end(), uint8_t{1});
+  EXPECT_EQ(std::count(geometry.closed.begin(), geometry.closed.end(), uint8_t{1}), 1);
+  return static_cast<size_t>(it - geometry.closed.begin());
+}
+
+TEST(Redirection, AClosedDoubleSidedMeshIsCulledOnlyWhereNoEyeCanSeeItsInside) {
+  Scene scene = test::load_builtin("box-wall");  // the box: x and z within 0.4 m of (0, -2.5), y 0..0.8 m
+  const Executor executor(2);
+  const auto culled_box = [&](const StereoRig& rig) {
+    const RenderScene prepared(scene);
+    const size_t box = closed_box(prepared.geometry());
+    uint64_t closed_culled = 0;
+    const bool culled = culled_meshes(prepared.geometry(), rig, executor, true, closed_culled)[box] != 0;
+    EXPECT_EQ(closed_culled, culled ? 1u : 0u);
+    EXPECT_EQ(culled_meshes(prepared.geometry(), rig, executor, false, closed_culled)[box], 0) << "option off";
+    return culled;
+  };
+  const auto rig_from = [](const dvec3& eye, const dvec3& target) {
+    RigParams p;
+    p.width = 64;
+    p.height = 36;
+    return StereoRig(CameraPose::look_at(eye, target), p);
+  };
+  EXPECT_TRUE(culled_box(test::rig_at(scene, 160, 90)));
+  EXPECT_FALSE(culled_box(rig_from({0.0, 0.4, -2.5}, {0.0, 0.4, -5.0}))) << "the eyes inside the box";
+  EXPECT_FALSE(culled_box(rig_from({0.0, 0.4, -2.07}, {0.0, 0.4, -5.0}))) << "the near plane (0.05 m) cuts the box";
+  EXPECT_TRUE(culled_box(rig_from({0.0, 0.4, -2.0}, {0.0, 0.4, -5.0}))) << "0.1 m before its face";
+  // A mirroring transform turns the loaded winding inside out.
+  {
+    const RenderScene prepared(scene);
+    dmat4 mirror(1.0);
+    mirror[0][0] = -1.0;
+    scene.meshes[closed_box(prepared.geometry())].moved = mirror;
+  }
+  EXPECT_FALSE(culled_box(test::rig_at(scene, 160, 90))) << "mirrored";
 }
 
 TEST(Redirection, EveryTriangleOfAManyMeshSceneAsRedirectDecidesAtAnyThreadCount) {
@@ -156,8 +202,16 @@ TEST(Redirection, EveryTriangleOfAManyMeshSceneAsRedirectDecidesAtAnyThreadCount
       const dvec3 v0(mesh.positions[mesh.indices[3 * t]]), v1(mesh.positions[mesh.indices[3 * t + 1]]),
           v2(mesh.positions[mesh.indices[3 * t + 2]]);
       const bool single_sided = geometry.single_sided[m] != 0;
-      expected[geometry.first_triangle[m] + t] = redirect(left, right, v0, v1, v2, single_sided);
-      expected_both[geometry.first_triangle[m] + t] = redirect(left, right, v0, v1, v2, single_sided, ClippedRule::both);
+      // A single-sided triangle goes to no eye that sees its back.
+      const auto facing = [&](uint8_t to) {
+        if (!single_sided) return to;
+        if (!front_facing(v0, v1, v2, left.origin)) to &= static_cast<uint8_t>(~kRedirectLeft);
+        if (!front_facing(v0, v1, v2, right.origin)) to &= static_cast<uint8_t>(~kRedirectRight);
+        return to;
+      };
+      expected[geometry.first_triangle[m] + t] = facing(redirect(left, right, v0, v1, v2, single_sided));
+      expected_both[geometry.first_triangle[m] + t] =
+          facing(redirect(left, right, v0, v1, v2, single_sided, ClippedRule::both));
       by_frustum += frustum_visibility(left, v0, v1, v2) != frustum_visibility(right, v0, v1, v2) ? 1 : 0;
       clipped_by_both +=
           frustum_visibility(left, v0, v1, v2) < 1.0 && frustum_visibility(right, v0, v1, v2) < 1.0 ? 1 : 0;
@@ -165,12 +219,18 @@ TEST(Redirection, EveryTriangleOfAManyMeshSceneAsRedirectDecidesAtAnyThreadCount
   }
   EXPECT_GT(by_frustum, 0u) << "some triangles decided by the frustum comparison";
   EXPECT_GT(clipped_by_both, 0u) << "some triangles clipped by both frusta";
+  EXPECT_GT(std::count(expected.begin(), expected.end(), uint8_t{0}), 0) << "some triangles face neither eye";
   for (const int threads : {1, 2, 3}) {
+    uint64_t closed_culled = 0;
+    const std::vector<uint8_t> culled = culled_meshes(geometry, rig, Executor(threads), true, closed_culled);
+    EXPECT_TRUE(culled == geometry.single_sided) << "the spheres are single-sided already";
+    EXPECT_EQ(closed_culled, 0u);
     RedirectionCounts both_counts;
-    EXPECT_TRUE(redirect_triangles(geometry, rig, Executor(threads), both_counts, ClippedRule::both) == expected_both)
+    EXPECT_TRUE(redirect_triangles(geometry, rig, culled, Executor(threads), both_counts, ClippedRule::both) ==
+                expected_both)
         << threads << " threads, clipped=both";
     RedirectionCounts counts;
-    const std::vector<uint8_t> bits = redirect_triangles(geometry, rig, Executor(threads), counts);
+    const std::vector<uint8_t> bits = redirect_triangles(geometry, rig, culled, Executor(threads), counts);
     ASSERT_EQ(bits.size(), expected.size());
     size_t differ = 0;
     for (size_t i = 0; i < bits.size(); ++i) differ += bits[i] != expected[i] ? 1 : 0;
@@ -178,6 +238,7 @@ TEST(Redirection, EveryTriangleOfAManyMeshSceneAsRedirectDecidesAtAnyThreadCount
     EXPECT_EQ(counts.left, static_cast<uint64_t>(std::count(expected.begin(), expected.end(), kRedirectLeft)));
     EXPECT_EQ(counts.right, static_cast<uint64_t>(std::count(expected.begin(), expected.end(), kRedirectRight)));
     EXPECT_EQ(counts.both, static_cast<uint64_t>(std::count(expected.begin(), expected.end(), kRedirectBoth)));
+    EXPECT_EQ(counts.culled, static_cast<uint64_t>(std::count(expected.begin(), expected.end(), uint8_t{0})));
   }
 }
 

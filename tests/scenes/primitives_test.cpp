@@ -85,6 +85,18 @@ TEST(Primitives, ClosedSolidsAreClosedAndOpenOrMiswoundMeshesAreNot) {
   for (size_t t = 0; t < inside_out.indices.size(); t += 3) std::swap(inside_out.indices[t + 1], inside_out.indices[t + 2]);
   EXPECT_FALSE(inside_out.is_closed()) << "closed, but only its back faces show from outside";
   EXPECT_FALSE(Mesh{}.is_closed());
+  // Parts: two boxes standing edge to edge (the shared edge met twice each way) are closed; a box
+  // beside a smaller inside-out one is not, though the volume of the two together is positive.
+  MeshData pair = make_box({0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f});
+  append_mesh(pair, make_box({1.0f, 1.0f, 0.0f}, {2.0f, 2.0f, 1.0f}));
+  EXPECT_TRUE(as_scene_mesh(pair).is_closed()) << "an edge shared by two closed parts";
+  Mesh mixed = as_scene_mesh(make_box({0.0f, 0.0f, 0.0f}, {2.0f, 2.0f, 2.0f}));
+  const auto first_of_inside_out = static_cast<uint32_t>(mixed.positions.size());
+  const MeshData small = make_box({3.0f, 0.0f, 0.0f}, {3.5f, 0.5f, 0.5f});
+  for (const vec3& p : small.positions) mixed.positions.push_back(p);
+  for (size_t t = 0; t < small.indices.size(); t += 3)
+    for (const int k : {0, 2, 1}) mixed.indices.push_back(first_of_inside_out + small.indices[t + static_cast<size_t>(k)]);
+  EXPECT_FALSE(mixed.is_closed()) << "one part inside out";
 }
 
 TEST(Primitives, PlaneFacesUp) {
