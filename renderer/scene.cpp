@@ -187,53 +187,68 @@ bool Mesh::is_closed() const {
     if (k > 0 && less(order[k - 1], order[k])) ++distinct;
     corner[order[k]] = distinct;
   }
-  // Every directed edge of a triangle with three distinct corners, keyed by its undirected edge
-  // (lower corner, higher corner) with its direction in the lowest bit; the corners joined into
-  // connected parts, each with six times the signed volume it encloses.
-  std::vector<uint64_t> edges;
-  edges.reserve(indices.size());
-  std::vector<uint32_t> part(distinct + 1);
-  for (uint32_t c = 0; c <= distinct; ++c) part[c] = c;
-  const auto root = [&part](uint32_t c) {
-    while (part[c] != c) c = part[c] = part[part[c]];
-    return c;
-  };
+  // The triangles with three distinct corners (a collapsed one, as at a pole, covers nothing).
+  std::vector<std::array<uint32_t, 3>> faces;  // corners
+  std::vector<uint32_t> first_index;           // of each face in `indices`
+  faces.reserve(indices.size() / 3);
+  first_index.reserve(indices.size() / 3);
   for (size_t t = 0; t + 2 < indices.size(); t += 3) {
     if (indices[t] >= n || indices[t + 1] >= n || indices[t + 2] >= n) return false;
-    const uint32_t c[3] = {corner[indices[t]], corner[indices[t + 1]], corner[indices[t + 2]]};
-    if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) continue;  // a collapsed triangle (a pole's)
-    for (int k = 0; k < 3; ++k) {
-      const uint64_t a = c[k], b = c[(k + 1) % 3];
-      edges.push_back((std::min(a, b) << 33) | (std::max(a, b) << 1) | (a > b ? 1u : 0u));
-    }
-    part[root(c[1])] = root(c[0]);
-    part[root(c[2])] = root(c[0]);
+    const std::array<uint32_t, 3> c = {corner[indices[t]], corner[indices[t + 1]], corner[indices[t + 2]]};
+    if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) continue;
+    faces.push_back(c);
+    first_index.push_back(static_cast<uint32_t>(t));
   }
-  if (edges.empty()) return false;
-  // Closed: every edge is met as often in one direction as in the other (once each on a manifold
-  // surface; parts that share an edge, as boxes of a wall standing edge to edge, meet it twice).
+  if (faces.empty() || faces.size() > std::numeric_limits<uint32_t>::max()) return false;
+  // Every directed edge, keyed by its undirected edge (lower corner, higher corner) with its
+  // direction in the lowest bit, beside the face it bounds.
+  std::vector<std::pair<uint64_t, uint32_t>> edges;
+  edges.reserve(3 * faces.size());
+  for (size_t f = 0; f < faces.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const uint64_t a = faces[f][static_cast<size_t>(k)], b = faces[f][static_cast<size_t>((k + 1) % 3)];
+      edges.emplace_back((std::min(a, b) << 33) | (std::max(a, b) << 1) | (a > b ? 1u : 0u), static_cast<uint32_t>(f));
+    }
   std::sort(edges.begin(), edges.end());
+  // Closed: every edge is met as often in one direction as in the other (once each on a manifold
+  // surface; closed parts that share an edge, as boxes of a wall standing edge to edge, meet it
+  // twice each way). Parts: faces joined across the edges met once each way, so that parts that
+  // only touch (at an edge met more often, or at a corner) stay apart.
+  std::vector<uint32_t> part(faces.size());
+  for (size_t f = 0; f < faces.size(); ++f) part[f] = static_cast<uint32_t>(f);
+  const auto root = [&part](uint32_t f) {
+    while (part[f] != f) f = part[f] = part[part[f]];
+    return f;
+  };
   for (size_t i = 0; i < edges.size();) {
     size_t j = i;
     int64_t balance = 0;
-    for (; j < edges.size() && (edges[j] >> 1) == (edges[i] >> 1); ++j) balance += (edges[j] & 1u) != 0 ? 1 : -1;
+    for (; j < edges.size() && (edges[j].first >> 1) == (edges[i].first >> 1); ++j)
+      balance += (edges[j].first & 1u) != 0 ? 1 : -1;
     if (balance != 0) return false;
+    if (j - i == 2) part[root(edges[i].second)] = root(edges[i + 1].second);
     i = j;
   }
   // Wound outwards, each part (triangles counter-clockwise seen from outside, as the positions and
   // indices of a mirrored mesh are too): an inside-out part shows only back faces from outside.
-  std::vector<double> volume6(distinct + 1, 0.0);
-  std::vector<uint8_t> faces(distinct + 1, 0);  // parts of collapsed triangles alone enclose nothing
-  for (size_t t = 0; t + 2 < indices.size(); t += 3) {
-    const uint32_t c0 = corner[indices[t]], c1 = corner[indices[t + 1]], c2 = corner[indices[t + 2]];
-    if (c0 == c1 || c1 == c2 || c2 == c0) continue;
+  // Six times each part's signed volume, summed about a vertex of the part (about the origin, the
+  // rounding of a small part far from it could flip the sign).
+  std::vector<double> volume6(faces.size(), 0.0);
+  std::vector<dvec3> origin(faces.size());
+  std::vector<uint8_t> has_origin(faces.size(), 0);
+  for (size_t f = 0; f < faces.size(); ++f) {
+    const uint32_t r = root(static_cast<uint32_t>(f));
+    const size_t t = first_index[f];
     const dvec3 p0(positions[indices[t]]), p1(positions[indices[t + 1]]), p2(positions[indices[t + 2]]);
-    const uint32_t r = root(c0);
-    volume6[r] += glm::dot(p0, glm::cross(p1, p2));
-    faces[r] = 1;
+    if (has_origin[r] == 0) {
+      origin[r] = p0;
+      has_origin[r] = 1;
+    }
+    const dvec3 o = origin[r];
+    volume6[r] += glm::dot(p0 - o, glm::cross(p1 - o, p2 - o));
   }
-  for (uint32_t c = 0; c <= distinct; ++c)
-    if (faces[c] != 0 && !(volume6[c] > 0.0)) return false;
+  for (size_t f = 0; f < faces.size(); ++f)
+    if (part[f] == f && !(volume6[f] > 0.0)) return false;
   return true;
 }
 

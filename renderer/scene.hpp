@@ -70,8 +70,9 @@ struct Mesh {
   /// Whether the mesh is closed and wound outwards: every edge of a triangle with three distinct
   /// corners (by position, so that vertices repeated along a seam count as one) is met as often in
   /// one direction as in the other (once each, or more where closed parts share an edge), and each
-  /// connected part encloses a positive volume (triangles counter-clockwise seen from outside). An
-  /// eye outside such a mesh never sees a back face of it.
+  /// part (triangles joined across the edges met once each way) encloses a positive volume
+  /// (triangles counter-clockwise seen from outside). An eye outside such a mesh never sees a back
+  /// face of it, unless its surface intersects itself (not checked).
   [[nodiscard]] bool is_closed() const;
 };
 

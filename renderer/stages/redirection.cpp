@@ -95,6 +95,15 @@ uint8_t redirect(const EyeCamera& left, const EyeCamera& right, const dvec3& v0,
   return redirect_from(left, right, xl, xr, v0, v1, v2, single_sided, clipped);
 }
 
+uint8_t facing_share(uint8_t to, const dvec3& v0, const dvec3& v1, const dvec3& v2, const EyeCamera& left,
+                     const EyeCamera& right) {
+  const auto facing = static_cast<uint8_t>((front_facing(v0, v1, v2, left.origin) ? kRedirectLeft : 0) |
+                                           (front_facing(v0, v1, v2, right.origin) ? kRedirectRight : 0));
+  // Eq. (1) ranks by the frustum before facing: it can pick the eye a triangle turns its back to
+  // (a sliver near a border, clipped less there); the eye it faces then takes it.
+  return (to & facing) != 0 ? static_cast<uint8_t>(to & facing) : facing;
+}
+
 std::vector<uint8_t> culled_meshes(const SceneGeometry& geometry, const StereoRig& rig, const Executor& executor,
                                    bool closed_too, uint64_t& closed_culled) {
   const Scene& scene = *geometry.scene;
@@ -107,17 +116,20 @@ std::vector<uint8_t> culled_meshes(const SceneGeometry& geometry, const StereoRi
   }
   executor.for_each(scene.meshes.size(), [&](size_t m) {
     if (geometry.closed[m] == 0) return;
+    // The positions and indices are wound as the file says under any transform (the loader and a
+    // path's frames reverse the triangles of a mirrored node), so the mesh stays closed and
+    // outward as loaded.
     const Mesh& mesh = scene.meshes[m];
-    // A transform that mirrors turns the loaded winding inside out.
-    const double det = glm::determinant(dmat3(mesh.moved));
-    if (!(det > 0.0)) return;
     std::atomic<bool> near{false};
     executor.for_range(mesh.positions.size(), 16384, [&](size_t begin, size_t end) {
       for (size_t v = begin; v < end && !near.load(std::memory_order_relaxed); ++v) {
         const dvec3 p(mesh.positions[v]);
+        // Not clearly beyond the near plane (NaN too): the plane may cut the mesh open, or the eye
+        // lie in it. The margin covers the rasterizer's own rounding of the depth (the eyes are
+        // parallel, so both give a point the same depth but for that rounding).
         for (const EyeCamera& eye : eyes)
-          // Not beyond the near plane (NaN too): the plane may cut the mesh open, or the eye lie in it.
-          if (!(-glm::dot(p - eye.origin, eye.back) > eye.znear)) near.store(true, std::memory_order_relaxed);
+          if (!(-glm::dot(p - eye.origin, eye.back) > eye.znear * (1.0 + 1e-6)))
+            near.store(true, std::memory_order_relaxed);
       }
     });
     if (near.load()) return;
@@ -160,10 +172,7 @@ std::vector<uint8_t> redirect_triangles(const SceneGeometry& geometry, const Ste
         const double xr[3] = {ndc[2 * i0 + 1], ndc[2 * i1 + 1], ndc[2 * i2 + 1]};
         const dvec3 v0(mesh.positions[i0]), v1(mesh.positions[i1]), v2(mesh.positions[i2]);
         uint8_t to = redirect_from(left, right, xl, xr, v0, v1, v2, cull, clipped);
-        if (cull) {
-          if (!front_facing(v0, v1, v2, left.origin)) to &= static_cast<uint8_t>(~kRedirectLeft);
-          if (!front_facing(v0, v1, v2, right.origin)) to &= static_cast<uint8_t>(~kRedirectRight);
-        }
+        if (cull) to = facing_share(to, v0, v1, v2, left, right);
         bits[geometry.first_triangle[m] + t] = to;
         (to == kRedirectBoth ? b : to == kRedirectLeft ? l : to == kRedirectRight ? r : none)++;
       }

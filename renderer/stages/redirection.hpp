@@ -52,7 +52,7 @@ enum class ClippedRule : uint8_t {
 [[nodiscard]] uint8_t redirect(const EyeCamera& left, const EyeCamera& right, const dvec3& v0, const dvec3& v1,
                                const dvec3& v2, bool single_sided, ClippedRule clipped = ClippedRule::one);
 
-/// Triangles sent to each eye, and those sent to neither (back faces of a culled mesh from both eyes).
+/// Triangles sent to each eye, and those sent to neither (of a culled mesh, facing neither eye).
 struct RedirectionCounts {
   uint64_t left = 0;
   uint64_t right = 0;
@@ -61,9 +61,8 @@ struct RedirectionCounts {
 };
 
 /// Per mesh, whether its back faces are culled (1) in the redirection: a mesh of a single-sided
-/// material; with `closed_too`, also a double-sided one that SceneGeometry::closed marks, is not
-/// mirrored by its current transform, and whose every vertex lies beyond the near plane of both
-/// eyes. An eye inside a closed mesh has some of it behind itself, so both eyes are then outside
+/// material; with `closed_too`, also a double-sided one that SceneGeometry::closed marks and whose
+/// every vertex lies beyond the near plane of both eyes. An eye inside a closed mesh has some of it behind itself, so both eyes are then outside
 /// it, and no near plane cuts it open: its front faces hide all its back faces in either eye, and
 /// culling them changes no full render. Kim's method assumes culling (§2.2, eq. (4)): an eye that
 /// rasterizes a closed mesh's back triangles while their front ones go to the other eye shows the
@@ -71,10 +70,15 @@ struct RedirectionCounts {
 [[nodiscard]] std::vector<uint8_t> culled_meshes(const SceneGeometry& geometry, const StereoRig& rig,
                                                  const Executor& executor, bool closed_too, uint64_t& closed_culled);
 
+/// The share of a triangle of a culled mesh, from redirect()'s decision `to`: the eyes of `to` it
+/// faces (front_facing, the rasterizer's culling rule); if it faces none of them, every eye it
+/// faces; none when it faces neither eye.
+[[nodiscard]] uint8_t facing_share(uint8_t to, const dvec3& v0, const dvec3& v1, const dvec3& v2,
+                                   const EyeCamera& left, const EyeCamera& right);
+
 /// The RedirectBits of every triangle of the scene, by global triangle id: redirect()'s decisions,
-/// with the meshes `culled` marks (one entry per mesh) taken as single-sided and each eye's bit
-/// cleared on a triangle of theirs that does not face that eye (front_facing, the rasterizer's
-/// culling rule): a triangle that faces neither eye goes to none.
+/// with the meshes `culled` marks (one entry per mesh) taken as single-sided and their triangles'
+/// shares by facing_share.
 [[nodiscard]] std::vector<uint8_t> redirect_triangles(const SceneGeometry& geometry, const StereoRig& rig,
                                                       const std::vector<uint8_t>& culled, const Executor& executor,
                                                       RedirectionCounts& counts,

@@ -97,6 +97,20 @@ TEST(Primitives, ClosedSolidsAreClosedAndOpenOrMiswoundMeshesAreNot) {
   for (size_t t = 0; t < small.indices.size(); t += 3)
     for (const int k : {0, 2, 1}) mixed.indices.push_back(first_of_inside_out + small.indices[t + static_cast<size_t>(k)]);
   EXPECT_FALSE(mixed.is_closed()) << "one part inside out";
+  // ... and so is one touching the other along an edge: parts join only across edges met once each way.
+  Mesh touching = as_scene_mesh(make_box({0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}));
+  const auto first_of_touching = static_cast<uint32_t>(touching.positions.size());
+  const MeshData beside = make_box({1.0f, 1.0f, 0.0f}, {1.5f, 1.5f, 1.0f});
+  for (const vec3& p : beside.positions) touching.positions.push_back(p);
+  for (size_t t = 0; t < beside.indices.size(); t += 3)
+    for (const int k : {0, 2, 1}) touching.indices.push_back(first_of_touching + beside.indices[t + static_cast<size_t>(k)]);
+  EXPECT_FALSE(touching.is_closed()) << "an inside-out part sharing an edge with an outward one";
+  Mesh not_finite = as_scene_mesh(make_box({0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}));
+  not_finite.positions[0].x = std::nanf("");
+  EXPECT_FALSE(not_finite.is_closed());
+  Mesh out_of_range = as_scene_mesh(make_box({0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}));
+  out_of_range.indices[4] = static_cast<uint32_t>(out_of_range.positions.size());
+  EXPECT_FALSE(out_of_range.is_closed());
 }
 
 TEST(Primitives, PlaneFacesUp) {
