@@ -69,6 +69,17 @@ Mesh as_scene_mesh(const MeshData& data) {
   return m;
 }
 
+/// A scene mesh of `outward`, and a box from `lo` to `hi` wound inside out beside it.
+Mesh with_inside_out_box(const MeshData& outward, const vec3& lo, const vec3& hi) {
+  Mesh m = as_scene_mesh(outward);
+  const auto first = static_cast<uint32_t>(m.positions.size());
+  const MeshData box = make_box(lo, hi);
+  for (const vec3& p : box.positions) m.positions.push_back(p);
+  for (size_t t = 0; t < box.indices.size(); t += 3)
+    for (const size_t k : {0, 2, 1}) m.indices.push_back(first + box.indices[t + k]);
+  return m;
+}
+
 TEST(Primitives, ClosedSolidsAreClosedAndOpenOrMiswoundMeshesAreNot) {
   // What decides whether an external truth's note on single-sided materials is due: a closed mesh
   // never shows a back face.
@@ -90,21 +101,13 @@ TEST(Primitives, ClosedSolidsAreClosedAndOpenOrMiswoundMeshesAreNot) {
   MeshData pair = make_box({0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f});
   append_mesh(pair, make_box({1.0f, 1.0f, 0.0f}, {2.0f, 2.0f, 1.0f}));
   EXPECT_TRUE(as_scene_mesh(pair).is_closed()) << "an edge shared by two closed parts";
-  Mesh mixed = as_scene_mesh(make_box({0.0f, 0.0f, 0.0f}, {2.0f, 2.0f, 2.0f}));
-  const auto first_of_inside_out = static_cast<uint32_t>(mixed.positions.size());
-  const MeshData small = make_box({3.0f, 0.0f, 0.0f}, {3.5f, 0.5f, 0.5f});
-  for (const vec3& p : small.positions) mixed.positions.push_back(p);
-  for (size_t t = 0; t < small.indices.size(); t += 3)
-    for (const int k : {0, 2, 1}) mixed.indices.push_back(first_of_inside_out + small.indices[t + static_cast<size_t>(k)]);
-  EXPECT_FALSE(mixed.is_closed()) << "one part inside out";
+  EXPECT_FALSE(with_inside_out_box(make_box({0.0f, 0.0f, 0.0f}, {2.0f, 2.0f, 2.0f}), {3.0f, 0.0f, 0.0f}, {3.5f, 0.5f, 0.5f})
+                   .is_closed())
+      << "one part inside out";
   // ... and so is one touching the other along an edge: parts join only across edges met once each way.
-  Mesh touching = as_scene_mesh(make_box({0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}));
-  const auto first_of_touching = static_cast<uint32_t>(touching.positions.size());
-  const MeshData beside = make_box({1.0f, 1.0f, 0.0f}, {1.5f, 1.5f, 1.0f});
-  for (const vec3& p : beside.positions) touching.positions.push_back(p);
-  for (size_t t = 0; t < beside.indices.size(); t += 3)
-    for (const int k : {0, 2, 1}) touching.indices.push_back(first_of_touching + beside.indices[t + static_cast<size_t>(k)]);
-  EXPECT_FALSE(touching.is_closed()) << "an inside-out part sharing an edge with an outward one";
+  EXPECT_FALSE(with_inside_out_box(make_box({0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}), {1.0f, 1.0f, 0.0f}, {1.5f, 1.5f, 1.0f})
+                   .is_closed())
+      << "an inside-out part sharing an edge with an outward one";
   Mesh not_finite = as_scene_mesh(make_box({0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}));
   not_finite.positions[0].x = std::nanf("");
   EXPECT_FALSE(not_finite.is_closed());
