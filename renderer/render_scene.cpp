@@ -96,6 +96,7 @@ double RenderScene::update_geometry(std::span<const size_t> moved) {
   // The offset follows the moved bounds, as a scene prepared at this frame has it: a frame's image
   // must not depend on which frame the worker prepared first.
   ray_epsilon_ = shadow_offset(checked_bounds(*scene_));
+  geometry_.forget_closed();
   return rays_.update(moved);
 }
 

@@ -189,17 +189,18 @@ bool Mesh::is_closed() const {
   }
   // The triangles with three distinct corners (a collapsed one, as at a pole, covers nothing).
   std::vector<std::array<uint32_t, 3>> faces;  // corners
-  std::vector<uint32_t> first_index;           // of each face in `indices`
+  std::vector<uint32_t> triangle;               // each face's triangle in `indices`
+  if (indices.size() / 3 > std::numeric_limits<uint32_t>::max()) return false;
   faces.reserve(indices.size() / 3);
-  first_index.reserve(indices.size() / 3);
+  triangle.reserve(indices.size() / 3);
   for (size_t t = 0; t + 2 < indices.size(); t += 3) {
     if (indices[t] >= n || indices[t + 1] >= n || indices[t + 2] >= n) return false;
     const std::array<uint32_t, 3> c = {corner[indices[t]], corner[indices[t + 1]], corner[indices[t + 2]]};
     if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) continue;
     faces.push_back(c);
-    first_index.push_back(static_cast<uint32_t>(t));
+    triangle.push_back(static_cast<uint32_t>(t / 3));
   }
-  if (faces.empty() || faces.size() > std::numeric_limits<uint32_t>::max()) return false;
+  if (faces.empty()) return false;
   // Every directed edge, keyed by its undirected edge (lower corner, higher corner) with its
   // direction in the lowest bit, beside the face it bounds.
   std::vector<std::pair<uint64_t, uint32_t>> edges;
@@ -231,21 +232,17 @@ bool Mesh::is_closed() const {
   }
   // Wound outwards, each part (triangles counter-clockwise seen from outside, as the positions and
   // indices of a mirrored mesh are too): an inside-out part shows only back faces from outside.
-  // Six times each part's signed volume, summed about a vertex of the part (about the origin, the
-  // rounding of a small part far from it could flip the sign).
+  // Six times each part's signed volume, summed about the first corner of the part's root face
+  // (about the origin, the rounding of a small part far from it could flip the sign).
+  const auto corner_of = [&](uint32_t f, int k) {
+    return dvec3(positions[indices[3 * size_t{triangle[f]} + static_cast<size_t>(k)]]);
+  };
   std::vector<double> volume6(faces.size(), 0.0);
-  std::vector<dvec3> origin(faces.size());
-  std::vector<uint8_t> has_origin(faces.size(), 0);
   for (size_t f = 0; f < faces.size(); ++f) {
-    const uint32_t r = root(static_cast<uint32_t>(f));
-    const size_t t = first_index[f];
-    const dvec3 p0(positions[indices[t]]), p1(positions[indices[t + 1]]), p2(positions[indices[t + 2]]);
-    if (has_origin[r] == 0) {
-      origin[r] = p0;
-      has_origin[r] = 1;
-    }
-    const dvec3 o = origin[r];
-    volume6[r] += glm::dot(p0 - o, glm::cross(p1 - o, p2 - o));
+    const auto face = static_cast<uint32_t>(f);
+    const uint32_t r = root(face);
+    const dvec3 o = corner_of(r, 0);
+    volume6[r] += glm::dot(corner_of(face, 0) - o, glm::cross(corner_of(face, 1) - o, corner_of(face, 2) - o));
   }
   for (size_t f = 0; f < faces.size(); ++f)
     if (part[f] == f && !(volume6[f] > 0.0)) return false;

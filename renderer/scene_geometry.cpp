@@ -46,7 +46,8 @@ SceneGeometry::SceneGeometry(const Scene& s) : scene(&s) {
 }
 
 const std::vector<uint8_t>& SceneGeometry::closed(const Executor& executor) const {
-  std::call_once(closed_once_, [&] {
+  const std::lock_guard<std::mutex> lock(closed_mutex_);
+  if (!closed_known_) {
     const Scene& s = *scene;
     std::vector<uint8_t> flags(s.meshes.size(), 0);
     // Each decision is the mesh's own, so the flags do not depend on the thread count.
@@ -54,8 +55,14 @@ const std::vector<uint8_t>& SceneGeometry::closed(const Executor& executor) cons
       flags[m] = single_sided[m] == 0 && cutout_of[m] < 0 && s.meshes[m].is_closed() ? 1 : 0;
     });
     closed_ = std::move(flags);
-  });
+    closed_known_ = true;
+  }
   return closed_;
+}
+
+void SceneGeometry::forget_closed() {
+  const std::lock_guard<std::mutex> lock(closed_mutex_);
+  closed_known_ = false;
 }
 
 bool SceneGeometry::opaque_at(uint32_t mesh, uint32_t tri, vec2 bary) const {

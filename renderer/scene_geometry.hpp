@@ -43,9 +43,14 @@ struct SceneGeometry {
   /// Per mesh: 1 = double-sided, opaque everywhere, and closed and wound outwards as loaded
   /// (Mesh::is_closed): seen from outside, with no plane cutting it open, its front faces hide every
   /// back face, so culling them changes no image (Kim's redirection relies on that). Computed on
-  /// the first call (meshes in parallel, a sort of each one's edges: about 1 s on 2 cores for 1e7
-  /// triangles), once for every caller; the other pipelines never pay for it.
+  /// the first call after construction or forget_closed() from the positions as they are then
+  /// (meshes in parallel, a sort of each one's edges: about 1 s on 2 cores for 1e7 triangles); the
+  /// other pipelines never pay for it. Not to be called from inside a loop of `executor`.
   [[nodiscard]] const std::vector<uint8_t>& closed(const Executor& executor) const;
+  /// Drops the flags closed() found: the positions moved (a path's frame), and a frame's flags
+  /// must not depend on the frame they were first found at (a node scaled to nothing at one frame
+  /// has only collapsed triangles there).
+  void forget_closed();
   /// Whether the mesh has a cut-out (alphaMode MASK).
   [[nodiscard]] bool has_cutout(uint32_t mesh) const { return cutout_of[mesh] >= 0; }
   /// Whether local triangle `tri` of `mesh` exists at barycentrics (b1, b2): always for an opaque
@@ -57,7 +62,8 @@ struct SceneGeometry {
 
  private:
   std::vector<MipTexture> cutout_textures_;  ///< level 0 of each texture a cut-out reads
-  mutable std::once_flag closed_once_;
+  mutable std::mutex closed_mutex_;
+  mutable bool closed_known_ = false;
   mutable std::vector<uint8_t> closed_;
 };
 

@@ -175,6 +175,28 @@ TEST(Redirection, AClosedDoubleSidedMeshIsCulledOnlyWhereNoEyeCanSeeItsInside) {
   EXPECT_FALSE(culled_box(rig_from({0.0, 0.4, -2.5}, {0.0, 0.4, -5.0}))) << "the eyes inside the box";
   EXPECT_FALSE(culled_box(rig_from({0.0, 0.4, -2.07}, {0.0, 0.4, -5.0}))) << "the near plane (0.05 m) cuts the box";
   EXPECT_TRUE(culled_box(rig_from({0.0, 0.4, -2.0}, {0.0, 0.4, -5.0}))) << "0.1 m before its face";
+  // The near-plane test keeps a relative margin of 1e-6 for the rasterizer's rounding: a face
+  // 1e-7 beyond the plane is not culled, one 1e-5 beyond is.
+  double front = -1e9;
+  {
+    const RenderScene prepared(scene);
+    for (const vec3& p : scene.meshes[closed_box(prepared.geometry())].positions) front = std::max(front, double(p.z));
+  }
+  const double znear = RigParams{}.znear;
+  EXPECT_FALSE(culled_box(rig_from({0.0, 0.4, front + znear * (1.0 + 1e-7)}, {0.0, 0.4, -5.0})));
+  EXPECT_TRUE(culled_box(rig_from({0.0, 0.4, front + znear * (1.0 + 1e-5)}, {0.0, 0.4, -5.0})));
+}
+
+TEST(Redirection, ClosedFlagsFollowAFramesPositions) {
+  // A path's frame moves positions in place; the flags are found again for the frame, so that they
+  // do not depend on the frame first rendered (here the box collapses to a point: nothing closed).
+  Scene scene = test::load_builtin("box-wall");
+  RenderScene prepared(scene, true);
+  const size_t box = closed_box(prepared.geometry());
+  for (vec3& p : scene.meshes[box].positions) p = vec3(0.0f, 0.4f, -2.5f);
+  const size_t moved[] = {box};
+  (void)prepared.update_geometry(moved);
+  EXPECT_EQ(prepared.geometry().closed(Executor(2))[box], 0);
 }
 
 TEST(Redirection, ATriangleGoesToTheEyeItFacesWhereTheFrustumRankingPicksTheOther) {
@@ -186,6 +208,7 @@ TEST(Redirection, ATriangleGoesToTheEyeItFacesWhereTheFrustumRankingPicksTheOthe
   EXPECT_EQ(facing_share(kRedirectLeft, a, b, c, front, behind), kRedirectLeft);
   EXPECT_EQ(facing_share(kRedirectRight, a, b, c, front, behind), kRedirectLeft) << "the eye it faces takes it";
   EXPECT_EQ(facing_share(kRedirectRight, a, b, c, front, front), kRedirectRight);
+  EXPECT_EQ(facing_share(kRedirectBoth, a, b, c, front, front), kRedirectBoth);
   EXPECT_EQ(facing_share(kRedirectLeft, a, b, c, behind, behind), 0) << "facing neither eye";
 }
 

@@ -108,6 +108,9 @@ TEST(Primitives, ClosedSolidsAreClosedAndOpenOrMiswoundMeshesAreNot) {
   EXPECT_FALSE(with_inside_out_box(make_box({0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}), {1.0f, 1.0f, 0.0f}, {1.5f, 1.5f, 1.0f})
                    .is_closed())
       << "an inside-out part sharing an edge with an outward one";
+  EXPECT_FALSE(with_inside_out_box(make_box({0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}), {1.0f, 1.0f, 1.0f}, {1.5f, 1.5f, 1.5f})
+                   .is_closed())
+      << "an inside-out part sharing a corner with an outward one";
   Mesh not_finite = as_scene_mesh(make_box({0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}));
   not_finite.positions[0].x = std::nanf("");
   EXPECT_FALSE(not_finite.is_closed());
