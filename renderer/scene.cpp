@@ -187,27 +187,26 @@ bool Mesh::is_closed() const {
     if (k > 0 && less(order[k - 1], order[k])) ++distinct;
     corner[order[k]] = distinct;
   }
-  // The triangles with three distinct corners (a collapsed one, as at a pole, covers nothing).
-  std::vector<std::array<uint32_t, 3>> faces;  // corners
-  std::vector<uint32_t> triangle;               // each face's triangle in `indices`
+  // The triangles with three distinct corners (a collapsed one, as at a pole, covers nothing):
+  // the faces, numbered in `triangle`'s order.
   if (indices.size() / 3 > std::numeric_limits<uint32_t>::max()) return false;
-  faces.reserve(indices.size() / 3);
+  const auto face_corner = [&](uint32_t t, int k) { return corner[indices[3 * size_t{t} + static_cast<size_t>(k)]]; };
+  std::vector<uint32_t> triangle;
   triangle.reserve(indices.size() / 3);
   for (size_t t = 0; t + 2 < indices.size(); t += 3) {
     if (indices[t] >= n || indices[t + 1] >= n || indices[t + 2] >= n) return false;
-    const std::array<uint32_t, 3> c = {corner[indices[t]], corner[indices[t + 1]], corner[indices[t + 2]]};
-    if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) continue;
-    faces.push_back(c);
-    triangle.push_back(static_cast<uint32_t>(t / 3));
+    const auto tri = static_cast<uint32_t>(t / 3);
+    const uint32_t c0 = face_corner(tri, 0), c1 = face_corner(tri, 1), c2 = face_corner(tri, 2);
+    if (c0 != c1 && c1 != c2 && c2 != c0) triangle.push_back(tri);
   }
-  if (faces.empty()) return false;
+  if (triangle.empty()) return false;
   // Every directed edge, keyed by its undirected edge (lower corner, higher corner) with its
   // direction in the lowest bit, beside the face it bounds.
   std::vector<std::pair<uint64_t, uint32_t>> edges;
-  edges.reserve(3 * faces.size());
-  for (size_t f = 0; f < faces.size(); ++f)
+  edges.reserve(3 * triangle.size());
+  for (size_t f = 0; f < triangle.size(); ++f)
     for (int k = 0; k < 3; ++k) {
-      const uint64_t a = faces[f][static_cast<size_t>(k)], b = faces[f][static_cast<size_t>((k + 1) % 3)];
+      const uint64_t a = face_corner(triangle[f], k), b = face_corner(triangle[f], (k + 1) % 3);
       edges.emplace_back((std::min(a, b) << 33) | (std::max(a, b) << 1) | (a > b ? 1u : 0u), static_cast<uint32_t>(f));
     }
   std::sort(edges.begin(), edges.end());
@@ -215,8 +214,8 @@ bool Mesh::is_closed() const {
   // surface; closed parts that share an edge, as boxes of a wall standing edge to edge, meet it
   // twice each way). Parts: faces joined across the edges met once each way, so that parts that
   // only touch (at an edge met more often, or at a corner) stay apart.
-  std::vector<uint32_t> part(faces.size());
-  for (size_t f = 0; f < faces.size(); ++f) part[f] = static_cast<uint32_t>(f);
+  std::vector<uint32_t> part(triangle.size());
+  for (size_t f = 0; f < triangle.size(); ++f) part[f] = static_cast<uint32_t>(f);
   const auto root = [&part](uint32_t f) {
     while (part[f] != f) f = part[f] = part[part[f]];
     return f;
@@ -237,14 +236,14 @@ bool Mesh::is_closed() const {
   const auto corner_of = [&](uint32_t f, int k) {
     return dvec3(positions[indices[3 * size_t{triangle[f]} + static_cast<size_t>(k)]]);
   };
-  std::vector<double> volume6(faces.size(), 0.0);
-  for (size_t f = 0; f < faces.size(); ++f) {
+  std::vector<double> volume6(triangle.size(), 0.0);
+  for (size_t f = 0; f < triangle.size(); ++f) {
     const auto face = static_cast<uint32_t>(f);
     const uint32_t r = root(face);
     const dvec3 o = corner_of(r, 0);
     volume6[r] += glm::dot(corner_of(face, 0) - o, glm::cross(corner_of(face, 1) - o, corner_of(face, 2) - o));
   }
-  for (size_t f = 0; f < faces.size(); ++f)
+  for (size_t f = 0; f < triangle.size(); ++f)
     if (part[f] == f && !(volume6[f] > 0.0)) return false;
   return true;
 }

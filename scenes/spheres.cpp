@@ -94,10 +94,9 @@ void build(const GeneratorContext& ctx, GltfBuilder& b) {
     const float hue = static_cast<float>(rng.uniform());
     const float sat = rng.uniformf(0.35, 0.85);
     const float val = rng.uniformf(0.45, 0.9);
-    // Single-sided: a sphere is closed, so its back faces are never seen, and a rasterizer culls
-    // them as Kim's bidirectional warping assumes (with them kept, an eye that rasterizes a
-    // sphere's back triangles while its front ones went to the other eye showed the inside).
-    const int material = b.add_material(fmt::format("sphere{:04d}", i), hsv_to_rgb(hue, sat, val), -1, false);
+    // Double-sided, as exported scenes mostly are: a sphere is closed, and Kim's redirection culls
+    // its back faces all the same (culled_meshes), while the ray tracer needs no back-face filter.
+    const int material = b.add_material(fmt::format("sphere{:04d}", i), hsv_to_rgb(hue, sat, val));
     const int mesh = b.add_mesh(fmt::format("sphere{:04d}", i), {MeshPrimitive{geometry, material}});
     NodeTransform t;
     t.translation = dvec3(spheres[i].centre);

@@ -110,9 +110,9 @@ TEST(SceneRegistry, RejectsUnknownAndOutOfRangeParameters) {
   EXPECT_FALSE(fs::exists(dir / "cli")) << "an empty --out was left";
 }
 
-TEST(SceneRegistry, TheSpheresAreClosedSingleSidedMeshesAsLoaded) {
-  // Their back faces are culled (Kim's bidirectional warping assumes it), and the external truths'
-  // note on single-sided materials leaves them out as closed: both as the loader gives them.
+TEST(SceneRegistry, TheSpheresAreClosedDoubleSidedMeshesAsLoaded) {
+  // Closed, so Kim's redirection culls their back faces (culled_meshes); double-sided, so the ray
+  // tracer runs no back-face filter on them: both as the loader gives them.
   ScratchDir dir("closedspheres");
   GenerateOptions o;
   o.params = {{"count", 12.0}};
@@ -122,7 +122,7 @@ TEST(SceneRegistry, TheSpheresAreClosedSingleSidedMeshesAsLoaded) {
   ASSERT_EQ(scene.meshes.size(), 12u);
   for (const Mesh& m : scene.meshes) {
     ASSERT_GE(m.material, 0) << m.name;
-    EXPECT_FALSE(scene.materials[static_cast<size_t>(m.material)].double_sided) << m.name;
+    EXPECT_TRUE(scene.materials[static_cast<size_t>(m.material)].double_sided) << m.name;
     EXPECT_TRUE(m.is_closed()) << m.name;
   }
 }
