@@ -110,7 +110,7 @@ void run_render(const RenderArgs& a) {
     record["scene"]["lights"] = scene.lights.size();
     record["scene"]["lights_in_file"] = lights_in_file;
     const io::RenderFiles files =
-        io::write_render_outputs(a.out, stem, result, record, holes ? &holes->overlay : nullptr, views);
+        io::write_render_outputs(a.out, stem, result, record, holes ? &holes->overlay : nullptr, views, executor);
     fmt::print("{} on {} ({} triangles, {}), {}, {} threads\n", entry.name, scene.name, scene.triangle_count(),
                describe_lights(scene.lights.size(), lights_in_file), describe(rig), executor.threads());
     fmt::print("  {:<22} {:>10.2f} ms ({:.1f} MiB)\n", "bvh build (once)", prepared.bvh_build_seconds() * 1e3,

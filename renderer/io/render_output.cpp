@@ -191,7 +191,7 @@ void check_no_folder_at(const std::vector<fs::path>& files, const std::string& w
 
 RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::string& stem,
                                  const StereoResult& result, const json& record, const Image* holes_overlay,
-                                 const StereoViews& views) {
+                                 const StereoViews& views, const Executor& executor) {
   check_extra_names(result);
   RenderFiles f = render_file_names(dir, stem, views);
   if (!holes_overlay) f.holes_png.reset();
@@ -220,8 +220,16 @@ RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::st
   meta["stereobench/record"] = json_text(stats);  // a scene path need not be UTF-8
 
   StagedFiles set;
-  set.add(f.exr, [&](const fs::path& tmp) { write_exr_stereo(tmp, result.left, result.right, meta); });
-  for (const auto& [file, image] : pngs) set.add(file, [&](const fs::path& tmp) { write_png_preview(tmp, *image); });
+  // The EXR and the PNGs are encoded side by side (most of a large render's writing is their
+  // compression); a failure cancels the files not yet started, and the set removes the others.
+  executor.for_each(pngs.size() + 1, [&](size_t i) {
+    if (i == 0) {
+      set.add(f.exr, [&](const fs::path& tmp) { write_exr_stereo(tmp, result.left, result.right, meta); });
+      return;
+    }
+    const auto& [file, image] = pngs[i - 1];
+    set.add(file, [&](const fs::path& tmp) { write_png_preview(tmp, *image); });
+  });
   set.add(f.stats_json, [&](const fs::path& tmp) { write_text_atomically(tmp, json_text(stats, 2) + "\n"); });
   for (const std::string& name : earlier)
     if (std::find(names.begin(), names.end(), name) == names.end()) set.retire(dir / name);

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "renderer/parallel.hpp"
 #include "renderer/pipeline.hpp"
 #include "renderer/stages/disocclusion.hpp"
 
@@ -76,9 +77,11 @@ void check_no_folder_at(const std::vector<std::filesystem::path>& files, const s
 /// `views` asks for, with `holes_overlay` also <stem>_holes.png, and a PNG preview of the "rgb"
 /// plane of each of the result's extras. An extra's name must be lowercase letters, digits and '_'
 /// and must not be one of the standard suffixes (left, right, anaglyph, sbs, ou, stats, holes)
-/// nor appear twice; InputError otherwise, before anything is written.
+/// nor appear twice; InputError otherwise, before anything is written. The images are encoded
+/// side by side on `executor`'s threads (the bytes of each file do not depend on it).
 RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::string& stem,
                                  const StereoResult& result, const nlohmann::json& record,
-                                 const Image* holes_overlay = nullptr, const StereoViews& views = {});
+                                 const Image* holes_overlay = nullptr, const StereoViews& views = {},
+                                 const Executor& executor = Executor(1));
 
 }  // namespace sb::io
