@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
@@ -260,6 +261,8 @@ constexpr const char* kStaging = ".stereobench-next";
 /// The parts of a report, the index first: it goes first and comes last, so that the folder never
 /// holds an index.html whose assets or images are gone.
 constexpr const char* kReportParts[] = {"index.html", "assets", "images"};
+/// The prefix of the names the earlier report's parts take while the new one takes their place.
+constexpr const char* kEarlier = ".stereobench-earlier";
 
 /// Prepares the output folder: new, empty, or an earlier report (finished, or stopped before its
 /// index was written), which stays in place until the new one is written whole (replace_report).
@@ -286,6 +289,23 @@ io::FileLock prepare_out_dir(const fs::path& out, const std::string& named) {
   for (const fs::directory_entry& e : fs::directory_iterator(out, ec))
     if (e.path().filename().string().starts_with(".index.html.tmp-")) stale.push_back(e.path());
   for (const fs::path& f : stale) fs::remove(f, ec);
+  // The earlier report's parts a report set aside: a report stopped before its own parts were all
+  // in place leaves the earlier part missing, and it goes back; one stopped (or refused) before
+  // removing them leaves both, and the set-aside one goes, best effort (replace_report warned of
+  // one it could not remove).
+  for (const char* part : kReportParts) {
+    const fs::path earlier = out / fmt::format("{}-{}", kEarlier, part);
+    if (!fs::exists(fs::symlink_status(earlier, ec))) continue;
+    if (!fs::exists(fs::symlink_status(out / part, ec))) {
+      fs::rename(earlier, out / part, ec);
+      if (ec)
+        throw IoError(fmt::format("cannot put back {}, the earlier report's {} that a stopped report set aside: {}; "
+                                  "move it back by hand",
+                                  earlier.string(), part, ec.message()));
+    } else {
+      fs::remove_all(earlier, ec);
+    }
+  }
   io::write_text_atomically(out / kReportMarker, fmt::format("{} {}\n", kGenerator, SB_VERSION_STRING));
   return std::move(*lock);
 }
@@ -297,22 +317,65 @@ bool holds_earlier_report(const fs::path& out) {
                      [&](const char* part) { return fs::exists(out / part, ec); });
 }
 
-/// Puts the report written whole into `stage` in the place of the folder's earlier one: the
-/// earlier index first, its assets and images after it, then the new images, assets and index.
-/// Removals and renames only, which a full disk does not stop.
-void replace_report(const fs::path& out, const fs::path& stage) {
+/// Where the earlier report's part `part` waits while the new report takes its place: a name in
+/// the same folder, since a folder renamed into another folder needs write permission on itself
+/// (to change its "..") and one renamed in place does not.
+fs::path set_aside(const fs::path& out, const char* part) { return out / fmt::format("{}-{}", kEarlier, part); }
+
+/// Puts the report written whole into `stage` in the place of the folder's earlier one, by renames
+/// only (which neither a full disk nor a read-only part of the earlier report stops): the earlier
+/// parts are set aside (index first), the new ones put in place (index last), then the earlier
+/// ones removed. A rename that fails puts back what was moved, so that the earlier report stays
+/// as it was (IoError saying so, or naming what could not be put back). An earlier part that
+/// cannot be removed at the end (its files not the user's to remove) stays under its set-aside
+/// name, with a warning; the report is in place either way.
+void replace_report(const fs::path& out, const fs::path& stage, std::vector<std::string>& warnings) {
   std::error_code ec;
+  std::vector<const char*> aside;  // the earlier parts set aside, in order
+  std::vector<const char*> placed;  // the new parts put in place, in order
+  // Puts back what was moved; the problems of doing so, or none.
+  const auto undo = [&]() {
+    std::vector<std::string> problems;
+    std::error_code undo_ec;
+    for (auto p = placed.rbegin(); p != placed.rend(); ++p) {
+      fs::rename(out / *p, stage / *p, undo_ec);
+      if (undo_ec) problems.push_back(fmt::format("the new {} stays in {} ({})", *p, out.string(), undo_ec.message()));
+    }
+    for (auto p = aside.rbegin(); p != aside.rend(); ++p) {
+      fs::rename(set_aside(out, *p), out / *p, undo_ec);
+      if (undo_ec)
+        problems.push_back(fmt::format("the earlier {} is at {} ({})", *p, set_aside(out, *p).string(),
+                                       undo_ec.message()));
+    }
+    return problems;
+  };
+  const auto fail = [&](const std::string& what) {
+    const std::vector<std::string> problems = undo();
+    if (problems.empty())
+      throw IoError(fmt::format("{}; the earlier report in {} is kept as it was", what, out.string()));
+    throw IoError(fmt::format("{}; putting the earlier report back failed too: {}; move them by hand", what,
+                              fmt::join(problems, "; ")));
+  };
   for (const char* part : kReportParts) {
-    fs::remove_all(out / part, ec);
-    if (ec) throw IoError(fmt::format("cannot remove the earlier report's {}: {}", (out / part).string(), ec.message()));
+    if (!fs::exists(fs::symlink_status(out / part, ec))) continue;
+    fs::rename(out / part, set_aside(out, part), ec);
+    if (ec) fail(fmt::format("cannot move the earlier report's {} aside: {}", (out / part).string(), ec.message()));
+    aside.push_back(part);
   }
   for (auto part = std::rbegin(kReportParts); part != std::rend(kReportParts); ++part) {
     if (!fs::exists(stage / *part, ec)) continue;  // no images copied (linked, or none named)
     fs::rename(stage / *part, out / *part, ec);
-    if (ec) throw IoError(fmt::format("cannot move the new report's {} into place: {}", (out / *part).string(),
-                                      ec.message()));
+    if (ec) fail(fmt::format("cannot move the new report's {} into place: {}", (out / *part).string(), ec.message()));
+    placed.push_back(*part);
   }
   io::sync_folder(out);
+  for (const char* part : aside) {
+    fs::remove_all(set_aside(out, part), ec);
+    if (ec)
+      warnings.push_back(fmt::format("cannot remove the earlier report's {}, set aside as {}: {}; the new report is in "
+                                     "place; remove it by hand",
+                                     part, set_aside(out, part).string(), ec.message()));
+  }
   fs::remove_all(stage, ec);  // empty by now
 }
 
@@ -636,7 +699,7 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
     if (!earlier) throw;
     throw IoError(fmt::format("{}; the earlier report in {} is kept as it was", e.what(), out.string()));
   }
-  replace_report(out, stage);
+  replace_report(out, stage, summary.warnings);
   staging.dismiss();
   summary.index_html = out / "index.html";
   return summary;

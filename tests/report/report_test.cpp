@@ -7,9 +7,11 @@
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -566,6 +568,71 @@ TEST(Report, AReportThatCannotBeWrittenLeavesTheEarlierOneAsItWas) {
   EXPECT_NE(test::read_text(dir / "out" / "index.html").find("<title>second</title>"), std::string::npos);
   EXPECT_TRUE(fs::exists(dir / "out" / left));
   EXPECT_FALSE(fs::exists(dir / "out" / ".stereobench-next"));
+}
+
+TEST(Report, AnEarlierPartThatCannotBeRemovedIsSetAsideAndTheNewReportTakesItsPlace) {
+  // The earlier report's images folder is not the user's to empty (another owner's, read-only):
+  // its index and assets were removed, its images folder emptied in part, and then the removal
+  // failed, leaving no report at all. The earlier parts are now set aside by renames (in the
+  // folder, which needs no permission on them), the new report takes their place, and a part that
+  // cannot be removed stays set aside, with a warning.
+  // As root the reports run as nobody (setpriv), from a folder under /tmp that nobody can reach
+  // (the build tree may lie under a private home); as another user a read-only folder of their
+  // own does the same.
+  std::string made = (fs::temp_directory_path() / "sb-report-aside-XXXXXX").string();
+  ASSERT_NE(::mkdtemp(made.data()), nullptr);
+  const fs::path dir = made;
+  const fs::perms read_only = fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
+                              fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec;
+  fs::permissions(dir, read_only | fs::perms::owner_write);
+  json line = minimal_line("a", 0);
+  line["images"] = {{"left_png", "cells/0000/left.png"}};
+  write_text(dir / "results.jsonl", line.dump() + "\n");
+  fs::create_directories(dir / "cells" / "0000");
+  fs::copy_file(kSource / "reference" / "store" / "box-wall_full_160x90_e64.0mm_c4.08m" / "right.png",
+                dir / "cells" / "0000" / "left.png");
+  fs::copy(fs::path(SB_BINARY_DIR) / "report-assets", dir / "assets", fs::copy_options::recursive);
+  fs::copy_file(SB_CLI_PATH, dir / "stereobench");
+  std::string as_user;  // setpriv's command line, as root
+  const auto report = [&](const std::string& title) {
+    return run_shell("STEREOBENCH_REPORT_ASSETS=" + quoted(dir / "assets") + " " + as_user +
+                     quoted(dir / "stereobench") + " report " + quoted(dir / "results.jsonl") + " --out " +
+                     quoted(dir / "out") + " --title " + title);
+  };
+  const test::CliRun first = report("first");
+  ASSERT_EQ(first.code, 0) << first.out;
+  const fs::path images = dir / "out" / "images";
+  ASSERT_TRUE(fs::is_directory(images));
+  if (::geteuid() == 0) {
+    ASSERT_EQ(run_shell("chown -R 65534 " + quoted(dir / "out") + " && chown root " + quoted(images)).code, 0);
+    as_user = "setpriv --reuid=65534 --regid=65534 --clear-groups ";
+  }
+  fs::permissions(images, read_only);
+  const test::CliRun second = report("second");
+  EXPECT_EQ(second.code, 0) << second.out;
+  const fs::path aside = dir / "out" / ".stereobench-earlier-images";
+  EXPECT_NE(second.out.find("cannot remove the earlier report's images, set aside as " + aside.string()),
+            std::string::npos)
+      << second.out;
+  EXPECT_NE(test::read_text(dir / "out" / "index.html").find("<title>second</title>"), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir / "out" / "assets" / "report.js"));
+  const std::string left = embedded_data(dir / "out" / "index.html")["cells"][0]["images"]["left"].get<std::string>();
+  EXPECT_TRUE(fs::exists(dir / "out" / left)) << "the new report's image: " << left;
+  // What of it could be removed is gone (the image, in a folder of the user's); the rest stays.
+  EXPECT_TRUE(fs::is_directory(aside));
+  EXPECT_FALSE(fs::exists(dir / "out" / ".stereobench-next"));
+
+  // Once the part can be removed, the next report removes it.
+  fs::permissions(aside, fs::perms::owner_write, fs::perm_options::add);
+  if (!as_user.empty()) {
+    ASSERT_EQ(run_shell("chown 65534 " + quoted(aside)).code, 0);
+  }
+  const test::CliRun third = report("third");
+  EXPECT_EQ(third.code, 0) << third.out;
+  EXPECT_EQ(third.out.find("cannot remove"), std::string::npos) << third.out;
+  EXPECT_FALSE(fs::exists(aside));
+  EXPECT_NE(test::read_text(dir / "out" / "index.html").find("<title>third</title>"), std::string::npos);
+  if (!::testing::Test::HasFailure()) fs::remove_all(dir);
 }
 
 }  // namespace
