@@ -317,10 +317,31 @@ int exit_code(Verdict worst) noexcept {
   return 0;
 }
 
+namespace {
+
+/// Whether `value` of threshold key `key` is a limit no measure can cross.
+bool vacuous_limit(const std::string& key, double value) {
+  for (const MetricCheck& m : kMetricChecks) {
+    if (key != m.fail_key && key != m.warn_key) continue;
+    return m.direction == Direction::at_least ? value <= m.smallest : value >= m.largest;
+  }
+  return false;
+}
+
+/// The vacuous limits of one table, as "KEY = VALUE (TABLE)".
+void note_vacuous(const ThresholdValues& values, const std::string& table, std::vector<std::string>& out) {
+  for (const auto& [key, value] : values)
+    if (key != kToleranceKey && value && vacuous_limit(key, *value))
+      out.push_back(fmt::format("{} = {} ({})", key, *value, table));
+}
+
+}  // namespace
+
 bool GateConfig::sets_limits() const {
   const auto sets_limit = [](const ThresholdValues& values) {
-    return std::any_of(values.begin(), values.end(),
-                       [](const auto& kv) { return kv.first != kToleranceKey && kv.second.has_value(); });
+    return std::any_of(values.begin(), values.end(), [](const auto& kv) {
+      return kv.first != kToleranceKey && kv.second.has_value() && !vacuous_limit(kv.first, *kv.second);
+    });
   };
   return sets_limit(defaults) ||
          std::any_of(rules.begin(), rules.end(), [&](const GateRule& r) { return sets_limit(r.values); });
@@ -372,10 +393,17 @@ GateConfig parse_gate_config(const std::string& text, const std::string& source)
     const auto t = r.values.find(kToleranceKey);
     return t != r.values.end() && t->second.has_value();
   });
+  note_vacuous(config.defaults, "[defaults]", config.vacuous);
+  for (const GateRule& rule : config.rules)
+    note_vacuous(rule.values, fmt::format("the [[rule]] at line {}", rule.line), config.vacuous);
   if (!config.sets_limits() && !config.regression_table && !rule_regression)
-    throw InputError(fmt::format("{}: the gate config sets no threshold, no [regression] and no rule's {}: it would "
+    throw InputError(fmt::format("{}: the gate config sets no threshold{}, no [regression] and no rule's {}: it would "
                                  "pass anything; give a limit a value in [defaults] or a [[rule]] (see docs/gate.md)",
-                                 source, kToleranceKey));
+                                 source,
+                                 config.vacuous.empty()
+                                     ? std::string()
+                                     : fmt::format(" that a measure can cross (only {})", fmt::join(config.vacuous, ", ")),
+                                 kToleranceKey));
   return config;
 }
 
@@ -1145,6 +1173,10 @@ GateReport evaluate_gate(const GateConfig& config, const GateResults& results, c
   if (std::optional<std::string> note = unused_rules_note(config, results, rule_used)) report.notes.push_back(*note);
   if (std::optional<std::string> note = unapplied_limits_note(config, rule_used, won, applied))
     report.notes.push_back(*note);
+  if (!config.vacuous.empty())
+    report.notes.push_back(fmt::format("{}: limits that no measure can cross, so they check nothing: {}; turn a check "
+                                       "off with = false, or give a limit that can fail",
+                                       config.source, fmt::join(config.vacuous, ", ")));
   // A baseline of another sweep (or of cells since renamed) skips every time check without a word.
   if (!baseline.empty() && regression_checks > 0 && regression_with_entry == 0)
     report.notes.push_back(fmt::format(

@@ -52,13 +52,17 @@ struct MetricCheck {
   /// undefined for the image itself (SSIM of an image smaller than its 11x11 window). A null value
   /// with that count 0 is skipped, not failed.
   const char* defined_by = nullptr;
+  /// The smallest value the metric takes: a minimum at or below it (a maximum at or above
+  /// `largest`) can never be crossed, and checks nothing. PSNR of 8-bit images is at least 0 dB
+  /// (the MSE at most 255^2); a speed-up is above 0.
+  double smallest = 0.0;
 };
 
 /// Every threshold check, in report order. The time regression is separate (RegressionSettings).
 inline constexpr MetricCheck kMetricChecks[] = {
     {"psnr", "min_psnr", "warn_psnr", Direction::at_least, "/validation/metrics/psnr", "PSNR"},
     {"ssim", "min_ssim", "warn_ssim", Direction::at_least, "/validation/metrics/ssim", "SSIM", 1.0, nullptr, false,
-     "/validation/metrics/ssim_pixels"},
+     "/validation/metrics/ssim_pixels", -1.0},
     {"error_fraction", "max_error_fraction", "warn_error_fraction", Direction::at_most,
      "/validation/metrics/error_fraction", "error-pixel fraction", 1.0},
     {"hole_fraction", "max_hole_fraction", "warn_hole_fraction", Direction::at_most, "/validation/holes/hole_fraction",
@@ -68,7 +72,7 @@ inline constexpr MetricCheck kMetricChecks[] = {
     {"left_psnr", "min_left_psnr", "warn_left_psnr", Direction::at_least, "/validation/left_eye/metrics/psnr",
      "left eye's PSNR", std::numeric_limits<double>::infinity(), "/validation/left_eye", true},
     {"left_ssim", "min_left_ssim", "warn_left_ssim", Direction::at_least, "/validation/left_eye/metrics/ssim",
-     "left eye's SSIM", 1.0, "/validation/left_eye", true, "/validation/left_eye/metrics/ssim_pixels"},
+     "left eye's SSIM", 1.0, "/validation/left_eye", true, "/validation/left_eye/metrics/ssim_pixels", -1.0},
     {"speedup", "min_speedup", "warn_speedup", Direction::at_least, "/timing/speedup_median", "median speed-up",
      std::numeric_limits<double>::infinity(), nullptr, true},
     {"right_share", "max_right_share", "warn_right_share", Direction::at_most, "/timing/right_over_left_median",
@@ -115,8 +119,12 @@ struct GateConfig {
 
   /// Whether some table gives a threshold a value; without one, only the time regressions that
   /// [regression] or a rule's regression_tolerance asks for are checked. A limit counts only when given a value: [[rule]]s without one, or keys
-  /// all turned off (= false), would pass anything as surely as an empty file.
+  /// all turned off (= false), would pass anything as surely as an empty file; so would limits no
+  /// measure can cross (`vacuous`), which do not count either.
   [[nodiscard]] bool sets_limits() const;
+  /// The limits no measure can cross (min_psnr = 0, max_hole_fraction = 1, min_speedup = 0), each
+  /// as "KEY = VALUE (TABLE)": they check nothing; the gate notes them.
+  std::vector<std::string> vacuous;
 };
 
 /// Parses gate.toml text. InputError naming `source`, the line and the key for a syntax error, an

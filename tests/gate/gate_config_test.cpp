@@ -4,6 +4,7 @@
 
 #include <map>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -100,6 +101,24 @@ TEST(GateConfig, BadValuesAreRejected) {
     EXPECT_NE(config_error(none).find("sets no threshold, no [regression] and no rule's regression_tolerance"),
               std::string::npos)
         << none;
+  // Limits no measure can cross pass anything too: PSNR of 8-bit images is at least 0 dB, a
+  // fraction or a recall lies in [0, 1], a speed-up is above 0.
+  for (const char* never : {"[defaults]\nmin_psnr = 0\n", "[defaults]\nmax_error_fraction = 1\nmax_hole_fraction = 1.0\n",
+                            "[[rule]]\npipeline = \"repro-*\"\nmin_speedup = 0\nmin_recall = 0\nwarn_left_psnr = 0\n"}) {
+    const std::string error = config_error(never);
+    EXPECT_NE(error.find("sets no threshold that a measure can cross (only "), std::string::npos) << never << error;
+  }
+  EXPECT_NE(config_error("[[rule]]\npipeline = \"repro-*\"\nmin_speedup = 0\n")
+                .find("(only min_speedup = 0 (the [[rule]] at line 1))"),
+            std::string::npos);
+  // Beside a limit that can fail, they are noted; SSIM can be negative, so min_ssim = 0 checks.
+  const GateConfig mixed = parse_gate_config("[defaults]\nmin_psnr = 0\nmin_ssim = 0\n[[rule]]\nscene = \"x\"\n"
+                                             "max_hole_fraction = 1\nmin_psnr = 30\n",
+                                             "test.toml");
+  EXPECT_EQ(mixed.vacuous, (std::vector<std::string>{"min_psnr = 0 ([defaults])",
+                                                     "max_hole_fraction = 1 (the [[rule]] at line 4)"}));
+  EXPECT_TRUE(parse_gate_config("[defaults]\nmin_ssim = 0\nmin_psnr = 0.01\nmax_hole_fraction = 0.999\n", "t")
+                  .vacuous.empty());
   // A rule's regression_tolerance asks for the time regressions of its cells: a check.
   EXPECT_EQ(config_error("[defaults]\nmin_psnr = false\n[[rule]]\nregression_tolerance = 0.1\n"), "");
   // An integer beyond 2^53 is a number too: it was read through a conversion that gives none for
