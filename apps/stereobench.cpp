@@ -130,6 +130,29 @@ void refuse_non_decimal_numbers(CLI::App& app) {
 /// names none of the next level's, with those names; or, when the words given end at a command
 /// that needs one of its own (`stereobench sweep`), those commands. "" when a word is an option
 /// or every word is a command that needs none.
+/// CLI11's usage messages in the words of the others: what was wrong and what to do.
+std::string usage_error_message(const std::string& what) {
+  std::smatch m;
+  // "--resolution: At Most 1 required but received 2"
+  if (std::regex_match(what, m, std::regex(R"((\S+): At Most 1 required but received (\d+))")))
+    return fmt::format("{} is given {} times; give it once", m[1].str(), m[2].str());
+  // "--threads: 1 required INT missing"
+  if (std::regex_match(what, m, std::regex(R"((-\S+): (\d+) required (\S+) missing)")))
+    return fmt::format("{} needs {} after it ({}); give {} {}", m[1].str(),
+                       m[2].str() == "1" ? std::string("a value") : m[2].str() + " values", m[3].str(), m[1].str(),
+                       m[3].str() == "INT" ? "N" : m[3].str() == "FLOAT" ? "X" : "VALUE");
+  // "inputs is required", "--results is required"
+  if (std::regex_match(what, m, std::regex(R"((\S+) is required)")))
+    return m[1].str().starts_with("-") ? fmt::format("{} is required; give it", m[1].str())
+                                       : fmt::format("the argument {} is missing; give it", m[1].str());
+  // "The following argument was not expected: --bogus"
+  if (std::regex_match(what, m, std::regex(R"(The following arguments? (?:was|were) not expected: (.+))")))
+    return fmt::format("unexpected argument(s) {}: an option this command does not have, or a value given "
+                       "without its option",
+                       m[1].str());
+  return what;
+}
+
 std::string unknown_command_message(const CLI::App& app, int argc, char** argv) {
   const CLI::App* level = &app;
   std::string path = "stereobench";
@@ -206,7 +229,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     // Usage errors read like every other error: one "stereobench: error:" line, then where to look.
     std::string message = unknown_command_message(app, argc, argv);
-    if (message.empty()) message = e.what();
+    if (message.empty()) message = usage_error_message(e.what());
     // Only decimal numbers reach the conversion (refuse_non_decimal_numbers): one that fails to
     // convert does not fit the option's integer type.
     if (dynamic_cast<const CLI::ConversionError*>(&e) != nullptr && message.starts_with("Could not convert: ")) {

@@ -114,6 +114,15 @@ TEST(Cli, BadArgumentsExitWith3AndSayWhy) {
        "--json: " + (dir / "new" / "folder").string() + "/ names a folder (it ends in '/'); give the name of the file"},
       {"sweep run x.toml --executor slurm --shards -1", "--shards: Value -1 not in range 1 to 1001"},
       {"sweep run x.toml --executor slurm --shards 0", "--shards: Value 0 not in range 1 to 1001"},
+      // The parser's own usage errors, in the words of the others (it said "--resolution: At Most
+      // 1 required but received 2", "--threads: 1 required INT missing", "inputs is required").
+      {"scenes info " + scene + " -r 64x36 -r 32x18", "--resolution is given 2 times; give it once"},
+      {"scenes info " + scene + " --vfov", "--vfov needs a value after it (FLOAT); give --vfov X"},
+      {"render --threads", "--threads needs a value after it (INT); give --threads N"},
+      {"sweep collect x.jsonl", "the argument inputs is missing; give it"},
+      {"gate", "--results is required; give it"},
+      {"scenes info " + scene + " --bogus",
+       "unexpected argument(s) --bogus: an option this command does not have, or a value given without its option"},
   };
   for (const Case& c : cases) {
     const CliRun r = run(c.args);
