@@ -619,6 +619,19 @@ TEST(SweepRun, BadDefinitionAndShardAreUsageErrors) {
   // 3000 px, and rt-buffer's default depth 2e exceeds its limit.
   refused("deep", "pipelines = [\"plain-rt\", \"rt-buffer\"]\nconvergence_m = [2.0, 0.001]\n",
           "rt-buffer: the default depth t = 2 x max disparity");
+  // A damaged scene file: refused naming the definition, the scene and its cells, then the file.
+  std::ofstream(dir / "cut.gltf") << "{\"asset\": {\"version\": \"2.0\"}, \"buffers\": [";
+  std::ofstream(dir / "cut.toml") << "[sweep]\nname = \"cut\"\nscenes = [\"box-wall\", \"cut.gltf\"]\n"
+                                     "pipelines = [\"plain-rt\"]\nresolutions = [\"96x54\", \"32x18\"]\n";
+  const test::CliRun cut = test::run_cli("sweep run " + quoted(dir / "cut.toml") + " --out " + quoted(dir / "cut") +
+                                         " --scenes-dir " + quoted(dir / "scenes"));
+  EXPECT_EQ(cut.code, 3) << cut.out;
+  EXPECT_NE(cut.out.find((dir / "cut.toml").string() + ": scene 'cut.gltf' of 2 cells (the first: cell 2 'cut.gltf|"),
+            std::string::npos)
+      << cut.out;
+  EXPECT_NE(cut.out.find((dir / "cut.gltf").string() + ": not valid JSON"), std::string::npos) << cut.out;
+  EXPECT_NE(cut.out.find("fix the scene file or the definition (no cell has run)"), std::string::npos) << cut.out;
+  EXPECT_EQ(cut.out.find("[1/4]"), std::string::npos) << "no cell may run: " << cut.out;
   // Fixed, it runs into the same folder: the refused run did not claim it for the old definition.
   std::ofstream(dir / "near.toml", std::ios::trunc)
       << "[sweep]\nname = \"near\"\nscenes = [\"box-wall\"]\npipelines = [\"plain-rt\"]\n"
