@@ -91,7 +91,9 @@ Baseline load_baseline(const std::filesystem::path& file, std::vector<DamagedEnt
   try {
     doc = io::parse_json(text);
   } catch (const io::JsonTextError& e) {
-    throw InputError(fmt::format("baseline {} is not valid JSON ({})", file.string(), e.what()));
+    throw InputError(fmt::format("baseline {} is not valid JSON ({}); mend it, or store it again with gate "
+                                 "--update-baseline",
+                                 file.string(), e.what()));
   }
   return parse_baseline(doc, file.string(), damaged);
 }

@@ -352,8 +352,8 @@ GateConfig parse_gate_config(const std::string& text, const std::string& source)
   try {
     root = toml::parse(text, source);
   } catch (const toml::parse_error& e) {
-    throw InputError(
-        fmt::format("{}:{}:{}: {}", source, e.source().begin.line, e.source().begin.column, e.description()));
+    throw InputError(fmt::format("{}:{}:{}: not valid TOML: {}; mend the syntax there (the format: docs/gate.md)",
+                                 source, e.source().begin.line, e.source().begin.column, e.description()));
   }
   GateConfig config;
   config.source = source;

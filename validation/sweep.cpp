@@ -448,8 +448,8 @@ SweepDefinition parse_sweep(const std::string& text, const fs::path& file) {
   try {
     root = toml::parse(text, file.string());
   } catch (const toml::parse_error& e) {
-    throw InputError(fmt::format("{}:{}:{}: not valid TOML: {}", file.string(), e.source().begin.line,
-                                 e.source().begin.column, e.description()));
+    throw InputError(fmt::format("{}:{}:{}: not valid TOML: {}; mend the syntax there (the format: docs/sweeps.md)",
+                                 file.string(), e.source().begin.line, e.source().begin.column, e.description()));
   }
   check_keys(where, root, "", kTopKeys);
 

@@ -1102,7 +1102,10 @@ class Converter {
         mesh.uvs.resize(nv);
         for (size_t v = 0; v < nv; ++v) mesh.uvs[v] = vec2(uv[v * 2], uv[v * 2 + 1]);
       } else if (prim.material >= 0 && scene.materials[static_cast<size_t>(prim.material)].base_color_texture >= 0) {
-        warn("missing-uv", "textured materials on primitives without texture coordinates (texture ignored there)");
+        warn("missing-uv:" + uv_name,
+             fmt::format("textured materials on primitives without the texture coordinates they read, {} (texture "
+                         "ignored there)",
+                         uv_name));
       }
       std::vector<uint32_t> idx;
       if (prim.indices >= 0) {
@@ -1282,7 +1285,9 @@ Scene load_gltf(const fs::path& path, const GltfLoadOptions& options) {
       throw InputError(fmt::format("{}: not a glTF scene (neither glTF JSON nor binary .glb); give a .gltf or .glb "
                                    "file, or a built-in scene name (stereobench scenes list)",
                                    file));
-    throw InputError(fmt::format("{}: not valid JSON at byte {}: {}", file, e.byte(), short_parse_error(e.what())));
+    throw InputError(fmt::format("{}: not valid JSON at byte {}: {}; the file is cut short or damaged there: export it "
+                                 "again, or mend the JSON",
+                                 file, e.byte(), short_parse_error(e.what())));
   }
   check_gltf_json(doc, file);
   const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();

@@ -101,6 +101,9 @@ TEST(GateConfig, BadValuesAreRejected) {
     EXPECT_NE(config_error(none).find("sets no threshold, no [regression] and no rule's regression_tolerance"),
               std::string::npos)
         << none;
+  EXPECT_NE(config_error("[defaults\nmin_psnr = 30\n").find("test.toml:1:10: not valid TOML: "), std::string::npos);
+  EXPECT_NE(config_error("[defaults\nmin_psnr = 30\n").find("; mend the syntax there (the format: docs/gate.md)"),
+            std::string::npos);
   // Limits no measure can cross pass anything too: PSNR of 8-bit images is at least 0 dB, a
   // fraction or a recall lies in [0, 1], a speed-up is above 0.
   for (const char* never : {"[defaults]\nmin_psnr = 0\n", "[defaults]\nmax_error_fraction = 1\nmax_hole_fraction = 1.0\n",

@@ -54,7 +54,7 @@ inline void write_text(const std::filesystem::path& p, const std::string& s) { M
 /// Every broken scene file the loader must refuse, with the part of the message naming its fault.
 inline std::vector<BadCase> bad_scene_corpus() {
   std::vector<BadCase> c;
-  c.push_back({"not_json", "a.gltf", [](auto& p) { write_text(p, "{ \"asset\": { \"version\": \"2.0\" "); }, "not valid JSON"});
+  c.push_back({"not_json", "a.gltf", [](auto& p) { write_text(p, "{ \"asset\": { \"version\": \"2.0\" "); }, "not valid JSON at byte 31: parse error at line 1, column 31: syntax error while parsing object - unexpected end of input; expected '}'; the file is cut short or damaged there: export it again, or mend the JSON"});
   c.push_back({"image_as_scene", "a.png", [](auto& p) { write_text(p, std::string("\x89PNG\r\n\x1a\n\0\0\0\rIHDR", 16)); },
                "not a glTF scene (neither glTF JSON nor binary .glb)"});
   c.push_back({"strip_of_two_vertices", "a.gltf", [](auto& p) {
