@@ -145,6 +145,9 @@ std::string usage_error_message(const std::string& what) {
   if (std::regex_match(what, m, std::regex(R"((\S+) is required)")))
     return m[1].str().starts_with("-") ? fmt::format("{} is required; give it", m[1].str())
                                        : fmt::format("the argument {} is missing; give it", m[1].str());
+  // "--interaxial excludes --max-disparity"
+  if (std::regex_match(what, m, std::regex(R"((-\S+) excludes (-\S+))")))
+    return fmt::format("{} and {} exclude each other; give one of them", m[1].str(), m[2].str());
   // "The following argument was not expected: --bogus"
   if (std::regex_match(what, m, std::regex(R"(The following arguments? (?:was|were) not expected: (.+))")))
     return fmt::format("unexpected argument(s) {}: an option this command does not have, or a value given "
