@@ -757,6 +757,24 @@ std::vector<json> collect_results(const std::vector<fs::path>& files, const fs::
   }
   std::vector<json> cells;
   for (const auto& [index, id] : id_of_index) cells.push_back(by_id.at(id).cell);
+  // The shards' cells as a whole: a shard left out (or one not finished) leaves a merge that the
+  // gate's sweep_complete check fails; said here, where the files are chosen.
+  if (warnings && !cells.empty()) {
+    const json count = value_at(cells.front(), "cell_count");
+    if (count.is_number_unsigned() && cells.size() < count.get<uint64_t>()) {
+      std::vector<std::string> missing;
+      size_t missing_count = 0;
+      for (uint64_t i = 0; i < count.get<uint64_t>(); ++i)
+        if (!id_of_index.count(i) && missing_count++ < 8) missing.push_back(std::to_string(i));
+      warnings->push_back(fmt::format("the {} file(s) hold {} of the sweep's {} cells (missing cell_index {}{}): a "
+                                      "shard is left out or unfinished; the gate fails the merge until every cell is "
+                                      "in it",
+                                      files.size(), cells.size(), count.get<uint64_t>(), fmt::join(missing, ", "),
+                                      missing_count > missing.size() ? fmt::format(" and {} more",
+                                                                                   missing_count - missing.size())
+                                                                     : ""));
+    }
+  }
   return cells;
 }
 

@@ -330,6 +330,12 @@ TEST(ResultsFile, CollectMergesShards) {
   // The merged text reads back as a results file.
   std::ofstream(dir / "all.jsonl") << results_text(merged);
   EXPECT_EQ(read_results(dir / "all.jsonl").cells, merged);
+  // The cells hold 3 of the sweep's 10: said, with the missing indices (a shard left out).
+  std::vector<std::string> warnings;
+  (void)collect_results({dir / "s0.jsonl", dir / "s1.jsonl"}, dir / "merged.jsonl", &warnings);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0], "the 2 file(s) hold 3 of the sweep's 10 cells (missing cell_index 3, 4, 5, 6, 7, 8, 9): a "
+                         "shard is left out or unfinished; the gate fails the merge until every cell is in it");
 
   append_result(dir / "s2.jsonl", cell(1, "b", 12.0));  // the same cell, other numbers
   try {
