@@ -295,11 +295,12 @@ void register_validate_command(CLI::App& root) {
       ->capture_default_str();
   v->add_option("--threads,-t", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
   v->add_option("--out", a->out, "Output folder")->capture_default_str();
-  CLI::Option* cache = v->add_option("--cache", a->cache,
-                                     "Folder of cached external ground-truth renders, keyed by content hash ('' to "
-                                     "disable)")
-                           ->capture_default_str();
-  v->add_flag("--no-cache", a->no_cache, "Render the ground truth again and do not store it")->excludes(cache);
+  v->add_option("--cache", a->cache,
+                "Folder of cached external ground-truth renders, keyed by content hash ('' to disable)")
+      ->capture_default_str();
+  v->add_flag("--no-cache", a->no_cache,
+              "Render the ground truth again and do not store it (beside --cache, --no-cache wins: the folder is "
+              "neither read nor written)");
   v->add_option("--error-threshold", a->error_threshold,
                 "Error pixel: largest channel difference above this many 8-bit codes")
       ->capture_default_str();

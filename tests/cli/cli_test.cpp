@@ -83,7 +83,6 @@ TEST(Cli, BadArgumentsExitWith3AndSayWhy) {
       {"scenes info " + scene + " --vfov 180", "--vfov 180 is out of range"},
       {"scenes info " + scene + " --interaxial 0.06 --max-disparity 20",
        "--interaxial and --max-disparity exclude each other; give one of them"},
-      {"validate --no-cache --cache x", "--cache and --no-cache exclude each other; give one of them"},
       {"scenes info " + scene + " --interaxial abc", "--interaxial"},
       {"scenes generate spheres --param count=0 --out '" + dir.path().string() + "'", "count"},
       {"scenes generate spheres --param nonsense=1 --out '" + dir.path().string() + "'", "nonsense"},
