@@ -126,21 +126,21 @@ void refuse_non_decimal_numbers(CLI::App& app) {
   }
 }
 
-/// When parsing stopped for want of a subcommand: the first word after the commands given that
-/// names none of the next level's, with those names; or, when the words given end at a command
-/// that needs one of its own (`stereobench sweep`), those commands. "" when a word is an option
-/// or every word is a command that needs none.
 /// CLI11's usage messages in the words of the others: what was wrong and what to do.
 std::string usage_error_message(const std::string& what) {
   std::smatch m;
   // "--resolution: At Most 1 required but received 2"
   if (std::regex_match(what, m, std::regex(R"((\S+): At Most 1 required but received (\d+))")))
     return fmt::format("{} is given {} times; give it once", m[1].str(), m[2].str());
-  // "--threads: 1 required INT missing"
-  if (std::regex_match(what, m, std::regex(R"((-\S+): (\d+) required (\S+) missing)")))
-    return fmt::format("{} needs {} after it ({}); give {} {}", m[1].str(),
-                       m[2].str() == "1" ? std::string("a value") : m[2].str() + " values", m[3].str(), m[1].str(),
-                       m[3].str() == "INT" ? "N" : m[3].str() == "FLOAT" ? "X" : "VALUE");
+  // "--threads: 1 required INT missing", "--shards: 1 required UINT:UINT in [1 - 1001] missing"
+  if (std::regex_match(what, m, std::regex(R"((-\S+): (\d+) required (.+) missing)"))) {
+    const std::string type = m[3].str(), base = type.substr(0, type.find_first_of(": "));
+    const std::string placeholder = base == "INT" || base == "UINT" ? "N" : base == "FLOAT" ? "X" : "VALUE";
+    std::string values;
+    for (int i = 0; i < std::stoi(m[2].str()) && i < 4; ++i) values += " " + placeholder;
+    return fmt::format("{} needs {} after it ({}); give {}{}", m[1].str(),
+                       m[2].str() == "1" ? std::string("a value") : m[2].str() + " values", type, m[1].str(), values);
+  }
   // "inputs is required", "--results is required"
   if (std::regex_match(what, m, std::regex(R"((\S+) is required)")))
     return m[1].str().starts_with("-") ? fmt::format("{} is required; give it", m[1].str())
@@ -156,6 +156,10 @@ std::string usage_error_message(const std::string& what) {
   return what;
 }
 
+/// When parsing stopped for want of a subcommand: the first word after the commands given that
+/// names none of the next level's, with those names; or, when the words given end at a command
+/// that needs one of its own (`stereobench sweep`), those commands. "" when a word is an option
+/// or every word is a command that needs none.
 std::string unknown_command_message(const CLI::App& app, int argc, char** argv) {
   const CLI::App* level = &app;
   std::string path = "stereobench";

@@ -12,8 +12,10 @@ build it was derived from and fails on a clear regression:
             (both also for the left eye where a pipeline synthesizes part of it: validation.left_eye)
   recall    fail 0.5 x (1 - lowest) (at least 0.005), warn half that, below the lowest; unchecked
             where the lowest is under 0.5 (ideal-copy and repro-warp trace no holes)
-  fractions (error pixels, holes): fail 1.25 x highest + 0.002, warn 1.12 x highest + 0.001
-  speed-up  warn only, at 0.7 x the lowest median (timings move with machine load)
+  fractions (error pixels, holes): fail 1.25 x highest + 0.002, warn 1.12 x highest + 0.001,
+            left out where that reaches 1 (no fraction exceeds it: the limit would check nothing)
+  speed-up  warn only, at 0.7 x the lowest median (timings move with machine load); left out
+            where that rounds to 0
   right eye / left eye time: warn only, at the highest median / 0.7 (where the stages split
             between the eyes; records written before the share carry none)
 
@@ -127,9 +129,12 @@ def main(paths):
         for key in ("error_fraction", "hole_fraction"):
             if got[key]:
                 hi = max(got[key])
-                # A fraction is at most 1, and the gate refuses a limit above it.
-                t["max_" + key] = fmt(min(1.0, ceil_to(1.25 * hi + 0.002, 0.001)), 3)
-                t["warn_" + key] = fmt(min(1.0, ceil_to(1.12 * hi + 0.001, 0.001)), 3)
+                # A fraction is at most 1: a limit of 1 or more checks nothing (the gate refuses one
+                # above 1 and notes one of 1), so the key is left out there.
+                for prefix, limit in (("max_", ceil_to(1.25 * hi + 0.002, 0.001)),
+                                      ("warn_", ceil_to(1.12 * hi + 0.001, 0.001))):
+                    if limit < 1.0:
+                        t[prefix + key] = fmt(limit, 3)
                 note.append(f"{key.split('_')[0]} {min(got[key]):.4f}..{hi:.4f}")
         if got["recall"] and min(got["recall"]) >= 0.5:  # pipelines that leave holes open score low: unchecked
             lo = min(got["recall"])
@@ -138,7 +143,8 @@ def main(paths):
             note.append(f"recall {lo:.4f}..{max(got['recall']):.4f}")
         if got["speedup"]:
             lo = min(got["speedup"])
-            t["warn_speedup"] = fmt(floor_to(0.7 * lo, 0.01), 2)
+            if floor_to(0.7 * lo, 0.01) > 0:  # a speed-up is above 0: a level of 0 checks nothing
+                t["warn_speedup"] = fmt(floor_to(0.7 * lo, 0.01), 2)
             note.append(f"speed-up {lo:.2f}..{max(got['speedup']):.2f}x")
         if got["right_share"]:
             hi = max(got["right_share"])

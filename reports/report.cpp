@@ -263,13 +263,43 @@ constexpr const char* kStaging = ".stereobench-next";
 constexpr const char* kReportParts[] = {"index.html", "assets", "images"};
 /// The prefix of the names the earlier report's parts take while the new one takes their place.
 constexpr const char* kEarlier = ".stereobench-earlier";
+/// The prefix of the names of earlier parts that could not be removed once the new report was in
+/// place; each such name is unique, so that it never stands in the way of a later report.
+constexpr const char* kLeftover = ".stereobench-leftover";
+
+/// Where the earlier report's part `part` waits while the new report takes its place: a name in
+/// the same folder, since a folder renamed into another folder needs write permission on itself
+/// (to change its "..") and one renamed in place does not.
+fs::path set_aside(const fs::path& out, const char* part) { return out / fmt::format("{}-{}", kEarlier, part); }
+
+/// Removes a set-aside earlier part once the new report is in place. One that cannot be removed
+/// (its files not the user's to remove) takes a leftover name of its own, freeing the set-aside
+/// name for the next report, and is warned of.
+void discard_set_aside(const fs::path& out, const char* part, std::vector<std::string>& warnings) {
+  const fs::path aside = set_aside(out, part);
+  std::error_code ec;
+  fs::remove_all(aside, ec);
+  if (!ec) return;
+  const std::string why = ec.message();
+  fs::path leftover;
+  for (int n = 1; n < 1000 && leftover.empty(); ++n) {
+    const fs::path candidate = out / fmt::format("{}-{}-{}", kLeftover, part, n);
+    if (fs::exists(fs::symlink_status(candidate, ec))) continue;
+    fs::rename(aside, candidate, ec);
+    if (!ec) leftover = candidate;
+    else break;
+  }
+  warnings.push_back(fmt::format("cannot remove the earlier report's {}, left as {}: {}; the new report is in place; "
+                                 "remove it by hand",
+                                 part, (leftover.empty() ? aside : leftover).string(), why));
+}
 
 /// Prepares the output folder: new, empty, or an earlier report (finished, or stopped before its
 /// index was written), which stays in place until the new one is written whole (replace_report).
 /// A folder holding anything else is refused (check_report_folder, naming it as `named`). Returns
 /// the lock on the folder, held until the report is written: a second report into the folder
 /// meanwhile is refused (InputError), since the two would replace each other's images and assets.
-io::FileLock prepare_out_dir(const fs::path& out, const std::string& named) {
+io::FileLock prepare_out_dir(const fs::path& out, const std::string& named, std::vector<std::string>& warnings) {
   check_report_folder(out, named);
   std::error_code ec;
   fs::create_directories(out, ec);
@@ -289,22 +319,34 @@ io::FileLock prepare_out_dir(const fs::path& out, const std::string& named) {
   for (const fs::directory_entry& e : fs::directory_iterator(out, ec))
     if (e.path().filename().string().starts_with(".index.html.tmp-")) stale.push_back(e.path());
   for (const fs::path& f : stale) fs::remove(f, ec);
-  // The earlier report's parts a report set aside: a report stopped before its own parts were all
-  // in place leaves the earlier part missing, and it goes back; one stopped (or refused) before
-  // removing them leaves both, and the set-aside one goes, best effort (replace_report warned of
-  // one it could not remove).
-  for (const char* part : kReportParts) {
-    const fs::path earlier = out / fmt::format("{}-{}", kEarlier, part);
-    if (!fs::exists(fs::symlink_status(earlier, ec))) continue;
-    if (!fs::exists(fs::symlink_status(out / part, ec))) {
-      fs::rename(earlier, out / part, ec);
+  // The earlier report's parts a stopped report set aside (replace_report). Its index comes last:
+  // without an index in place the new report never took the folder, and every set-aside part goes
+  // back (over a new part put in place before the stop); with one, the set-aside parts are the
+  // replaced report's, and go.
+  const bool aside = std::any_of(std::begin(kReportParts), std::end(kReportParts),
+                                 [&](const char* part) { return fs::exists(fs::symlink_status(set_aside(out, part), ec)); });
+  if (aside && !fs::exists(fs::symlink_status(out / "index.html", ec))) {
+    for (const char* part : kReportParts) {
+      if (!fs::exists(fs::symlink_status(set_aside(out, part), ec))) continue;
+      fs::remove_all(out / part, ec);
+      if (!ec) fs::rename(set_aside(out, part), out / part, ec);
       if (ec)
         throw IoError(fmt::format("cannot put back {}, the earlier report's {} that a stopped report set aside: {}; "
-                                  "move it back by hand",
-                                  earlier.string(), part, ec.message()));
-    } else {
-      fs::remove_all(earlier, ec);
+                                  "move it to {} by hand",
+                                  set_aside(out, part).string(), part, ec.message(), (out / part).string()));
     }
+  }
+  for (const char* part : kReportParts)
+    if (fs::exists(fs::symlink_status(set_aside(out, part), ec))) discard_set_aside(out, part, warnings);
+  // Earlier parts that could not be removed before: tried again.
+  std::vector<fs::path> leftovers;
+  for (const fs::directory_entry& e : fs::directory_iterator(out, ec))
+    if (e.path().filename().string().starts_with(std::string(kLeftover) + "-")) leftovers.push_back(e.path());
+  for (const fs::path& f : leftovers) {
+    fs::remove_all(f, ec);
+    if (ec)
+      warnings.push_back(fmt::format("cannot remove {}, an earlier report's part left there: {}; remove it by hand",
+                                     f.string(), ec.message()));
   }
   io::write_text_atomically(out / kReportMarker, fmt::format("{} {}\n", kGenerator, SB_VERSION_STRING));
   return std::move(*lock);
@@ -317,18 +359,13 @@ bool holds_earlier_report(const fs::path& out) {
                      [&](const char* part) { return fs::exists(out / part, ec); });
 }
 
-/// Where the earlier report's part `part` waits while the new report takes its place: a name in
-/// the same folder, since a folder renamed into another folder needs write permission on itself
-/// (to change its "..") and one renamed in place does not.
-fs::path set_aside(const fs::path& out, const char* part) { return out / fmt::format("{}-{}", kEarlier, part); }
-
 /// Puts the report written whole into `stage` in the place of the folder's earlier one, by renames
 /// only (which neither a full disk nor a read-only part of the earlier report stops): the earlier
 /// parts are set aside (index first), the new ones put in place (index last), then the earlier
 /// ones removed. A rename that fails puts back what was moved, so that the earlier report stays
 /// as it was (IoError saying so, or naming what could not be put back). An earlier part that
-/// cannot be removed at the end (its files not the user's to remove) stays under its set-aside
-/// name, with a warning; the report is in place either way.
+/// cannot be removed at the end (its files not the user's to remove) stays under a leftover name
+/// (discard_set_aside), with a warning; the report is in place either way.
 void replace_report(const fs::path& out, const fs::path& stage, std::vector<std::string>& warnings) {
   std::error_code ec;
   std::vector<const char*> aside;  // the earlier parts set aside, in order
@@ -369,13 +406,7 @@ void replace_report(const fs::path& out, const fs::path& stage, std::vector<std:
     placed.push_back(*part);
   }
   io::sync_folder(out);
-  for (const char* part : aside) {
-    fs::remove_all(set_aside(out, part), ec);
-    if (ec)
-      warnings.push_back(fmt::format("cannot remove the earlier report's {}, set aside as {}: {}; the new report is in "
-                                     "place; remove it by hand",
-                                     part, set_aside(out, part).string(), ec.message()));
-  }
+  for (const char* part : aside) discard_set_aside(out, part, warnings);
   fs::remove_all(stage, ec);  // empty by now
 }
 
@@ -686,8 +717,9 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
   }
 
   const fs::path out = options.out_dir;
-  const io::FileLock lock =
-      prepare_out_dir(out, options.out_name.empty() ? fmt::format("--out {}", out.string()) : options.out_name);
+  std::vector<std::string> folder_warnings;
+  const io::FileLock lock = prepare_out_dir(
+      out, options.out_name.empty() ? fmt::format("--out {}", out.string()) : options.out_name, folder_warnings);
   const bool earlier = holds_earlier_report(out);
   // Everything is written into `stage` first and takes the earlier report's place at the end.
   const fs::path stage = out / kStaging;
@@ -699,6 +731,7 @@ ReportSummary write_report(const ResultsFile& results, const ReportOptions& opti
     if (!earlier) throw;
     throw IoError(fmt::format("{}; the earlier report in {} is kept as it was", e.what(), out.string()));
   }
+  summary.warnings.insert(summary.warnings.begin(), folder_warnings.begin(), folder_warnings.end());
   replace_report(out, stage, summary.warnings);
   staging.dismiss();
   summary.index_html = out / "index.html";

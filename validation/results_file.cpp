@@ -762,17 +762,19 @@ std::vector<json> collect_results(const std::vector<fs::path>& files, const fs::
   if (warnings && !cells.empty()) {
     const json count = value_at(cells.front(), "cell_count");
     if (count.is_number_unsigned() && cells.size() < count.get<uint64_t>()) {
+      // The indices are distinct and below the count (read_results), so the first few missing
+      // are found within as many steps past the cells held, whatever the count.
+      const uint64_t total = count.get<uint64_t>(), missing_count = total - cells.size();
       std::vector<std::string> missing;
-      size_t missing_count = 0;
-      for (uint64_t i = 0; i < count.get<uint64_t>(); ++i)
-        if (!id_of_index.count(i) && missing_count++ < 8) missing.push_back(std::to_string(i));
+      for (uint64_t i = 0; i < total && missing.size() < 8; ++i)
+        if (!id_of_index.count(i)) missing.push_back(std::to_string(i));
       warnings->push_back(fmt::format("the {} file(s) hold {} of the sweep's {} cells (missing cell_index {}{}): a "
                                       "shard is left out or unfinished; the gate fails the merge until every cell is "
                                       "in it",
-                                      files.size(), cells.size(), count.get<uint64_t>(), fmt::join(missing, ", "),
-                                      missing_count > missing.size() ? fmt::format(" and {} more",
-                                                                                   missing_count - missing.size())
-                                                                     : ""));
+                                      files.size(), cells.size(), total, fmt::join(missing, ", "),
+                                      missing_count > missing.size()
+                                          ? fmt::format(" and {} more", missing_count - missing.size())
+                                          : ""));
     }
   }
   return cells;

@@ -535,14 +535,19 @@ void check_cells(const SweepDefinition& d, const std::vector<SweepCell>& cells, 
   const std::vector<BenchEntry> entries = bench_config(d).entries();  // as run_cell runs them
   for (const auto& [file, indices] : by_file) {
     Scene scene;
+    const auto naming_cells = [&](const std::exception& e) {
+      const SweepCell& first = cells[indices.front()];
+      return fmt::format("{}: scene '{}' of {} cell{} (the first: cell {} '{}'): {}; fix the scene file or the "
+                         "definition (no cell has run)",
+                         d.file.string(), first.scene.label, indices.size(), indices.size() == 1 ? "" : "s",
+                         first.index, first.id, e.what());
+    };
     try {
       scene = io::load_gltf(file);
     } catch (const InputError& e) {
-      const SweepCell& first = cells[indices.front()];
-      throw InputError(fmt::format("{}: scene '{}' of {} cell{} (the first: cell {} '{}'): {}; fix the scene file or "
-                                   "the definition (no cell has run)",
-                                   d.file.string(), first.scene.label, indices.size(), indices.size() == 1 ? "" : "s",
-                                   first.index, first.id, e.what()));
+      throw InputError(naming_cells(e));
+    } catch (const IoError& e) {
+      throw IoError(naming_cells(e));
     }
     // Cells measured on this scene as it was: new cells beside them must see the same content.
     std::optional<std::string> content;

@@ -120,6 +120,8 @@ TEST(Cli, BadArgumentsExitWith3AndSayWhy) {
       {"scenes info " + scene + " -r 64x36 -r 32x18", "--resolution is given 2 times; give it once"},
       {"scenes info " + scene + " --vfov", "--vfov needs a value after it (FLOAT); give --vfov X"},
       {"render --threads", "--threads needs a value after it (INT); give --threads N"},
+      {"sweep run x.toml --executor slurm --shards",
+       "--shards needs a value after it (UINT:UINT in [1 - 1001]); give --shards N"},
       {"sweep collect x.jsonl", "the argument inputs is missing; give it"},
       {"gate", "--results is required; give it"},
       {"scenes info " + scene + " --bogus",

@@ -579,7 +579,7 @@ TEST(Report, AnEarlierPartThatCannotBeRemovedIsSetAsideAndTheNewReportTakesItsPl
   // As root the reports run as nobody (setpriv), from a folder under /tmp that nobody can reach
   // (the build tree may lie under a private home); as another user a read-only folder of their
   // own does the same.
-  std::string made = (fs::temp_directory_path() / "sb-report-aside-XXXXXX").string();
+  std::string made = "/tmp/sb-report-aside-XXXXXX";  // not TMPDIR, which nobody may not reach
   ASSERT_NE(::mkdtemp(made.data()), nullptr);
   const fs::path dir = made;
   const fs::perms read_only = fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
@@ -610,8 +610,8 @@ TEST(Report, AnEarlierPartThatCannotBeRemovedIsSetAsideAndTheNewReportTakesItsPl
   fs::permissions(images, read_only);
   const test::CliRun second = report("second");
   EXPECT_EQ(second.code, 0) << second.out;
-  const fs::path aside = dir / "out" / ".stereobench-earlier-images";
-  EXPECT_NE(second.out.find("cannot remove the earlier report's images, set aside as " + aside.string()),
+  const fs::path leftover = dir / "out" / ".stereobench-leftover-images-1";
+  EXPECT_NE(second.out.find("cannot remove the earlier report's images, left as " + leftover.string()),
             std::string::npos)
       << second.out;
   EXPECT_NE(test::read_text(dir / "out" / "index.html").find("<title>second</title>"), std::string::npos);
@@ -619,20 +619,69 @@ TEST(Report, AnEarlierPartThatCannotBeRemovedIsSetAsideAndTheNewReportTakesItsPl
   const std::string left = embedded_data(dir / "out" / "index.html")["cells"][0]["images"]["left"].get<std::string>();
   EXPECT_TRUE(fs::exists(dir / "out" / left)) << "the new report's image: " << left;
   // What of it could be removed is gone (the image, in a folder of the user's); the rest stays.
-  EXPECT_TRUE(fs::is_directory(aside));
+  EXPECT_TRUE(fs::is_directory(leftover));
+  EXPECT_FALSE(fs::exists(dir / "out" / ".stereobench-earlier-images"));
   EXPECT_FALSE(fs::exists(dir / "out" / ".stereobench-next"));
 
-  // Once the part can be removed, the next report removes it.
-  fs::permissions(aside, fs::perms::owner_write, fs::perm_options::add);
-  if (!as_user.empty()) {
-    ASSERT_EQ(run_shell("chown 65534 " + quoted(aside)).code, 0);
-  }
+  // The leftover does not stand in the way of the next report, which says again that it is there.
   const test::CliRun third = report("third");
   EXPECT_EQ(third.code, 0) << third.out;
-  EXPECT_EQ(third.out.find("cannot remove"), std::string::npos) << third.out;
-  EXPECT_FALSE(fs::exists(aside));
+  EXPECT_NE(third.out.find("cannot remove " + leftover.string() + ", an earlier report's part left there"),
+            std::string::npos)
+      << third.out;
   EXPECT_NE(test::read_text(dir / "out" / "index.html").find("<title>third</title>"), std::string::npos);
+
+  // Once it can be removed, the next report removes it.
+  fs::permissions(leftover, fs::perms::owner_write, fs::perm_options::add);
+  if (!as_user.empty()) {
+    ASSERT_EQ(run_shell("chown 65534 " + quoted(leftover)).code, 0);
+  }
+  const test::CliRun fourth = report("fourth");
+  EXPECT_EQ(fourth.code, 0) << fourth.out;
+  EXPECT_EQ(fourth.out.find("cannot remove"), std::string::npos) << fourth.out;
+  EXPECT_FALSE(fs::exists(leftover));
+  EXPECT_NE(test::read_text(dir / "out" / "index.html").find("<title>fourth</title>"), std::string::npos);
   if (!::testing::Test::HasFailure()) fs::remove_all(dir);
+}
+
+TEST(Report, AReportStoppedWhileTakingTheFolderLeavesTheEarlierOneToComeBack) {
+  // A report stopped after its images took their place but before its index did: the next report
+  // puts back every part of the earlier one (its images over the stopped report's), so that the
+  // earlier report is whole again, as a failing next report then says.
+  test::ScratchDir dir;
+  json line = minimal_line("a", 0);
+  line["images"] = {{"left_png", "cells/0000/left.png"}};
+  write_text(dir / "results.jsonl", line.dump() + "\n");
+  fs::create_directories(dir / "cells" / "0000");
+  fs::copy_file(kSource / "reference" / "store" / "box-wall_full_160x90_e64.0mm_c4.08m" / "right.png",
+                dir / "cells" / "0000" / "left.png");
+  const std::string args = "report " + quoted(dir / "results.jsonl") + " --out " + quoted(dir / "out");
+  ASSERT_EQ(test::run_cli(args + " --title first").code, 0);
+  const fs::path out = dir / "out";
+  const std::string index = test::read_text(out / "index.html");
+  const std::string left = embedded_data(out / "index.html")["cells"][0]["images"]["left"].get<std::string>();
+  const std::string image = test::read_text(out / left);
+  // The state a stop between the images' and the index's renames leaves.
+  for (const char* part : {"index.html", "assets", "images"})
+    fs::rename(out / part, out / (std::string(".stereobench-earlier-") + part));
+  fs::create_directories(out / fs::path(left).parent_path());
+  write_text(out / left, "the stopped report's image");
+  {
+    const test::FileSizeLimit limit(100000);  // the next report cannot copy Chart.js
+    ASSERT_TRUE(limit.ok());
+    const test::CliRun full = test::run_cli(args + " --title second");
+    EXPECT_EQ(full.code, 4) << full.out;
+    EXPECT_NE(full.out.find("the earlier report in " + out.string() + " is kept as it was"), std::string::npos)
+        << full.out;
+  }
+  EXPECT_EQ(test::read_text(out / "index.html"), index);
+  EXPECT_EQ(test::read_text(out / left), image) << "the earlier report's image, not the stopped one's";
+  EXPECT_TRUE(fs::exists(out / "assets" / "report.js"));
+  for (const char* part : {"index.html", "assets", "images"})
+    EXPECT_FALSE(fs::exists(out / (std::string(".stereobench-earlier-") + part))) << part;
+  const test::CliRun again = test::run_cli(args + " --title second");
+  ASSERT_EQ(again.code, 0) << again.out;
+  EXPECT_NE(test::read_text(out / "index.html").find("<title>second</title>"), std::string::npos);
 }
 
 }  // namespace
