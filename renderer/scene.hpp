@@ -2,6 +2,7 @@
 // punctual lights and cameras, as loaded from glTF (renderer/io/gltf_loader.hpp).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <cmath>
 #include <optional>
@@ -33,6 +34,13 @@ struct Material {
   vec4 base_color{1.0f};
   int base_color_texture = -1;  ///< index into Scene::textures, or -1
   int texcoord = 0;             ///< which TEXCOORD_n set the texture reads
+  /// The base colour texture's KHR_texture_transform in glTF texture space: a texture coordinate
+  /// (u, v) reads (t[0] u + t[1] v + t[2], t[3] u + t[4] v + t[5]). The loader has applied it to
+  /// the meshes' uvs already; it is kept for a tool that reads the file's own coordinates (Blender).
+  std::array<double, 6> uv_transform{1.0, 0.0, 0.0, 0.0, 1.0, 0.0};
+  [[nodiscard]] bool has_uv_transform() const {
+    return uv_transform != std::array<double, 6>{1.0, 0.0, 0.0, 0.0, 1.0, 0.0};
+  }
   bool double_sided = false;    ///< glTF doubleSided
   AlphaMode alpha_mode = AlphaMode::opaque;
   float alpha_cutoff = 0.5f;    ///< glTF alphaCutoff (mask only): opaque where alpha >= alpha_cutoff

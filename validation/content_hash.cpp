@@ -86,6 +86,11 @@ std::string hash_scene(const Scene& scene) {
       sha.add("alpha-mask");
       sha.add_value(m.alpha_cutoff);
     }
+    // Likewise a texture transform (the meshes' uvs hold it already; Blender's material reads it).
+    if (m.has_uv_transform()) {
+      sha.add("uv-transform");
+      for (const double v : m.uv_transform) sha.add_value(v);
+    }
   }
   sha.add_value(static_cast<uint64_t>(scene.textures.size()));
   for (const Texture& t : scene.textures) {

@@ -182,6 +182,15 @@ class Checker {
     require_object(*t, p);
     opt_index(*t, "index", p, "textures", true);
     opt_integer(*t, "texCoord", p, 0, 255);
+    const json* ext = find(*t, "extensions");
+    if (const json* tt = ext && ext->is_object() ? find(*ext, "KHR_texture_transform") : nullptr) {
+      const std::string tp = p + "/extensions/KHR_texture_transform";
+      require_object(*tt, tp);
+      opt_number_array(*tt, "offset", tp, 2);
+      opt_number(*tt, "rotation", tp);
+      opt_number_array(*tt, "scale", tp, 2);
+      opt_integer(*tt, "texCoord", tp, 0, 255);
+    }
   }
 
   /// Whether the file uses `extension`.

@@ -493,12 +493,13 @@ class Converter {
   }
 
   void check_extensions() {
-    static const std::set<std::string> supported = {"KHR_lights_punctual", "KHR_mesh_quantization"};
+    static const std::set<std::string> supported = {"KHR_lights_punctual", "KHR_mesh_quantization",
+                                                    "KHR_texture_transform"};
     for (size_t i = 0; i < m_.extensionsRequired.size(); ++i)
       if (!supported.count(m_.extensionsRequired[i]))
         fail(fmt::format("/extensionsRequired/{}", i),
              fmt::format("extension '{}' is required by the file but not supported (supported: "
-                         "KHR_lights_punctual, KHR_mesh_quantization); re-export without it",
+                         "KHR_lights_punctual, KHR_mesh_quantization, KHR_texture_transform); re-export without it",
                          m_.extensionsRequired[i]));
     for (const std::string& e : m_.extensionsUsed)
       if (!supported.count(e)) warn("ext:" + e, fmt::format("extension '{}' is ignored", e));
@@ -619,6 +620,28 @@ class Converter {
     return out;
   }
 
+  /// KHR_texture_transform of a textureInfo (checked by check_gltf_json): the affine map of the
+  /// extension's GLSL, translation x rotation x scale, with the rotation as its example reads it
+  /// (rotation pi/2, scale 0.5, offset (0, 1) maps the unit square onto the lower left quadrant:
+  /// u' = cos r su u + sin r sv v + ou, v' = -sin r su u + cos r sv v + ov); its texCoord
+  /// overrides the textureInfo's.
+  static void read_texture_transform(Material& mat, const json& texture_info) {
+    const auto ext = texture_info.find("extensions");
+    if (ext == texture_info.end() || !ext->is_object()) return;
+    const auto tt = ext->find("KHR_texture_transform");
+    if (tt == ext->end()) return;
+    const auto pair = [&](const char* key, double fallback) {
+      const auto v = tt->find(key);
+      return v == tt->end() ? std::array<double, 2>{fallback, fallback}
+                            : std::array<double, 2>{(*v)[0].get<double>(), (*v)[1].get<double>()};
+    };
+    const std::array<double, 2> offset = pair("offset", 0.0), scale = pair("scale", 1.0);
+    const double rotation = tt->value("rotation", 0.0);
+    const double c = std::cos(rotation), s = std::sin(rotation);
+    mat.uv_transform = {c * scale[0], s * scale[1], offset[0], -s * scale[0], c * scale[1], offset[1]};
+    if (const auto tc = tt->find("texCoord"); tc != tt->end()) mat.texcoord = tc->get<int>();
+  }
+
   void convert_materials(Scene& scene) {
     std::map<int, int> texture_of_gltf;  // glTF texture index -> Scene::textures index
     for (size_t i = 0; i < m_.materials.size(); ++i) {
@@ -650,6 +673,7 @@ class Converter {
       const int t = gm.pbrMetallicRoughness.baseColorTexture.index;
       if (t >= 0 && options_.load_textures) {
         mat.texcoord = gm.pbrMetallicRoughness.baseColorTexture.texCoord;
+        read_texture_transform(mat, doc_.at("materials").at(i).at("pbrMetallicRoughness").at("baseColorTexture"));
         auto it = texture_of_gltf.find(t);
         if (it == texture_of_gltf.end()) {
           const int converted = convert_texture(scene, t, path + "/pbrMetallicRoughness/baseColorTexture");
@@ -1101,6 +1125,15 @@ class Converter {
         const std::vector<float> uv = read_floats(it->second, 2, ppath + "/attributes/" + uv_name);
         mesh.uvs.resize(nv);
         for (size_t v = 0; v < nv; ++v) mesh.uvs[v] = vec2(uv[v * 2], uv[v * 2 + 1]);
+        // The texture's KHR_texture_transform, applied once here: every renderer, the texture LOD
+        // and the POV-Ray export read transformed coordinates.
+        if (prim.material >= 0 && scene.materials[static_cast<size_t>(prim.material)].has_uv_transform()) {
+          const std::array<double, 6>& t = scene.materials[static_cast<size_t>(prim.material)].uv_transform;
+          for (vec2& c : mesh.uvs) {
+            const double u = c.x, w = c.y;
+            c = vec2(static_cast<float>(t[0] * u + t[1] * w + t[2]), static_cast<float>(t[3] * u + t[4] * w + t[5]));
+          }
+        }
       } else if (prim.material >= 0 && scene.materials[static_cast<size_t>(prim.material)].base_color_texture >= 0) {
         warn("missing-uv:" + uv_name,
              fmt::format("textured materials on primitives without the texture coordinates they read, {} (texture "

@@ -437,6 +437,40 @@ TEST(BlenderCutout, SeesAndCastsShadowsThroughTheSameHolesAsFull) {
   EXPECT_LE(differ, 40u);
 }
 
+/// Pixels of two images that differ (differs()).
+size_t differing_pixels(const Image& a, const Image& b) {
+  size_t n = 0;
+  for (int y = 0; y < b.height(); ++y)
+    for (int x = 0; x < b.width(); ++x) n += differs(a, b, x, y) ? 1 : 0;
+  return n;
+}
+
+TEST(BlenderCutout, ATransformedTextureCutsTheSameHolesAsFull) {
+  // KHR_texture_transform: Blender's importer reads the file's own coordinates, and the script's
+  // material applies the transform the loader applied to ours.
+  SB_NEED_BLENDER(provider);
+  const test::ScratchDir dir;
+  const Scene scene = test::cutout_scene_transformed(dir);
+  ASSERT_TRUE(std::any_of(scene.materials.begin(), scene.materials.end(),
+                          [](const Material& m) { return m.has_uv_transform(); }));
+  const RenderScene prepared(scene);
+  const StereoRig rig = test::rig_at(scene, 160, 120);
+  const fs::path file = test::cutout_transformed_file(dir);
+  const TruthRender b = render_truth(*provider, prepared, file, rig, dir / "blender");
+  const auto full = validation::make_truth_provider("full");
+  const TruthRender f = render_truth(*full, prepared, file, rig, dir / "full");
+  // The holes the untransformed checker cuts, for scale.
+  const Scene plain = test::cutout_scene(dir, test::Front::cutout_texture);
+  const RenderScene untransformed(plain);  // holds the scene by reference
+  const TruthRender u = render_truth(*full, untransformed, test::cutout_file(dir), rig, dir / "untransformed");
+  const size_t differ = differing_pixels(b.right, f.right), moved = differing_pixels(u.right, f.right);
+  std::cout << fmt::format("[blender texture transform] {} of 19200 pixels differ; {} without the transform\n",
+                           differ, moved);
+  ASSERT_GT(moved, 2000u) << "the transform must move the holes";
+  // As the cut-out test: a pixel centre a hair from a cut edge may flip.
+  EXPECT_LE(differ, 40u);
+}
+
 /// A box (mesh and node 0) on a floor before a wall, lit by a point light, as glTF JSON for a test
 /// to add what GltfBuilder does not write (morph targets, skins).
 struct BoxSceneJson {
@@ -479,13 +513,6 @@ struct BoxSceneJson {
   }
 };
 
-/// Pixels of two images that differ (differs()).
-size_t differing_pixels(const Image& a, const Image& b) {
-  size_t n = 0;
-  for (int y = 0; y < b.height(); ++y)
-    for (int x = 0; x < b.width(); ++x) n += differs(a, b, x, y) ? 1 : 0;
-  return n;
-}
 
 /// Writes the scene, loads it (the loader warns that it leaves `what` out) and returns how many
 /// pixels of Blender's right eye differ from full's at 96x54.

@@ -336,6 +336,60 @@ TEST(GltfLoader, UrisAreRelativeToTheSceneFolderWithSubfoldersAndDotDot) {
   EXPECT_EQ(io::load_gltf(dir / "pack" / "plus.gltf").triangle_count(), 1u);
 }
 
+TEST(GltfLoader, ATextureTransformIsAppliedToTheTextureCoordinates) {
+  // KHR_texture_transform's example: rotation pi/2, scale 0.5, offset (0, 1) maps the unit square
+  // onto the lower left quadrant of the image, (1, 0) -> (0, 0.5) and (0, 1) -> (0.5, 1). Its
+  // texCoord picks TEXCOORD_1 over the textureInfo's TEXCOORD_0.
+  ScratchDir dir("texture-transform");
+  MiniGltf g;
+  const int pos = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  std::vector<float> uv0 = {9, 9, 9, 9, 9, 9}, uv1 = {0, 0, 1, 0, 0, 1};
+  const int a0 = g.add_accessor(g.add_view(uv0), 5126, 3, "VEC2");
+  const int a1 = g.add_accessor(g.add_view(uv1), 5126, 3, "VEC2");
+  const uint8_t px[] = {255, 255, 255, 255};
+  const std::vector<unsigned char> png = io::encode_png(px, 1, 1, 4);
+  g.doc["images"] = json::array({{{"bufferView", g.add_view(png.data(), png.size())}, {"mimeType", "image/png"}}});
+  g.doc["textures"] = json::array({{{"source", 0}}});
+  g.doc["materials"] = json::array(
+      {{{"pbrMetallicRoughness",
+         {{"baseColorTexture",
+           {{"index", 0},
+            {"extensions",
+             {{"KHR_texture_transform",
+               {{"offset", {0, 1}}, {"rotation", 1.57079632679}, {"scale", {0.5, 0.5}}, {"texCoord", 1}}}}}}}}}}});
+  g.add_node({{"mesh", g.add_mesh(json::array({{{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", a0}, {"TEXCOORD_1", a1}}},
+                                                 {"material", 0}}}))}});
+  g.doc["extensionsUsed"] = {"KHR_texture_transform"};
+  g.doc["extensionsRequired"] = {"KHR_texture_transform"};
+  g.write_gltf(dir / "t.gltf");
+  const Scene scene = io::load_gltf(dir / "t.gltf");
+  ASSERT_EQ(scene.meshes.size(), 1u);
+  EXPECT_EQ(scene.materials[0].texcoord, 1);
+  EXPECT_TRUE(scene.materials[0].has_uv_transform());
+  const std::vector<vec2>& uv = scene.meshes[0].uvs;
+  ASSERT_EQ(uv.size(), 3u);
+  const vec2 want[] = {{0.0f, 1.0f}, {0.0f, 0.5f}, {0.5f, 1.0f}};
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_NEAR(uv[i].x, want[i].x, 1e-6) << i;
+    EXPECT_NEAR(uv[i].y, want[i].y, 1e-6) << i;
+  }
+  for (const std::string& w : scene.warnings) EXPECT_EQ(w.find("KHR_texture_transform"), std::string::npos) << w;
+
+  // A malformed transform names itself.
+  g.doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"]["scale"] =
+      {1, 2, 3};
+  g.write_gltf(dir / "bad.gltf");
+  try {
+    (void)io::load_gltf(dir / "bad.gltf");
+    ADD_FAILURE() << "a scale of three numbers loaded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "/materials/0/pbrMetallicRoughness/baseColorTexture/extensions/KHR_texture_transform/scale"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(GltfLoader, AnImageThatIsNoImageIsNotQuotedInTheError) {
   ScratchDir dir("notimage");
   std::filesystem::create_directories(dir / "scene");

@@ -4,8 +4,11 @@
 #pragma once
 
 #include <cstdint>
+#include <fstream>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "renderer/io/gltf_loader.hpp"
 #include "renderer/scene.hpp"
@@ -55,5 +58,28 @@ inline Scene cutout_scene(const test::ScratchDir& dir, Front front, float factor
 
 /// The file cutout_scene wrote into `dir`.
 inline std::filesystem::path cutout_file(const ScratchDir& dir) { return dir / "cutout.gltf"; }
+
+/// The KHR_texture_transform cutout_scene_transformed gives the checker: two periods across and
+/// half of one down, turned by 0.4 rad and moved by a fifth of a period, so that a tool reading
+/// the coordinates untransformed (or turned the other way) cuts different holes.
+constexpr const char* kCheckerTransform = R"({"offset": [0.05, 0.3], "rotation": 0.4, "scale": [2.0, 0.5]})";
+
+/// cutout_scene with the checker cut-out, its texture transformed (kCheckerTransform; the file
+/// lists the extension as required), written as cutout-transformed.gltf and loaded.
+inline Scene cutout_scene_transformed(const ScratchDir& dir) {
+  (void)cutout_scene(dir, Front::cutout_texture);
+  nlohmann::json doc = nlohmann::json::parse(read_text(cutout_file(dir)));
+  for (nlohmann::json& m : doc["materials"])
+    if (m["pbrMetallicRoughness"].contains("baseColorTexture"))
+      m["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"] =
+          nlohmann::json::parse(kCheckerTransform);
+  doc["extensionsUsed"].push_back("KHR_texture_transform");
+  doc["extensionsRequired"].push_back("KHR_texture_transform");
+  std::ofstream(dir / "cutout-transformed.gltf", std::ios::trunc) << doc.dump();
+  return io::load_gltf(dir / "cutout-transformed.gltf");
+}
+
+/// The file cutout_scene_transformed wrote into `dir`.
+inline std::filesystem::path cutout_transformed_file(const ScratchDir& dir) { return dir / "cutout-transformed.gltf"; }
 
 }  // namespace sb::test

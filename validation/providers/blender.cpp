@@ -257,7 +257,11 @@ nlohmann::json material_json(const Material& m, int texture_count) {
                       {"base_color", {double(m.base_color.x), double(m.base_color.y), double(m.base_color.z)}},
                       {"texture", texture},
                       {"texcoord", m.texcoord},
+                      {"uv_transform", nullptr},
                       {"cutout", nullptr}};
+  // Blender imports the file's own texture coordinates: the transform the loader applied to ours
+  // goes into its material.
+  if (texture >= 0 && m.has_uv_transform()) j["uv_transform"] = m.uv_transform;
   // A cut-out: opaque where factor alpha x texture alpha >= cutoff (SceneGeometry::opaque_at).
   if (m.alpha_mode == Material::AlphaMode::mask)
     j["cutout"] = {{"factor_alpha", double(m.base_color.w)}, {"cutoff", double(m.alpha_cutoff)}};

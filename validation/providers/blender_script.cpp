@@ -165,6 +165,31 @@ def uv_map_name(texcoord):
     return "UVMap" if texcoord == 0 else "UVMap.%03d" % texcoord
 
 
+def transformed_uv(tree, nodes, uv_socket, t):
+    # The texture's KHR_texture_transform t (glTF texture space, v down: u' = t0 u + t1 v + t2,
+    # v' = t3 u + t4 v + t5) in Blender's, where the importer's UVs are (u, 1 - v):
+    # x' = t0 x - t1 y + t1 + t2, y' = -t3 x + t4 y + 1 - t4 - t5.
+    split = nodes.new("ShaderNodeSeparateXYZ")
+    tree.links.new(uv_socket, split.inputs["Vector"])
+    along_x = nodes.new("ShaderNodeVectorMath")
+    along_x.operation = "SCALE"
+    along_x.inputs[0].default_value = (t[0], -t[3], 0.0)
+    tree.links.new(split.outputs["X"], along_x.inputs["Scale"])
+    along_y = nodes.new("ShaderNodeVectorMath")
+    along_y.operation = "SCALE"
+    along_y.inputs[0].default_value = (-t[1], t[4], 0.0)
+    tree.links.new(split.outputs["Y"], along_y.inputs["Scale"])
+    both = nodes.new("ShaderNodeVectorMath")
+    both.operation = "ADD"
+    tree.links.new(along_x.outputs["Vector"], both.inputs[0])
+    tree.links.new(along_y.outputs["Vector"], both.inputs[1])
+    moved = nodes.new("ShaderNodeVectorMath")
+    moved.operation = "ADD"
+    tree.links.new(both.outputs["Vector"], moved.inputs[0])
+    moved.inputs[1].default_value = (t[1] + t[2], 1.0 - t[4] - t[5], 0.0)
+    return moved.outputs["Vector"]
+
+
 def make_material(name, spec, textures, switches):
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
@@ -202,14 +227,17 @@ def make_material(name, spec, textures, switches):
     colour_socket = None
     uv = None
     if spec["texture"] >= 0:
-        uv = nodes.new("ShaderNodeUVMap")
-        uv.uv_map = uv_map_name(spec["texcoord"])
+        uv_node = nodes.new("ShaderNodeUVMap")
+        uv_node.uv_map = uv_map_name(spec["texcoord"])
+        uv = uv_node.outputs["UV"]
+        if spec.get("uv_transform") is not None:
+            uv = transformed_uv(tree, nodes, uv, spec["uv_transform"])
         tex = textures[spec["texture"]]
         image_node = nodes.new("ShaderNodeTexImage")
         image_node.image = tex["image"]
         image_node.interpolation = "Linear"
         image_node.extension = tex["extension"]
-        tree.links.new(uv.outputs["UV"], image_node.inputs["Vector"])
+        tree.links.new(uv, image_node.inputs["Vector"])
         multiply = nodes.new("ShaderNodeVectorMath")
         multiply.operation = "MULTIPLY"
         tree.links.new(image_node.outputs["Color"], multiply.inputs[0])
@@ -240,7 +268,7 @@ def make_material(name, spec, textures, switches):
             alpha_node.image = textures[spec["texture"]]["alpha"]
             alpha_node.interpolation = "Linear"
             alpha_node.extension = textures[spec["texture"]]["extension"]
-            tree.links.new(uv.outputs["UV"], alpha_node.inputs["Vector"])
+            tree.links.new(uv, alpha_node.inputs["Vector"])
             channels = nodes.new("ShaderNodeSeparateColor")
             tree.links.new(alpha_node.outputs["Color"], channels.inputs["Color"])
             tree.links.new(channels.outputs[0], alpha.inputs[1])
