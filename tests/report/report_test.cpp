@@ -528,16 +528,22 @@ TEST(Report, ASecondReportIntoAFolderBeingWrittenIsRefused) {
   EXPECT_EQ(after.code, 0) << after.out;
 }
 
-TEST(Report, AReportThatCannotBeWrittenLeavesTheEarlierOneAsItWas) {
-  // A full disk while the new report is written: the earlier report in the folder was removed
-  // before the new one was written, and lost. It now stays as it was until the new one is whole.
-  test::ScratchDir dir;
+/// A results file of one cell, dir/results.jsonl, whose record names one image (a left eye's) that
+/// lies beside it: the smallest input a report copies an image for.
+void write_one_cell_results(const fs::path& dir) {
   json line = minimal_line("a", 0);
   line["images"] = {{"left_png", "cells/0000/left.png"}};
   write_text(dir / "results.jsonl", line.dump() + "\n");
   fs::create_directories(dir / "cells" / "0000");
   fs::copy_file(kSource / "reference" / "store" / "box-wall_full_160x90_e64.0mm_c4.08m" / "right.png",
                 dir / "cells" / "0000" / "left.png");
+}
+
+TEST(Report, AReportThatCannotBeWrittenLeavesTheEarlierOneAsItWas) {
+  // A full disk while the new report is written: the earlier report in the folder was removed
+  // before the new one was written, and lost. It now stays as it was until the new one is whole.
+  test::ScratchDir dir;
+  write_one_cell_results(dir.path());
   const std::string args = "report " + quoted(dir / "results.jsonl") + " --out " + quoted(dir / "out");
   const test::CliRun first = test::run_cli(args + " --title first");
   ASSERT_EQ(first.code, 0) << first.out;
@@ -585,12 +591,7 @@ TEST(Report, AnEarlierPartThatCannotBeRemovedIsSetAsideAndTheNewReportTakesItsPl
   const fs::perms read_only = fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
                               fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec;
   fs::permissions(dir, read_only | fs::perms::owner_write);
-  json line = minimal_line("a", 0);
-  line["images"] = {{"left_png", "cells/0000/left.png"}};
-  write_text(dir / "results.jsonl", line.dump() + "\n");
-  fs::create_directories(dir / "cells" / "0000");
-  fs::copy_file(kSource / "reference" / "store" / "box-wall_full_160x90_e64.0mm_c4.08m" / "right.png",
-                dir / "cells" / "0000" / "left.png");
+  write_one_cell_results(dir);
   fs::copy(fs::path(SB_BINARY_DIR) / "report-assets", dir / "assets", fs::copy_options::recursive);
   fs::copy_file(SB_CLI_PATH, dir / "stereobench");
   std::string as_user;  // setpriv's command line, as root
@@ -649,12 +650,7 @@ TEST(Report, AReportStoppedWhileTakingTheFolderLeavesTheEarlierOneToComeBack) {
   // puts back every part of the earlier one (its images over the stopped report's), so that the
   // earlier report is whole again, as a failing next report then says.
   test::ScratchDir dir;
-  json line = minimal_line("a", 0);
-  line["images"] = {{"left_png", "cells/0000/left.png"}};
-  write_text(dir / "results.jsonl", line.dump() + "\n");
-  fs::create_directories(dir / "cells" / "0000");
-  fs::copy_file(kSource / "reference" / "store" / "box-wall_full_160x90_e64.0mm_c4.08m" / "right.png",
-                dir / "cells" / "0000" / "left.png");
+  write_one_cell_results(dir.path());
   const std::string args = "report " + quoted(dir / "results.jsonl") + " --out " + quoted(dir / "out");
   ASSERT_EQ(test::run_cli(args + " --title first").code, 0);
   const fs::path out = dir / "out";
