@@ -13,7 +13,7 @@ build it was derived from and fails on a clear regression:
   recall    fail 0.5 x (1 - lowest) (at least 0.005), warn half that, below the lowest; unchecked
             where the lowest is under 0.5 (ideal-copy and repro-warp trace no holes)
   fractions (error pixels, holes): fail 1.25 x highest + 0.002, warn 1.12 x highest + 0.001,
-            left out where that reaches 1 (no fraction exceeds it: the limit would check nothing)
+            turned off (false) where that reaches 1 (no fraction exceeds it)
   speed-up  warn only, at 0.7 x the lowest median (timings move with machine load); left out
             where that rounds to 0
   right eye / left eye time: warn only, at the highest median / 0.7 (where the stages split
@@ -129,12 +129,12 @@ def main(paths):
         for key in ("error_fraction", "hole_fraction"):
             if got[key]:
                 hi = max(got[key])
-                # A fraction is at most 1: a limit of 1 or more checks nothing (the gate refuses one
-                # above 1 and notes one of 1), so the key is left out there.
+                # A fraction is at most 1: where the margin reaches 1 the check is turned off
+                # (false; a limit of 1 checks nothing, and leaving the key out would bring in the
+                # stricter [defaults] level below).
                 for prefix, limit in (("max_", ceil_to(1.25 * hi + 0.002, 0.001)),
                                       ("warn_", ceil_to(1.12 * hi + 0.001, 0.001))):
-                    if limit < 1.0:
-                        t[prefix + key] = fmt(limit, 3)
+                    t[prefix + key] = fmt(limit, 3) if limit < 1.0 else "false"
                 note.append(f"{key.split('_')[0]} {min(got[key]):.4f}..{hi:.4f}")
         if got["recall"] and min(got["recall"]) >= 0.5:  # pipelines that leave holes open score low: unchecked
             lo = min(got["recall"])

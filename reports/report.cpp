@@ -326,7 +326,10 @@ io::FileLock prepare_out_dir(const fs::path& out, const std::string& named, std:
   const bool aside = std::any_of(std::begin(kReportParts), std::end(kReportParts),
                                  [&](const char* part) { return fs::exists(fs::symlink_status(set_aside(out, part), ec)); });
   if (aside && !fs::exists(fs::symlink_status(out / "index.html", ec))) {
-    for (const char* part : kReportParts) {
+    // The index last, as replace_report places it: a stop on the way leaves no index, and the
+    // next run puts back the rest.
+    for (auto it = std::rbegin(kReportParts); it != std::rend(kReportParts); ++it) {
+      const char* part = *it;
       if (!fs::exists(fs::symlink_status(set_aside(out, part), ec))) continue;
       fs::remove_all(out / part, ec);
       if (!ec) fs::rename(set_aside(out, part), out / part, ec);

@@ -1132,6 +1132,12 @@ class Converter {
           for (vec2& c : mesh.uvs) {
             const double u = c.x, w = c.y;
             c = vec2(static_cast<float>(t[0] * u + t[1] * w + t[2]), static_cast<float>(t[3] * u + t[4] * w + t[5]));
+            if (!std::isfinite(c.x) || !std::isfinite(c.y))
+              fail(fmt::format("/materials/{}/pbrMetallicRoughness/baseColorTexture/extensions/KHR_texture_transform",
+                               prim.material),
+                   fmt::format("takes the texture coordinates of {} beyond the range of a float ({} at ({}, {})); "
+                               "give a smaller scale or offset",
+                               ppath, c.x, u, w));
           }
         }
       } else if (prim.material >= 0 && scene.materials[static_cast<size_t>(prim.material)].base_color_texture >= 0) {

@@ -375,6 +375,20 @@ TEST(GltfLoader, ATextureTransformIsAppliedToTheTextureCoordinates) {
   }
   for (const std::string& w : scene.warnings) EXPECT_EQ(w.find("KHR_texture_transform"), std::string::npos) << w;
 
+  // A finite transform that takes the coordinates beyond a float's range is refused by name (the
+  // coordinates were infinite: POV-Ray failed on 'inf', the ray tracer read texel 0).
+  g.doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"]["scale"] =
+      {1e39, 1};
+  g.write_gltf(dir / "huge.gltf");
+  try {
+    (void)io::load_gltf(dir / "huge.gltf");
+    ADD_FAILURE() << "texture coordinates beyond a float's range loaded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("KHR_texture_transform: takes the texture coordinates of /meshes/0/"
+                                         "primitives/0 beyond the range of a float"),
+              std::string::npos)
+        << e.what();
+  }
   // A malformed transform names itself.
   g.doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"]["scale"] =
       {1, 2, 3};

@@ -678,6 +678,22 @@ TEST(Report, AReportStoppedWhileTakingTheFolderLeavesTheEarlierOneToComeBack) {
   const test::CliRun again = test::run_cli(args + " --title second");
   ASSERT_EQ(again.code, 0) << again.out;
   EXPECT_NE(test::read_text(out / "index.html").find("<title>second</title>"), std::string::npos);
+
+  // A run stopped while it put the earlier parts back puts the index back last: stopped after the
+  // images, the folder holds no index, and the next run puts back the assets and the index.
+  const std::string second = test::read_text(out / "index.html");
+  const std::string report_js = test::read_text(out / "assets" / "report.js");
+  for (const char* part : {"index.html", "assets"})
+    fs::rename(out / part, out / (std::string(".stereobench-earlier-") + part));
+  fs::create_directories(out / "assets");
+  write_text(out / "assets" / "report.js", "the stopped report's script");
+  {
+    const test::FileSizeLimit limit(100000);
+    ASSERT_TRUE(limit.ok());
+    EXPECT_EQ(test::run_cli(args + " --title third").code, 4);
+  }
+  EXPECT_EQ(test::read_text(out / "index.html"), second);
+  EXPECT_EQ(test::read_text(out / "assets" / "report.js"), report_js);
 }
 
 }  // namespace
