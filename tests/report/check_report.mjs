@@ -328,7 +328,17 @@ try {
         if (state.missing) problems.push(`${where}: ${state.missing} image(s) not in the results`);
 
         if (mode === 'slider') {
-          const box = await cell.locator('.compare').boundingBox();
+          // Dragged where the divider is once the layout holds still: its images loaded (the box
+          // takes their size) and the box in view (a pointer outside the viewport reaches nothing;
+          // on a loaded machine the drag otherwise landed beside a box still growing).
+          const compare = cell.locator('.compare');
+          await compare.scrollIntoViewIfNeeded();
+          await compare.evaluate(async (c) => {
+            await Promise.all([...c.querySelectorAll('img')].map((i) => (i.complete ? null
+              : new Promise((done) => { i.addEventListener('load', done, { once: true }); i.addEventListener('error', done, { once: true }); }))));
+            await new Promise((done) => requestAnimationFrame(() => requestAnimationFrame(done)));
+          });
+          const box = await compare.boundingBox();
           if (!box) problems.push(`${where}: no slider`);
           else {
             await page.mouse.move(box.x + box.width * 0.5, box.y + box.height / 2);
