@@ -36,11 +36,7 @@ Srgb8Image disocclusion_image(const Srgb8Image& truth, const TrueDisocclusions& 
 
 namespace {
 
-/// One image file: its path and the function that writes it to a given path.
-struct FileWriter {
-  std::filesystem::path path;
-  std::function<void(const std::filesystem::path&)> write;
-};
+using io::FileWriter;
 
 /// Runs the file writers side by side on the executor's threads. A failure cancels the writers
 /// not yet started and is rethrown once the running ones have finished; each writes atomically,
@@ -49,7 +45,7 @@ struct FileWriter {
 void write_side_by_side(const std::vector<FileWriter>& writers, const std::vector<std::filesystem::path>& paths,
                         const Executor& executor, const ImageFileOptions& options) {
   if (options.staged != nullptr) {
-    executor.for_each(writers.size(), [&](size_t i) { options.staged->add(writers[i].path, writers[i].write); });
+    options.staged->add_side_by_side(writers, executor);
     return;
   }
   try {

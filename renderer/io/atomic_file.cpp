@@ -353,6 +353,10 @@ StagedFiles::~StagedFiles() {
     if (!e.placed) fs::remove(e.staged.path, ec);
 }
 
+void StagedFiles::add_side_by_side(std::span<const FileWriter> writers, const Executor& executor) {
+  executor.for_each(writers.size(), [&](size_t i) { add(writers[i].path, writers[i].write); });
+}
+
 void StagedFiles::add(const fs::path& given, const std::function<void(const fs::path&)>& write) {
   const Target target = target_of(given);
   if (target.through)

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "renderer/parallel.hpp"
+
 namespace sb::io {
 
 /// Calls `write(tmp_path)` to produce the file under a temporary name in the same folder, then
@@ -35,6 +37,12 @@ void write_atomically(const std::filesystem::path& path,
 /// from several threads at once (each file is written by the thread that adds it). The file added
 /// last is the set's marker (a stats or summary file that says the set is complete): placed last,
 /// and removed should the set end up half in place.
+/// A file to write: its final path and the function that writes it to a given (temporary) path.
+struct FileWriter {
+  std::filesystem::path path;
+  std::function<void(const std::filesystem::path&)> write;
+};
+
 class StagedFiles {
  public:
   StagedFiles();
@@ -45,6 +53,10 @@ class StagedFiles {
   /// Calls `write(tmp_path)` and flushes the file; on failure its temporary file is removed and
   /// the error passed on (IoError naming `path` for an untyped one).
   void add(const std::filesystem::path& path, const std::function<void(const std::filesystem::path& tmp_path)>& write);
+  /// add() for every writer, side by side on `executor`'s threads (each file's bytes are its own
+  /// writer's, whatever the thread). A failure cancels the writers not yet started and is passed on
+  /// once the running ones have finished. Not for the marker, which is added alone, last.
+  void add_side_by_side(std::span<const FileWriter> writers, const Executor& executor);
   /// An earlier file of the set: removed once the set is in place (best effort), never before,
   /// unless the set writes it again (added under the same path).
   void retire(const std::filesystem::path& path);

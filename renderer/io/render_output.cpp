@@ -219,17 +219,14 @@ RenderFiles write_render_outputs(const std::filesystem::path& dir, const std::st
   ImageMetadata meta;
   meta["stereobench/record"] = json_text(stats);  // a scene path need not be UTF-8
 
-  StagedFiles set;
   // The EXR and the PNGs are encoded side by side (most of a large render's writing is their
-  // compression); a failure cancels the files not yet started, and the set removes the others.
-  executor.for_each(pngs.size() + 1, [&](size_t i) {
-    if (i == 0) {
-      set.add(f.exr, [&](const fs::path& tmp) { write_exr_stereo(tmp, result.left, result.right, meta); });
-      return;
-    }
-    const auto& [file, image] = pngs[i - 1];
-    set.add(file, [&](const fs::path& tmp) { write_png_preview(tmp, *image); });
-  });
+  // compression); the set removes what a failure leaves.
+  std::vector<FileWriter> writers{
+      {f.exr, [&](const fs::path& tmp) { write_exr_stereo(tmp, result.left, result.right, meta); }}};
+  for (const auto& [file, image] : pngs)
+    writers.push_back({file, [image = image](const fs::path& tmp) { write_png_preview(tmp, *image); }});
+  StagedFiles set;
+  set.add_side_by_side(writers, executor);
   set.add(f.stats_json, [&](const fs::path& tmp) { write_text_atomically(tmp, json_text(stats, 2) + "\n"); });
   for (const std::string& name : earlier)
     if (std::find(names.begin(), names.end(), name) == names.end()) set.retire(dir / name);
