@@ -267,6 +267,21 @@ constexpr const char* kEarlier = ".stereobench-earlier";
 /// place; each such name is unique, so that it never stands in the way of a later report.
 constexpr const char* kLeftover = ".stereobench-leftover";
 
+/// Whether something is at `p`, a link counted as itself (not followed).
+bool present(const fs::path& p) {
+  std::error_code ec;
+  return fs::exists(fs::symlink_status(p, ec));
+}
+
+/// The entries of `folder` whose names start with `prefix`.
+std::vector<fs::path> entries_starting_with(const fs::path& folder, const std::string& prefix) {
+  std::error_code ec;
+  std::vector<fs::path> found;
+  for (const fs::directory_entry& e : fs::directory_iterator(folder, ec))
+    if (e.path().filename().string().starts_with(prefix)) found.push_back(e.path());
+  return found;
+}
+
 /// Where the earlier report's part `part` waits while the new report takes its place: a name in
 /// the same folder, since a folder renamed into another folder needs write permission on itself
 /// (to change its "..") and one renamed in place does not.
@@ -284,7 +299,7 @@ void discard_set_aside(const fs::path& out, const char* part, std::vector<std::s
   fs::path leftover;
   for (int n = 1; n < 1000 && leftover.empty(); ++n) {
     const fs::path candidate = out / fmt::format("{}-{}-{}", kLeftover, part, n);
-    if (fs::exists(fs::symlink_status(candidate, ec))) continue;
+    if (present(candidate)) continue;
     fs::rename(aside, candidate, ec);
     if (!ec) leftover = candidate;
     else break;
@@ -292,6 +307,36 @@ void discard_set_aside(const fs::path& out, const char* part, std::vector<std::s
   warnings.push_back(fmt::format("cannot remove the earlier report's {}, left as {}: {}; the new report is in place; "
                                  "remove it by hand",
                                  part, (leftover.empty() ? aside : leftover).string(), why));
+}
+
+/// What a report stopped while replacing the folder's earlier one left (replace_report). Its
+/// index comes last: without an index in place the new report never took the folder, and every
+/// set-aside part goes back (index last, over a new part put in place before the stop); with one,
+/// the set-aside parts are the replaced report's, and go. Leftovers earlier reports could not
+/// remove are tried again.
+void recover_set_aside(const fs::path& out, std::vector<std::string>& warnings) {
+  const auto aside = [&](const char* part) { return present(set_aside(out, part)); };
+  if (std::any_of(std::begin(kReportParts), std::end(kReportParts), aside) && !present(out / "index.html")) {
+    for (auto it = std::rbegin(kReportParts); it != std::rend(kReportParts); ++it) {
+      if (!aside(*it)) continue;
+      std::error_code ec;
+      fs::remove_all(out / *it, ec);
+      if (!ec) fs::rename(set_aside(out, *it), out / *it, ec);
+      if (ec)
+        throw IoError(fmt::format("cannot put back {}, the earlier report's {} that a stopped report set aside: {}; "
+                                  "move it to {} by hand",
+                                  set_aside(out, *it).string(), *it, ec.message(), (out / *it).string()));
+    }
+  }
+  for (const char* part : kReportParts)
+    if (aside(part)) discard_set_aside(out, part, warnings);
+  for (const fs::path& f : entries_starting_with(out, std::string(kLeftover) + "-")) {
+    std::error_code ec;
+    fs::remove_all(f, ec);
+    if (ec)
+      warnings.push_back(fmt::format("cannot remove {}, an earlier report's part left there: {}; remove it by hand",
+                                     f.string(), ec.message()));
+  }
 }
 
 /// Prepares the output folder: new, empty, or an earlier report (finished, or stopped before its
@@ -315,42 +360,8 @@ io::FileLock prepare_out_dir(const fs::path& out, const std::string& named, std:
   fs::remove_all(out / kStaging, ec);
   if (ec) throw IoError(fmt::format("cannot remove {}, left by a report that was stopped: {}",
                                     (out / kStaging).string(), ec.message()));
-  std::vector<fs::path> stale;
-  for (const fs::directory_entry& e : fs::directory_iterator(out, ec))
-    if (e.path().filename().string().starts_with(".index.html.tmp-")) stale.push_back(e.path());
-  for (const fs::path& f : stale) fs::remove(f, ec);
-  // The earlier report's parts a stopped report set aside (replace_report). Its index comes last:
-  // without an index in place the new report never took the folder, and every set-aside part goes
-  // back (over a new part put in place before the stop); with one, the set-aside parts are the
-  // replaced report's, and go.
-  const bool aside = std::any_of(std::begin(kReportParts), std::end(kReportParts),
-                                 [&](const char* part) { return fs::exists(fs::symlink_status(set_aside(out, part), ec)); });
-  if (aside && !fs::exists(fs::symlink_status(out / "index.html", ec))) {
-    // The index last, as replace_report places it: a stop on the way leaves no index, and the
-    // next run puts back the rest.
-    for (auto it = std::rbegin(kReportParts); it != std::rend(kReportParts); ++it) {
-      const char* part = *it;
-      if (!fs::exists(fs::symlink_status(set_aside(out, part), ec))) continue;
-      fs::remove_all(out / part, ec);
-      if (!ec) fs::rename(set_aside(out, part), out / part, ec);
-      if (ec)
-        throw IoError(fmt::format("cannot put back {}, the earlier report's {} that a stopped report set aside: {}; "
-                                  "move it to {} by hand",
-                                  set_aside(out, part).string(), part, ec.message(), (out / part).string()));
-    }
-  }
-  for (const char* part : kReportParts)
-    if (fs::exists(fs::symlink_status(set_aside(out, part), ec))) discard_set_aside(out, part, warnings);
-  // Earlier parts that could not be removed before: tried again.
-  std::vector<fs::path> leftovers;
-  for (const fs::directory_entry& e : fs::directory_iterator(out, ec))
-    if (e.path().filename().string().starts_with(std::string(kLeftover) + "-")) leftovers.push_back(e.path());
-  for (const fs::path& f : leftovers) {
-    fs::remove_all(f, ec);
-    if (ec)
-      warnings.push_back(fmt::format("cannot remove {}, an earlier report's part left there: {}; remove it by hand",
-                                     f.string(), ec.message()));
-  }
+  for (const fs::path& f : entries_starting_with(out, ".index.html.tmp-")) fs::remove(f, ec);
+  recover_set_aside(out, warnings);
   io::write_text_atomically(out / kReportMarker, fmt::format("{} {}\n", kGenerator, SB_VERSION_STRING));
   return std::move(*lock);
 }
@@ -397,7 +408,7 @@ void replace_report(const fs::path& out, const fs::path& stage, std::vector<std:
                               fmt::join(problems, "; ")));
   };
   for (const char* part : kReportParts) {
-    if (!fs::exists(fs::symlink_status(out / part, ec))) continue;
+    if (!present(out / part)) continue;
     fs::rename(out / part, set_aside(out, part), ec);
     if (ec) fail(fmt::format("cannot move the earlier report's {} aside: {}", (out / part).string(), ec.message()));
     aside.push_back(part);
