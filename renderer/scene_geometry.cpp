@@ -47,7 +47,7 @@ SceneGeometry::SceneGeometry(const Scene& s) : scene(&s) {
 
 const std::vector<uint8_t>& SceneGeometry::closed(const Executor& executor) const {
   const std::lock_guard<std::mutex> lock(closed_mutex_);
-  if (!closed_known_) {
+  if (!closed_) {
     const Scene& s = *scene;
     std::vector<uint8_t> flags(s.meshes.size(), 0);
     // Each decision is the mesh's own, so the flags do not depend on the thread count.
@@ -55,14 +55,13 @@ const std::vector<uint8_t>& SceneGeometry::closed(const Executor& executor) cons
       flags[m] = single_sided[m] == 0 && cutout_of[m] < 0 && s.meshes[m].is_closed() ? 1 : 0;
     });
     closed_ = std::move(flags);
-    closed_known_ = true;
   }
-  return closed_;
+  return *closed_;
 }
 
 void SceneGeometry::forget_closed() {
   const std::lock_guard<std::mutex> lock(closed_mutex_);
-  closed_known_ = false;
+  closed_.reset();
 }
 
 bool SceneGeometry::opaque_at(uint32_t mesh, uint32_t tri, vec2 bary) const {

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <mutex>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -63,8 +64,7 @@ struct SceneGeometry {
  private:
   std::vector<MipTexture> cutout_textures_;  ///< level 0 of each texture a cut-out reads
   mutable std::mutex closed_mutex_;
-  mutable bool closed_known_ = false;
-  mutable std::vector<uint8_t> closed_;
+  mutable std::optional<std::vector<uint8_t>> closed_;  ///< closed()'s flags, once found
 };
 
 /// A triangle is front-facing when its vertices appear counter-clockwise from the viewer

@@ -62,11 +62,12 @@ struct RedirectionCounts {
 
 /// Per mesh, whether its back faces are culled (1) in the redirection: a mesh of a single-sided
 /// material; with `closed_too`, also a double-sided one that SceneGeometry::closed() marks and
-/// whose every vertex lies beyond the near plane of both eyes. An eye inside a closed mesh has some of it behind itself, so both eyes are then outside
-/// it, and no near plane cuts it open: its front faces hide all its back faces in either eye, and
-/// culling them changes no full render. Kim's method assumes culling (§2.2, eq. (4)): an eye that
-/// rasterizes a closed mesh's back triangles while their front ones go to the other eye shows the
-/// mesh's inside. Counts the meshes so culled that were double-sided in `closed_culled`.
+/// whose every vertex lies beyond the near plane of both eyes. An eye inside a closed mesh has
+/// some of it behind itself, so both eyes are then outside it, and no near plane cuts it open: its
+/// front faces hide all its back faces in either eye, and culling them changes no full render.
+/// Kim's method assumes culling (§2.2, eq. (4)): an eye that rasterizes a closed mesh's back
+/// triangles while their front ones go to the other eye shows the mesh's inside. Counts the meshes
+/// so culled that were double-sided in `closed_culled`.
 [[nodiscard]] std::vector<uint8_t> culled_meshes(const SceneGeometry& geometry, const StereoRig& rig,
                                                  const Executor& executor, bool closed_too, uint64_t& closed_culled);
 
