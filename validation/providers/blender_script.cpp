@@ -160,6 +160,13 @@ def place_moved_nodes():
     place_objects(targets)
 
 
+def math_node(nodes, operation, vector=False):
+    # A Math (or Vector Math) node doing `operation`.
+    node = nodes.new("ShaderNodeVectorMath" if vector else "ShaderNodeMath")
+    node.operation = operation
+    return node
+
+
 def uv_map_name(texcoord):
     # The importer's names of the TEXCOORD_n sets.
     return "UVMap" if texcoord == 0 else "UVMap.%03d" % texcoord
@@ -171,20 +178,16 @@ def transformed_uv(tree, nodes, uv_socket, t):
     # x' = t0 x - t1 y + t1 + t2, y' = -t3 x + t4 y + 1 - t4 - t5.
     split = nodes.new("ShaderNodeSeparateXYZ")
     tree.links.new(uv_socket, split.inputs["Vector"])
-    along_x = nodes.new("ShaderNodeVectorMath")
-    along_x.operation = "SCALE"
+    along_x = math_node(nodes, "SCALE", vector=True)
     along_x.inputs[0].default_value = (t[0], -t[3], 0.0)
     tree.links.new(split.outputs["X"], along_x.inputs["Scale"])
-    along_y = nodes.new("ShaderNodeVectorMath")
-    along_y.operation = "SCALE"
+    along_y = math_node(nodes, "SCALE", vector=True)
     along_y.inputs[0].default_value = (-t[1], t[4], 0.0)
     tree.links.new(split.outputs["Y"], along_y.inputs["Scale"])
-    both = nodes.new("ShaderNodeVectorMath")
-    both.operation = "ADD"
+    both = math_node(nodes, "ADD", vector=True)
     tree.links.new(along_x.outputs["Vector"], both.inputs[0])
     tree.links.new(along_y.outputs["Vector"], both.inputs[1])
-    moved = nodes.new("ShaderNodeVectorMath")
-    moved.operation = "ADD"
+    moved = math_node(nodes, "ADD", vector=True)
     tree.links.new(both.outputs["Vector"], moved.inputs[0])
     moved.inputs[1].default_value = (t[1] + t[2], 1.0 - t[4] - t[5], 0.0)
     return moved.outputs["Vector"]
@@ -204,21 +207,17 @@ def make_material(name, spec, textures, switches):
     diffuse.inputs["Roughness"].default_value = 0.0
     # The shading normal turned to the viewer (DESIGN §3): N * (N . incoming < 0 ? -1 : 1).
     geometry = nodes.new("ShaderNodeNewGeometry")
-    facing = nodes.new("ShaderNodeVectorMath")
-    facing.operation = "DOT_PRODUCT"
+    facing = math_node(nodes, "DOT_PRODUCT", vector=True)
     tree.links.new(geometry.outputs["Normal"], facing.inputs[0])
     tree.links.new(geometry.outputs["Incoming"], facing.inputs[1])
-    away = nodes.new("ShaderNodeMath")
-    away.operation = "LESS_THAN"
+    away = math_node(nodes, "LESS_THAN")
     tree.links.new(facing.outputs["Value"], away.inputs[0])
     away.inputs[1].default_value = 0.0
-    sign = nodes.new("ShaderNodeMath")
-    sign.operation = "MULTIPLY_ADD"
+    sign = math_node(nodes, "MULTIPLY_ADD")
     tree.links.new(away.outputs["Value"], sign.inputs[0])
     sign.inputs[1].default_value = -2.0
     sign.inputs[2].default_value = 1.0
-    turned = nodes.new("ShaderNodeVectorMath")
-    turned.operation = "SCALE"
+    turned = math_node(nodes, "SCALE", vector=True)
     tree.links.new(geometry.outputs["Normal"], turned.inputs[0])
     tree.links.new(sign.outputs["Value"], turned.inputs["Scale"])
     tree.links.new(turned.outputs["Vector"], diffuse.inputs["Normal"])
@@ -238,8 +237,7 @@ def make_material(name, spec, textures, switches):
         image_node.interpolation = "Linear"
         image_node.extension = tex["extension"]
         tree.links.new(uv, image_node.inputs["Vector"])
-        multiply = nodes.new("ShaderNodeVectorMath")
-        multiply.operation = "MULTIPLY"
+        multiply = math_node(nodes, "MULTIPLY", vector=True)
         tree.links.new(image_node.outputs["Color"], multiply.inputs[0])
         multiply.inputs[1].default_value = (factor[0], factor[1], factor[2])
         colour_socket = multiply.outputs["Vector"]
@@ -259,8 +257,7 @@ def make_material(name, spec, textures, switches):
     if spec["cutout"] is not None:
         # A cut-out: a Transparent BSDF where alpha = factor alpha x texture alpha (bilinear, as
         # SceneGeometry::opaque_at reads it) is below the cutoff, the material where it is not.
-        alpha = nodes.new("ShaderNodeMath")
-        alpha.operation = "MULTIPLY"
+        alpha = math_node(nodes, "MULTIPLY")
         alpha.inputs[0].default_value = spec["cutout"]["factor_alpha"]
         alpha.inputs[1].default_value = 1.0
         if spec["texture"] >= 0 and textures[spec["texture"]]["alpha"] is not None:
@@ -272,8 +269,7 @@ def make_material(name, spec, textures, switches):
             channels = nodes.new("ShaderNodeSeparateColor")
             tree.links.new(alpha_node.outputs["Color"], channels.inputs["Color"])
             tree.links.new(channels.outputs[0], alpha.inputs[1])
-        below = nodes.new("ShaderNodeMath")
-        below.operation = "LESS_THAN"
+        below = math_node(nodes, "LESS_THAN")
         below.use_clamp = False
         tree.links.new(alpha.outputs["Value"], below.inputs[0])
         below.inputs[1].default_value = spec["cutout"]["cutoff"]
@@ -388,13 +384,11 @@ def shape_spot(data, spot):
     emission = next(n for n in tree.nodes if n.type == "EMISSION")
     coords = tree.nodes.new("ShaderNodeTexCoord")
     split = tree.nodes.new("ShaderNodeSeparateXYZ")
-    ramp = tree.nodes.new("ShaderNodeMath")
-    ramp.operation = "MULTIPLY_ADD"
+    ramp = math_node(tree.nodes, "MULTIPLY_ADD")
     ramp.use_clamp = True
     ramp.inputs[1].default_value = -spot["scale"]
     ramp.inputs[2].default_value = -spot["cos_outer"] * spot["scale"]
-    square = tree.nodes.new("ShaderNodeMath")
-    square.operation = "MULTIPLY"
+    square = math_node(tree.nodes, "MULTIPLY")
     tree.links.new(coords.outputs["Normal"], split.inputs[0])
     tree.links.new(split.outputs["Z"], ramp.inputs[0])
     tree.links.new(ramp.outputs[0], square.inputs[0])
