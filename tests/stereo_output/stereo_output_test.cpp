@@ -10,6 +10,7 @@
 
 #include "renderer/error.hpp"
 #include "renderer/image.hpp"
+#include "support/input_error.hpp"
 
 namespace sb {
 namespace {
@@ -34,17 +35,6 @@ Image coded_eye(int w, int h, float eye) {
 
 float clamp01(double v) { return v < 0.0 ? 0.0f : (v > 1.0 ? 1.0f : static_cast<float>(v)); }
 
-/// The message of the InputError that f throws, or a failure.
-template <class F>
-std::string input_error_message(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no InputError";
-  return {};
-}
 
 TEST(Anaglyph, WhitePairGivesTheClampedRowSums) {
   const Image out = anaglyph_dubois(uniform_eye(3, 2, {1.0f, 1.0f, 1.0f}), uniform_eye(3, 2, {1.0f, 1.0f, 1.0f}));
@@ -127,7 +117,7 @@ TEST(StereoOutputErrors, SizeMismatchNamesBothSizes) {
        {std::pair<std::string, Image (*)(const Image&, const Image&)>{"anaglyph_dubois", &anaglyph_dubois},
         {"side_by_side", &side_by_side},
         {"over_under", &over_under}}) {
-    const std::string message = input_error_message([&, f = fn] { (void)f(left, right); });
+    const std::string message = test::input_error([&, f = fn] { (void)f(left, right); });
     EXPECT_NE(message.find(name), std::string::npos) << message;
     EXPECT_NE(message.find("4x3"), std::string::npos) << message;
     EXPECT_NE(message.find("4x2"), std::string::npos) << message;
@@ -138,18 +128,18 @@ TEST(StereoOutputErrors, MissingRgbPlaneNamesTheEyeAndItsPlanes) {
   Image depth_only(4, 3);
   depth_only.add_plane(planes::depth);
   const Image good = uniform_eye(4, 3, {0.5f, 0.5f, 0.5f});
-  const std::string right_missing = input_error_message([&] { (void)anaglyph_dubois(good, depth_only); });
+  const std::string right_missing = test::input_error([&] { (void)anaglyph_dubois(good, depth_only); });
   EXPECT_NE(right_missing.find("right eye"), std::string::npos) << right_missing;
   EXPECT_NE(right_missing.find("\"rgb\""), std::string::npos) << right_missing;
   EXPECT_NE(right_missing.find("depth"), std::string::npos) << right_missing;
-  const std::string left_missing = input_error_message([&] { (void)over_under(Image(4, 3), good); });
+  const std::string left_missing = test::input_error([&] { (void)over_under(Image(4, 3), good); });
   EXPECT_NE(left_missing.find("left eye"), std::string::npos) << left_missing;
   EXPECT_NE(left_missing.find("none"), std::string::npos) << left_missing;
 }
 
 TEST(StereoOutputErrors, CombinedSizeAboveTheLimitIsRejected) {
   const int wide = kMaxImageDimension / 2 + 1;
-  const std::string message = input_error_message([&] {
+  const std::string message = test::input_error([&] {
     (void)side_by_side(uniform_eye(wide, 1, {0, 0, 0}), uniform_eye(wide, 1, {0, 0, 0}));
   });
   EXPECT_NE(message.find("width"), std::string::npos) << message;

@@ -20,6 +20,7 @@
 #include "renderer/error.hpp"
 #include "renderer/io/atomic_file.hpp"
 #include "renderer/io/image_io.hpp"
+#include "support/input_error.hpp"
 #include "support/scratch_dir.hpp"
 #include "validation/image_files.hpp"
 #include "validation/metric_images.hpp"
@@ -67,17 +68,7 @@ Image linear_of(const Srgb8Image& s) {
   return im;
 }
 
-/// Runs a function expected to throw InputError and returns its message.
-template <class F>
-std::string input_error(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no InputError thrown";
-  return {};
-}
+using test::input_error;
 
 // ---- Definitions on hand-computed cases ---------------------------------------------------------
 
