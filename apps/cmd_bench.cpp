@@ -211,7 +211,7 @@ void register_bench_command(CLI::App& root) {
   b->add_option("--pipelines,-p", a->pipelines,
                 "Pipelines to time, comma-separated, 'all' for every registered one (default: all; with --preset, "
                 "the preset's); NAME:KEY=VALUE[:KEY=VALUE...] times a variant with those options, beside NAME "
-                "itself (e.g. bidir-warp,bidir-warp:occlusion=ztest)");
+                "itself where that is listed too (e.g. bidir-warp,bidir-warp:occlusion=ztest)");
   CLI::Option* baseline = b->add_option("--baseline,-b", a->baseline,
                                         "Pipeline the speed-ups are measured against (with --preset: the preset's)")
                               ->capture_default_str();

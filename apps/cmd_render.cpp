@@ -136,7 +136,7 @@ void list_pipelines() {
   fmt::print(
       "\nA variant fixes options in the pipeline's name, NAME:KEY=VALUE[:KEY=VALUE...] (e.g.\n"
       "bidir-warp:occlusion=ztest): render, validate, bench, path and sweeps run it under that name,\n"
-      "beside the pipeline itself.\n");
+      "beside the pipeline itself where that is listed too.\n");
 }
 
 }  // namespace

@@ -669,7 +669,7 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
     io::write_exr(staged / kImage, right);
     validation::write_png(staged / kPreview, validation::encode_srgb8(right, "the reference"));
     fs::remove_all(staged / "work", ec);
-    const json provenance = {
+    json provenance = {
         {"kind", kKind},
         {"version", 1},
         {"id", id},
@@ -678,15 +678,8 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
          {{"name", render.provider},
           {"tool_version", render.tool_version},
           {"revision", provider->revision()},
-          // The provider ran its tool in request.work_dir inside the staging folder, both gone once
-          // the entry is stored: the provenance writes that folder as $WORK and says so.
           {"settings", without_scratch_path(render.settings, request.work_dir)},
           {"command", without_scratch_path(render.command, request.work_dir)},
-          {"work_folder",
-           fmt::format("{} is the folder the provider exported the scene to and ran its tool in; it is removed once "
-                       "the reference is stored. `stereobench reference generate` with this spec makes it again "
-                       "(`stereobench validate --truth {} --out DIR` keeps its own under DIR/work/).",
-                       kWorkPlaceholder, render.provider)},
           {"seconds", render.seconds}}},
         {"scene",
          {{"name", scene.name},
@@ -708,6 +701,15 @@ std::string ReferenceStore::generate(const ReferenceSpec& spec, const fs::path& 
         {"date", utc_now()},
         {"stereobench_version", SB_VERSION_STRING},
         {"versions", io::versions_json()}};
+    // An external provider ran its tool in request.work_dir inside the staging folder, both gone
+    // once the entry is stored: the provenance writes that folder as $WORK and says so. The
+    // built-in provider runs no tool and uses no folder.
+    if (!render.command.empty())
+      provenance["provider"]["work_folder"] = fmt::format(
+          "{} is the folder the provider exported the scene to and ran its tool in; it is removed once the reference "
+          "is stored. `stereobench reference generate` with this spec makes it again (`stereobench validate --truth "
+          "{} --out DIR` keeps its own under DIR/work/).",
+          kWorkPlaceholder, render.provider);
     io::write_text_atomically(staged / kProvenance, io::json_text(provenance, 2) + "\n");
     replace_folder(staged, root_ / id);
   } catch (const IoError& e) {

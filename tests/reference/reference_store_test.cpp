@@ -73,6 +73,8 @@ TEST(ReferenceStore, GenerateWritesImageAndProvenance) {
   const json p = store.provenance(id);
   EXPECT_EQ(p["provider"]["name"], "full");
   EXPECT_FALSE(p["provider"]["tool_version"].get<std::string>().empty());
+  // The built-in provider runs no tool in a work folder, so the provenance names none.
+  EXPECT_FALSE(p["provider"].contains("work_folder")) << p["provider"].dump();
   EXPECT_EQ(p["scene"]["content_sha256"].get<std::string>().size(), 64u);
   EXPECT_EQ(p["scene"]["file_sha256"].get<std::string>().size(), 64u);
   EXPECT_EQ(p["image"]["sha256"].get<std::string>().size(), 64u);
