@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "renderer/error.hpp"
@@ -299,6 +300,17 @@ class Checker {
         require_array(*a, std::string("/") + key);
         for (size_t i = 0; i < a->size(); ++i) string((*a)[i], fmt::format("/{}/{}", key, i));
       }
+    if (const json* required = find(doc_, "extensionsRequired")) {
+      const std::vector<std::string>& supported = supported_gltf_extensions();
+      for (size_t i = 0; i < required->size(); ++i) {
+        const std::string& e = (*required)[i].get_ref<const std::string&>();
+        if (std::find(supported.begin(), supported.end(), e) == supported.end())
+          fail(fmt::format("/extensionsRequired/{}", i),
+               fmt::format("extension '{}' is required by the file but not supported (supported: {}); export the "
+                           "file without it (e.g. without mesh compression)",
+                           e, fmt::join(supported, ", ")));
+      }
+    }
 
     // The top-level arrays first: an index into one that is not an array would read as an index
     // past its end.
@@ -636,7 +648,9 @@ class Checker {
               outer = number_in(*o, p + "/spot/outerConeAngle", 0.0, kHalfPi, "radians from the spot's axis");
             if (!(inner < outer))
               fail(p + "/spot",
-                   fmt::format("innerConeAngle {:g} must be less than outerConeAngle {:g} (radians)", inner, outer));
+                   fmt::format("innerConeAngle {:g} must be less than outerConeAngle {:g} (radians), as glTF requires; "
+                               "give the spot a soft edge (Blender: a Spot Blend above 0) or lower innerConeAngle",
+                               inner, outer));
           }
         });
       }
@@ -649,6 +663,12 @@ class Checker {
 };
 
 }  // namespace
+
+const std::vector<std::string>& supported_gltf_extensions() {
+  static const std::vector<std::string> supported = {"KHR_lights_punctual", "KHR_mesh_quantization",
+                                                     "KHR_texture_transform"};
+  return supported;
+}
 
 void check_gltf_json(const nlohmann::json& doc, const std::string& file) { Checker(doc, file).run(); }
 

@@ -4,12 +4,18 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <nlohmann/json_fwd.hpp>
 
 namespace sb::io {
 
+/// The glTF extensions the loader reads, in the order messages list them.
+[[nodiscard]] const std::vector<std::string>& supported_gltf_extensions();
+
 /// Throws InputError "<file>: <json pointer>: <what is wrong>; <what to do>" at the first fault.
+/// An extension the file requires and the loader does not read is that fault before any other:
+/// it changes what the rest of the document means (compressed geometry, for one).
 void check_gltf_json(const nlohmann::json& doc, const std::string& file);
 
 }  // namespace sb::io

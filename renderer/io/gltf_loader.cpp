@@ -492,17 +492,13 @@ class Converter {
     if (warning_counts_[key]++ == 0) warning_text_[key] = text;
   }
 
+  /// Required extensions were checked with the JSON (check_gltf_json); the unsupported ones the
+  /// file only uses are ignored, and said so.
   void check_extensions() {
-    static const std::set<std::string> supported = {"KHR_lights_punctual", "KHR_mesh_quantization",
-                                                    "KHR_texture_transform"};
-    for (size_t i = 0; i < m_.extensionsRequired.size(); ++i)
-      if (!supported.count(m_.extensionsRequired[i]))
-        fail(fmt::format("/extensionsRequired/{}", i),
-             fmt::format("extension '{}' is required by the file but not supported (supported: "
-                         "KHR_lights_punctual, KHR_mesh_quantization, KHR_texture_transform); re-export without it",
-                         m_.extensionsRequired[i]));
+    const std::vector<std::string>& supported = supported_gltf_extensions();
     for (const std::string& e : m_.extensionsUsed)
-      if (!supported.count(e)) warn("ext:" + e, fmt::format("extension '{}' is ignored", e));
+      if (std::find(supported.begin(), supported.end(), e) == supported.end())
+        warn("ext:" + e, fmt::format("extension '{}' is ignored", e));
   }
 
   AccessorView view_of(int index, const std::string& path) const {

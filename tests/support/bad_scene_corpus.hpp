@@ -204,6 +204,19 @@ inline std::vector<BadCase> bad_scene_corpus() {
     MiniGltf::write_bytes(p, data);
   }, "JSON chunk"});
   c.push_back({"required_extension", "a.gltf", edited([](MiniGltf& g) { g.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"}; }), "/extensionsRequired/0: extension 'KHR_draco_mesh_compression'"});
+  // Compressed geometry leaves the core fields without data (Draco: accessors with no bufferView;
+  // meshopt: a fallback buffer with no uri). The unsupported extension is named first, not those
+  // fields, which the extension makes legal.
+  c.push_back({"required_draco_without_views", "a.gltf", edited([](MiniGltf& g) {
+    g.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+    g.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+    for (json& a : g.doc["accessors"]) a.erase("bufferView");
+  }), "/extensionsRequired/0: extension 'KHR_draco_mesh_compression' is required by the file but not supported"});
+  c.push_back({"required_meshopt_fallback_buffer", "a.gltf", edited([](MiniGltf& g) {
+    g.doc["extensionsUsed"] = {"EXT_meshopt_compression"};
+    g.doc["extensionsRequired"] = {"EXT_meshopt_compression"};
+    g.doc["buffers"].push_back({{"byteLength", 64}, {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}});
+  }), "/extensionsRequired/0: extension 'EXT_meshopt_compression' is required by the file but not supported"});
   c.push_back({"light_reference_out_of_range", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["extensions"]["KHR_lights_punctual"]["light"] = 2; }), "/nodes/0/extensions/KHR_lights_punctual/light: refers to lights[2]"});
   c.push_back({"light_bad_type", "a.gltf", edited([](MiniGltf& g) { g.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array({{{"type", "area"}}}); }), "/extensions/KHR_lights_punctual/lights/0/type"});
   c.push_back({"light_negative_intensity", "a.gltf", edited([](MiniGltf& g) { g.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array({{{"type", "point"}, {"intensity", -1}}}); }), "/extensions/KHR_lights_punctual/lights/0/intensity"});
