@@ -258,9 +258,9 @@ void SceneAnimator::apply(int frame) {
         }
       }
       // A mirroring transform reverses the triangles, so that they face the way the file says.
-      if ((det < 0.0) != mesh.mirrored) {
+      if (const bool mirrors = (det < 0.0) != mesh.instance_mirrored; mirrors != mesh.mirrored) {
         for (size_t k = 0; k < mesh.indices.size(); k += 3) std::swap(mesh.indices[k + 1], mesh.indices[k + 2]);
-        mesh.mirrored = det < 0.0;
+        mesh.mirrored = mirrors;
       }
     }
     return;

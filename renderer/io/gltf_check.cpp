@@ -380,6 +380,19 @@ class Checker {
           require_object(*l, lp);
           opt_index(*l, "light", lp, "lights", true);
         }
+        if (const json* inst = find(*ext, "EXT_mesh_gpu_instancing")) {
+          // Each attribute an accessor of one instance's translation, rotation or scale; all of
+          // one count (checked as they are read).
+          const std::string ip = p + "/extensions/EXT_mesh_gpu_instancing";
+          require_object(*inst, ip);
+          const json* attributes = member(*inst, "attributes", ip);
+          if (!attributes) fail(ip, "has no 'attributes'; give TRANSLATION, ROTATION and/or SCALE accessors");
+          require_object(*attributes, ip + "/attributes");
+          for (const auto& [name, accessor] : attributes->items()) {
+            if (name != "TRANSLATION" && name != "ROTATION" && name != "SCALE") continue;  // custom _ATTRIBUTES
+            index(accessor, ip + "/attributes/" + name, "accessors");
+          }
+        }
       }
       extras(n, p, ExtrasOf::node);
     });
@@ -665,8 +678,8 @@ class Checker {
 }  // namespace
 
 const std::vector<std::string>& supported_gltf_extensions() {
-  static const std::vector<std::string> supported = {"KHR_lights_punctual", "KHR_mesh_quantization",
-                                                     "KHR_texture_transform"};
+  static const std::vector<std::string> supported = {"EXT_mesh_gpu_instancing", "KHR_lights_punctual",
+                                                     "KHR_mesh_quantization", "KHR_texture_transform"};
   return supported;
 }
 

@@ -781,6 +781,53 @@ class Converter {
     return l;
   }
 
+  /// EXT_mesh_gpu_instancing: the node's instances, each its translation, rotation and scale
+  /// (T * R * S, in the node's space: the node's world transform times it places the instance).
+  /// nullopt where the node has no instancing (its mesh is drawn once); an empty list draws nothing.
+  std::optional<std::vector<dmat4>> instances_of(int ni) {
+    const json& node = doc_.at("nodes").at(static_cast<size_t>(ni));
+    if (!node.contains("extensions") || !node["extensions"].contains("EXT_mesh_gpu_instancing")) return std::nullopt;
+    const std::string ip = fmt::format("/nodes/{}/extensions/EXT_mesh_gpu_instancing/attributes", ni);
+    const json& attributes = node["extensions"]["EXT_mesh_gpu_instancing"]["attributes"];
+    std::optional<size_t> count;
+    const auto read = [&](const char* name, int components) -> std::vector<float> {
+      if (!attributes.contains(name)) return {};
+      const std::string where = ip + "/" + name;
+      std::vector<float> values = read_floats(attributes[name].get<int>(), components, where);
+      const size_t n = values.size() / static_cast<size_t>(components);
+      if (count && *count != n)
+        fail(where, fmt::format("has {} instances where the node's other instancing attributes have {}; give every "
+                                "attribute one element per instance",
+                                n, *count));
+      count = n;
+      return values;
+    };
+    const std::vector<float> t = read("TRANSLATION", 3), r = read("ROTATION", 4), sc = read("SCALE", 3);
+    if (!count) {
+      note("instancing-no-attributes", fmt::format("{}: no TRANSLATION, ROTATION or SCALE; the mesh is drawn once, "
+                                                   "where the node places it",
+                                                   ip));
+      return std::nullopt;
+    }
+    std::vector<dmat4> out(*count);
+    for (size_t k = 0; k < *count; ++k) {
+      NodeAnimation::Local l;
+      if (!t.empty()) l.translation = dvec3(t[k * 3], t[k * 3 + 1], t[k * 3 + 2]);
+      if (!r.empty()) {
+        const dquat q(r[k * 4 + 3], r[k * 4], r[k * 4 + 1], r[k * 4 + 2]);  // glm: (w, x, y, z)
+        const double len = glm::length(q);
+        if (!(len > 0.0))
+          fail(ip + "/ROTATION", fmt::format("instance {}'s quaternion has length zero; a rotation is a unit "
+                                             "quaternion [x, y, z, w], e.g. [0, 0, 0, 1] for none",
+                                             k));
+        l.rotation = q / len;
+      }
+      if (!sc.empty()) l.scale = dvec3(sc[k * 3], sc[k * 3 + 1], sc[k * 3 + 2]);
+      out[k] = l.transform();
+    }
+    return out;
+  }
+
 
   /// The file's node animations (translation, rotation, scale channels of the loaded scene's
   /// nodes) and the node hierarchy they move, for paths (renderer/animation.hpp); a still render
@@ -935,13 +982,15 @@ class Converter {
       item.world = item.world * local_of(n).transform();
       order.push_back(item);
       if (n.mesh >= 0) {
+        const uint64_t copies = instance_count(static_cast<int>(ni));
         const auto& prims = m_.meshes[static_cast<size_t>(n.mesh)].primitives;
         for (size_t pi = 0; pi < prims.size(); ++pi) {
           const std::string ppath = fmt::format("/meshes/{}/primitives/{}", n.mesh, pi);
           if (all_at_origin(prims[pi])) continue;
-          triangles += estimated_triangles(prims[pi], ppath);
+          triangles += copies * estimated_triangles(prims[pi], ppath);
           if (auto it = prims[pi].attributes.find("POSITION"); it != prims[pi].attributes.end())
-            vertices += view_of(it->second, ppath).count;
+            vertices += copies * view_of(it->second, ppath).count;
+          if (triangles > kMaxSceneTriangles) break;
         }
       }
       if (triangles > kMaxSceneTriangles)
@@ -980,6 +1029,19 @@ class Converter {
         }
   }
 
+  /// How many times a node's mesh is drawn: the element count of its first EXT_mesh_gpu_instancing
+  /// attribute (instances_of checks that the others agree as it reads them), else once.
+  uint64_t instance_count(int ni) const {
+    const json& node = doc_.at("nodes").at(static_cast<size_t>(ni));
+    if (!node.contains("extensions") || !node["extensions"].contains("EXT_mesh_gpu_instancing")) return 1;
+    const json& attributes = node["extensions"]["EXT_mesh_gpu_instancing"]["attributes"];
+    for (const char* name : {"TRANSLATION", "ROTATION", "SCALE"})
+      if (attributes.contains(name))
+        return view_of(attributes[name].get<int>(), fmt::format("/nodes/{}/extensions/EXT_mesh_gpu_instancing", ni))
+            .count;
+    return 1;
+  }
+
   /// Whether a primitive's POSITION accessor has neither a bufferView nor sparse values: glTF
   /// makes every such vertex (0, 0, 0), so every triangle is degenerate and nothing of it can be seen.
   bool all_at_origin(const tinygltf::Primitive& prim) const {
@@ -1009,7 +1071,14 @@ class Converter {
     const std::string npath = fmt::format("/nodes/{}", ni);
     if (doc_.at("nodes")[static_cast<size_t>(ni)].contains("skin"))  // skins are not handed to tinygltf
       warn("node-skin", "skinned nodes render in their bind pose");
-    if (n.mesh >= 0) convert_mesh(scene, ni, n.mesh, world);
+    if (n.mesh >= 0) {
+      if (const std::optional<std::vector<dmat4>> instances = instances_of(ni)) {
+        for (size_t k = 0; k < instances->size(); ++k)
+          convert_mesh(scene, ni, n.mesh, world, (*instances)[k], static_cast<int>(k));
+      } else {
+        convert_mesh(scene, ni, n.mesh, world, dmat4(1.0), -1);
+      }
+    }
     if (n.camera >= 0) {
       convert_camera(scene, ni, world);
     } else if (const json& node_json = doc_.at("nodes").at(static_cast<size_t>(ni));
@@ -1028,9 +1097,13 @@ class Converter {
     }
   }
 
-  void convert_mesh(Scene& scene, int ni, int mi, const dmat4& world) {
+  /// Adds the primitives of mesh `mi` on node `ni` at `node_world * instance` (instance `k` of
+  /// the node's EXT_mesh_gpu_instancing, or -1 with the identity where it has none).
+  void convert_mesh(Scene& scene, int ni, int mi, const dmat4& node_world, const dmat4& instance, int k) {
     const tinygltf::Mesh& gm = m_.meshes[static_cast<size_t>(mi)];
+    const dmat4 world = node_world * instance;
     const dmat3 normal_matrix = glm::transpose(glm::inverse(dmat3(world)));
+    const dmat3 instance_normals = glm::transpose(glm::inverse(dmat3(instance)));
     const bool flip = glm::determinant(dmat3(world)) < 0.0;
     for (size_t pi = 0; pi < gm.primitives.size(); ++pi) {
       const tinygltf::Primitive& prim = gm.primitives[pi];
@@ -1055,7 +1128,10 @@ class Converter {
       Mesh mesh;
       mesh.name = gm.name.empty() ? fmt::format("mesh{}", mi) : gm.name;
       if (gm.primitives.size() > 1) mesh.name += fmt::format(".{}", pi);
+      if (k >= 0) mesh.name += fmt::format("#{}", k);
       mesh.node = ni;
+      mesh.instance = k;
+      mesh.instance_mirrored = glm::determinant(dmat3(instance)) < 0.0;
       mesh.material = prim.material;
       const std::vector<float> pos = read_floats(pos_it->second, 3, ppath + "/attributes/POSITION");
       const size_t nv = pos.size() / 3;
@@ -1063,7 +1139,8 @@ class Converter {
       const bool animated = scene.animation.moves(ni);
       if (animated) {
         mesh.local_positions.resize(nv);
-        for (size_t v = 0; v < nv; ++v) mesh.local_positions[v] = vec3(pos[v * 3], pos[v * 3 + 1], pos[v * 3 + 2]);
+        for (size_t v = 0; v < nv; ++v)
+          mesh.local_positions[v] = vec3(dvec3(instance * dvec4(pos[v * 3], pos[v * 3 + 1], pos[v * 3 + 2], 1.0)));
       }
       mesh.mirrored = flip;
       mesh.positions.resize(nv);
@@ -1106,7 +1183,8 @@ class Converter {
         mesh.normals.resize(nv);
         if (animated) {
           mesh.local_normals.resize(nv);
-          for (size_t v = 0; v < nv; ++v) mesh.local_normals[v] = vec3(nrm[v * 3], nrm[v * 3 + 1], nrm[v * 3 + 2]);
+          for (size_t v = 0; v < nv; ++v)
+            mesh.local_normals[v] = vec3(instance_normals * dvec3(nrm[v * 3], nrm[v * 3 + 1], nrm[v * 3 + 2]));
         }
         for (size_t v = 0; v < nv; ++v) {
           dvec3 nn = normal_matrix * dvec3(nrm[v * 3], nrm[v * 3 + 1], nrm[v * 3 + 2]);

@@ -627,6 +627,32 @@ TEST(BlenderFailure, APrimitiveWhoseFileNormalsWereDroppedIsRefused) {
   EXPECT_NO_THROW(validation::make_truth_provider("povray")->check_scene(scene, dir / "z.gltf"));
 }
 
+TEST(BlenderFailure, GpuInstancesAreRefused) {
+  // Blender 3.4's importer ignores EXT_mesh_gpu_instancing: it would draw the mesh once, where the
+  // node stands, and none of the instances.
+  const test::ScratchDir dir;
+  test::MiniGltf g;
+  const int pos = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  std::vector<float> t = {0, 0, 0, 2, 0, 0};
+  const int tr = g.add_accessor(g.add_view(t), 5126, 2, "VEC3");
+  g.add_node({{"mesh", g.add_mesh(nlohmann::json::array({{{"attributes", {{"POSITION", pos}}}}}))},
+              {"extensions", {{"EXT_mesh_gpu_instancing", {{"attributes", {{"TRANSLATION", tr}}}}}}}});
+  g.doc["extensionsUsed"] = {"EXT_mesh_gpu_instancing"};
+  g.write_gltf(dir / "inst.gltf");
+  const Scene scene = io::load_gltf(dir / "inst.gltf");
+  ASSERT_EQ(scene.meshes.size(), 2u);
+  try {
+    validation::make_truth_provider("blender")->check_scene(scene, dir / "inst.gltf");
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("as GPU instances (EXT_mesh_gpu_instancing), which Blender's glTF importer"),
+              std::string::npos)
+        << e.what();
+  }
+  // POV-Ray renders the loaded scene, instances and all.
+  EXPECT_NO_THROW(validation::make_truth_provider("povray")->check_scene(scene, dir / "inst.gltf"));
+}
+
 // ---------------------------------------------------------------------------------------------
 // Determinism and failure modes.
 

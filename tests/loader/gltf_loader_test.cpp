@@ -84,6 +84,74 @@ TEST(GltfLoader, MatrixTransformAndNegativeScaleKeepsFacing) {
   EXPECT_GT(glm::cross(b - a, c - a).z, 0.0f);
 }
 
+TEST(GltfLoader, GpuInstancesArePlacedInTheirNodesSpace) {
+  // EXT_mesh_gpu_instancing: instance k at node_world * T_k * R_k * S_k. The node moves by
+  // (0, 0, -5); instance 0 moves by (2, 0, 0); instance 1 turns 90 degrees about Z (rotation as
+  // normalized shorts, which the extension allows) and mirrors in x (scale -1, 1, 1).
+  ScratchDir dir("inst");
+  // The file, with `edit` applied to its instancing attributes before it is written.
+  const auto write = [&](const std::string& name, const std::function<void(MiniGltf&, json&)>& edit) {
+    MiniGltf g;
+    const int p = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+    const int m = g.add_mesh(json::array({{{"attributes", {{"POSITION", p}}}}}));
+    const std::vector<float> t = {2, 0, 0, 0, 0, 0};
+    const int16_t q = 23170;  // sqrt(0.5) as a normalized short
+    const std::vector<int16_t> r = {0, 0, 0, 32767, 0, 0, q, q};
+    const std::vector<float> sc = {1, 1, 1, -1, 1, 1};
+    json attributes = {{"TRANSLATION", g.add_accessor(g.add_view(t), 5126, 2, "VEC3")},
+                       {"ROTATION", g.add_accessor(g.add_view(r), 5122, 2, "VEC4", 0, true)},
+                       {"SCALE", g.add_accessor(g.add_view(sc), 5126, 2, "VEC3")}};
+    edit(g, attributes);
+    g.add_node({{"mesh", m}, {"translation", {0, 0, -5}},
+                {"extensions", {{"EXT_mesh_gpu_instancing", {{"attributes", attributes}}}}}});
+    g.doc["extensionsUsed"] = {"EXT_mesh_gpu_instancing"};
+    g.doc["extensionsRequired"] = {"EXT_mesh_gpu_instancing"};
+    g.write_gltf(dir / name);
+  };
+  write("i.gltf", [](MiniGltf&, json&) {});
+  const Scene scene = io::load_gltf(dir / "i.gltf");
+  ASSERT_EQ(scene.meshes.size(), 2u);
+  for (const std::string& w : scene.warnings) EXPECT_EQ(w.find("EXT_mesh_gpu_instancing"), std::string::npos) << w;
+  const Mesh& a = scene.meshes[0];
+  const Mesh& b = scene.meshes[1];
+  EXPECT_EQ(a.instance, 0);
+  EXPECT_EQ(b.instance, 1);
+  EXPECT_EQ(a.node, 0);
+  EXPECT_EQ(b.node, 0);
+  expect_vec3(a.positions[1], {3, 0, -5});
+  EXPECT_FALSE(a.mirrored);
+  // (1, 0, 0) mirrors to (-1, 0, 0) and turns to (0, -1, 0); (0, 1, 0) turns to (-1, 0, 0).
+  expect_vec3(b.positions[1], {0, -1, -5}, 1e-4f);
+  expect_vec3(b.positions[2], {-1, 0, -5}, 1e-4f);
+  EXPECT_TRUE(b.mirrored);
+  EXPECT_TRUE(b.instance_mirrored);
+  // Mirrored, the triangle is reversed so that it still faces +Z as the file says.
+  const vec3 b0 = b.positions[b.indices[0]], b1 = b.positions[b.indices[1]], b2 = b.positions[b.indices[2]];
+  EXPECT_GT(glm::cross(b1 - b0, b2 - b0).z, 0.0f);
+
+  // Attributes of different counts, a rotation of length zero and an accessor out of range are
+  // refused by path.
+  write("counts.gltf", [](MiniGltf& g, json& attributes) {
+    const std::vector<float> three = {0, 0, 0, 1, 0, 0, 2, 0, 0};
+    attributes["TRANSLATION"] = g.add_accessor(g.add_view(three), 5126, 3, "VEC3");
+  });
+  EXPECT_NE(test::input_error([&] { (void)io::load_gltf(dir / "counts.gltf"); })
+                .find("/nodes/0/extensions/EXT_mesh_gpu_instancing/attributes/ROTATION: has 2 instances where the "
+                      "node's other instancing attributes have 3"),
+            std::string::npos);
+  write("zero.gltf", [](MiniGltf& g, json& attributes) {
+    const std::vector<float> none = {0, 0, 0, 0, 0, 0, 0, 1};
+    attributes["ROTATION"] = g.add_accessor(g.add_view(none), 5126, 2, "VEC4");
+  });
+  EXPECT_NE(test::input_error([&] { (void)io::load_gltf(dir / "zero.gltf"); })
+                .find("ROTATION: instance 0's quaternion has length zero"),
+            std::string::npos);
+  write("range.gltf", [](MiniGltf&, json& attributes) { attributes["SCALE"] = 99; });
+  EXPECT_NE(test::input_error([&] { (void)io::load_gltf(dir / "range.gltf"); })
+                .find("/nodes/0/extensions/EXT_mesh_gpu_instancing/attributes/SCALE: refers to accessors[99]"),
+            std::string::npos);
+}
+
 TEST(GltfLoader, EveryComponentTypeStrideAndNormalisation) {
   ScratchDir dir("acc");
   MiniGltf g;

@@ -366,6 +366,15 @@ class BlenderProvider final : public TruthProvider {
             "geometric normals, while Blender's importer would smooth it with the file's normals: give the "
             "primitive unit normals (or none), or use the full or povray provider",
             scene.name, m.name, m.node));
+    // Blender 3.4's glTF importer does not read EXT_mesh_gpu_instancing: it would draw each
+    // instanced mesh once, where its node stands, and none of its instances.
+    for (const Mesh& m : scene.meshes)
+      if (m.instance >= 0)
+        throw InputError(fmt::format(
+            "scene '{}': node {} draws mesh '{}' as GPU instances (EXT_mesh_gpu_instancing), which Blender's glTF "
+            "importer ({}) does not read, so its render would lack them: export the file without instancing (e.g. "
+            "gltf-transform uninstance), or use the full or povray provider",
+            scene.name, m.node, m.name, "3.4, Debian 12"));
     // Blender's importer brings in every node of the file; the loaded scene is glTF scene 0 (or
     // `scene`) alone.
     if (scene.nodes_not_loaded > 0)
