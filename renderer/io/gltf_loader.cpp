@@ -465,8 +465,6 @@ class Converter {
                                    "area (its vertices coincide or lie on one line), so nothing can be seen; check "
                                    "the primitives' indices and POSITION accessors, or pick another scene",
                                    file_, scene.triangle_count()));
-    if (auto skins = doc_.find("skins"); skins != doc_.end() && !skins->empty())  // not handed to tinygltf
-      warn("skins", fmt::format("{} skin(s) ignored: meshes render in their bind pose", skins->size()));
     for (const auto& [key, count] : warning_counts_)
       scene.warnings.push_back(count > 1 ? fmt::format("{} ({} occurrences)", warning_text_[key], count)
                                          : warning_text_[key]);
@@ -1029,6 +1027,102 @@ class Converter {
         }
   }
 
+  /// A skinned node's joint matrices (glTF 2.0 §3.7.3): joint i's world transform, as the file
+  /// places its node, times its inverse bind matrix (identity where the skin gives none). The skinned
+  /// node's own transform is not used, as glTF says.
+  struct Skinning {
+    int skin = -1;
+    std::vector<dmat4> joints;
+  };
+
+  /// The skinning of node `ni`, or nullopt where it has no skin. Skeletal animation is not played:
+  /// a skinned mesh keeps the pose of its joints at rest, which a path whose animation moves them
+  /// is told.
+  std::optional<Skinning> skinning_of(Scene& scene, int ni) {
+    const json& node = doc_.at("nodes").at(static_cast<size_t>(ni));
+    if (!node.contains("skin")) return std::nullopt;
+    Skinning s;
+    s.skin = node["skin"].get<int>();
+    const std::string sp = fmt::format("/skins/{}", s.skin);
+    const json& skin = doc_.at("skins").at(static_cast<size_t>(s.skin));
+    const json& joints = skin.at("joints");
+    std::vector<float> inverse_bind;
+    if (skin.contains("inverseBindMatrices")) {
+      const int a = skin["inverseBindMatrices"].get<int>();
+      inverse_bind = read_floats(a, 16, sp + "/inverseBindMatrices");
+      if (inverse_bind.size() / 16 < joints.size())
+        fail(sp + "/inverseBindMatrices", fmt::format("accessor {} has {} matrices for {} joints; give one per joint",
+                                                      a, inverse_bind.size() / 16, joints.size()));
+    }
+    bool moved = scene.animation.moves(ni);
+    for (size_t j = 0; j < joints.size(); ++j) {
+      const int joint = joints[j].get<int>();
+      dmat4 ibm(1.0);
+      if (!inverse_bind.empty())
+        for (int c = 0; c < 4; ++c)
+          for (int r = 0; r < 4; ++r) ibm[c][r] = inverse_bind[j * 16 + static_cast<size_t>(c * 4 + r)];
+      s.joints.push_back(rest_world_of(joint) * ibm);
+      moved = moved || scene.animation.moves(joint);
+    }
+    if (moved)
+      note("skin-animation", "skeletal animation is not played: skinned meshes keep the pose of their joints at rest "
+                             "in every frame of a path");
+    return s;
+  }
+
+  /// Node `ni`'s world transform as the file places it, whether or not the loaded scene reaches it
+  /// (a skin's joints may lie outside it).
+  dmat4 rest_world_of(int ni) {
+    if (all_parents_.empty()) {
+      all_parents_.assign(m_.nodes.size(), -1);
+      for (size_t p = 0; p < m_.nodes.size(); ++p)
+        for (int c : m_.nodes[p].children) all_parents_[static_cast<size_t>(c)] = static_cast<int>(p);
+    }
+    dmat4 world(1.0);
+    for (int n = ni; n >= 0; n = all_parents_[static_cast<size_t>(n)])
+      world = local_of(m_.nodes[static_cast<size_t>(n)]).transform() * world;
+    return world;
+  }
+
+  /// Per vertex of a skinned primitive: the sum over its JOINTS_n / WEIGHTS_n sets of weight times
+  /// joint matrix, the weights normalized to sum 1 (a vertex with none keeps the skin's bind space).
+  std::vector<dmat4> skin_matrices(const Skinning& skin, const tinygltf::Primitive& prim, size_t nv,
+                                   const std::string& ppath) {
+    std::vector<dmat4> out(nv, dmat4(0.0));
+    std::vector<double> total(nv, 0.0);
+    bool any = false;
+    for (int set = 0;; ++set) {
+      const auto j = prim.attributes.find(fmt::format("JOINTS_{}", set));
+      const auto w = prim.attributes.find(fmt::format("WEIGHTS_{}", set));
+      if (j == prim.attributes.end() || w == prim.attributes.end()) break;
+      any = true;
+      const std::string jp = fmt::format("{}/attributes/JOINTS_{}", ppath, set);
+      const std::string wp = fmt::format("{}/attributes/WEIGHTS_{}", ppath, set);
+      const std::vector<float> joints = read_floats(j->second, 4, jp);
+      const std::vector<float> weights = read_floats(w->second, 4, wp);
+      if (joints.size() != nv * 4) fail(jp, fmt::format("has {} elements but POSITION has {}", joints.size() / 4, nv));
+      if (weights.size() != nv * 4) fail(wp, fmt::format("has {} elements but POSITION has {}", weights.size() / 4, nv));
+      for (size_t v = 0; v < nv; ++v)
+        for (int c = 0; c < 4; ++c) {
+          const double weight = weights[v * 4 + static_cast<size_t>(c)];
+          if (weight == 0.0) continue;
+          const float joint = joints[v * 4 + static_cast<size_t>(c)];
+          if (joint < 0.0f || joint >= static_cast<float>(skin.joints.size()))
+            fail(jp, fmt::format("vertex {} names joint {} of skin {}, which has {} joints", v, joint, skin.skin,
+                                 skin.joints.size()));
+          if (weight < 0.0) fail(wp, fmt::format("vertex {} has a negative weight {:g}", v, weight));
+          out[v] += weight * skin.joints[static_cast<size_t>(joint)];
+          total[v] += weight;
+        }
+    }
+    if (!any)
+      note("skin-without-weights", fmt::format("{}: a skinned primitive without JOINTS_0 and WEIGHTS_0 is placed in "
+                                               "its skin's bind space, as the file's vertices are",
+                                               ppath));
+    for (size_t v = 0; v < nv; ++v) out[v] = total[v] > 0.0 ? out[v] / total[v] : dmat4(1.0);
+    return out;
+  }
+
   /// How many times a node's mesh is drawn: the element count of its first EXT_mesh_gpu_instancing
   /// attribute (instances_of checks that the others agree as it reads them), else once.
   uint64_t instance_count(int ni) const {
@@ -1069,10 +1163,10 @@ class Converter {
   void visit(Scene& scene, int ni, const dmat4& world) {
     const tinygltf::Node& n = m_.nodes[static_cast<size_t>(ni)];
     const std::string npath = fmt::format("/nodes/{}", ni);
-    if (doc_.at("nodes")[static_cast<size_t>(ni)].contains("skin"))  // skins are not handed to tinygltf
-      warn("node-skin", "skinned nodes render in their bind pose");
     if (n.mesh >= 0) {
-      if (const std::optional<std::vector<dmat4>> instances = instances_of(ni)) {
+      if (const std::optional<Skinning> skin = skinning_of(scene, ni)) {
+        convert_mesh(scene, ni, n.mesh, world, dmat4(1.0), -1, &*skin);
+      } else if (const std::optional<std::vector<dmat4>> instances = instances_of(ni)) {
         for (size_t k = 0; k < instances->size(); ++k)
           convert_mesh(scene, ni, n.mesh, world, (*instances)[k], static_cast<int>(k));
       } else {
@@ -1099,7 +1193,10 @@ class Converter {
 
   /// Adds the primitives of mesh `mi` on node `ni` at `node_world * instance` (instance `k` of
   /// the node's EXT_mesh_gpu_instancing, or -1 with the identity where it has none).
-  void convert_mesh(Scene& scene, int ni, int mi, const dmat4& node_world, const dmat4& instance, int k) {
+  /// With `skin`, each vertex is placed by its joints instead (skinning_of), and `node_world` and
+  /// `instance` are not used.
+  void convert_mesh(Scene& scene, int ni, int mi, const dmat4& node_world, const dmat4& instance, int k,
+                    const Skinning* skin = nullptr) {
     const tinygltf::Mesh& gm = m_.meshes[static_cast<size_t>(mi)];
     const dmat4 world = node_world * instance;
     const dmat3 normal_matrix = glm::transpose(glm::inverse(dmat3(world)));
@@ -1135,17 +1232,20 @@ class Converter {
       mesh.material = prim.material;
       const std::vector<float> pos = read_floats(pos_it->second, 3, ppath + "/attributes/POSITION");
       const size_t nv = pos.size() / 3;
-      // A mesh that an animation moves keeps its node-local geometry for the frames of a path.
-      const bool animated = scene.animation.moves(ni);
+      // A mesh that an animation moves keeps its node-local geometry for the frames of a path. A
+      // skinned one stays in the pose of its joints at rest (skinning_of says so where they move).
+      const bool animated = !skin && scene.animation.moves(ni);
+      // Per vertex, the transform of its joints blended by its weights.
+      const std::vector<dmat4> skinned = skin ? skin_matrices(*skin, prim, nv, ppath) : std::vector<dmat4>();
       if (animated) {
         mesh.local_positions.resize(nv);
         for (size_t v = 0; v < nv; ++v)
           mesh.local_positions[v] = vec3(dvec3(instance * dvec4(pos[v * 3], pos[v * 3 + 1], pos[v * 3 + 2], 1.0)));
       }
-      mesh.mirrored = flip;
+      mesh.mirrored = skin ? nv > 0 && glm::determinant(dmat3(skinned[0])) < 0.0 : flip;
       mesh.positions.resize(nv);
       for (size_t v = 0; v < nv; ++v) {
-        const dvec3 p = dvec3(world * dvec4(pos[v * 3], pos[v * 3 + 1], pos[v * 3 + 2], 1.0));
+        const dvec3 p = dvec3((skin ? skinned[v] : world) * dvec4(pos[v * 3], pos[v * 3 + 1], pos[v * 3 + 2], 1.0));
         if (!within_scene_range(p))
           fail(fmt::format("/nodes/{}", ni),
                fmt::format("places vertex {} of mesh '{}' at ({:g}, {:g}, {:g}) m, beyond the ±{:g} m a scene may "
@@ -1187,7 +1287,8 @@ class Converter {
             mesh.local_normals[v] = vec3(instance_normals * dvec3(nrm[v * 3], nrm[v * 3 + 1], nrm[v * 3 + 2]));
         }
         for (size_t v = 0; v < nv; ++v) {
-          dvec3 nn = normal_matrix * dvec3(nrm[v * 3], nrm[v * 3 + 1], nrm[v * 3 + 2]);
+          const dmat3 to_world = skin ? glm::transpose(glm::inverse(dmat3(skinned[v]))) : normal_matrix;
+          dvec3 nn = to_world * dvec3(nrm[v * 3], nrm[v * 3 + 1], nrm[v * 3 + 2]);
           const double len = glm::length(nn);
           mesh.normals[v] = len > 0.0 ? vec3(nn / len) : vec3(0.0f, 1.0f, 0.0f);
         }
@@ -1354,6 +1455,7 @@ class Converter {
   std::string file_;
   GltfLoadOptions options_;
   std::vector<int> parent_;    ///< per node: its parent as the traversal reached it, -1 for a root or unreached
+  std::vector<int> all_parents_;  ///< per node: its parent in the file, -1 for a root (rest_world_of)
   std::vector<bool> visited_;  ///< per node: whether the loaded scene reaches it
   std::map<std::string, int> warning_counts_;
   std::map<std::string, std::string> warning_text_;

@@ -282,8 +282,9 @@ TEST(GltfLoader, QuantizedPositionsLoadWithKhrMeshQuantization) {
   expect_vec3(scene.meshes[0].positions[2], {0, 1, 0});
 }
 
-TEST(GltfLoader, ASkinWithoutInverseBindMatricesLoadsInItsBindPose) {
-  // inverseBindMatrices is optional in glTF 2.0 (identity matrices); the skin is not played.
+TEST(GltfLoader, ASkinWithoutInverseBindMatricesLoads) {
+  // inverseBindMatrices is optional in glTF 2.0 (identity matrices). A primitive without JOINTS_0
+  // and WEIGHTS_0 stays in the skin's bind space, where its vertices are, with a note.
   ScratchDir dir("skin");
   for (const char* name : {"s.gltf", "s.glb"}) {
     MiniGltf g;
@@ -298,10 +299,59 @@ TEST(GltfLoader, ASkinWithoutInverseBindMatricesLoadsInItsBindPose) {
     ASSERT_EQ(scene.meshes.size(), 1u) << name;
     expect_vec3(scene.meshes[0].positions[1], {1, 0, 0});
     EXPECT_EQ(std::count_if(scene.warnings.begin(), scene.warnings.end(),
-                            [](const std::string& w) { return w.find("1 skin(s) ignored") != std::string::npos; }),
+                            [](const std::string& w) {
+                              return w.find("without JOINTS_0 and WEIGHTS_0 is placed in its skin's bind space") !=
+                                     std::string::npos;
+                            }),
               1)
         << name;
   }
+}
+
+TEST(GltfLoader, ASkinnedMeshIsPosedByItsJoints) {
+  // glTF 2.0 §3.7.3: vertex v goes to sum_i w_i * world(joint_i) * inverseBind_i * v, and the
+  // skinned node's own transform is not used. Joint 0 stands at (0, 0, 0), joint 1 at (0, 1, 0) is
+  // turned 90 degrees about Z; both were bound where they stand unturned (inverse binds: identity
+  // and a translation by (0, -1, 0)).
+  ScratchDir dir("skin-pose");
+  MiniGltf g;
+  const int pos = g.add_positions({0, 0, 0, 1, 1, 0, 0, 2, 0});
+  const std::vector<uint8_t> joints = {0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0};
+  const std::vector<float> weights = {1, 0, 0, 0, 1, 0, 0, 0, 0.5f, 0.5f, 0, 0};
+  const int ja = g.add_accessor(g.add_view(joints), 5121, 3, "VEC4");
+  const int wa = g.add_accessor(g.add_view(weights), 5126, 3, "VEC4");
+  const std::vector<float> ibm = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1,
+                                  1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1};
+  const int ia = g.add_accessor(g.add_view(ibm), 5126, 2, "MAT4");
+  const int m = g.add_mesh(json::array({{{"attributes", {{"POSITION", pos}, {"JOINTS_0", ja}, {"WEIGHTS_0", wa}}}}}));
+  // Node 0: the skinned mesh, moved by (100, 0, 0), which skinning ignores. Nodes 1 and 2: the joints.
+  g.add_node({{"mesh", m}, {"skin", 0}, {"translation", {100, 0, 0}}});
+  const double s = std::sqrt(0.5);
+  g.add_node({{"children", {2}}});
+  g.add_node({{"translation", {0, 1, 0}}, {"rotation", {0, 0, s, s}}}, false);
+  g.doc["skins"] = json::array({{{"joints", {1, 2}}, {"inverseBindMatrices", ia}}});
+  g.write_gltf(dir / "p.gltf");
+  const Scene scene = io::load_gltf(dir / "p.gltf");
+  ASSERT_EQ(scene.meshes.size(), 1u);
+  const Mesh& mesh = scene.meshes[0];
+  // Vertex 0 follows joint 0 (in place). Vertex 1, (1, 1, 0), is (1, 0, 0) from joint 1, which
+  // turns it to (0, 1, 0) there: (0, 2, 0). Vertex 2, (0, 2, 0), is (0, 1, 0) from joint 1, turned
+  // to (-1, 0, 0): (-1, 1, 0); half of that and half of (0, 2, 0) is (-0.5, 1.5, 0).
+  expect_vec3(mesh.positions[0], {0, 0, 0});
+  expect_vec3(mesh.positions[1], {0, 2, 0});
+  expect_vec3(mesh.positions[2], {-0.5f, 1.5f, 0});
+  for (const std::string& w : scene.warnings) {
+    EXPECT_EQ(w.find("skeletal"), std::string::npos) << w;
+    EXPECT_EQ(w.find("JOINTS_0"), std::string::npos) << w;
+  }
+
+  // A joint index past the skin's joints is refused by path.
+  g.doc["skins"][0]["joints"] = {1};
+  g.doc["skins"][0].erase("inverseBindMatrices");
+  g.write_gltf(dir / "q.gltf");
+  EXPECT_NE(test::input_error([&] { (void)io::load_gltf(dir / "q.gltf"); })
+                .find("/meshes/0/primitives/0/attributes/JOINTS_0: vertex 1 names joint 1 of skin 0, which has 1 joints"),
+            std::string::npos);
 }
 
 TEST(GltfLoader, AnImageDataUriOfAnExtensionsTypeLoads) {

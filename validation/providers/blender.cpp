@@ -29,7 +29,7 @@ namespace {
 namespace fs = std::filesystem;
 
 /// Bumped whenever the export, the script or the settings change.
-constexpr const char* kRevision = "blender-export-7";
+constexpr const char* kRevision = "blender-export-8";
 /// Cut-out holes a camera or shadow ray may pass in Cycles (transparent bounces); ours pass any.
 constexpr int kTransparentBounces = 64;
 /// Environment variable naming the Blender executable (a path, or a name looked up on PATH).

@@ -91,15 +91,14 @@ def import_scene():
     for obj in removed:
         bpy.data.objects.remove(obj, do_unlink=True)
     # As the in-memory scene renders them: morph targets at their base shape (no shape key weighs
-    # in) and skinned meshes in their bind pose (no armature deforms them).
+    # in). Skinned meshes keep their armature, posed by the joints' node transforms as the loader
+    # skins them.
     for obj in bpy.data.objects:
         if obj.type != "MESH":
             continue
         if obj.data.shape_keys is not None:
             for block in obj.data.shape_keys.key_blocks:
                 block.value = 0.0
-        for modifier in [m for m in obj.modifiers if m.type == "ARMATURE"]:
-            obj.modifiers.remove(modifier)
     bpy.context.view_layer.update()
 
 
