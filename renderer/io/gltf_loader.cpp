@@ -497,6 +497,30 @@ class Converter {
     for (const std::string& e : m_.extensionsUsed)
       if (std::find(supported.begin(), supported.end(), e) == supported.end())
         warn("ext:" + e, fmt::format("extension '{}' is ignored", e));
+    // glTF requires every extension an object uses to be listed in extensionsUsed; one that is
+    // not would otherwise be dropped without a word.
+    std::set<std::string> unlisted;
+    collect_unlisted_extensions(doc_, unlisted);
+    for (const std::string& e : unlisted)
+      if (std::find(supported.begin(), supported.end(), e) == supported.end())
+        warn("ext:" + e, fmt::format("extension '{}' is ignored (the file uses it without listing it in "
+                                     "extensionsUsed, which glTF requires)",
+                                     e));
+  }
+
+  void collect_unlisted_extensions(const json& v, std::set<std::string>& out) const {
+    if (v.is_object()) {
+      for (const auto& [key, value] : v.items()) {
+        if (key == "extensions" && value.is_object()) {
+          for (const auto& [name, ext] : value.items())
+            if (std::find(m_.extensionsUsed.begin(), m_.extensionsUsed.end(), name) == m_.extensionsUsed.end())
+              out.insert(name);
+        }
+        if (key != "extras") collect_unlisted_extensions(value, out);
+      }
+    } else if (v.is_array()) {
+      for (const json& e : v) collect_unlisted_extensions(e, out);
+    }
   }
 
   AccessorView view_of(int index, const std::string& path) const {
@@ -660,10 +684,6 @@ class Converter {
         mat.alpha_mode = Material::AlphaMode::blend;
         warn("alpha:BLEND", "alphaMode BLEND (rendered as OPAQUE: surfaces are not blended)");
       }
-      // An extension the file lists in extensionsUsed was reported there, once.
-      for (const auto& [ext, value] : gm.extensions)
-        if (std::find(m_.extensionsUsed.begin(), m_.extensionsUsed.end(), ext) == m_.extensionsUsed.end())
-          warn("ext:" + ext, fmt::format("material extension '{}' is ignored", ext));
       const int t = gm.pbrMetallicRoughness.baseColorTexture.index;
       if (t >= 0 && options_.load_textures) {
         mat.texcoord = gm.pbrMetallicRoughness.baseColorTexture.texCoord;

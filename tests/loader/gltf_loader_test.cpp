@@ -651,7 +651,8 @@ TEST(GltfLoader, UnsupportedFeaturesAreNamedOnce) {
   const int m = g.add_mesh(json::array({{{"attributes", {{"POSITION", pos}, {"COLOR_0", colour}}}, {"material", 0}},
                                         {{"attributes", {{"POSITION", pos}}}, {"material", 1}},
                                         {{"attributes", {{"POSITION", pos}}}, {"mode", 1}}}));
-  g.add_node({{"mesh", m}});
+  // A node extension the file does not list in extensionsUsed (glTF requires it to): named too.
+  g.add_node({{"mesh", m}, {"extensions", {{"EXT_unknown_thing", {{"a", 1}}}}}});
   g.doc["extensionsUsed"] = {"KHR_materials_unlit"};
   g.write_gltf(dir / "u.gltf");
   const Scene scene = io::load_gltf(dir / "u.gltf");
@@ -671,6 +672,8 @@ TEST(GltfLoader, UnsupportedFeaturesAreNamedOnce) {
   for (const char* named : {"vertex colours (COLOR_n) are ignored", "occlusion textures are ignored",
                             "metallic-roughness textures are ignored",
                             "NEAREST texture filtering (textures are filtered trilinearly)",
+                            "extension 'EXT_unknown_thing' is ignored (the file uses it without listing it in "
+                            "extensionsUsed",
                             // the texture's material on a primitive without TEXCOORD_0
                             "primitives without the texture coordinates they read, TEXCOORD_0 (texture ignored there)"})
     EXPECT_EQ(std::count_if(scene.warnings.begin(), scene.warnings.end(),
