@@ -97,9 +97,9 @@ float ray_cone_lod(const RenderScene& scene, const SurfacePoint& p, const ConeSe
   const Mesh& mesh = scene.scene().meshes[mesh_index];
   const uint32_t i0 = mesh.indices[tri * 3 + 0], i1 = mesh.indices[tri * 3 + 1], i2 = mesh.indices[tri * 3 + 2];
   const MipTexture& mt = scene.texture(tex);
-  const float delta = ray_cone_triangle_lod(mesh.positions[i0], mesh.positions[i1], mesh.positions[i2], mesh.uvs[i0],
-                                            mesh.uvs[i1], mesh.uvs[i2], mt.width(), mt.height());
-  return lod_from_elliptic_cone(delta, cone.axis_a, cone.axis_b, p.geometric_normal, dir);
+  const TexelMap map = triangle_texel_map(mesh.positions[i0], mesh.positions[i1], mesh.positions[i2], mesh.uvs[i0],
+                                          mesh.uvs[i1], mesh.uvs[i2], mt.width(), mt.height());
+  return lod_from_elliptic_cone(map, cone.axis_a, cone.axis_b, p.geometric_normal, dir);
 }
 
 float derivative_lod(const RenderScene& scene, const SurfacePoint& p, const vec4& duv) {

@@ -49,8 +49,9 @@ struct ConeSection {
 /// is still up to 0.5 log2(1 / cos(phi)) levels off the rasterizer (texture.hpp, lod_from_ray_cone).
 [[nodiscard]] ConeSection primary_cone(float t, float tan_spread, const vec3& dir, const vec3& view_dir);
 
-/// Texture level of detail by ray cones (lod_from_elliptic_cone) for a ray along unit `dir` whose
-/// cone has section `cone` where it hits `p` (0 when the material has no texture).
+/// Texture level of detail by ray cones (lod_from_elliptic_cone through the hit triangle's texel
+/// map) for a ray along unit `dir` whose cone has section `cone` where it hits `p` (0 when the
+/// material has no texture).
 [[nodiscard]] float ray_cone_lod(const RenderScene& scene, const SurfacePoint& p, const ConeSection& cone,
                                  const vec3& dir);
 

@@ -16,6 +16,23 @@
 namespace sb {
 namespace {
 
+/// The largest eigenvalue of the Gram matrix [e f; f g] (the squared major axis of the ellipse
+/// two vectors span), in the form without cancellation.
+double major_axis_squared(double e, double g, double f) {
+  const double half_diff = 0.5 * (e - g);
+  return 0.5 * (e + g) + std::sqrt(half_diff * half_diff + f * f);
+}
+
+/// The cone's cross-section axes projected along the ray onto the tangent plane of `normal`:
+/// w - (n.w / n.d) d. A ray along the surface reads as |n.d| = 1e-6: a finite, very coarse level
+/// instead of inf - inf.
+std::pair<dvec3, dvec3> footprint_axes(const vec3& axis_a, const vec3& axis_b, const vec3& normal, const vec3& dir) {
+  const dvec3 n(normal), d(dir), a(axis_a), b(axis_b);
+  double nd = glm::dot(n, d);
+  if (!(std::fabs(nd) >= 1e-6)) nd = nd < 0.0 ? -1e-6 : 1e-6;
+  return {a - (glm::dot(n, a) / nd) * d, b - (glm::dot(n, b) / nd) * d};
+}
+
 /// The source texels (first, first + 1, ...) and weights that make one output texel along an axis.
 struct AxisTaps {
   int first = 0;
@@ -154,11 +171,8 @@ float lod_from_derivatives(const vec4& duv, int width, int height) {
   // Columns of the texel-space Jacobian: the pixel's x and y axes mapped to texels.
   const double ax = static_cast<double>(duv.x) * width, ay = static_cast<double>(duv.y) * height;
   const double bx = static_cast<double>(duv.z) * width, by = static_cast<double>(duv.w) * height;
-  const double e = ax * ax + ay * ay, g = bx * bx + by * by, f = ax * bx + ay * by;
-  // Largest eigenvalue of J^T J (the squared major axis), in the form without cancellation.
-  const double half_diff = 0.5 * (e - g);
-  const double sigma_max_sq = 0.5 * (e + g) + std::sqrt(half_diff * half_diff + f * f);
-  return static_cast<float>(0.5 * std::log2(sigma_max_sq));
+  // Largest eigenvalue of J^T J (the squared major axis).
+  return static_cast<float>(0.5 * std::log2(major_axis_squared(ax * ax + ay * ay, bx * bx + by * by, ax * bx + ay * by)));
 }
 
 double ray_cone_spread(double vfov, int height) {
@@ -186,19 +200,47 @@ float lod_from_ray_cone(float triangle_lod, float cone_width, float abs_cos_thet
                             std::log2(std::fabs(static_cast<double>(abs_cos_theta))));
 }
 
+
 float lod_from_elliptic_cone(float triangle_lod, const vec3& axis_a, const vec3& axis_b, const vec3& normal,
                              const vec3& dir) {
-  // The cross-section's axes projected along the ray onto the tangent plane: w - (n.w / n.d) d.
-  const dvec3 n(normal), d(dir), a(axis_a), b(axis_b);
-  // A ray along the surface reads as |n.d| = 1e-6: a finite, very coarse level instead of inf - inf.
-  double nd = glm::dot(n, d);
-  if (!(std::fabs(nd) >= 1e-6)) nd = nd < 0.0 ? -1e-6 : 1e-6;
-  const dvec3 pa = a - (glm::dot(n, a) / nd) * d, pb = b - (glm::dot(n, b) / nd) * d;
-  // Largest eigenvalue of the 2x2 Gram matrix (the squared major axis), as in lod_from_derivatives.
-  const double e = glm::dot(pa, pa), g = glm::dot(pb, pb), f = glm::dot(pa, pb);
-  const double half_diff = 0.5 * (e - g);
-  const double sigma_max_sq = 0.5 * (e + g) + std::sqrt(half_diff * half_diff + f * f);
+  const auto [pa, pb] = footprint_axes(axis_a, axis_b, normal, dir);
+  const double sigma_max_sq = major_axis_squared(glm::dot(pa, pa), glm::dot(pb, pb), glm::dot(pa, pb));
   return static_cast<float>(static_cast<double>(triangle_lod) + 0.5 * std::log2(sigma_max_sq));
+}
+
+TexelMap triangle_texel_map(const vec3& p0, const vec3& p1, const vec3& p2, const vec2& uv0, const vec2& uv1,
+                            const vec2& uv2, int width, int height) {
+  if (width <= 0 || height <= 0)
+    throw InputError(fmt::format("triangle_texel_map: texture size {}x{} is not positive", width, height));
+  // w = a e1 + b e2 in the plane has (a, b) = G^-1 (e1 . w, e2 . w), G the edges' Gram matrix, and
+  // moves the coordinates by a d1 + b d2 (d1, d2 the edges' coordinate steps in texels).
+  const dvec3 e1 = dvec3(p1) - dvec3(p0), e2 = dvec3(p2) - dvec3(p0);
+  const double g11 = glm::dot(e1, e1), g12 = glm::dot(e1, e2), g22 = glm::dot(e2, e2);
+  const double det = g11 * g22 - g12 * g12;
+  TexelMap m;
+  if (!(det > 0.0) || !std::isfinite(det)) {
+    m.flat = true;
+    return m;
+  }
+  const dvec2 size(width, height);
+  const dvec2 d1 = (dvec2(uv1) - dvec2(uv0)) * size, d2 = (dvec2(uv2) - dvec2(uv0)) * size;
+  // Row k of the map: (d1_k, d2_k) G^-1 (e1, e2)^T.
+  const auto row = [&](double s1, double s2) {
+    return ((s1 * g22 - s2 * g12) / det) * e1 + ((s2 * g11 - s1 * g12) / det) * e2;
+  };
+  m.u = row(d1.x, d2.x);
+  m.v = row(d1.y, d2.y);
+  return m;
+}
+
+float lod_from_elliptic_cone(const TexelMap& map, const vec3& axis_a, const vec3& axis_b, const vec3& normal,
+                             const vec3& dir) {
+  if (map.flat) return std::numeric_limits<float>::infinity();
+  const auto [pa, pb] = footprint_axes(axis_a, axis_b, normal, dir);
+  // The footprint's axes in texels: the columns of the 2x2 matrix whose major axis is the level.
+  const dvec2 ta(glm::dot(map.u, pa), glm::dot(map.v, pa)), tb(glm::dot(map.u, pb), glm::dot(map.v, pb));
+  const double sigma_max_sq = major_axis_squared(glm::dot(ta, ta), glm::dot(tb, tb), glm::dot(ta, tb));
+  return static_cast<float>(0.5 * std::log2(sigma_max_sq));
 }
 
 }  // namespace sb

@@ -140,10 +140,33 @@ class MipTexture {
 /// the rasterizer its planar interpolation), so this holds triangle by triangle on curved meshes
 /// too. The triangle constant is area based: where a triangle stretches the texture k times more
 /// along one surface axis than the other, the cone's level differs from the rasterizer's major
-/// axis by up to 0.5 log2(k), depending on how the footprint lies. |n . d| is taken as at least
-/// 1e-6 (a ray along the surface reads as a very coarse level); otherwise the raw value is
-/// returned (-inf for a zero cross-section, NaN for non-finite input).
+/// axis by up to 0.5 log2(k), depending on how the footprint lies; the ray tracer therefore maps
+/// the footprint through the triangle's texel map instead (the overload below), of which this is
+/// the isotropic case. |n . d| is taken as at least 1e-6 (a ray along the surface reads as a very
+/// coarse level); otherwise the raw value is returned (-inf for a zero cross-section, NaN for
+/// non-finite input).
 [[nodiscard]] float lod_from_elliptic_cone(float triangle_lod, const vec3& axis_a, const vec3& axis_b,
+                                           const vec3& normal, const vec3& dir);
+
+/// The linear map from a triangle's plane to texel space: a world-space vector w in the plane
+/// moves the texture coordinates by (u . w, v . w) texels of a width x height texture. It is the
+/// triangle's own (the map its vertices' positions and coordinates define), so it holds anisotropy
+/// that the area ratio of ray_cone_triangle_lod averages away.
+struct TexelMap {
+  dvec3 u{0.0}, v{0.0};
+  bool flat = false;  ///< the triangle has no area: no map (the LOD is +inf, the coarsest level)
+};
+[[nodiscard]] TexelMap triangle_texel_map(const vec3& p0, const vec3& p1, const vec3& p2, const vec2& uv0,
+                                          const vec2& uv1, const vec2& uv2, int width, int height);
+
+/// Ray-cone LOD through a triangle's texel map: log2 of the major axis, in texels, of the cone's
+/// footprint on the triangle's plane (the cross-section projected along the ray as above, then
+/// mapped by `map`). The rasterizer's lod_from_derivatives is log2 of the major axis of the
+/// pixel's footprint mapped the same way, so with the primary cone the two agree on any planar
+/// mapping, stretched or sheared too (tests/texture/lod_test.cpp); for an isotropic map of scale
+/// 2^triangle_lod this is the overload above. +inf for a flat triangle, -inf where the footprint
+/// maps to a point.
+[[nodiscard]] float lod_from_elliptic_cone(const TexelMap& map, const vec3& axis_a, const vec3& axis_b,
                                            const vec3& normal, const vec3& dir);
 
 }  // namespace sb
