@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cmath>
 #include <optional>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -55,6 +56,8 @@ struct Mesh {
   /// Whether that instance's own transform mirrors (negative determinant): its local_positions
   /// are the instance's, so a frame's node transform mirrors them when exactly one of the two does.
   bool instance_mirrored = false;
+  /// Posed by a glTF skin (its vertices placed by its joints, not by its node).
+  bool skinned = false;
   int material = -1;   ///< index into Scene::materials; -1 = default white material
   std::vector<vec3> positions;
   std::vector<vec3> normals;  ///< empty, or one per position (shading normals, world space)
@@ -221,6 +224,10 @@ struct Scene {
   /// Nodes of the file with a mesh or light that the loaded glTF scene does not reach (those of
   /// another scene, or of none): not part of this scene.
   size_t nodes_not_loaded = 0;
+  /// Per node drawn by EXT_mesh_gpu_instancing: each instance's transform in the node's space
+  /// (Mesh::instance indexes it). A ground truth that imports the file (Blender, whose importer
+  /// does not read the extension) places the copies with it.
+  std::map<int, std::vector<dmat4>> instances;
 
   [[nodiscard]] size_t triangle_count() const;
   /// Triangles of zero area (Mesh::zero_area); one pass over every triangle.

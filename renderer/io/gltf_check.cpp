@@ -205,7 +205,32 @@ class Checker {
   /// 16-bit integers, normalized or not), NORMAL VEC3 of floats (quantized: normalized signed 8 or
   /// 16 bits), TEXCOORD_n VEC2 of floats or normalized unsigned 8 or 16 bits (quantized: any 8- or
   /// 16-bit integers).
+  /// Checks that accessor `index` (read at `path`) has glTF type `type` and a component type
+  /// allowed there: FLOAT where `with_float`, else one of `normalized_ints` with normalized set, or
+  /// one of `plain_ints` without; `allowed` says the same in words.
+  void typed_accessor(const json& index, const std::string& path, std::string_view type, bool with_float,
+                      std::initializer_list<uint64_t> normalized_ints, std::initializer_list<uint64_t> plain_ints,
+                      std::string_view allowed) const {
+    const size_t ai = index.get<size_t>();
+    const json& a = (*find(doc_, "accessors"))[ai];
+    const uint64_t c = find(a, "componentType")->get<uint64_t>();
+    const json* nm = find(a, "normalized");
+    const bool normalized = nm && nm->get<bool>();
+    const std::string& t = find(a, "type")->get_ref<const std::string&>();
+    const auto among = [c](std::initializer_list<uint64_t> set) { return std::find(set.begin(), set.end(), c) != set.end(); };
+    const bool ok = (with_float && c == 5126) || (normalized ? among(normalized_ints) : among(plain_ints));
+    if (t != type || !ok)
+      fail(path, fmt::format("accessor {} is {} of component type {}{}; it must be {} {}", ai, t, c,
+                             normalized ? " (normalized)" : "", type, allowed));
+  }
+
   void attribute_type(const std::string& name, const json& accessor_index, const std::string& prim_path) const {
+    if (name.rfind("JOINTS_", 0) == 0)
+      typed_accessor(accessor_index, prim_path + "/attributes/" + name, "VEC4", false, {}, {5121, 5123},
+                     "of UNSIGNED_BYTE (5121) or UNSIGNED_SHORT (5123), not normalized (joint indices)");
+    if (name.rfind("WEIGHTS_", 0) == 0)
+      typed_accessor(accessor_index, prim_path + "/attributes/" + name, "VEC4", true, {5121, 5123}, {},
+                     "of FLOAT (5126), or of normalized UNSIGNED_BYTE (5121) or UNSIGNED_SHORT (5123)");
     const bool position = name == "POSITION", normal = name == "NORMAL", uv = name.rfind("TEXCOORD_", 0) == 0;
     if (!position && !normal && !uv) return;
     const size_t ai = accessor_index.get<size_t>();
@@ -392,6 +417,7 @@ class Checker {
             if (name != "TRANSLATION" && name != "ROTATION" && name != "SCALE") continue;  // custom _ATTRIBUTES
             index(accessor, ip + "/attributes/" + name, "accessors");
           }
+
         }
       }
       extras(n, p, ExtrasOf::node);
@@ -415,6 +441,7 @@ class Checker {
     each(doc_, "skins", "", [&](const json& sk, const std::string& p) {
       const json* joints = member(sk, "joints", p, true);
       require_array(*joints, p + "/joints");
+      if (joints->empty()) fail(p + "/joints", "is empty; glTF requires a skin to have at least one joint");
       for (size_t i = 0; i < joints->size(); ++i) index((*joints)[i], fmt::format("{}/joints/{}", p, i), "nodes");
       opt_index(sk, "inverseBindMatrices", p, "accessors");
       opt_index(sk, "skeleton", p, "nodes");
@@ -489,6 +516,23 @@ class Checker {
         const json& attrs = *find(prim, "attributes");
         for (auto it = attrs.begin(); it != attrs.end(); ++it) attribute_type(it.key(), it.value(), pp);
       });
+    });
+    // The same for EXT_mesh_gpu_instancing's attributes (their indices were checked with the nodes).
+    each(doc_, "nodes", "", [&](const json& n, const std::string& p) {
+      const json* ext = find(n, "extensions");
+      const json* inst = ext ? find(*ext, "EXT_mesh_gpu_instancing") : nullptr;
+      if (!inst) return;
+      const bool quantized = uses("KHR_mesh_quantization");
+      const std::initializer_list<uint64_t> none{}, small{5120, 5121, 5122, 5123};
+      for (const auto& [name, accessor] : find(*inst, "attributes")->items()) {
+        const std::string where = p + "/extensions/EXT_mesh_gpu_instancing/attributes/" + name;
+        if (name == "ROTATION")
+          typed_accessor(accessor, where, "VEC4", true, {5120, 5122}, none,
+                         "of FLOAT (5126), or of normalized BYTE (5120) or SHORT (5122)");
+        else if (name == "TRANSLATION" || name == "SCALE")
+          typed_accessor(accessor, where, "VEC3", true, quantized ? small : none, quantized ? small : none,
+                         "of FLOAT (5126), or of 8- or 16-bit integers with KHR_mesh_quantization");
+      }
     });
 
     each(doc_, "bufferViews", "", [&](const json& v, const std::string& p) {

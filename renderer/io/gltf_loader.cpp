@@ -117,9 +117,9 @@ GlbParts split_container(const std::string& bytes, const std::string& file, bool
 
 /// The file as tinygltf is to read it. tinygltf 2.7 refuses some valid files: a skin without
 /// inverseBindMatrices (optional in glTF 2.0), an animation channel without a target node, and an
-/// index accessor that has no bufferView (every index from sparse substitution). Skins are not
-/// played (nodes render in their bind pose; the converter reads their use from the JSON), so a file
-/// with skins is handed over without them. The other two are refused here, naming the JSON path.
+/// index accessor that has no bufferView (every index from sparse substitution). The converter
+/// reads skins from the JSON, so a file with skins is handed over without them. The other two are
+/// refused here, naming the JSON path.
 std::string tinygltf_input(const json& doc, const std::string& bytes, const GlbParts& parts, const std::string& file) {
   if (auto anims = doc.find("animations"); anims != doc.end())
     for (size_t a = 0; a < anims->size(); ++a)
@@ -413,6 +413,8 @@ const char* type_name(int components) {
     case 2: return "VEC2";
     case 3: return "VEC3";
     case 4: return "VEC4";
+    case 9: return "MAT3";
+    case 16: return "MAT4";
     default: return "MAT";
   }
 }
@@ -1005,9 +1007,17 @@ class Converter {
         for (size_t pi = 0; pi < prims.size(); ++pi) {
           const std::string ppath = fmt::format("/meshes/{}/primitives/{}", n.mesh, pi);
           if (all_at_origin(prims[pi])) continue;
-          triangles += copies * estimated_triangles(prims[pi], ppath);
+          const uint64_t each = estimated_triangles(prims[pi], ppath);
+          // Against the limit before multiplying: a count of 2^53 copies would wrap around.
+          if (each > 0 && copies > kMaxSceneTriangles / each) {
+            triangles = kMaxSceneTriangles + 1;
+            break;
+          }
+          triangles += copies * each;
           if (auto it = prims[pi].attributes.find("POSITION"); it != prims[pi].attributes.end())
-            vertices += copies * view_of(it->second, ppath).count;
+            if (const uint64_t count = view_of(it->second, ppath).count; count > 0)
+              vertices = copies > ((uint64_t{1} << 62) - vertices) / count ? uint64_t{1} << 62
+                                                                            : vertices + copies * count;
           if (triangles > kMaxSceneTriangles) break;
         }
       }
@@ -1099,55 +1109,77 @@ class Converter {
         for (int c : m_.nodes[p].children) all_parents_[static_cast<size_t>(c)] = static_cast<int>(p);
     }
     dmat4 world(1.0);
-    for (int n = ni; n >= 0; n = all_parents_[static_cast<size_t>(n)])
+    size_t steps = 0;
+    for (int n = ni; n >= 0; n = all_parents_[static_cast<size_t>(n)]) {
+      if (++steps > m_.nodes.size())
+        fail(fmt::format("/nodes/{}", ni), "the node's ancestors form a cycle, which glTF forbids (a node that is its "
+                                           "own ancestor); it is a skin's joint, so its place is needed");
       world = local_of(m_.nodes[static_cast<size_t>(n)]).transform() * world;
+    }
     return world;
   }
 
-  /// Per vertex of a skinned primitive: the sum over its JOINTS_n / WEIGHTS_n sets of weight times
-  /// joint matrix, the weights normalized to sum 1 (a vertex with none keeps the skin's bind space).
-  std::vector<dmat4> skin_matrices(const Skinning& skin, const tinygltf::Primitive& prim, size_t nv,
-                                   const std::string& ppath) {
-    std::vector<dmat4> out(nv, dmat4(0.0));
-    std::vector<double> total(nv, 0.0);
-    bool any = false;
+  /// A skinned primitive's JOINTS_n / WEIGHTS_n sets, read once; at(v) is vertex v's transform:
+  /// the sum of weight times joint matrix over its sets, the weights normalized to sum 1 (as
+  /// Blender's armature modifier does). A vertex with no weight keeps the skin's bind space.
+  struct SkinBlend {
+    const Skinning* skin = nullptr;
+    std::vector<std::vector<float>> joints, weights;  ///< per set, 4 per vertex
+
+    [[nodiscard]] dmat4 at(size_t v) const {
+      dmat4 sum(0.0);
+      double total = 0.0;
+      for (size_t set = 0; set < joints.size(); ++set)
+        for (size_t c = 0; c < 4; ++c) {
+          const double weight = weights[set][v * 4 + c];
+          if (weight == 0.0) continue;
+          sum += weight * skin->joints[static_cast<size_t>(joints[set][v * 4 + c])];
+          total += weight;
+        }
+      return total > 0.0 ? sum / total : dmat4(1.0);
+    }
+  };
+
+  /// Reads and checks the skin attributes of a primitive with nv vertices (joints in range,
+  /// weights not negative).
+  SkinBlend skin_blend(const Skinning& skin, const tinygltf::Primitive& prim, size_t nv, const std::string& ppath) {
+    SkinBlend b;
+    b.skin = &skin;
     for (int set = 0;; ++set) {
       const auto j = prim.attributes.find(fmt::format("JOINTS_{}", set));
       const auto w = prim.attributes.find(fmt::format("WEIGHTS_{}", set));
       if (j == prim.attributes.end() || w == prim.attributes.end()) break;
-      any = true;
       const std::string jp = fmt::format("{}/attributes/JOINTS_{}", ppath, set);
       const std::string wp = fmt::format("{}/attributes/WEIGHTS_{}", ppath, set);
-      const std::vector<float> joints = read_floats(j->second, 4, jp);
-      const std::vector<float> weights = read_floats(w->second, 4, wp);
+      std::vector<float> joints = read_floats(j->second, 4, jp);
+      std::vector<float> weights = read_floats(w->second, 4, wp);
       if (joints.size() != nv * 4) fail(jp, fmt::format("has {} elements but POSITION has {}", joints.size() / 4, nv));
       if (weights.size() != nv * 4) fail(wp, fmt::format("has {} elements but POSITION has {}", weights.size() / 4, nv));
       for (size_t v = 0; v < nv; ++v)
-        for (int c = 0; c < 4; ++c) {
-          const double weight = weights[v * 4 + static_cast<size_t>(c)];
-          if (weight == 0.0) continue;
-          const float joint = joints[v * 4 + static_cast<size_t>(c)];
-          if (joint < 0.0f || joint >= static_cast<float>(skin.joints.size()))
-            fail(jp, fmt::format("vertex {} names joint {} of skin {}, which has {} joints", v, joint, skin.skin,
+        for (size_t c = 0; c < 4; ++c) {
+          const float weight = weights[v * 4 + c], joint = joints[v * 4 + c];
+          if (weight < 0.0f) fail(wp, fmt::format("vertex {} has a negative weight {:g}", v, weight));
+          if (weight > 0.0f && !(joint < static_cast<float>(skin.joints.size())))
+            fail(jp, fmt::format("vertex {} names joint {:g} of skin {}, which has {} joints", v, joint, skin.skin,
                                  skin.joints.size()));
-          if (weight < 0.0) fail(wp, fmt::format("vertex {} has a negative weight {:g}", v, weight));
-          out[v] += weight * skin.joints[static_cast<size_t>(joint)];
-          total[v] += weight;
         }
+      b.joints.push_back(std::move(joints));
+      b.weights.push_back(std::move(weights));
     }
-    if (!any)
+    if (b.joints.empty())
       note("skin-without-weights", fmt::format("{}: a skinned primitive without JOINTS_0 and WEIGHTS_0 is placed in "
                                                "its skin's bind space, as the file's vertices are",
                                                ppath));
-    for (size_t v = 0; v < nv; ++v) out[v] = total[v] > 0.0 ? out[v] / total[v] : dmat4(1.0);
-    return out;
+    return b;
   }
 
   /// How many times a node's mesh is drawn: the element count of its first EXT_mesh_gpu_instancing
   /// attribute (instances_of checks that the others agree as it reads them), else once.
   uint64_t instance_count(int ni) const {
     const json& node = doc_.at("nodes").at(static_cast<size_t>(ni));
-    if (!node.contains("extensions") || !node["extensions"].contains("EXT_mesh_gpu_instancing")) return 1;
+    if (node.contains("skin") || !node.contains("extensions") ||
+        !node["extensions"].contains("EXT_mesh_gpu_instancing"))
+      return 1;
     const json& attributes = node["extensions"]["EXT_mesh_gpu_instancing"]["attributes"];
     for (const char* name : {"TRANSLATION", "ROTATION", "SCALE"})
       if (attributes.contains(name))
@@ -1185,10 +1217,17 @@ class Converter {
     const std::string npath = fmt::format("/nodes/{}", ni);
     if (n.mesh >= 0) {
       if (const std::optional<Skinning> skin = skinning_of(scene, ni)) {
+        if (doc_.at("nodes")[static_cast<size_t>(ni)].contains("extensions") &&
+            doc_.at("nodes")[static_cast<size_t>(ni)]["extensions"].contains("EXT_mesh_gpu_instancing"))
+          note(fmt::format("skin-instances-{}", ni),
+               fmt::format("/nodes/{}: a skinned node's EXT_mesh_gpu_instancing is ignored (its mesh is drawn once, "
+                           "posed by its skin)",
+                           ni));
         convert_mesh(scene, ni, n.mesh, world, dmat4(1.0), -1, &*skin);
       } else if (const std::optional<std::vector<dmat4>> instances = instances_of(ni)) {
         for (size_t k = 0; k < instances->size(); ++k)
           convert_mesh(scene, ni, n.mesh, world, (*instances)[k], static_cast<int>(k));
+        scene.instances[ni] = *instances;
       } else {
         convert_mesh(scene, ni, n.mesh, world, dmat4(1.0), -1);
       }
@@ -1249,6 +1288,7 @@ class Converter {
       mesh.node = ni;
       mesh.instance = k;
       mesh.instance_mirrored = glm::determinant(dmat3(instance)) < 0.0;
+      mesh.skinned = skin != nullptr;
       mesh.material = prim.material;
       const std::vector<float> pos = read_floats(pos_it->second, 3, ppath + "/attributes/POSITION");
       const size_t nv = pos.size() / 3;
@@ -1256,16 +1296,17 @@ class Converter {
       // skinned one stays in the pose of its joints at rest (skinning_of says so where they move).
       const bool animated = !skin && scene.animation.moves(ni);
       // Per vertex, the transform of its joints blended by its weights.
-      const std::vector<dmat4> skinned = skin ? skin_matrices(*skin, prim, nv, ppath) : std::vector<dmat4>();
+      const SkinBlend blend = skin ? skin_blend(*skin, prim, nv, ppath) : SkinBlend();
       if (animated) {
         mesh.local_positions.resize(nv);
         for (size_t v = 0; v < nv; ++v)
           mesh.local_positions[v] = vec3(dvec3(instance * dvec4(pos[v * 3], pos[v * 3 + 1], pos[v * 3 + 2], 1.0)));
       }
-      mesh.mirrored = skin ? nv > 0 && glm::determinant(dmat3(skinned[0])) < 0.0 : flip;
+      // A skinned mesh's triangles are reversed one by one below, where their joints mirror.
+      mesh.mirrored = !skin && flip;
       mesh.positions.resize(nv);
       for (size_t v = 0; v < nv; ++v) {
-        const dvec3 p = dvec3((skin ? skinned[v] : world) * dvec4(pos[v * 3], pos[v * 3 + 1], pos[v * 3 + 2], 1.0));
+        const dvec3 p = dvec3((skin ? blend.at(v) : world) * dvec4(pos[v * 3], pos[v * 3 + 1], pos[v * 3 + 2], 1.0));
         if (!within_scene_range(p))
           fail(fmt::format("/nodes/{}", ni),
                fmt::format("places vertex {} of mesh '{}' at ({:g}, {:g}, {:g}) m, beyond the ±{:g} m a scene may "
@@ -1307,7 +1348,7 @@ class Converter {
             mesh.local_normals[v] = vec3(instance_normals * dvec3(nrm[v * 3], nrm[v * 3 + 1], nrm[v * 3 + 2]));
         }
         for (size_t v = 0; v < nv; ++v) {
-          const dmat3 to_world = skin ? glm::transpose(glm::inverse(dmat3(skinned[v]))) : normal_matrix;
+          const dmat3 to_world = skin ? glm::transpose(glm::inverse(dmat3(blend.at(v)))) : normal_matrix;
           dvec3 nn = to_world * dvec3(nrm[v * 3], nrm[v * 3 + 1], nrm[v * 3 + 2]);
           const double len = glm::length(nn);
           mesh.normals[v] = len > 0.0 ? vec3(nn / len) : vec3(0.0f, 1.0f, 0.0f);
@@ -1354,8 +1395,14 @@ class Converter {
         note("short-" + ppath, fmt::format("{}: a {} of {} {} has no triangle; it is skipped", ppath,
                                            prim.mode == TINYGLTF_MODE_TRIANGLE_STRIP ? "TRIANGLE_STRIP" : "TRIANGLE_FAN",
                                            idx.size(), idx.size() == 1 ? "vertex" : "vertices"));
-      if (flip)
+      if (skin) {
+        // Each triangle keeps facing the way the file says under the blend at its first corner.
+        for (size_t t = 0; t < mesh.indices.size(); t += 3)
+          if (glm::determinant(dmat3(blend.at(mesh.indices[t]))) < 0.0)
+            std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
+      } else if (flip) {
         for (size_t t = 0; t < mesh.indices.size(); t += 3) std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
+      }
       if (!mesh.indices.empty()) scene.meshes.push_back(std::move(mesh));
     }
   }

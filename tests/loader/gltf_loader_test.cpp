@@ -152,6 +152,32 @@ TEST(GltfLoader, GpuInstancesArePlacedInTheirNodesSpace) {
             std::string::npos);
 }
 
+TEST(GltfLoader, ASkinnedTriangleKeepsFacingTheWayTheFileSaysUnderMirroringJoints) {
+  // Bound to one joint scaled (-1, 1, 1), the triangle (facing +Z) mirrors; its corners are
+  // reversed so that it still faces +Z. On a node scaled (-1, 1, 1) instead, which skinning
+  // ignores, it neither mirrors nor is reversed.
+  ScratchDir dir("skin-mirror");
+  for (const bool joint_mirrors : {true, false}) {
+    MiniGltf g;
+    const int pos = g.add_positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+    const std::vector<uint8_t> joints(12, 0);
+    const std::vector<float> weights = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    const int m = g.add_mesh(json::array({{{"attributes",
+                                            {{"POSITION", pos},
+                                             {"JOINTS_0", g.add_accessor(g.add_view(joints), 5121, 3, "VEC4")},
+                                             {"WEIGHTS_0", g.add_accessor(g.add_view(weights), 5126, 3, "VEC4")}}}}}));
+    g.add_node({{"mesh", m}, {"skin", 0}, {"scale", {joint_mirrors ? 1 : -1, 1, 1}}});
+    g.add_node({{"scale", {joint_mirrors ? -1 : 1, 1, 1}}});
+    g.doc["skins"] = json::array({{{"joints", {1}}}});
+    g.write_gltf(dir / "m.gltf");
+    const Scene scene = io::load_gltf(dir / "m.gltf");
+    const Mesh& mesh = scene.meshes[0];
+    expect_vec3(mesh.positions[1], {joint_mirrors ? -1.0f : 1.0f, 0, 0});
+    const vec3 a = mesh.positions[mesh.indices[0]], b = mesh.positions[mesh.indices[1]], c = mesh.positions[mesh.indices[2]];
+    EXPECT_GT(glm::cross(b - a, c - a).z, 0.0f) << (joint_mirrors ? "mirroring joint" : "mirroring node");
+  }
+}
+
 TEST(GltfLoader, EveryComponentTypeStrideAndNormalisation) {
   ScratchDir dir("acc");
   MiniGltf g;
@@ -343,6 +369,18 @@ TEST(GltfLoader, ASkinnedMeshIsPosedByItsJoints) {
   for (const std::string& w : scene.warnings) {
     EXPECT_EQ(w.find("skeletal"), std::string::npos) << w;
     EXPECT_EQ(w.find("JOINTS_0"), std::string::npos) << w;
+  }
+
+  // Weights that do not sum to 1 are normalized (vertex 2's (2, 2) is its (0.5, 0.5)).
+  std::vector<float> doubled = weights;
+  for (float& w : doubled) w *= 2.0f;
+  {
+    MiniGltf h = g;
+    h.doc["meshes"][0]["primitives"][0]["attributes"]["WEIGHTS_0"] = h.add_accessor(h.add_view(doubled), 5126, 3, "VEC4");
+    h.doc.erase("buffers");
+    h.write_gltf(dir / "doubled.gltf");
+    const Scene d = io::load_gltf(dir / "doubled.gltf");
+    expect_vec3(d.meshes[0].positions[2], {-0.5f, 1.5f, 0});
   }
 
   // A joint index past the skin's joints is refused by path.

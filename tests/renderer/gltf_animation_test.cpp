@@ -5,12 +5,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
+#include <fstream>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "renderer/animation.hpp"
 #include "renderer/error.hpp"
@@ -19,6 +22,7 @@
 #include "renderer/render_scene.hpp"
 #include "renderer/stages/trace.hpp"
 #include "scenes/gltf_builder.hpp"
+#include "support/mini_gltf.hpp"
 #include "support/render_support.hpp"
 #include "support/scratch_dir.hpp"
 
@@ -127,6 +131,62 @@ TEST(GltfAnimation, TranslationMovesTheNodeItsChildAndTheCameraOverTheFrames) {
   // Camera keys or a spin beside the animation: one or the other.
   path.camera_keys = {CameraKey{dvec3(0.0, 1.0, 5.0), dvec3(0.0)}};
   EXPECT_THROW(SceneAnimator(scene, path), InputError);
+}
+
+/// Six times the signed volume a closed mesh's triangles enclose: positive where they are wound
+/// outwards (counter-clockwise seen from outside), negative where they are turned inside out.
+double signed_volume(const Mesh& m) {
+  double v = 0.0;
+  for (size_t t = 0; t < m.indices.size(); t += 3)
+    v += glm::dot(dvec3(m.positions[m.indices[t]]),
+                  glm::cross(dvec3(m.positions[m.indices[t + 1]]), dvec3(m.positions[m.indices[t + 2]])));
+  return v;
+}
+
+TEST(GltfAnimation, GpuInstancesMoveWithTheirAnimatedNodeAndKeepFacingOutwards) {
+  // The mover draws its box twice by EXT_mesh_gpu_instancing: in place, and 2 m up mirrored in x
+  // (scale -1, 1, 1). The animation moves the node 4 m along +X in 2 s; both instances follow,
+  // and the mirrored one stays wound outwards in every frame.
+  test::ScratchDir dir;
+  AnimatedScene a;
+  const std::vector<float> times = {0.0f, 2.0f};
+  const std::vector<float> moves = {0, 0, 0, 4, 0, 0};
+  a.builder.add_animation_channel(a.mover, "translation", times, moves);
+  a.builder.write(dir / "plain.gltf");
+  nlohmann::json doc = nlohmann::json::parse(std::ifstream(dir / "plain.gltf"));
+  const auto add_floats = [&](const std::vector<float>& values, const char* type, size_t count) {
+    std::vector<unsigned char> bytes(values.size() * sizeof(float));
+    std::memcpy(bytes.data(), values.data(), bytes.size());
+    doc["buffers"].push_back({{"byteLength", bytes.size()},
+                              {"uri", "data:application/octet-stream;base64," + test::MiniGltf::base64(bytes)}});
+    doc["bufferViews"].push_back({{"buffer", doc["buffers"].size() - 1}, {"byteLength", bytes.size()}});
+    doc["accessors"].push_back(
+        {{"bufferView", doc["bufferViews"].size() - 1}, {"componentType", 5126}, {"count", count}, {"type", type}});
+    return doc["accessors"].size() - 1;
+  };
+  doc["nodes"][a.mover]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"] = {
+      {"TRANSLATION", add_floats({0, 0, 0, 0, 2, 0}, "VEC3", 2)}, {"SCALE", add_floats({1, 1, 1, -1, 1, 1}, "VEC3", 2)}};
+  doc["extensionsUsed"].push_back("EXT_mesh_gpu_instancing");
+  std::ofstream(dir / "instanced.gltf") << doc.dump();
+  Scene scene = io::load_gltf(dir / "instanced.gltf");
+  std::vector<size_t> instances;
+  for (size_t m = 0; m < scene.meshes.size(); ++m)
+    if (scene.meshes[m].node == a.mover) instances.push_back(m);
+  ASSERT_EQ(instances.size(), 2u);
+  const auto centre = [&](size_t m) {
+    dvec3 sum(0.0);
+    for (const vec3& p : scene.meshes[m].positions) sum += dvec3(p);
+    return sum / static_cast<double>(scene.meshes[m].positions.size());
+  };
+  SceneAnimator animator(scene, gltf_path(3));
+  for (int f = 0; f < 3; ++f) {
+    animator.apply(f);
+    const std::string frame = "frame " + std::to_string(f);
+    expect_near(centre(instances[0]), dvec3(2.0 * f, 0.0, 0.0), 1e-5, "instance 0, " + frame);
+    expect_near(centre(instances[1]), dvec3(2.0 * f, 2.0, 0.0), 1e-5, "instance 1, " + frame);
+    EXPECT_GT(signed_volume(scene.meshes[instances[0]]), 0.0) << frame;
+    EXPECT_GT(signed_volume(scene.meshes[instances[1]]), 0.0) << "the mirrored instance, " << frame;
+  }
 }
 
 TEST(GltfAnimation, RotationSlerpsStepHoldsAndCubicSplineFollowsHermite) {

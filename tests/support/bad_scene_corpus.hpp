@@ -217,6 +217,28 @@ inline std::vector<BadCase> bad_scene_corpus() {
     g.doc["extensionsRequired"] = {"EXT_meshopt_compression"};
     g.doc["buffers"].push_back({{"byteLength", 64}, {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}});
   }), "/extensionsRequired/0: extension 'EXT_meshopt_compression' is required by the file but not supported"});
+  // Skins and GPU instancing: joints form a cycle outside the loaded scene, a skin without joints,
+  // joint indices as floats, an instance rotation of the wrong type.
+  c.push_back({"skin_joint_cycle", "a.gltf", edited([](MiniGltf& g) {
+    g.doc["nodes"][0]["skin"] = 0;
+    g.add_node({{"children", {2}}}, false);
+    g.add_node({{"children", {1}}}, false);
+    g.doc["skins"] = json::array({{{"joints", {1}}}});
+  }), "/nodes/1: the node's ancestors form a cycle"});
+  c.push_back({"skin_without_joints", "a.gltf", edited([](MiniGltf& g) {
+    g.doc["nodes"][0]["skin"] = 0;
+    g.doc["skins"] = json::array({{{"joints", json::array()}}});
+  }), "/skins/0/joints: is empty; glTF requires a skin to have at least one joint"});
+  c.push_back({"skin_float_joints", "a.gltf", edited([](MiniGltf& g) {
+    const std::vector<float> four = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+    g.doc["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] = g.add_accessor(g.add_view(four), 5126, 3, "VEC4");
+    g.doc["meshes"][0]["primitives"][0]["attributes"]["WEIGHTS_0"] = g.add_accessor(g.add_view(four), 5126, 3, "VEC4");
+  }), "/meshes/0/primitives/0/attributes/JOINTS_0: accessor 1 is VEC4 of component type 5126; it must be VEC4 of UNSIGNED_BYTE"});
+  c.push_back({"instancing_rotation_mat2", "a.gltf", edited([](MiniGltf& g) {
+    const std::vector<float> m = {1, 0, 0, 1};
+    g.doc["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["ROTATION"] =
+        g.add_accessor(g.add_view(m), 5126, 1, "MAT2");
+  }), "/nodes/0/extensions/EXT_mesh_gpu_instancing/attributes/ROTATION: accessor 1 is MAT2 of component type 5126; it must be VEC4"});
   c.push_back({"light_reference_out_of_range", "a.gltf", edited([](MiniGltf& g) { g.doc["nodes"][0]["extensions"]["KHR_lights_punctual"]["light"] = 2; }), "/nodes/0/extensions/KHR_lights_punctual/light: refers to lights[2]"});
   c.push_back({"light_bad_type", "a.gltf", edited([](MiniGltf& g) { g.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array({{{"type", "area"}}}); }), "/extensions/KHR_lights_punctual/lights/0/type"});
   c.push_back({"light_negative_intensity", "a.gltf", edited([](MiniGltf& g) { g.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array({{{"type", "point"}, {"intensity", -1}}}); }), "/extensions/KHR_lights_punctual/lights/0/intensity"});

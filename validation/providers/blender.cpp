@@ -167,9 +167,30 @@ nlohmann::json export_moved_nodes(const Scene& scene) {
                                      scene.name, first->second->name, m.name, m.node));
       continue;
     }
+    if (m.moved != dmat4(1.0) && m.skinned)
+      throw InputError(fmt::format("scene '{}': node {} (mesh '{}') is skinned and moves in this frame; Blender would "
+                                   "move its object while its armature stays, which deforms it otherwise than the "
+                                   "rigid move this suite renders: use the full or povray provider",
+                                   scene.name, m.node, m.name));
     if (m.moved != dmat4(1.0)) moved.push_back({{"node", m.node}, {"matrix", std::vector<double>(v, v + 16)}});
   }
   return moved;
+}
+
+/// The EXT_mesh_gpu_instancing instances of each node, each transform column by column (glTF
+/// space, in the node's space): Blender 3.4's importer does not read the extension and draws the
+/// node's mesh once where the node stands, so the script puts a copy at each instance instead.
+nlohmann::json export_instances(const Scene& scene) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& [node, transforms] : scene.instances) {
+    nlohmann::json matrices = nlohmann::json::array();
+    for (const dmat4& t : transforms) {
+      const double* v = glm::value_ptr(t);
+      matrices.push_back(std::vector<double>(v, v + 16));
+    }
+    out.push_back({{"node", node}, {"matrices", matrices}});
+  }
+  return out;
 }
 
 /// Lights that contribute (positive intensity), with their Blender parameters: a spot is a point
@@ -366,15 +387,6 @@ class BlenderProvider final : public TruthProvider {
             "geometric normals, while Blender's importer would smooth it with the file's normals: give the "
             "primitive unit normals (or none), or use the full or povray provider",
             scene.name, m.name, m.node));
-    // Blender 3.4's glTF importer does not read EXT_mesh_gpu_instancing: it would draw each
-    // instanced mesh once, where its node stands, and none of its instances.
-    for (const Mesh& m : scene.meshes)
-      if (m.instance >= 0)
-        throw InputError(fmt::format(
-            "scene '{}': node {} draws mesh '{}' as GPU instances (EXT_mesh_gpu_instancing), which Blender's glTF "
-            "importer ({}) does not read, so its render would lack them: export the file without instancing (e.g. "
-            "gltf-transform uninstance), or use the full or povray provider",
-            scene.name, m.node, m.name, "3.4, Debian 12"));
     // Blender's importer brings in every node of the file; the loaded scene is glTF scene 0 (or
     // `scene`) alone.
     if (scene.nodes_not_loaded > 0)
@@ -520,6 +532,7 @@ class BlenderProvider final : public TruthProvider {
     // Everything the script needs, from the in-memory scene and rig.
     params["scene_file"] = fs::absolute(request.scene_file).string();
     params["moved_nodes"] = export_moved_nodes(scene);
+    params["instances"] = export_instances(scene);
     params["textures"] = export_textures(scene, work_dir);
     params["materials"] = nlohmann::json::array();
     for (const Material& m : scene.materials)

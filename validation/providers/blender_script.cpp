@@ -159,6 +159,33 @@ def place_moved_nodes():
     place_objects(targets)
 
 
+def place_instances():
+    # EXT_mesh_gpu_instancing, which the importer does not read: the object of each instanced node
+    # stays for what hangs below it but renders nothing, and a copy sharing its mesh stands at each
+    # instance, its world matrix the node's (as it now stands, moved or not) times the instance's.
+    from mathutils import Matrix
+    if not PARAMS["instances"]:
+        return
+    bpy.context.view_layer.update()
+    by_node = {int(obj["stereobench_node"]): obj for obj in bpy.data.objects if "stereobench_node" in obj}
+    to_blender = Matrix(((1.0, 0.0, 0.0, 0.0), (0.0, 0.0, -1.0, 0.0), (0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)))
+    targets = {}
+    for entry in PARAMS["instances"]:
+        node = entry["node"]
+        if node not in by_node:
+            fail("the importer made no object for the instanced glTF node %d" % node)
+        original = by_node[node]
+        for k, v in enumerate(entry["matrices"]):
+            instance = Matrix([[v[c * 4 + r] for c in range(4)] for r in range(4)])
+            copy = original.copy()
+            del copy["stereobench_node"]
+            for collection in original.users_collection:
+                collection.objects.link(copy)
+            targets[copy] = original.matrix_world @ to_blender @ instance @ to_blender.transposed()
+        original.hide_render = True
+    place_objects(targets)
+
+
 def math_node(nodes, operation, vector=False):
     # A Math (or Vector Math) node doing `operation`.
     node = nodes.new("ShaderNodeVectorMath" if vector else "ShaderNodeMath")
@@ -540,6 +567,7 @@ def render_passes(lights, switches, background_strength):
 
 import_scene()
 place_moved_nodes()
+place_instances()
 switches = setup_materials()
 background_strength = setup_world()
 lights = setup_lights()
