@@ -188,6 +188,25 @@ void print_info(const InfoArgs& args) {
                scene.meshes.size());
     fmt::print("materials  {} ({} textured), {} textures\n", scene.materials.size(), textured, scene.textures.size());
     fmt::print("lights     {} point, {} directional, {} spot\n", lights_by_type[0], lights_by_type[1], lights_by_type[2]);
+    // Each light with the values the shading reads (DESIGN §3 units), so that a file's light units
+    // can be checked; a long list is cut short.
+    constexpr size_t kLightsListed = 16;
+    for (size_t i = 0; i < std::min(scene.lights.size(), kLightsListed); ++i) {
+      const Light& l = scene.lights[i];
+      const std::string colour = fmt::format("colour ({:.3g}, {:.3g}, {:.3g})", l.color.x, l.color.y, l.color.z);
+      if (l.type == Light::Type::directional)
+        fmt::print("           directional '{}': irradiance {:.4g} W/m², {}, towards ({:.3f}, {:.3f}, {:.3f})\n", l.name,
+                   l.intensity, colour, l.direction.x, l.direction.y, l.direction.z);
+      else
+        fmt::print("           {} '{}': intensity {:.4g} W/sr, {}, at ({:.3f}, {:.3f}, {:.3f}) m{}\n",
+                   l.type == Light::Type::spot ? "spot" : "point", l.name, l.intensity, colour, l.position.x,
+                   l.position.y, l.position.z,
+                   l.type == Light::Type::spot ? fmt::format(", cone {:.1f}..{:.1f} deg", radians_to_degrees(l.inner_cone),
+                                                             radians_to_degrees(l.outer_cone))
+                                               : std::string());
+    }
+    if (scene.lights.size() > kLightsListed)
+      fmt::print("           ... and {} more\n", scene.lights.size() - kLightsListed);
     fmt::print("bounds     [{:.3f}, {:.3f}, {:.3f}] .. [{:.3f}, {:.3f}, {:.3f}] m\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x,
                b.hi.y, b.hi.z);
     fmt::print("cameras    {}\n", scene.cameras.empty() ? std::string("none (rig frames the bounds)") : scene.cameras.front().name);

@@ -21,7 +21,26 @@ std::vector<std::string> truth_warnings(const TruthRender& render) {
     out.push_back(fmt::format("{} truth: texture(s) {} repeat along one axis and clamp along the other; Blender "
                               "repeats them along both",
                               render.provider, it->dump()));
+  if (render.right.has_plane(planes::rgb))
+    if (const double clipped = clipped_fraction(render.right); clipped > kOverExposedFraction)
+      out.push_back(fmt::format(
+          "{} truth: {:.1f} % of the right eye's pixels are over-exposed (a channel at 1.0 or more, 255 in the 8-bit "
+          "images the metrics compare), where no pipeline's error can show; lower the lights' intensities. A file "
+          "exported from Blender with its 'Standard' lighting mode gives a P watt point light as 683·P/4π cd, 683 "
+          "times the W/sr read here: export with Lighting Mode 'Unitless' (README, Conventions)",
+          render.provider, 100.0 * clipped));
   return out;
+}
+
+double clipped_fraction(const Image& image) {
+  const Plane& rgb = image.plane(planes::rgb);
+  const float* v = rgb.data_f32();
+  const size_t n = image.pixel_count();
+  if (n == 0) return 0.0;
+  size_t clipped = 0;
+  for (size_t i = 0; i < n; ++i)
+    clipped += !(v[i * 3] < 1.0f && v[i * 3 + 1] < 1.0f && v[i * 3 + 2] < 1.0f);
+  return static_cast<double>(clipped) / static_cast<double>(n);
 }
 
 Image rgb_plane_only(const Image& image) {

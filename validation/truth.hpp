@@ -88,8 +88,14 @@ class TruthProvider {
 
 /// What a provider's settings say makes its truth differ from the scene (POV-Ray's
 /// export_warnings, Blender's textures_wrapped_on_both_axes), as lines for the terminal; also for
-/// a truth from the cache, whose settings are kept.
+/// a truth from the cache, whose settings are kept. And an over-exposed truth: where more than
+/// kOverExposedFraction of its pixels clip (a channel at 1.0 or above, 255 in the 8-bit images the
+/// metrics compare), no pipeline's error can show there, so a comparison would pass blind.
 [[nodiscard]] std::vector<std::string> truth_warnings(const TruthRender& render);
+inline constexpr double kOverExposedFraction = 0.25;
+
+/// The fraction of the image's pixels whose "rgb" has a channel at 1.0 or above (NaN counts).
+[[nodiscard]] double clipped_fraction(const Image& image);
 
 /// The providers' names in their canonical order: full, blender, povray.
 [[nodiscard]] std::vector<std::string> truth_provider_names();

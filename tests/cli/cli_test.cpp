@@ -164,10 +164,25 @@ TEST(Cli, SceneInfoPrintsRigAndDisparities) {
   test::ScratchDir dir("cliinfo");
   test::MiniGltf g;
   g.add_triangle();
+  // Two lights, listed with the values the shading reads (their units checkable there).
+  g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+  g.doc["extensions"]["KHR_lights_punctual"]["lights"] = nlohmann::json::array(
+      {{{"type", "point"}, {"name", "lamp"}, {"intensity", 54.35}},
+       {{"type", "spot"}, {"name", "cone"}, {"intensity", 2}, {"color", {1, 0.5, 0.25}},
+        {"spot", {{"innerConeAngle", 0.2}, {"outerConeAngle", 0.5}}}}});
+  g.add_node({{"translation", {0, 2, 1}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  g.add_node({{"translation", {1, 2, 1}}, {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}});
   g.write_gltf(dir / "tri.gltf");
   const CliRun r = run("scenes info '" + (dir / "tri.gltf").string() + "' --resolution 640x360 --max-disparity 20 --convergence 2");
   EXPECT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("1 triangles"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("point 'lamp': intensity 54.35 W/sr, colour (1, 1, 1), at (0.000, 2.000, 1.000) m"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("spot 'cone': intensity 2 W/sr, colour (1, 0.5, 0.25), at (1.000, 2.000, 1.000) m, cone "
+                       "11.5..28.6 deg"),
+            std::string::npos)
+      << r.out;
   EXPECT_NE(r.out.find("640x360"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("max disparity 20.00 px"), std::string::npos) << r.out;
 }

@@ -125,6 +125,28 @@ TEST(TruthWarnings, WhatTheSettingsSayDiffersIsSaid) {
   EXPECT_TRUE(validation::truth_warnings(blender).empty());
 }
 
+TEST(TruthWarnings, AnOverExposedTruthIsSaid) {
+  // Where most pixels clip at 255, a comparison cannot see a pipeline's error there: said, with
+  // the usual cause (photometric light units) and what to do.
+  validation::TruthRender full;
+  full.provider = "full";
+  full.right = Image(10, 10);
+  Plane& rgb = full.right.add_plane(planes::rgb);
+  float* v = rgb.data_f32();
+  for (size_t i = 0; i < 100; ++i)
+    for (size_t c = 0; c < 3; ++c) v[i * 3 + c] = i < 30 && c == 1 ? 1.0f : 0.5f;  // 30 % clip in green
+  EXPECT_DOUBLE_EQ(validation::clipped_fraction(full.right), 0.30);
+  const std::vector<std::string> warnings = validation::truth_warnings(full);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("full truth: 30.0 % of the right eye's pixels are over-exposed"), std::string::npos)
+      << warnings[0];
+  EXPECT_NE(warnings[0].find("Lighting Mode 'Unitless'"), std::string::npos) << warnings[0];
+  // A quarter or less: nothing said.
+  for (size_t i = 25; i < 30; ++i) v[i * 3 + 1] = 0.99f;
+  EXPECT_DOUBLE_EQ(validation::clipped_fraction(full.right), 0.25);
+  EXPECT_TRUE(validation::truth_warnings(full).empty());
+}
+
 TEST_F(TruthCacheTest, RendersOncePerContentAndKeysFollowTheRig) {
   CountingProvider provider;
   const TruthRequest request = request_at(64, 36);
