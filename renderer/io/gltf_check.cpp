@@ -205,18 +205,31 @@ class Checker {
   /// 16-bit integers, normalized or not), NORMAL VEC3 of floats (quantized: normalized signed 8 or
   /// 16 bits), TEXCOORD_n VEC2 of floats or normalized unsigned 8 or 16 bits (quantized: any 8- or
   /// 16-bit integers).
+  /// An accessor's index, component type, normalized flag and type, as checked before.
+  struct AccessorKind {
+    size_t index = 0;
+    uint64_t component = 0;
+    bool normalized = false;
+    std::string type;
+  };
+  [[nodiscard]] AccessorKind accessor_kind(const json& index) const {
+    AccessorKind k;
+    k.index = index.get<size_t>();
+    const json& a = (*find(doc_, "accessors"))[k.index];
+    k.component = find(a, "componentType")->get<uint64_t>();
+    const json* nm = find(a, "normalized");
+    k.normalized = nm && nm->get<bool>();
+    k.type = find(a, "type")->get<std::string>();
+    return k;
+  }
+
   /// Checks that accessor `index` (read at `path`) has glTF type `type` and a component type
   /// allowed there: FLOAT where `with_float`, else one of `normalized_ints` with normalized set, or
   /// one of `plain_ints` without; `allowed` says the same in words.
   void typed_accessor(const json& index, const std::string& path, std::string_view type, bool with_float,
                       std::initializer_list<uint64_t> normalized_ints, std::initializer_list<uint64_t> plain_ints,
                       std::string_view allowed) const {
-    const size_t ai = index.get<size_t>();
-    const json& a = (*find(doc_, "accessors"))[ai];
-    const uint64_t c = find(a, "componentType")->get<uint64_t>();
-    const json* nm = find(a, "normalized");
-    const bool normalized = nm && nm->get<bool>();
-    const std::string& t = find(a, "type")->get_ref<const std::string&>();
+    const auto [ai, c, normalized, t] = accessor_kind(index);
     const auto among = [c](std::initializer_list<uint64_t> set) { return std::find(set.begin(), set.end(), c) != set.end(); };
     const bool ok = (with_float && c == 5126) || (normalized ? among(normalized_ints) : among(plain_ints));
     if (t != type || !ok)
@@ -233,12 +246,7 @@ class Checker {
                      "of FLOAT (5126), or of normalized UNSIGNED_BYTE (5121) or UNSIGNED_SHORT (5123)");
     const bool position = name == "POSITION", normal = name == "NORMAL", uv = name.rfind("TEXCOORD_", 0) == 0;
     if (!position && !normal && !uv) return;
-    const size_t ai = accessor_index.get<size_t>();
-    const json& a = (*find(doc_, "accessors"))[ai];
-    const uint64_t c = find(a, "componentType")->get<uint64_t>();
-    const json* nm = find(a, "normalized");
-    const bool normalized = nm && nm->get<bool>();
-    const std::string& t = find(a, "type")->get_ref<const std::string&>();
+    const auto [ai, c, normalized, t] = accessor_kind(accessor_index);
     const bool quantized = uses("KHR_mesh_quantization");
     const bool small_int = c == 5120 || c == 5121 || c == 5122 || c == 5123;
     bool ok = c == 5126;
