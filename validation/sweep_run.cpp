@@ -323,6 +323,10 @@ json run_cell(const SweepDefinition& d, const SweepCell& cell, size_t cell_count
       options.truth_cache ? std::optional<TruthCache>(TruthCache(*options.truth_cache)) : std::nullopt;
   const ValidationTarget target = prepare_target(scene.prepared, file, rig, *provider, cache ? &*cache : nullptr,
                                                  options.out_dir / "work" / dir_name / cell.truth, executor);
+  // What makes this cell's truth differ from the scene, or blind to errors (over-exposed), as
+  // validate says it.
+  for (const std::string& w : truth_warnings(target.truth.render))
+    print_warnings({fmt::format("cell {} ({}): {}", cell.index, cell_id(cell), w)});
 
   // Quality: each pipeline rendered once and measured.
   const ImageFileOptions image_options{d.exr};

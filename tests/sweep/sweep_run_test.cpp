@@ -374,6 +374,27 @@ baseline = "plain-raster"
   EXPECT_TRUE(fs::exists(dir / "out" / right));
 }
 
+TEST(SweepRun, AnOverExposedTruthIsSaidForItsCell) {
+  // A wall and floor under a lamp a thousand times too bright: most of the truth clips at 255,
+  // where no pipeline's error can show. The sweep says so, naming the cell, as validate does.
+  test::ScratchDir dir;
+  scenes::GltfBuilder b("bright", 1);
+  const int grey = b.add_material("grey", vec3(0.6f));
+  b.add_node("wall", b.add_mesh("wall", scenes::make_box(vec3(-3.0f, 0.0f, -2.2f), vec3(3.0f, 2.5f, -2.0f)), grey));
+  b.add_node("floor", b.add_mesh("floor", scenes::make_box(vec3(-3.0f, -0.1f, -2.0f), vec3(3.0f, 0.0f, 2.0f)), grey));
+  b.add_point_light("lamp", vec3(0.0f, 2.0f, 2.0f), vec3(1.0f), 15000.0f);
+  b.set_camera("camera", CameraPose::look_at(dvec3(0.0, 1.2, 2.5), dvec3(0.0, 1.0, -2.0)), 0.8, 0.05, 0.0,
+               RigDefaults{});
+  b.write(dir / "bright.gltf");
+  std::ofstream(dir / "bright.toml") << "[sweep]\nname = \"bright\"\nscenes = [\"bright.gltf\"]\nresolutions = [\"64x36\"]\n"
+                                        "pipelines = [\"plain-rt\"]\n[timing]\nrepetitions = 1\nwarmup = 0\n";
+  const test::CliRun r = test::run_cli("sweep run " + quoted(dir / "bright.toml") + " --out " + quoted(dir / "out"));
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("cell 0 (bright.gltf|"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("full truth: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("of the right eye's pixels are over-exposed"), std::string::npos) << r.out;
+}
+
 TEST(SweepRun, ABaselineThatSynthesizesItsLeftEyeShowsPlainRtsBesideEveryRightEye) {
   test::ScratchDir dir;
   const json cell = run_one_cell(dir, R"(name = "bidir-baseline"
