@@ -258,7 +258,12 @@ void SceneAnimator::apply(int frame) {
         }
       }
       // A mirroring transform reverses the triangles, so that they face the way the file says.
-      if (const bool mirrors = (det < 0.0) != mesh.instance_mirrored; mirrors != mesh.mirrored) {
+      // An instance's local_positions are already the instance's: the node's transform mirrors
+      // them when exactly one of the two does.
+      const bool instance_mirrors =
+          mesh.instance >= 0 &&
+          glm::determinant(dmat3(scene_.instances.at(mesh.node)[static_cast<size_t>(mesh.instance)])) < 0.0;
+      if (const bool mirrors = (det < 0.0) != instance_mirrors; mirrors != mesh.mirrored) {
         for (size_t k = 0; k < mesh.indices.size(); k += 3) std::swap(mesh.indices[k + 1], mesh.indices[k + 2]);
         mesh.mirrored = mirrors;
       }

@@ -53,9 +53,6 @@ struct Mesh {
   int node = -1;       ///< glTF node index that instanced it
   /// Which of its node's EXT_mesh_gpu_instancing instances it is; -1 where the node has none.
   int instance = -1;
-  /// Whether that instance's own transform mirrors (negative determinant): its local_positions
-  /// are the instance's, so a frame's node transform mirrors them when exactly one of the two does.
-  bool instance_mirrored = false;
   /// Posed by a glTF skin (its vertices placed by its joints, not by its node).
   bool skinned = false;
   int material = -1;   ///< index into Scene::materials; -1 = default white material

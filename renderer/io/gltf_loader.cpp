@@ -805,10 +805,10 @@ class Converter {
   /// (T * R * S, in the node's space: the node's world transform times it places the instance).
   /// nullopt where the node has no instancing (its mesh is drawn once); an empty list draws nothing.
   std::optional<std::vector<dmat4>> instances_of(int ni) {
-    const json& node = doc_.at("nodes").at(static_cast<size_t>(ni));
-    if (!node.contains("extensions") || !node["extensions"].contains("EXT_mesh_gpu_instancing")) return std::nullopt;
+    const json* found = instancing_attributes(ni);
+    if (!found) return std::nullopt;
+    const json& attributes = *found;
     const std::string ip = fmt::format("/nodes/{}/extensions/EXT_mesh_gpu_instancing/attributes", ni);
-    const json& attributes = node["extensions"]["EXT_mesh_gpu_instancing"]["attributes"];
     std::optional<size_t> count;
     const auto read = [&](const char* name, int components) -> std::vector<float> {
       if (!attributes.contains(name)) return {};
@@ -1176,16 +1176,22 @@ class Converter {
   /// How many times a node's mesh is drawn: the element count of its first EXT_mesh_gpu_instancing
   /// attribute (instances_of checks that the others agree as it reads them), else once.
   uint64_t instance_count(int ni) const {
-    const json& node = doc_.at("nodes").at(static_cast<size_t>(ni));
-    if (node.contains("skin") || !node.contains("extensions") ||
-        !node["extensions"].contains("EXT_mesh_gpu_instancing"))
-      return 1;
-    const json& attributes = node["extensions"]["EXT_mesh_gpu_instancing"]["attributes"];
+    const json* attributes = instancing_attributes(ni);
+    if (!attributes || doc_.at("nodes").at(static_cast<size_t>(ni)).contains("skin")) return 1;
     for (const char* name : {"TRANSLATION", "ROTATION", "SCALE"})
-      if (attributes.contains(name))
-        return view_of(attributes[name].get<int>(), fmt::format("/nodes/{}/extensions/EXT_mesh_gpu_instancing", ni))
+      if (attributes->contains(name))
+        return view_of((*attributes)[name].get<int>(), fmt::format("/nodes/{}/extensions/EXT_mesh_gpu_instancing", ni))
             .count;
     return 1;
+  }
+
+  /// The attributes of node `ni`'s EXT_mesh_gpu_instancing (checked by check_gltf_json), or
+  /// nullptr where it has none.
+  const json* instancing_attributes(int ni) const {
+    const json& node = doc_.at("nodes").at(static_cast<size_t>(ni));
+    const auto ext = node.find("extensions");
+    if (ext == node.end() || !ext->contains("EXT_mesh_gpu_instancing")) return nullptr;
+    return &(*ext)["EXT_mesh_gpu_instancing"]["attributes"];
   }
 
   /// Whether a primitive's POSITION accessor has neither a bufferView nor sparse values: glTF
@@ -1217,8 +1223,7 @@ class Converter {
     const std::string npath = fmt::format("/nodes/{}", ni);
     if (n.mesh >= 0) {
       if (const std::optional<Skinning> skin = skinning_of(scene, ni)) {
-        if (doc_.at("nodes")[static_cast<size_t>(ni)].contains("extensions") &&
-            doc_.at("nodes")[static_cast<size_t>(ni)]["extensions"].contains("EXT_mesh_gpu_instancing"))
+        if (instancing_attributes(ni))
           note(fmt::format("skin-instances-{}", ni),
                fmt::format("/nodes/{}: a skinned node's EXT_mesh_gpu_instancing is ignored (its mesh is drawn once, "
                            "posed by its skin)",
@@ -1287,7 +1292,6 @@ class Converter {
       if (k >= 0) mesh.name += fmt::format("#{}", k);
       mesh.node = ni;
       mesh.instance = k;
-      mesh.instance_mirrored = glm::determinant(dmat3(instance)) < 0.0;
       mesh.skinned = skin != nullptr;
       mesh.material = prim.material;
       const std::vector<float> pos = read_floats(pos_it->second, 3, ppath + "/attributes/POSITION");
@@ -1297,6 +1301,8 @@ class Converter {
       const bool animated = !skin && scene.animation.moves(ni);
       // Per vertex, the transform of its joints blended by its weights.
       const SkinBlend blend = skin ? skin_blend(*skin, prim, nv, ppath) : SkinBlend();
+      // Per vertex of a skinned primitive, whether its blend mirrors (its triangles are reversed).
+      std::vector<bool> mirrors(skin ? nv : 0);
       if (animated) {
         mesh.local_positions.resize(nv);
         for (size_t v = 0; v < nv; ++v)
@@ -1306,7 +1312,9 @@ class Converter {
       mesh.mirrored = !skin && flip;
       mesh.positions.resize(nv);
       for (size_t v = 0; v < nv; ++v) {
-        const dvec3 p = dvec3((skin ? blend.at(v) : world) * dvec4(pos[v * 3], pos[v * 3 + 1], pos[v * 3 + 2], 1.0));
+        const dmat4 to_world = skin ? blend.at(v) : world;
+        if (skin) mirrors[v] = glm::determinant(dmat3(to_world)) < 0.0;
+        const dvec3 p = dvec3(to_world * dvec4(pos[v * 3], pos[v * 3 + 1], pos[v * 3 + 2], 1.0));
         if (!within_scene_range(p))
           fail(fmt::format("/nodes/{}", ni),
                fmt::format("places vertex {} of mesh '{}' at ({:g}, {:g}, {:g}) m, beyond the ±{:g} m a scene may "
@@ -1348,6 +1356,7 @@ class Converter {
             mesh.local_normals[v] = vec3(instance_normals * dvec3(nrm[v * 3], nrm[v * 3 + 1], nrm[v * 3 + 2]));
         }
         for (size_t v = 0; v < nv; ++v) {
+          // A skinned vertex's blend again (cheaper than holding a matrix per vertex).
           const dmat3 to_world = skin ? glm::transpose(glm::inverse(dmat3(blend.at(v)))) : normal_matrix;
           dvec3 nn = to_world * dvec3(nrm[v * 3], nrm[v * 3 + 1], nrm[v * 3 + 2]);
           const double len = glm::length(nn);
@@ -1398,7 +1407,7 @@ class Converter {
       if (skin) {
         // Each triangle keeps facing the way the file says under the blend at its first corner.
         for (size_t t = 0; t < mesh.indices.size(); t += 3)
-          if (glm::determinant(dmat3(blend.at(mesh.indices[t]))) < 0.0)
+          if (mirrors[mesh.indices[t]])
             std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
       } else if (flip) {
         for (size_t t = 0; t < mesh.indices.size(); t += 3) std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);

@@ -127,26 +127,32 @@ def place_objects(targets):
                  "object without a parent cannot hold" % obj.name)
 
 
+def gltf_transform_in_blender(v):
+    # A glTF-space affine transform, 16 numbers column by column, in Blender's axes: conjugated by
+    # the map of gltf_to_blender, as the importer turns the nodes' transforms.
+    from mathutils import Matrix
+    m = Matrix([[v[c * 4 + r] for c in range(4)] for r in range(4)])
+    axes = Matrix(((1.0, 0.0, 0.0, 0.0), (0.0, 0.0, -1.0, 0.0), (0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)))
+    return axes @ m @ axes.transposed()
+
+
+def objects_by_node():
+    # The mesh object the importer made for each glTF node (create_object recorded it).
+    return {int(obj["stereobench_node"]): obj for obj in bpy.data.objects if "stereobench_node" in obj}
+
+
 def place_moved_nodes():
     # The mesh objects of the nodes a path's frame has moved, and every mesh object below them, are
     # placed where the in-memory scene has them: a moved node at its transform from the file's
     # placement (glTF world space) times its place at rest, the others at rest.
-    from mathutils import Matrix
-    moved = {}
-    for m in PARAMS["moved_nodes"]:
-        v = m["matrix"]  # column by column
-        moved[m["node"]] = Matrix([[v[c * 4 + r] for c in range(4)] for r in range(4)])
+    moved = {m["node"]: gltf_transform_in_blender(m["matrix"]) for m in PARAMS["moved_nodes"]}
     if not moved:
         return
     bpy.context.view_layer.update()  # world matrices as the import left them
-    by_node = {}
-    for obj in bpy.data.objects:
-        if "stereobench_node" in obj:
-            by_node[int(obj["stereobench_node"])] = obj
+    by_node = objects_by_node()
     missing = sorted(set(moved) - set(by_node))
     if missing:
         fail("the importer made no object for the moved glTF node(s) " + ", ".join(map(str, missing)))
-    to_blender = Matrix(((1.0, 0.0, 0.0, 0.0), (0.0, 0.0, -1.0, 0.0), (0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)))
     moving = {by_node[n] for n in moved}
     targets = {}
     for obj in bpy.data.objects:
@@ -154,7 +160,7 @@ def place_moved_nodes():
             rest = obj.matrix_world.copy()
             node = obj.get("stereobench_node")
             if obj in moving:
-                rest = to_blender @ moved[int(node)] @ to_blender.transposed() @ rest
+                rest = moved[int(node)] @ rest
             targets[obj] = rest
     place_objects(targets)
 
@@ -163,25 +169,22 @@ def place_instances():
     # EXT_mesh_gpu_instancing, which the importer does not read: the object of each instanced node
     # stays for what hangs below it but renders nothing, and a copy sharing its mesh stands at each
     # instance, its world matrix the node's (as it now stands, moved or not) times the instance's.
-    from mathutils import Matrix
     if not PARAMS["instances"]:
         return
     bpy.context.view_layer.update()
-    by_node = {int(obj["stereobench_node"]): obj for obj in bpy.data.objects if "stereobench_node" in obj}
-    to_blender = Matrix(((1.0, 0.0, 0.0, 0.0), (0.0, 0.0, -1.0, 0.0), (0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)))
+    by_node = objects_by_node()
     targets = {}
     for entry in PARAMS["instances"]:
         node = entry["node"]
         if node not in by_node:
             fail("the importer made no object for the instanced glTF node %d" % node)
         original = by_node[node]
-        for k, v in enumerate(entry["matrices"]):
-            instance = Matrix([[v[c * 4 + r] for c in range(4)] for r in range(4)])
+        for v in entry["matrices"]:
             copy = original.copy()
             del copy["stereobench_node"]
             for collection in original.users_collection:
                 collection.objects.link(copy)
-            targets[copy] = original.matrix_world @ to_blender @ instance @ to_blender.transposed()
+            targets[copy] = original.matrix_world @ gltf_transform_in_blender(v)
         original.hide_render = True
     place_objects(targets)
 
